@@ -1,0 +1,111 @@
+#include "vdds.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "viscera.h"
+
+typedef enum qos_kind { QOS_STATE, QOS_STREAM, QOS_EVENTS, QOS_METRICS } qos_kind_t;
+
+static const struct {
+  const char *name;
+  const dds_topic_descriptor_t *desc;
+  qos_kind_t qos;
+} TOPICS[VT_COUNT] = {
+    [VT_SCENE_INFO] = {"viscera_SceneInfo", &viscera_SceneInfo_desc, QOS_STATE},
+    [VT_MESH_STATE] = {"viscera_MeshState", &viscera_MeshState_desc, QOS_STATE},
+    /* Deltas are cumulative, so keep-last 1 transient-local lets a late joiner
+     * draw the current mesh at once instead of waiting for the next frame. */
+    [VT_MESH_DELTA] = {"viscera_MeshDelta", &viscera_MeshDelta_desc, QOS_STATE},
+    [VT_TOOL_COMMAND] = {"viscera_ToolCommand", &viscera_ToolCommand_desc, QOS_STREAM},
+    [VT_CONTACT_FEEDBACK] = {"viscera_ContactFeedback", &viscera_ContactFeedback_desc, QOS_STREAM},
+    [VT_SESSION_EVENT] = {"viscera_SessionEvent", &viscera_SessionEvent_desc, QOS_EVENTS},
+    [VT_METRICS] = {"viscera_Metrics", &viscera_Metrics_desc, QOS_METRICS},
+};
+
+const char *vdds_topic_name(vdds_topic_id_t t) { return t < VT_COUNT ? TOPICS[t].name : "?"; }
+
+static dds_qos_t *make_qos(qos_kind_t k) {
+  dds_qos_t *q = dds_create_qos();
+  switch (k) {
+  case QOS_STATE:
+    dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
+    dds_qset_durability(q, DDS_DURABILITY_TRANSIENT_LOCAL);
+    dds_qset_history(q, DDS_HISTORY_KEEP_LAST, 1);
+    break;
+  case QOS_STREAM:
+    dds_qset_reliability(q, DDS_RELIABILITY_BEST_EFFORT, 0);
+    dds_qset_durability(q, DDS_DURABILITY_VOLATILE);
+    dds_qset_history(q, DDS_HISTORY_KEEP_LAST, 1);
+    break;
+  case QOS_EVENTS:
+    dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
+    dds_qset_durability(q, DDS_DURABILITY_TRANSIENT_LOCAL);
+    dds_qset_history(q, DDS_HISTORY_KEEP_LAST, 64);
+    dds_qset_durability_service(q, 0, DDS_HISTORY_KEEP_LAST, 64, DDS_LENGTH_UNLIMITED, DDS_LENGTH_UNLIMITED,
+                                DDS_LENGTH_UNLIMITED);
+    break;
+  case QOS_METRICS:
+    dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
+    dds_qset_durability(q, DDS_DURABILITY_VOLATILE);
+    dds_qset_history(q, DDS_HISTORY_KEEP_LAST, 1);
+    break;
+  }
+  return q;
+}
+
+int vdds_open(vdds_t *v, dds_domainid_t domain, const char *partition, verr_t *err) {
+  memset(v, 0, sizeof *v);
+  v->participant = dds_create_participant(domain, NULL, NULL);
+  if (v->participant < 0)
+    return verr_set(err, "DDS: cannot create participant on domain %d: %s (check CYCLONEDDS_URI)", (int)domain,
+                    dds_strretcode(v->participant));
+  const char *part = partition && *partition ? partition : VDDS_DEFAULT_PARTITION;
+  dds_qos_t *q = dds_create_qos();
+  dds_qset_partition1(q, part);
+  v->publisher = dds_create_publisher(v->participant, q, NULL);
+  v->subscriber = dds_create_subscriber(v->participant, q, NULL);
+  dds_delete_qos(q);
+  if (v->publisher < 0 || v->subscriber < 0) {
+    dds_delete(v->participant);
+    return verr_set(err, "DDS: cannot create publisher/subscriber in partition '%s'", part);
+  }
+  for (int t = 0; t < VT_COUNT; t++) {
+    dds_qos_t *tq = make_qos(TOPICS[t].qos);
+    v->topics[t] = dds_create_topic(v->participant, TOPICS[t].desc, TOPICS[t].name, tq, NULL);
+    dds_delete_qos(tq);
+    if (v->topics[t] < 0) {
+      dds_delete(v->participant);
+      return verr_set(err, "DDS: cannot create topic %s: %s", TOPICS[t].name, dds_strretcode(v->topics[t]));
+    }
+  }
+  return 0;
+}
+
+void vdds_close(vdds_t *v) {
+  if (v->participant > 0) dds_delete(v->participant);
+  memset(v, 0, sizeof *v);
+}
+
+dds_entity_t vdds_writer(vdds_t *v, vdds_topic_id_t t, verr_t *err) {
+  dds_qos_t *q = make_qos(TOPICS[t].qos);
+  dds_entity_t w = dds_create_writer(v->publisher, v->topics[t], q, NULL);
+  dds_delete_qos(q);
+  if (w < 0) verr_set(err, "DDS: cannot create writer for %s: %s", TOPICS[t].name, dds_strretcode(w));
+  return w;
+}
+
+dds_entity_t vdds_reader(vdds_t *v, vdds_topic_id_t t, verr_t *err) {
+  dds_qos_t *q = make_qos(TOPICS[t].qos);
+  dds_entity_t r = dds_create_reader(v->subscriber, v->topics[t], q, NULL);
+  dds_delete_qos(q);
+  if (r < 0) verr_set(err, "DDS: cannot create reader for %s: %s", TOPICS[t].name, dds_strretcode(r));
+  return r;
+}
+
+int vdds_parse_domain(const char *s) {
+  char *end = NULL;
+  long d = strtol(s, &end, 10);
+  if (!s[0] || *end || d < 0 || d > 230) return -1;
+  return (int)d;
+}

@@ -1,0 +1,14 @@
+/* vtime: monotonic time in nanoseconds and absolute sleeps for fixed-rate loops. */
+#ifndef VISCERA_VTIME_H
+#define VISCERA_VTIME_H
+
+#include <stdint.h>
+
+/* CLOCK_MONOTONIC in ns. Thread-safe. */
+uint64_t vtime_mono_ns(void);
+/* CLOCK_REALTIME in ns (for DDS source timestamps and recordings). */
+int64_t vtime_wall_ns(void);
+/* Sleep until the absolute CLOCK_MONOTONIC time t_ns; returns at once if past. */
+void vtime_sleep_until(uint64_t t_ns);
+
+#endif
