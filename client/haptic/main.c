@@ -1,0 +1,288 @@
+/* viscera-haptic: a haptic-device client. Runs a 1 kHz loop that reads the
+ * device, publishes ToolCommand and renders force from the latest
+ * ContactFeedback's local contact model. Prints rate, jitter, force and
+ * latency statistics on exit. */
+#include <getopt.h>
+#include <inttypes.h>
+#include <math.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "contact_model.h"
+#include "device.h"
+#include "vdds.h"
+#include "viscera.h"
+#include "vmath.h"
+#include "vstats.h"
+#include "vtime.h"
+
+static volatile sig_atomic_t g_stop = 0;
+static void on_signal(int sig) {
+  (void)sig;
+  g_stop = 1;
+}
+
+static void usage(FILE *f) {
+  fprintf(f, "usage: viscera-haptic --trajectory FILE [options]\n"
+             "  --trajectory FILE   scripted device: play this path (t x y z [buttons] per line)\n"
+             "  --tool N            tool index in the scene (default 0)\n"
+             "  --domain N          DDS domain id (default: $VISCERA_DOMAIN or 0)\n"
+             "  --partition P       session partition (default: " VDDS_DEFAULT_PARTITION ")\n"
+             "  --rate HZ           loop rate (default 1000)\n"
+             "  --max-force N       device capability in newtons (default 4)\n"
+             "  --wait-server S     wait up to S s for the server's scene before starting (default 10)\n"
+             "  --duration S        stop after S s (default: end of the trajectory + 0.5 s)\n"
+             "  --force-csv FILE    write t,x,y,z,fx,fy,fz,in_contact per tick\n"
+             "  --quiet             only the summary\n"
+             "  --help              this text\n");
+}
+
+typedef struct stats {
+  double *period_us, *latency_us;
+  size_t nperiod, nlat, cap;
+  double peak_force, force_sum;
+  uint64_t ticks, contact_ticks, late_ticks, feedback;
+} stats_t;
+
+int main(int argc, char **argv) {
+  const char *traj = NULL, *partition = NULL, *force_csv = NULL;
+  int domain = 0, quiet = 0;
+  unsigned tool = 0;
+  double rate = 1000, max_force = 4, wait_server = 10, duration = -1;
+  const char *env_domain = getenv("VISCERA_DOMAIN");
+  if (env_domain && (domain = vdds_parse_domain(env_domain)) < 0) {
+    fprintf(stderr, "viscera-haptic: VISCERA_DOMAIN='%s' is not a domain id 0..230\n", env_domain);
+    return 2;
+  }
+  static const struct option lo[] = {
+      {"trajectory", required_argument, 0, 'j'}, {"tool", required_argument, 0, 'n'},
+      {"domain", required_argument, 0, 'd'},     {"partition", required_argument, 0, 'p'},
+      {"rate", required_argument, 0, 'r'},       {"max-force", required_argument, 0, 'm'},
+      {"wait-server", required_argument, 0, 'w'}, {"duration", required_argument, 0, 't'},
+      {"force-csv", required_argument, 0, 'f'},  {"quiet", no_argument, 0, 'q'},
+      {"help", no_argument, 0, 'h'},             {0, 0, 0, 0}};
+  int c;
+  while ((c = getopt_long(argc, argv, "j:n:d:p:r:m:w:t:f:qh", lo, NULL)) != -1) {
+    char *end = NULL;
+    double v = 0;
+    if (c == 'r' || c == 'm' || c == 'w' || c == 't' || c == 'n') {
+      v = strtod(optarg, &end);
+      if (*end || !isfinite(v) || v < 0) {
+        fprintf(stderr, "viscera-haptic: option --%s: '%s' is not a non-negative number\n",
+                c == 'r' ? "rate" : c == 'm' ? "max-force" : c == 'w' ? "wait-server" : c == 't' ? "duration" : "tool",
+                optarg);
+        return 2;
+      }
+    }
+    switch (c) {
+    case 'j': traj = optarg; break;
+    case 'n': tool = (unsigned)v; break;
+    case 'd':
+      if ((domain = vdds_parse_domain(optarg)) < 0) {
+        fprintf(stderr, "viscera-haptic: --domain '%s' is not a domain id 0..230\n", optarg);
+        return 2;
+      }
+      break;
+    case 'p': partition = optarg; break;
+    case 'r': rate = v; break;
+    case 'm': max_force = v; break;
+    case 'w': wait_server = v; break;
+    case 't': duration = v; break;
+    case 'f': force_csv = optarg; break;
+    case 'q': quiet = 1; break;
+    case 'h': usage(stdout); return 0;
+    default: usage(stderr); return 2;
+    }
+  }
+  if (!traj) {
+    fprintf(stderr, "viscera-haptic: --trajectory FILE is required (the scripted device is the one built in)\n");
+    return 2;
+  }
+  if (!(rate >= 10 && rate <= 10000) || !(max_force > 0)) {
+    fprintf(stderr, "viscera-haptic: --rate must be 10..10000 Hz and --max-force > 0\n");
+    return 2;
+  }
+  verr_t err;
+  device_t dev;
+  if (device_scripted_open(&dev, traj, max_force, &err)) {
+    fprintf(stderr, "viscera-haptic: %s\n", err.msg);
+    return 1;
+  }
+  vdds_t dds;
+  if (vdds_open(&dds, domain, partition, &err)) {
+    fprintf(stderr, "viscera-haptic: %s\n", err.msg);
+    dev.ops->close(&dev);
+    return 1;
+  }
+  dds_entity_t w_cmd = vdds_writer(&dds, VT_TOOL_COMMAND, &err);
+  dds_entity_t r_fb = vdds_reader(&dds, VT_CONTACT_FEEDBACK, &err);
+  dds_entity_t r_scene = vdds_reader(&dds, VT_SCENE_INFO, &err);
+  if (w_cmd < 0 || r_fb < 0 || r_scene < 0) {
+    fprintf(stderr, "viscera-haptic: %s\n", err.msg);
+    return 1;
+  }
+  struct sigaction sa;
+  memset(&sa, 0, sizeof sa);
+  sa.sa_handler = on_signal;
+  sigaction(SIGINT, &sa, NULL);
+  sigaction(SIGTERM, &sa, NULL);
+
+  /* Wait for the scene so the script starts when the server can answer. */
+  uint64_t wait_until = vtime_mono_ns() + (uint64_t)(wait_server * 1e9);
+  int have_scene = 0;
+  while (!g_stop && vtime_mono_ns() < wait_until) {
+    void *samples[1] = {0};
+    dds_sample_info_t info;
+    int n = dds_take(r_scene, samples, &info, 1, 1);
+    if (n > 0) {
+      const viscera_SceneInfo *si = samples[0];
+      if (info.valid_data) {
+        have_scene = 1;
+        if (!quiet)
+          fprintf(stderr, "haptic: scene '%s', %u tool(s); driving tool %u\n", si->scene, si->tools._length, tool);
+        if (tool >= si->tools._length)
+          fprintf(stderr, "haptic: warning: tool %u is not in the scene; the server will reject its commands\n", tool);
+      }
+      dds_return_loan(r_scene, samples, n);
+      if (have_scene) break;
+    }
+    dds_sleepfor(DDS_MSECS(5));
+  }
+  if (!have_scene && !g_stop) {
+    fprintf(stderr, "viscera-haptic: no server answered within %.1f s (domain %d, partition '%s')\n", wait_server,
+            domain, partition ? partition : VDDS_DEFAULT_PARTITION);
+    vdds_close(&dds);
+    dev.ops->close(&dev);
+    return 1;
+  }
+
+  FILE *csv = NULL;
+  if (force_csv) {
+    csv = fopen(force_csv, "w");
+    if (!csv) {
+      fprintf(stderr, "viscera-haptic: %s: cannot open for writing\n", force_csv);
+      return 1;
+    }
+    fprintf(csv, "t,x,y,z,fx,fy,fz,in_contact\n");
+  }
+
+  uint64_t period_ns = (uint64_t)(1e9 / rate);
+  stats_t st = {0};
+  double run_for = duration >= 0 ? duration : 1e300;
+  st.cap = (size_t)fmin(1e7, fmax(1000, rate * (duration >= 0 ? duration + 1 : 600)));
+  st.period_us = malloc(st.cap * sizeof(double));
+  st.latency_us = malloc(st.cap * sizeof(double));
+  if (!st.period_us || !st.latency_us) {
+    fprintf(stderr, "viscera-haptic: out of memory\n");
+    return 1;
+  }
+  contact_model_t model = {0};
+  uint64_t last_fb_seq = 0, last_fb_mono = 0, seq = 0;
+  int server_lost_reported = 0;
+  uint64_t start = vtime_mono_ns(), next = start, prev_tick = 0;
+  double finished_at = -1;
+  while (!g_stop) {
+    vtime_sleep_until(next);
+    uint64_t now = vtime_mono_ns();
+    double t = (double)(now - start) * 1e-9;
+    if (prev_tick) {
+      if (st.nperiod < st.cap) st.period_us[st.nperiod++] = (double)(now - prev_tick) * 1e-3;
+      if (now > next + 1000000ull) st.late_ticks++; /* more than 1 ms late */
+    }
+    prev_tick = now;
+    double pos[3], quat[4];
+    uint32_t buttons = 0;
+    dev.ops->read(&dev, t, pos, quat, &buttons);
+
+    viscera_ToolCommand cmd;
+    memset(&cmd, 0, sizeof cmd);
+    cmd.tool_id = tool;
+    cmd.seq = ++seq;
+    cmd.client_mono_ns = now;
+    for (int k = 0; k < 3; k++) cmd.position[k] = (float)pos[k];
+    for (int k = 0; k < 4; k++) cmd.orientation[k] = (float)quat[k];
+    cmd.buttons = buttons;
+    cmd.max_force = (float)dev.max_force;
+    dds_write(w_cmd, &cmd);
+
+    /* Latest feedback for our tool; keep-last 1 so this is at most a few. */
+    void *samples[4] = {0};
+    dds_sample_info_t infos[4];
+    int n = dds_take(r_fb, samples, infos, 4, 4);
+    for (int i = 0; i < n; i++) {
+      const viscera_ContactFeedback *fb = samples[i];
+      if (!infos[i].valid_data || fb->tool_id != tool) continue;
+      int finite = isfinite(fb->stiffness);
+      for (int k = 0; k < 3; k++) finite = finite && isfinite(fb->proxy_position[k]) && isfinite(fb->normal[k]);
+      if (!finite || fb->stiffness < 0) continue; /* untrusted: never render a corrupt plane */
+      model.in_contact = fb->in_contact;
+      model.stiffness = fb->stiffness;
+      for (int k = 0; k < 3; k++) {
+        model.proxy[k] = fb->proxy_position[k];
+        model.normal[k] = fb->normal[k];
+      }
+      v3_normalize(model.normal);
+      last_fb_mono = now;
+      st.feedback++;
+      if (fb->cmd_seq != last_fb_seq && fb->cmd_client_mono_ns > 0 && fb->cmd_client_mono_ns <= now) {
+        last_fb_seq = fb->cmd_seq;
+        if (st.nlat < st.cap) st.latency_us[st.nlat++] = (double)(now - fb->cmd_client_mono_ns) * 1e-3;
+      }
+      if (server_lost_reported) {
+        fprintf(stderr, "haptic: server back\n");
+        server_lost_reported = 0;
+      }
+    }
+    if (n > 0) dds_return_loan(r_fb, samples, n);
+    /* No feedback for 50 ms: the server is gone or stalled, so render nothing
+     * rather than a stale wall. */
+    if (last_fb_mono && now - last_fb_mono > 50000000ull) {
+      model.in_contact = 0;
+      if (!server_lost_reported) {
+        fprintf(stderr, "haptic: server lost (no feedback for 50 ms), force set to zero\n");
+        server_lost_reported = 1;
+      }
+    }
+    double f[3];
+    double mag = contact_model_force(&model, pos, dev.max_force, f);
+    dev.ops->write_force(&dev, f);
+    st.ticks++;
+    if (mag > 0) st.contact_ticks++;
+    st.force_sum += mag;
+    if (mag > st.peak_force) st.peak_force = mag;
+    if (csv) fprintf(csv, "%.4f,%.6f,%.6f,%.6f,%.5f,%.5f,%.5f,%d\n", t, pos[0], pos[1], pos[2], f[0], f[1], f[2], model.in_contact);
+
+    if (t >= run_for) break;
+    if (duration < 0 && dev.ops->finished(&dev, t)) {
+      if (finished_at < 0) finished_at = t;
+      if (t - finished_at > 0.5) break;
+    }
+    next += period_ns;
+    if (now > next + 100000000ull) next = now; /* resynchronise after a long stall */
+  }
+  if (csv) fclose(csv);
+  double elapsed = (double)(vtime_mono_ns() - start) * 1e-9;
+  vstats_summary_t per = vstats_summarise(st.period_us, st.nperiod);
+  vstats_summary_t lat = vstats_summarise(st.latency_us, st.nlat);
+  double jitter_p99 = fmax(fabs(per.p99 - 1e6 / rate), fabs(per.min - 1e6 / rate));
+  fprintf(stderr,
+          "haptic: %" PRIu64 " ticks in %.2f s (%.1f Hz); period median %.1f us, p99 %.1f us, max %.1f us; "
+          "%" PRIu64 " ticks over 1 ms late\n",
+          st.ticks, elapsed, (double)st.ticks / elapsed, per.median, per.p99, per.max, st.late_ticks);
+  fprintf(stderr, "haptic: force peak %.3f N, mean in contact %.3f N, %" PRIu64 " ticks in contact, %" PRIu64
+                  " feedback samples\n",
+          st.peak_force, st.contact_ticks ? st.force_sum / (double)st.contact_ticks : 0.0, st.contact_ticks, st.feedback);
+  fprintf(stderr, "haptic: command->feedback latency median %.1f us, p99 %.1f us (%zu samples)\n", lat.median, lat.p99,
+          lat.n);
+  printf("SUMMARY ticks=%" PRIu64 " rate_hz=%.1f peak_force=%.4f contact_ticks=%" PRIu64 " latency_us_median=%.1f "
+         "latency_us_p99=%.1f period_us_p99=%.1f jitter_us_p99=%.1f late_ticks=%" PRIu64 "\n",
+         st.ticks, (double)st.ticks / elapsed, st.peak_force, st.contact_ticks, lat.median, lat.p99, per.p99, jitter_p99,
+         st.late_ticks);
+  free(st.period_us);
+  free(st.latency_us);
+  vdds_close(&dds);
+  dev.ops->close(&dev);
+  return 0;
+}

@@ -1,0 +1,138 @@
+#include "proxy.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "vmath.h"
+
+static void tri_vertices(const proxy_surface_t *s, uint32_t t, const double **a, const double **b, const double **c) {
+  *a = s->x + 3 * s->tris[3 * t];
+  *b = s->x + 3 * s->tris[3 * t + 1];
+  *c = s->x + 3 * s->tris[3 * t + 2];
+}
+
+static void tri_normal(const proxy_surface_t *s, uint32_t t, double n[3]) {
+  const double *a, *b, *c;
+  double e1[3], e2[3];
+  tri_vertices(s, t, &a, &b, &c);
+  v3_sub(e1, b, a);
+  v3_sub(e2, c, a);
+  v3_cross(n, e1, e2);
+  v3_normalize(n);
+}
+
+void proxy_reset(proxy_t *p) {
+  memset(p, 0, sizeof *p);
+  p->surface = -1;
+}
+
+void proxy_follow_surface(proxy_t *p, const proxy_surface_t *surfaces, size_t nsurfaces) {
+  if (!p->in_contact || p->surface < 0 || (size_t)p->surface >= nsurfaces) return;
+  const proxy_surface_t *s = &surfaces[p->surface];
+  const double *a, *b, *c;
+  tri_vertices(s, p->tri, &a, &b, &c);
+  for (int k = 0; k < 3; k++) p->pos[k] = p->bary[0] * a[k] + p->bary[1] * b[k] + p->bary[2] * c[k];
+  tri_normal(s, p->tri, p->normal);
+}
+
+/* Nearest surface point to q over all triangles of all surfaces. */
+static void nearest_on_surfaces(const double q[3], const proxy_surface_t *surfaces, size_t nsurfaces, proxy_t *p) {
+  double best = INFINITY;
+  for (size_t si = 0; si < nsurfaces; si++) {
+    const proxy_surface_t *s = &surfaces[si];
+    for (size_t t = 0; t < s->ntris; t++) {
+      const double *a, *b, *c;
+      double cp[3], bary[3];
+      tri_vertices(s, (uint32_t)t, &a, &b, &c);
+      tri_closest_point(q, a, b, c, cp, bary);
+      double d[3];
+      v3_sub(d, cp, q);
+      double d2 = v3_dot(d, d);
+      if (d2 < best) {
+        best = d2;
+        p->surface = (int)si;
+        p->tri = (uint32_t)t;
+        v3_copy(p->bary, bary);
+        v3_copy(p->pos, cp);
+      }
+    }
+  }
+}
+
+/* First triangle the device path enters from outside. */
+static int find_entry(const double p0[3], const double p1[3], const proxy_surface_t *surfaces, size_t nsurfaces,
+                      proxy_t *p) {
+  double best_t = INFINITY, dir[3];
+  v3_sub(dir, p1, p0);
+  for (size_t si = 0; si < nsurfaces; si++) {
+    const proxy_surface_t *s = &surfaces[si];
+    for (size_t t = 0; t < s->ntris; t++) {
+      const double *a, *b, *c;
+      double tt, bary[3], n[3];
+      tri_vertices(s, (uint32_t)t, &a, &b, &c);
+      if (!seg_tri_intersect(p0, p1, a, b, c, &tt, bary) || tt >= best_t) continue;
+      tri_normal(s, (uint32_t)t, n);
+      if (v3_dot(dir, n) >= 0) continue; /* leaving, not entering */
+      best_t = tt;
+      p->surface = (int)si;
+      p->tri = (uint32_t)t;
+      v3_copy(p->bary, bary);
+    }
+  }
+  return isfinite(best_t);
+}
+
+int proxy_update(proxy_t *p, const double device[3], const proxy_surface_t *surfaces, size_t nsurfaces,
+                 double stiffness, double max_force, double force[3]) {
+  v3_set(force, 0, 0, 0);
+  if (!p->have_prev) {
+    v3_copy(p->device_prev, device);
+    p->have_prev = 1;
+  }
+  if (!p->in_contact) {
+    if (find_entry(p->device_prev, device, surfaces, nsurfaces, p)) {
+      p->in_contact = 1;
+      proxy_follow_surface(p, surfaces, nsurfaces);
+    }
+  } else {
+    proxy_follow_surface(p, surfaces, nsurfaces);
+  }
+  v3_copy(p->device_prev, device);
+  if (!p->in_contact) {
+    p->surface = -1;
+    v3_copy(p->pos, device);
+    return 0;
+  }
+  double d[3];
+  v3_sub(d, device, p->pos);
+  double depth = v3_dot(d, p->normal);
+  if (depth >= 0) { /* device back above the tangent plane: release */
+    p->in_contact = 0;
+    p->surface = -1;
+    v3_copy(p->pos, device);
+    return 0;
+  }
+  /* Slide: the device projected on the tangent plane, then back onto the surface. */
+  double target[3];
+  v3_copy(target, device);
+  v3_axpy(target, p->normal, -depth);
+  nearest_on_surfaces(target, surfaces, nsurfaces, p);
+  proxy_follow_surface(p, surfaces, nsurfaces);
+  proxy_spring_force(p, device, stiffness, max_force, force);
+  return 1;
+}
+
+double proxy_spring_force(const proxy_t *p, const double device[3], double stiffness, double max_force, double f[3]) {
+  if (!p->in_contact) {
+    v3_set(f, 0, 0, 0);
+    return 0;
+  }
+  v3_sub(f, p->pos, device);
+  v3_scale(f, f, stiffness);
+  double mag = v3_norm(f);
+  if (mag > max_force && mag > 0) {
+    v3_scale(f, f, max_force / mag);
+    mag = max_force;
+  }
+  return mag;
+}

@@ -1,0 +1,53 @@
+/* proxy: god-object haptic proxy with a virtual spring (seed 000 eq. 12).
+ *
+ * The device point (SUN) may sink into an organ; the proxy (IUN) may not: it
+ * stays on the deforming surface, attached to a triangle by barycentric
+ * coordinates so it moves with the tissue. The tool feels f = K (proxy - device),
+ * clamped to max_force; the tissue feels -f at the contact triangle.
+ * Contact starts when the device path crosses a triangle from outside (so a
+ * tool pushed 10 cm inside keeps its proxy on the entry surface) and ends when
+ * the device is back above the tangent plane at the proxy. The proxy slides
+ * frictionlessly: each tick it moves to the surface point nearest the device
+ * projected onto the current tangent plane.
+ * v1 treats the tool tip as a point; brute-force over triangles (an AABB tree
+ * replaces this with the collision work). */
+#ifndef VISCERA_PROXY_H
+#define VISCERA_PROXY_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+typedef struct proxy_surface {
+  const double *x;       /* 3 per vertex, current positions */
+  const uint32_t *tris;  /* 3 per triangle, outward CCW */
+  size_t ntris;
+} proxy_surface_t;
+
+typedef struct proxy {
+  int in_contact;
+  int surface;       /* index into the surfaces array while in contact, else -1 */
+  uint32_t tri;      /* contact triangle */
+  double bary[3];    /* proxy in that triangle */
+  double pos[3];     /* proxy position (device position when free) */
+  double normal[3];  /* outward unit normal at the proxy (valid in contact) */
+  double device_prev[3];
+  int have_prev;
+} proxy_t;
+
+void proxy_reset(proxy_t *p);
+
+/* One haptic tick. `device` is the commanded tool tip; writes the force on the
+ * tool into force[3] (zero when free) and returns 1 if in contact. */
+int proxy_update(proxy_t *p, const double device[3], const proxy_surface_t *surfaces, size_t nsurfaces,
+                 double stiffness, double max_force, double force[3]);
+
+/* The virtual spring f = K (proxy - device) (seed 000 eq. 12: f = -K x with
+ * x = device - proxy), clamped to max_force; zero when not in contact.
+ * Returns |f|. */
+double proxy_spring_force(const proxy_t *p, const double device[3], double stiffness, double max_force, double f[3]);
+
+/* Re-evaluates pos and normal from the attached triangle's current vertices
+ * (call after the surface moved, e.g. after a physics step). */
+void proxy_follow_surface(proxy_t *p, const proxy_surface_t *surfaces, size_t nsurfaces);
+
+#endif

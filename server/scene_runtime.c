@@ -1,0 +1,171 @@
+#include "scene_runtime.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "mesh_import.h"
+#include "vmath.h"
+
+static int organ_init(organ_rt_t *o, const scene_t *sc, const scene_organ_t *cfg, uint32_t id, double tool_k,
+                      verr_t *err) {
+  memset(o, 0, sizeof *o);
+  o->cfg = cfg;
+  o->id = id;
+  verr_t e;
+  if (mesh_import(cfg->mesh, &o->rest, &e))
+    return verr_set(err, "%s:%d: organ '%s': %s", sc->path, cfg->line, cfg->name, e.msg);
+  for (size_t i = 0; i < o->rest.nverts; i++)
+    for (int k = 0; k < 3; k++) o->rest.pos[3 * i + k] = o->rest.pos[3 * i + k] * cfg->scale + cfg->position[k];
+  if (strcmp(cfg->model, "mass_spring_surface") != 0) {
+    mesh_free(&o->rest);
+    return verr_set(err, "%s:%d: organ '%s': model '%s' is not available in this build", sc->path, cfg->line, cfg->name,
+                    cfg->model);
+  }
+  ms_params_t p = {.mass = cfg->material.mass,
+                   .stiffness = cfg->material.stiffness,
+                   .damping = cfg->material.damping,
+                   .home_stiffness = cfg->material.home_stiffness,
+                   .home_damping = cfg->material.home_damping,
+                   .integrator = strcmp(cfg->integrator, "explicit_euler") == 0 ? MS_EXPLICIT_EULER : MS_SYMPLECTIC_EULER};
+  v3_copy(p.gravity, sc->gravity);
+  if (mass_spring_create(&o->ms, &o->rest, &p, &e)) {
+    mesh_free(&o->rest);
+    return verr_set(err, "%s:%d: organ '%s': %s", sc->path, cfg->line, cfg->name, e.msg);
+  }
+  if (cfg->fixed_below_set) mass_spring_fix_below(&o->ms, cfg->fixed_below);
+  /* The proxy spring acts on the contact vertices like an extra home spring,
+   * so the stability bound includes the stiffest tool. */
+  double saved = o->ms.p.home_stiffness;
+  o->ms.p.home_stiffness += tool_k;
+  o->stable_dt = mass_spring_stable_dt(&o->ms);
+  o->ms.p.home_stiffness = saved;
+  double safe = 0.9 * o->stable_dt;
+  double need = safe > 0 ? ceil(sc->dt / safe) : INFINITY;
+  if (!(need <= 256)) {
+    mass_spring_destroy(&o->ms);
+    mesh_free(&o->rest);
+    return verr_set(err,
+                    "%s:%d: organ '%s': %s is stable only below dt = %.3g s here, which would need %.0f sub-steps of "
+                    "the %.3g s step (limit 256); lower material stiffness/damping or use symplectic_euler",
+                    sc->path, cfg->line, cfg->name, cfg->integrator, o->stable_dt, need, sc->dt);
+  }
+  o->substeps = need < 1 ? 1 : (int)need;
+  return 0;
+}
+
+int runtime_init(runtime_t *rt, const scene_t *scene, verr_t *err) {
+  memset(rt, 0, sizeof *rt);
+  rt->scene = *scene;
+  double tool_k = 0;
+  for (size_t t = 0; t < scene->ntools; t++)
+    if (scene->tools[t].stiffness > tool_k) tool_k = scene->tools[t].stiffness;
+  double bmin[3] = {INFINITY, INFINITY, INFINITY}, bmax[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (size_t i = 0; i < scene->norgans; i++) {
+    if (organ_init(&rt->organs[i], &rt->scene, &rt->scene.organs[i], (uint32_t)i, tool_k, err)) {
+      runtime_destroy(rt);
+      return -1;
+    }
+    rt->norgans++;
+    organ_rt_t *o = &rt->organs[i];
+    rt->surfaces[i] = (proxy_surface_t){.x = o->ms.x, .tris = o->rest.tris, .ntris = o->rest.ntris};
+    double lo[3], hi[3];
+    mesh_bounds(&o->rest, lo, hi);
+    for (int k = 0; k < 3; k++) {
+      bmin[k] = fmin(bmin[k], lo[k]);
+      bmax[k] = fmax(bmax[k], hi[k]);
+    }
+  }
+  /* Tools may roam a generous box around the organs; beyond it a command is
+   * a corrupt sample, not a hand movement. */
+  double diag = v3_dist(bmin, bmax), margin = fmax(1.0, 2 * diag);
+  for (int k = 0; k < 3; k++) {
+    rt->workspace.min[k] = bmin[k] - margin;
+    rt->workspace.max[k] = bmax[k] + margin;
+  }
+  rt->ntools = scene->ntools;
+  for (size_t t = 0; t < scene->ntools; t++) {
+    rt->tools[t].cfg = &rt->scene.tools[t];
+    proxy_reset(&rt->tools[t].proxy);
+  }
+  return 0;
+}
+
+void runtime_destroy(runtime_t *rt) {
+  for (size_t i = 0; i < rt->norgans; i++) {
+    mass_spring_destroy(&rt->organs[i].ms);
+    mesh_free(&rt->organs[i].rest);
+  }
+  rt->norgans = 0;
+}
+
+void runtime_set_tool(runtime_t *rt, size_t t, const double pos[3], double device_max_force) {
+  if (t >= rt->ntools) return;
+  tool_rt_t *tool = &rt->tools[t];
+  v3_copy(tool->device, pos);
+  tool->max_force = fmin(tool->cfg->max_force, device_max_force);
+  tool->active = 1;
+}
+
+void runtime_release_tool(runtime_t *rt, size_t t) {
+  if (t >= rt->ntools) return;
+  rt->tools[t].active = 0;
+  proxy_reset(&rt->tools[t].proxy);
+  v3_set(rt->tools[t].force, 0, 0, 0);
+}
+
+typedef struct contact_ctx {
+  runtime_t *rt;
+  size_t organ;
+} contact_ctx_t;
+
+/* Re-evaluates every proxy spring attached to this organ at the sub-step's
+ * positions and applies the reaction -f to the contact triangle's vertices
+ * by barycentric weight. */
+static void apply_contacts(mass_spring_t *ms, void *vctx) {
+  contact_ctx_t *c = vctx;
+  runtime_t *rt = c->rt;
+  for (size_t t = 0; t < rt->ntools; t++) {
+    tool_rt_t *tool = &rt->tools[t];
+    proxy_t *p = &tool->proxy;
+    if (!tool->active || !p->in_contact || (size_t)p->surface != c->organ) continue;
+    proxy_follow_surface(p, rt->surfaces, rt->norgans);
+    double f[3];
+    proxy_spring_force(p, tool->device, tool->cfg->stiffness, tool->max_force, f);
+    const uint32_t *tri = rt->organs[c->organ].rest.tris + 3 * p->tri;
+    for (int k = 0; k < 3; k++) {
+      double fk[3];
+      v3_scale(fk, f, -p->bary[k]);
+      mass_spring_add_force(ms, tri[k], fk);
+    }
+  }
+}
+
+int runtime_step(runtime_t *rt) {
+  double dt = rt->scene.dt;
+  for (size_t t = 0; t < rt->ntools; t++) {
+    tool_rt_t *tool = &rt->tools[t];
+    if (!tool->active) continue;
+    proxy_update(&tool->proxy, tool->device, rt->surfaces, rt->norgans, tool->cfg->stiffness, tool->max_force,
+                 tool->force);
+  }
+  int rolled = 0;
+  for (size_t i = 0; i < rt->norgans; i++) {
+    organ_rt_t *o = &rt->organs[i];
+    contact_ctx_t ctx = {rt, i};
+    if (mass_spring_step(&o->ms, dt, o->substeps, apply_contacts, &ctx) < 0) {
+      o->rollbacks++;
+      rolled++;
+    }
+  }
+  /* Report the force at the end of the step, with the proxy on the moved surface. */
+  for (size_t t = 0; t < rt->ntools; t++) {
+    tool_rt_t *tool = &rt->tools[t];
+    if (!tool->active) continue;
+    proxy_follow_surface(&tool->proxy, rt->surfaces, rt->norgans);
+    double mag = proxy_spring_force(&tool->proxy, tool->device, tool->cfg->stiffness, tool->max_force, tool->force);
+    if (mag > tool->peak_force) tool->peak_force = mag;
+  }
+  rt->steps++;
+  rt->sim_time = (double)rt->steps * dt;
+  return rolled;
+}

@@ -1,0 +1,308 @@
+#include "server.h"
+
+#include <inttypes.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mesh.h"
+#include "viscera.h"
+#include "vmath.h"
+#include "vstats.h"
+#include "vtime.h"
+
+#define STEP_RING 65536
+
+typedef struct server {
+  const server_opts_t *opts;
+  runtime_t rt;
+  vdds_t dds;
+  dds_entity_t w_scene, w_state, w_delta, w_feedback, w_event, w_metrics, r_cmd;
+  mesh_publisher_t pubs[SCENE_MAX_ORGANS];
+  uint64_t cmd_seq[SCENE_MAX_TOOLS], cmd_echo[SCENE_MAX_TOOLS], last_cmd_mono[SCENE_MAX_TOOLS];
+  int was_contact[SCENE_MAX_TOOLS];
+  uint64_t event_seq;
+  double *step_us; /* ring of recent step times */
+  size_t nstep_us;
+  server_stats_t *stats;
+} server_t;
+
+static uint64_t sim_ns(const server_t *s) { return (uint64_t)(s->rt.sim_time * 1e9); }
+
+static void publish_event(server_t *s, viscera_EventKind kind, int organ, int tool, double value, const char *text) {
+  viscera_SessionEvent e;
+  memset(&e, 0, sizeof e);
+  e.source_id = 0;
+  e.seq = ++s->event_seq;
+  e.sim_time_ns = sim_ns(s);
+  e.kind = kind;
+  e.organ_id = organ;
+  e.tool_id = tool;
+  e.value = value;
+  snprintf(e.text, sizeof e.text, "%s", text);
+  dds_write(s->w_event, &e);
+}
+
+static void publish_scene_info(server_t *s) {
+  const scene_t *sc = &s->rt.scene;
+  viscera_SceneInfo si;
+  memset(&si, 0, sizeof si);
+  viscera_OrganInfo organs[SCENE_MAX_ORGANS];
+  viscera_ToolInfo tools[SCENE_MAX_TOOLS];
+  memset(organs, 0, sizeof organs);
+  memset(tools, 0, sizeof tools);
+  snprintf(si.scene, sizeof si.scene, "%s", sc->name);
+  snprintf(si.description, sizeof si.description, "%s", sc->description);
+  si.physics_dt = sc->dt;
+  si.publish_hz = sc->publish_hz;
+  si.quant_step = (float)sc->quant_step;
+  for (size_t i = 0; i < s->rt.norgans; i++) {
+    const organ_rt_t *o = &s->rt.organs[i];
+    organs[i].organ_id = o->id;
+    snprintf(organs[i].name, sizeof organs[i].name, "%s", o->cfg->name);
+    snprintf(organs[i].model, sizeof organs[i].model, "%s", o->cfg->model);
+    snprintf(organs[i].integrator, sizeof organs[i].integrator, "%s", o->cfg->integrator);
+    organs[i].vertex_count = (uint32_t)o->rest.nverts;
+    organs[i].triangle_count = (uint32_t)o->rest.ntris;
+    memcpy(organs[i].color, o->cfg->color, sizeof organs[i].color);
+  }
+  for (size_t t = 0; t < s->rt.ntools; t++) {
+    const scene_tool_t *c = s->rt.tools[t].cfg;
+    tools[t].tool_id = (uint32_t)t;
+    snprintf(tools[t].name, sizeof tools[t].name, "%s", c->name);
+    snprintf(tools[t].kind, sizeof tools[t].kind, "%s", c->kind);
+    tools[t].radius = (float)c->radius;
+    tools[t].length = (float)c->length;
+    tools[t].stiffness = (float)c->stiffness;
+    tools[t].max_force = (float)c->max_force;
+  }
+  si.organs._buffer = organs;
+  si.organs._length = si.organs._maximum = (uint32_t)s->rt.norgans;
+  si.tools._buffer = tools;
+  si.tools._length = si.tools._maximum = (uint32_t)s->rt.ntools;
+  dds_write(s->w_scene, &si);
+}
+
+static int setup(server_t *s, const scene_t *scene, verr_t *err) {
+  if (runtime_init(&s->rt, scene, err)) return -1;
+  if (vdds_open(&s->dds, s->opts->domain, s->opts->partition, err)) return -1;
+  s->w_scene = vdds_writer(&s->dds, VT_SCENE_INFO, err);
+  s->w_state = vdds_writer(&s->dds, VT_MESH_STATE, err);
+  s->w_delta = vdds_writer(&s->dds, VT_MESH_DELTA, err);
+  s->w_feedback = vdds_writer(&s->dds, VT_CONTACT_FEEDBACK, err);
+  s->w_event = vdds_writer(&s->dds, VT_SESSION_EVENT, err);
+  s->w_metrics = vdds_writer(&s->dds, VT_METRICS, err);
+  s->r_cmd = vdds_reader(&s->dds, VT_TOOL_COMMAND, err);
+  if (s->w_scene < 0 || s->w_state < 0 || s->w_delta < 0 || s->w_feedback < 0 || s->w_event < 0 ||
+      s->w_metrics < 0 || s->r_cmd < 0)
+    return -1;
+  for (size_t i = 0; i < s->rt.norgans; i++) {
+    organ_rt_t *o = &s->rt.organs[i];
+    if (mesh_publisher_init(&s->pubs[i], o->id, o->rest.nverts, o->rest.tris, o->rest.ntris,
+                            (float)scene->quant_step, s->w_state, s->w_delta, err))
+      return -1;
+  }
+  s->step_us = calloc(STEP_RING, sizeof(double));
+  if (!s->step_us) return verr_set(err, "out of memory");
+  return 0;
+}
+
+static void teardown(server_t *s) {
+  for (size_t i = 0; i < s->rt.norgans; i++) mesh_publisher_destroy(&s->pubs[i]);
+  runtime_destroy(&s->rt);
+  vdds_close(&s->dds);
+  free(s->step_us);
+}
+
+/* Takes every pending ToolCommand; applies valid ones, counts and reports the rest. */
+static void read_commands(server_t *s, uint64_t now) {
+  enum { MAXS = 16 };
+  void *samples[MAXS] = {0};
+  dds_sample_info_t infos[MAXS];
+  for (;;) {
+    int n = dds_take(s->r_cmd, samples, infos, MAXS, MAXS);
+    if (n <= 0) break;
+    for (int i = 0; i < n; i++) {
+      if (!infos[i].valid_data) continue;
+      const viscera_ToolCommand *c = samples[i];
+      tool_cmd_verdict_t v = tool_command_check(c, s->rt.ntools, &s->rt.workspace);
+      if (v != TOOLCMD_OK) {
+        s->stats->rejected[v]++;
+        uint64_t r = ++s->stats->rejected_total;
+        /* Report the first few and then every 1000th, so a flood of garbage
+         * cannot flood the event topic or the log. */
+        if (r <= 5 || r % 1000 == 0) {
+          char text[200];
+          snprintf(text, sizeof text, "ToolCommand from tool %u rejected: %s (%" PRIu64 " rejected so far)", c->tool_id,
+                   tool_command_verdict_str(v), r);
+          if (!s->opts->quiet) fprintf(stderr, "server: %s\n", text);
+          publish_event(s, viscera_EVENT_INPUT_REJECTED, -1, (int)(c->tool_id < 1u << 30 ? c->tool_id : 0), (double)r,
+                        text);
+        }
+        continue;
+      }
+      double pos[3] = {c->position[0], c->position[1], c->position[2]};
+      runtime_set_tool(&s->rt, c->tool_id, pos, c->max_force);
+      s->cmd_seq[c->tool_id] = c->seq;
+      s->cmd_echo[c->tool_id] = c->client_mono_ns;
+      s->last_cmd_mono[c->tool_id] = now;
+      s->stats->commands++;
+    }
+    dds_return_loan(s->r_cmd, samples, n);
+    if (n < MAXS) break;
+  }
+  for (size_t t = 0; t < s->rt.ntools; t++) {
+    if (s->rt.tools[t].active && now - s->last_cmd_mono[t] > (uint64_t)(s->opts->tool_timeout * 1e9)) {
+      runtime_release_tool(&s->rt, t);
+      if (!s->opts->quiet) fprintf(stderr, "server: tool %zu: no commands for %.1f s, released\n", t, s->opts->tool_timeout);
+      publish_event(s, viscera_EVENT_CLIENT_LOST, -1, (int)t, 0, "haptic client lost: tool released");
+    }
+  }
+}
+
+static void publish_feedback(server_t *s) {
+  for (size_t t = 0; t < s->rt.ntools; t++) {
+    const tool_rt_t *tool = &s->rt.tools[t];
+    if (!tool->active) continue;
+    viscera_ContactFeedback fb;
+    memset(&fb, 0, sizeof fb);
+    fb.tool_id = (uint32_t)t;
+    fb.cmd_seq = s->cmd_seq[t];
+    fb.cmd_client_mono_ns = s->cmd_echo[t];
+    fb.sim_time_ns = sim_ns(s);
+    fb.in_contact = tool->proxy.in_contact != 0;
+    fb.organ_id = tool->proxy.in_contact ? tool->proxy.surface : -1;
+    fb.stiffness = (float)tool->cfg->stiffness;
+    for (int k = 0; k < 3; k++) {
+      fb.proxy_position[k] = (float)tool->proxy.pos[k];
+      fb.normal[k] = (float)tool->proxy.normal[k];
+      fb.force[k] = (float)tool->force[k];
+    }
+    dds_write(s->w_feedback, &fb);
+    int c = tool->proxy.in_contact != 0;
+    if (c != s->was_contact[t]) {
+      publish_event(s, c ? viscera_EVENT_CONTACT_BEGIN : viscera_EVENT_CONTACT_END, fb.organ_id, (int)t, 0,
+                    c ? "contact begins" : "contact ends");
+      s->was_contact[t] = c;
+    }
+  }
+}
+
+static void publish_metrics(server_t *s, uint64_t window_steps) {
+  size_t n = s->nstep_us < STEP_RING ? s->nstep_us : STEP_RING;
+  size_t take = window_steps < n ? window_steps : n;
+  double *tmp = malloc((take + 1) * sizeof(double));
+  if (!tmp) return;
+  for (size_t i = 0; i < take; i++) tmp[i] = s->step_us[(s->nstep_us - 1 - i) % STEP_RING];
+  vstats_summary_t st = vstats_summarise(tmp, take);
+  free(tmp);
+  double peak = 0;
+  for (size_t t = 0; t < s->rt.ntools; t++) peak = fmax(peak, s->rt.tools[t].peak_force);
+  for (size_t i = 0; i < s->rt.norgans; i++) {
+    viscera_Metrics m;
+    memset(&m, 0, sizeof m);
+    m.organ_id = s->rt.organs[i].id;
+    m.sim_time_ns = sim_ns(s);
+    m.step_time_us_median = st.median;
+    m.step_time_us_p99 = st.p99;
+    m.steps_per_s = (double)take;
+    m.error_estimate = mass_spring_max_strain(&s->rt.organs[i].ms);
+    snprintf(m.error_kind, sizeof m.error_kind, "%s", "max_edge_strain");
+    m.peak_force = peak;
+    m.rejected_commands = s->stats->rejected_total;
+    dds_write(s->w_metrics, &m);
+  }
+}
+
+static void publish_frames(server_t *s) {
+  for (size_t i = 0; i < s->rt.norgans; i++) mesh_publisher_frame(&s->pubs[i], s->rt.organs[i].ms.x, sim_ns(s));
+}
+
+static void write_final_mesh(server_t *s) {
+  /* Exact positions of the last published frame, so a test can compare a
+   * viewer's reconstruction with the server's state at the same frame. */
+  for (size_t i = 0; i < s->rt.norgans; i++) {
+    char path[1100];
+    if (s->rt.norgans == 1)
+      snprintf(path, sizeof path, "%s", s->opts->final_mesh);
+    else
+      snprintf(path, sizeof path, "%s.%zu", s->opts->final_mesh, i);
+    mesh_t m = s->rt.organs[i].rest;
+    m.pos = s->rt.organs[i].ms.x;
+    char comment[160];
+    snprintf(comment, sizeof comment, "organ %zu topology %u keyframe %u frame %u", i, s->pubs[i].topology_version,
+             s->pubs[i].keyframe_seq, s->pubs[i].frame_seq);
+    verr_t e;
+    if (mesh_write_obj(&m, path, comment, &e)) fprintf(stderr, "server: %s\n", e.msg);
+  }
+}
+
+int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_atomic_t *stop, server_stats_t *stats,
+               verr_t *err) {
+  server_t s;
+  memset(&s, 0, sizeof s);
+  memset(stats, 0, sizeof *stats);
+  s.opts = opts;
+  s.stats = stats;
+  if (setup(&s, scene, err)) {
+    teardown(&s);
+    return -1;
+  }
+  if (!opts->quiet) {
+    for (size_t i = 0; i < s.rt.norgans; i++) {
+      const organ_rt_t *o = &s.rt.organs[i];
+      fprintf(stderr,
+              "server: organ '%s': %zu vertices, %zu triangles, %zu springs, %s, %d sub-step(s) per %.3g ms "
+              "(stable below %.3g ms)\n",
+              o->cfg->name, o->rest.nverts, o->rest.ntris, o->ms.nsprings, o->cfg->integrator, o->substeps,
+              scene->dt * 1e3, o->stable_dt * 1e3);
+    }
+    fprintf(stderr, "server: scene '%s' running on domain %d, partition '%s'\n", scene->name, opts->domain,
+            opts->partition ? opts->partition : VDDS_DEFAULT_PARTITION);
+  }
+  publish_scene_info(&s);
+  for (size_t i = 0; i < s.rt.norgans; i++) mesh_publisher_keyframe(&s.pubs[i], s.rt.organs[i].ms.x, 0);
+  publish_event(&s, viscera_EVENT_SESSION_STARTED, -1, -1, 0, scene->name);
+
+  uint64_t dt_ns = (uint64_t)(scene->dt * 1e9);
+  uint64_t publish_every = (uint64_t)fmax(1.0, floor(1.0 / (scene->publish_hz * scene->dt) + 0.5));
+  uint64_t metrics_every = (uint64_t)fmax(1.0, floor(1.0 / scene->dt + 0.5));
+  uint64_t start = vtime_mono_ns(), next = start;
+  while (!*stop && (opts->duration <= 0 || (double)(vtime_mono_ns() - start) * 1e-9 < opts->duration)) {
+    uint64_t t0 = vtime_mono_ns();
+    read_commands(&s, t0);
+    int rolled = runtime_step(&s.rt);
+    if (rolled) {
+      stats->rollbacks += (uint64_t)rolled;
+      publish_event(&s, viscera_EVENT_STEP_ROLLED_BACK, -1, -1, rolled, "non-finite state: step rolled back");
+      if (!opts->quiet) fprintf(stderr, "server: step %" PRIu64 ": non-finite state, rolled back\n", s.rt.steps);
+    }
+    publish_feedback(&s);
+    if (s.rt.steps % publish_every == 0) publish_frames(&s);
+    uint64_t t1 = vtime_mono_ns();
+    s.step_us[s.nstep_us++ % STEP_RING] = (double)(t1 - t0) * 1e-3;
+    if (s.rt.steps % metrics_every == 0) publish_metrics(&s, metrics_every);
+    next += dt_ns;
+    if (t1 > next + 100 * 1000000ull) { /* far behind (debugger, overload): resynchronise */
+      stats->overruns++;
+      next = t1;
+    }
+    vtime_sleep_until(next);
+  }
+  publish_frames(&s);
+  if (opts->final_mesh) write_final_mesh(&s);
+  publish_event(&s, viscera_EVENT_SESSION_STOPPED, -1, -1, 0, scene->name);
+
+  stats->steps = s.rt.steps;
+  for (size_t t = 0; t < s.rt.ntools; t++) stats->peak_force = fmax(stats->peak_force, s.rt.tools[t].peak_force);
+  size_t n = s.nstep_us < STEP_RING ? s.nstep_us : STEP_RING;
+  vstats_summary_t st = vstats_summarise(s.step_us, n);
+  stats->step_us_median = st.median;
+  stats->step_us_p99 = st.p99;
+  stats->step_us_max = st.max;
+  /* Give reliable late samples (last frame, stop event) a moment to leave. */
+  dds_sleepfor(DDS_MSECS(100));
+  teardown(&s);
+  return 0;
+}

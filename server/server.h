@@ -1,0 +1,35 @@
+/* server: the scene runtime wired to DDS. Reads ToolCommand, steps physics in
+ * real time at the scene's fixed dt, publishes ContactFeedback every step,
+ * MeshDelta at publish_hz, MeshState keyframes, SceneInfo, SessionEvent and
+ * Metrics (once per second). One thread; DDS reads never block the loop. */
+#ifndef VISCERA_SERVER_H
+#define VISCERA_SERVER_H
+
+#include <signal.h>
+#include <stdint.h>
+
+#include "mesh_publisher.h"
+#include "scene_runtime.h"
+#include "vdds.h"
+
+typedef struct server_opts {
+  int domain;
+  const char *partition;
+  double duration;        /* s of wall time; 0 = until stopped */
+  const char *final_mesh; /* write exact positions of the last published frame here (OBJ) */
+  int quiet;
+  double tool_timeout;    /* s without a command before a tool is released */
+} server_opts_t;
+
+typedef struct server_stats {
+  uint64_t steps, overruns, rollbacks, rejected[TOOLCMD_VERDICT_COUNT], rejected_total, commands;
+  double peak_force;
+  double step_us_median, step_us_p99, step_us_max;
+} server_stats_t;
+
+/* Runs a whole session: set-up, loop until *stop or the duration, shutdown.
+ * Returns 0, or -1 with err on set-up failure. */
+int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_atomic_t *stop, server_stats_t *stats,
+               verr_t *err);
+
+#endif
