@@ -33,7 +33,8 @@ int mesh_delta_apply(const float *key, size_t nverts, float q, const uint32_t *i
     uint32_t i = idx[j];
     if (i >= nverts) return verr_set(err, "delta index %u at position %zu is out of range (keyframe has %zu vertices)", i, j, nverts);
     if (j > 0 && i <= idx[j - 1]) return verr_set(err, "delta indices not ascending at position %zu (%u after %u)", j, i, idx[j - 1]);
-    for (int k = 0; k < 3; k++) out[3 * i + k] = key[3 * i + k] + (float)dq[3 * j + k] * q;
+    /* Sum in double, round once: the error is then q/2 plus one float ulp. */
+    for (int k = 0; k < 3; k++) out[3 * i + k] = (float)((double)key[3 * i + k] + (double)dq[3 * j + k] * (double)q);
   }
   return 0;
 }

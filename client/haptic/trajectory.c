@@ -60,10 +60,10 @@ int trajectory_load(const char *path, trajectory_t *out, verr_t *err) {
       s.buttons = (uint32_t)b;
     }
     if (out->n > 0 && !(s.t > out->s[out->n - 1].t)) {
+      double prev = out->s[out->n - 1].t;
       fclose(f);
       trajectory_free(out);
-      return verr_set(err, "%s:%d: field 't': %g is not after the previous sample's %g", path, lineno, s.t,
-                      out->s[out->n - 1].t);
+      return verr_set(err, "%s:%d: field 't': %g is not after the previous sample's %g", path, lineno, s.t, prev);
     }
     if (out->n == TRAJECTORY_MAX_SAMPLES) {
       fclose(f);

@@ -1,0 +1,674 @@
+/* scene: YAML scene file -> scene_t.
+ *
+ * Two passes. libyaml's event parser first builds a small tree of scalars,
+ * lists and mappings that remembers where each node starts; the schema check
+ * then walks that tree, so every message can name the line and the field path
+ * even though the error is found after parsing. The tree is freed before
+ * returning: the result is plain data. */
+#include "scene.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <yaml.h>
+
+/* A scene is a few kilobytes; the caps keep a hostile or mistaken file (a
+ * mesh passed by accident, a YAML bomb) from costing more than a few MB. */
+#define SCENE_MAX_BYTES (1u << 20)
+#define SCENE_MAX_DEPTH 16 /* the schema needs 4 */
+#define SCENE_MAX_NODES 20000
+#define SCENE_MAX_KEYS 16 /* most keys any one mapping of the schema has */
+#define SHOW_LEN 48       /* longest excerpt of user text quoted in a message */
+#define COUNT(a) (sizeof(a) / sizeof((a)[0]))
+
+/* The accepted names for each choice field, the first being the default.
+ * Adding a model, integrator or tool kind means adding it here only. */
+static const char *const scene_models[] = {"mass_spring_surface"};
+static const char *const scene_integrators[] = {"symplectic_euler", "explicit_euler"};
+static const char *const scene_tool_kinds[] = {"probe"};
+
+/* ---- the tree ---------------------------------------------------------- */
+
+enum node_kind { N_SCALAR, N_SEQ, N_MAP };
+
+typedef struct node {
+  enum node_kind kind;
+  int line, col;      /* 1-based, where the node starts */
+  int plain;          /* scalar: plain style and untagged, so it may be a number or null */
+  char *text;         /* scalar: NUL-terminated copy */
+  size_t len;         /* scalar: length in bytes (YAML escapes can put NUL bytes inside) */
+  struct node **kids; /* list: items; mapping: key, value, key, value, ... */
+  size_t nkids, cap;
+} node_t;
+
+static void node_free(node_t *n) {
+  if (!n) return;
+  for (size_t i = 0; i < n->nkids; i++) node_free(n->kids[i]);
+  free(n->kids);
+  free(n->text);
+  free(n);
+}
+
+typedef struct ctx {
+  const char *name; /* file name for messages */
+  verr_t *err;
+} ctx_t;
+
+typedef struct builder {
+  node_t *root;
+  node_t *stack[SCENE_MAX_DEPTH]; /* open lists and mappings, innermost last */
+  int depth;
+  size_t nnodes;
+  int ndocs;
+} builder_t;
+
+static int add_node(const ctx_t *c, builder_t *b, enum node_kind kind, const yaml_event_t *ev) {
+  int line = (int)ev->start_mark.line + 1, col = (int)ev->start_mark.column + 1;
+  if (++b->nnodes > SCENE_MAX_NODES)
+    return verr_set(c->err, "%s:%d:%d: too many YAML nodes (max %d)", c->name, line, col, SCENE_MAX_NODES);
+  if (kind != N_SCALAR && b->depth >= SCENE_MAX_DEPTH)
+    return verr_set(c->err, "%s:%d:%d: nesting deeper than %d levels", c->name, line, col, SCENE_MAX_DEPTH);
+  node_t *n = calloc(1, sizeof *n);
+  if (!n) return verr_set(c->err, "%s: out of memory", c->name);
+  n->kind = kind;
+  n->line = line;
+  n->col = col;
+  if (kind == N_SCALAR) {
+    n->len = ev->data.scalar.length;
+    n->text = malloc(n->len + 1);
+    if (!n->text) {
+      free(n);
+      return verr_set(c->err, "%s: out of memory", c->name);
+    }
+    memcpy(n->text, ev->data.scalar.value, n->len);
+    n->text[n->len] = '\0';
+    /* A quoted or tagged scalar is a string by the author's choice: it is
+     * never read as a number or as null. */
+    n->plain = ev->data.scalar.style == YAML_PLAIN_SCALAR_STYLE && ev->data.scalar.tag == NULL;
+  }
+  if (b->depth == 0) {
+    b->root = n; /* one document, so one root: a second DOCUMENT_START is refused */
+  } else {
+    node_t *parent = b->stack[b->depth - 1];
+    if (parent->nkids == parent->cap) {
+      size_t cap = parent->cap ? 2 * parent->cap : 8;
+      node_t **kids = realloc(parent->kids, cap * sizeof *kids);
+      if (!kids) {
+        node_free(n);
+        return verr_set(c->err, "%s: out of memory", c->name);
+      }
+      parent->kids = kids;
+      parent->cap = cap;
+    }
+    parent->kids[parent->nkids++] = n;
+  }
+  if (kind != N_SCALAR) b->stack[b->depth++] = n;
+  return 0;
+}
+
+static int syntax_err(const ctx_t *c, const yaml_parser_t *p, const char *text, size_t len) {
+  if (p->error == YAML_MEMORY_ERROR) return verr_set(c->err, "%s: out of memory while parsing", c->name);
+  const char *problem = p->problem ? p->problem : "unknown error";
+  size_t line, col;
+  if (p->error == YAML_READER_ERROR) {
+    /* Reader errors (bad UTF-8, control characters) carry a byte offset, not
+     * a mark: count the lines up to it ourselves. */
+    size_t off = p->problem_offset < len ? p->problem_offset : len, bol = 0;
+    line = 1;
+    for (size_t i = 0; i < off; i++)
+      if (text[i] == '\n') {
+        line++;
+        bol = i + 1;
+      }
+    col = off - bol + 1;
+    if (p->problem_value >= 0)
+      return verr_set(c->err, "%s:%zu:%zu: YAML syntax error: %s (byte 0x%02X)", c->name, line, col, problem,
+                      (unsigned)p->problem_value);
+    return verr_set(c->err, "%s:%zu:%zu: YAML syntax error: %s", c->name, line, col, problem);
+  }
+  line = p->problem_mark.line + 1;
+  col = p->problem_mark.column + 1;
+  if (p->context)
+    return verr_set(c->err, "%s:%zu:%zu: YAML syntax error: %s (%s at line %zu)", c->name, line, col, problem,
+                    p->context, (size_t)p->context_mark.line + 1);
+  return verr_set(c->err, "%s:%zu:%zu: YAML syntax error: %s", c->name, line, col, problem);
+}
+
+/* Parses one YAML document into a tree; *root is NULL for a stream with no
+ * document at all (empty or comments only). */
+static int parse_tree(const ctx_t *c, const char *text, size_t len, node_t **root) {
+  yaml_parser_t p;
+  *root = NULL;
+  if (!yaml_parser_initialize(&p)) return verr_set(c->err, "%s: out of memory", c->name);
+  yaml_parser_set_input_string(&p, (const unsigned char *)text, len);
+  builder_t b;
+  memset(&b, 0, sizeof b);
+  int rc = 0, done = 0;
+  while (!done && rc == 0) {
+    yaml_event_t ev;
+    if (!yaml_parser_parse(&p, &ev)) {
+      rc = syntax_err(c, &p, text, len);
+      break;
+    }
+    int line = (int)ev.start_mark.line + 1, col = (int)ev.start_mark.column + 1;
+    switch (ev.type) {
+    case YAML_STREAM_END_EVENT:
+      done = 1;
+      break;
+    case YAML_DOCUMENT_START_EVENT:
+      /* Silently using the first of several documents would hide the rest. */
+      if (++b.ndocs > 1)
+        rc = verr_set(c->err, "%s:%d: only one YAML document is allowed in a scene file", c->name, line);
+      break;
+    case YAML_ALIAS_EVENT:
+      /* Aliases would make the tree a graph and open the door to
+       * exponential expansion; a scene is small enough to write out. */
+      rc = verr_set(c->err, "%s:%d:%d: YAML alias '*%.*s' is not supported: write the value out", c->name, line, col,
+                    SHOW_LEN, (const char *)ev.data.alias.anchor);
+      break;
+    case YAML_SCALAR_EVENT:
+      rc = add_node(c, &b, N_SCALAR, &ev);
+      break;
+    case YAML_SEQUENCE_START_EVENT:
+      rc = add_node(c, &b, N_SEQ, &ev);
+      break;
+    case YAML_MAPPING_START_EVENT:
+      rc = add_node(c, &b, N_MAP, &ev);
+      break;
+    case YAML_SEQUENCE_END_EVENT:
+    case YAML_MAPPING_END_EVENT:
+      b.depth--;
+      break;
+    default:
+      break;
+    }
+    yaml_event_delete(&ev);
+  }
+  yaml_parser_delete(&p);
+  if (rc) {
+    node_free(b.root);
+    return -1;
+  }
+  *root = b.root;
+  return 0;
+}
+
+/* ---- messages ---------------------------------------------------------- */
+
+static int field_err(const ctx_t *c, const node_t *n, const char *path, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+static int field_err(const ctx_t *c, const node_t *n, const char *path, const char *fmt, ...) {
+  char what[VERR_MSG_LEN];
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(what, sizeof what, fmt, ap);
+  va_end(ap);
+  return verr_set(c->err, "%s:%d: field '%s': %s", c->name, n->line, path, what);
+}
+
+static int is_null(const node_t *n) {
+  if (n->kind != N_SCALAR || !n->plain) return 0;
+  const char *t = n->text;
+  return n->len == 0 || !strcmp(t, "~") || !strcmp(t, "null") || !strcmp(t, "Null") || !strcmp(t, "NULL");
+}
+
+static const char *kind_name(const node_t *n) {
+  if (n->kind == N_SEQ) return "a list";
+  if (n->kind == N_MAP) return "a mapping";
+  return is_null(n) ? "null" : "a single value";
+}
+
+/* "%.*s%s" arguments quoting at most SHOW_LEN bytes of a scalar. */
+#define SHOW(n) (int)((n)->len > SHOW_LEN ? SHOW_LEN : (n)->len), (n)->text, ((n)->len > SHOW_LEN ? "..." : "")
+
+/* Field path "prefix.key". Schema paths are far shorter than the buffers;
+ * should one ever be cut, the "..." shows it rather than hiding it. */
+static void join(char *dst, size_t size, const char *prefix, const char *key) {
+  int w = snprintf(dst, size, "%s%s%s", prefix, *prefix ? "." : "", key);
+  if (w < 0 || (size_t)w >= size) memcpy(dst + size - 4, "...", 4);
+}
+
+static void list_names(char *dst, size_t size, const char *const *names, size_t n) {
+  size_t k = 0;
+  dst[0] = '\0';
+  for (size_t i = 0; i < n && k < size; i++) {
+    int w = snprintf(dst + k, size - k, "%s%s", i ? ", " : "", names[i]);
+    if (w < 0) break;
+    k += (size_t)w;
+  }
+}
+
+/* ---- value readers ----------------------------------------------------- */
+
+enum bound { B_NONE, B_INCL, B_EXCL };
+typedef struct range {
+  enum bound lo_kind;
+  double lo;
+  enum bound hi_kind;
+  double hi;
+} range_t;
+
+static const range_t ANY = {B_NONE, 0, B_NONE, 0};
+static const range_t GT0 = {B_EXCL, 0, B_NONE, 0};
+static const range_t GE0 = {B_INCL, 0, B_NONE, 0};
+
+static int get_number(const ctx_t *c, const node_t *n, const char *path, const range_t *r, double *out) {
+  if (n->kind != N_SCALAR || is_null(n)) return field_err(c, n, path, "must be a number (got %s)", kind_name(n));
+  if (!n->plain) return field_err(c, n, path, "must be a number, not a quoted string (got \"%.*s%s\")", SHOW(n));
+  /* YAML spells them .nan and .inf; strtod would also take nan and inf. */
+  const char *t = n->text + (n->text[0] == '+' || n->text[0] == '-');
+  if (*t == '.') t++;
+  if (!strcasecmp(t, "nan") || !strcasecmp(t, "inf") || !strcasecmp(t, "infinity"))
+    return field_err(c, n, path, "must be a finite number (got %.*s%s)", SHOW(n));
+  /* Only decimal notation: strtod would also read hex floats, and YAML 1.1
+   * forms such as 1_000 or 0o17 are not worth a surprise. */
+  if (n->len == 0 || strspn(n->text, "0123456789+-.eE") != n->len)
+    return field_err(c, n, path, "must be a number (got '%.*s%s')", SHOW(n));
+  char *end;
+  errno = 0;
+  double v = strtod(n->text, &end);
+  if (end != n->text + n->len) return field_err(c, n, path, "must be a number (got '%.*s%s')", SHOW(n));
+  if (!isfinite(v)) return field_err(c, n, path, "must be a finite number (got %.*s%s)", SHOW(n));
+  int ok = 1;
+  if ((r->lo_kind == B_INCL && !(v >= r->lo)) || (r->lo_kind == B_EXCL && !(v > r->lo))) ok = 0;
+  if ((r->hi_kind == B_INCL && !(v <= r->hi)) || (r->hi_kind == B_EXCL && !(v < r->hi))) ok = 0;
+  if (!ok) {
+    char want[96] = "";
+    int k = 0;
+    if (r->lo_kind != B_NONE) k = snprintf(want, sizeof want, "%s %g", r->lo_kind == B_INCL ? ">=" : ">", r->lo);
+    if (r->hi_kind != B_NONE)
+      snprintf(want + k, sizeof want - (size_t)k, "%s%s %g", k ? " and " : "", r->hi_kind == B_INCL ? "<=" : "<",
+               r->hi);
+    return field_err(c, n, path, "must be %s (got %.*s%s)", want, SHOW(n));
+  }
+  *out = v;
+  return 0;
+}
+
+/* Optional number field: n == NULL (absent) keeps the default in *out. */
+static int opt_number(const ctx_t *c, const node_t *n, const char *prefix, const char *key, const range_t *r,
+                      double *out) {
+  if (!n) return 0;
+  char path[128];
+  join(path, sizeof path, prefix, key);
+  return get_number(c, n, path, r, out);
+}
+
+static int get_vec3(const ctx_t *c, const node_t *n, const char *path, const range_t *r, double out[3]) {
+  if (n->kind != N_SEQ || n->nkids != 3) {
+    if (n->kind == N_SEQ)
+      return field_err(c, n, path, "must be a list of 3 numbers [x, y, z] (got %zu items)", n->nkids);
+    return field_err(c, n, path, "must be a list of 3 numbers [x, y, z] (got %s)", kind_name(n));
+  }
+  double v[3];
+  for (int i = 0; i < 3; i++) {
+    char p[160];
+    snprintf(p, sizeof p, "%s[%d]", path, i);
+    if (get_number(c, n->kids[i], p, r, &v[i])) return -1;
+  }
+  memcpy(out, v, sizeof v);
+  return 0;
+}
+
+static int get_string(const ctx_t *c, const node_t *n, const char *path, char *dst, size_t size) {
+  if (n->kind != N_SCALAR || is_null(n)) return field_err(c, n, path, "must be a string (got %s)", kind_name(n));
+  if (memchr(n->text, '\0', n->len)) return field_err(c, n, path, "must not contain NUL bytes");
+  if (n->len >= size) return field_err(c, n, path, "too long (%zu bytes, max %zu)", n->len, size - 1);
+  memcpy(dst, n->text, n->len + 1);
+  return 0;
+}
+
+/* Names end up in topic keys, file names and log lines: keep them plain. */
+static int get_name(const ctx_t *c, const node_t *n, const char *path, char *dst, size_t size) {
+  if (get_string(c, n, path, dst, size)) return -1;
+  if (!dst[0]) return field_err(c, n, path, "must not be empty");
+  size_t ok = strspn(dst, "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789_-");
+  if (dst[ok]) return field_err(c, n, path, "may contain only letters, digits, '_' and '-' (got '%.*s%s')", SHOW(n));
+  return 0;
+}
+
+static int get_choice(const ctx_t *c, const node_t *n, const char *path, const char *const *names, size_t count,
+                      char *dst, size_t size) {
+  char buf[64];
+  if (get_string(c, n, path, buf, sizeof buf) == 0)
+    for (size_t i = 0; i < count; i++)
+      if (!strcmp(buf, names[i])) {
+        if (strlen(names[i]) >= size) return field_err(c, n, path, "'%s' does not fit the scene_t field", names[i]);
+        strcpy(dst, names[i]);
+        return 0;
+      }
+  /* Either not a string or not a known name: list what is accepted. */
+  char allowed[256];
+  list_names(allowed, sizeof allowed, names, count);
+  if (n->kind != N_SCALAR || is_null(n))
+    return field_err(c, n, path, "must be one of: %s (got %s)", allowed, kind_name(n));
+  return field_err(c, n, path, "must be one of: %s (got '%.*s%s')", allowed, SHOW(n));
+}
+
+/* Checks that `n` is a mapping whose keys are all in `keys`, each at most
+ * once, and sets vals[i] to the value given for keys[i] (NULL if absent). */
+static int get_fields(const ctx_t *c, const node_t *n, const char *path, const char *const *keys, size_t nkeys,
+                      const node_t **vals) {
+  const node_t *seen[SCENE_MAX_KEYS] = {0};
+  if (n->kind != N_MAP)
+    return field_err(c, n, *path ? path : "(top level)", "must be a mapping of fields (got %s)", kind_name(n));
+  for (size_t i = 0; i < nkeys; i++) vals[i] = NULL;
+  for (size_t p = 0; p + 1 < n->nkids; p += 2) {
+    const node_t *k = n->kids[p];
+    char kpath[160];
+    if (k->kind != N_SCALAR)
+      return field_err(c, k, *path ? path : "(top level)", "keys must be plain names (got %s)", kind_name(k));
+    snprintf(kpath, sizeof kpath, "%s%s%.*s%s", path, *path ? "." : "", SHOW(k));
+    size_t i = 0;
+    while (i < nkeys && !(strlen(keys[i]) == k->len && !memcmp(keys[i], k->text, k->len))) i++;
+    if (i == nkeys) {
+      char allowed[256];
+      list_names(allowed, sizeof allowed, keys, nkeys);
+      return field_err(c, k, kpath, "unknown key (allowed: %s)", allowed);
+    }
+    if (seen[i]) return field_err(c, k, kpath, "duplicate key (first given at line %d)", seen[i]->line);
+    seen[i] = k;
+    vals[i] = n->kids[p + 1];
+  }
+  return 0;
+}
+
+static int missing(const ctx_t *c, const node_t *owner, const char *prefix, const char *key) {
+  char path[128];
+  join(path, sizeof path, prefix, key);
+  return field_err(c, owner, path, "required field missing");
+}
+
+/* ---- the schema -------------------------------------------------------- */
+
+enum { P_DT, P_PUBLISH_HZ, P_QUANT_STEP, P_GRAVITY, P_NKEYS };
+static const char *const physics_keys[P_NKEYS] = {
+    [P_DT] = "dt", [P_PUBLISH_HZ] = "publish_hz", [P_QUANT_STEP] = "quant_step", [P_GRAVITY] = "gravity"};
+
+enum { M_MASS, M_STIFFNESS, M_DAMPING, M_HOME_STIFFNESS, M_HOME_DAMPING, M_NKEYS };
+static const char *const material_keys[M_NKEYS] = {[M_MASS] = "mass",
+                                                   [M_STIFFNESS] = "stiffness",
+                                                   [M_DAMPING] = "damping",
+                                                   [M_HOME_STIFFNESS] = "home_stiffness",
+                                                   [M_HOME_DAMPING] = "home_damping"};
+
+enum { O_NAME, O_MESH, O_MODEL, O_INTEGRATOR, O_POSITION, O_SCALE, O_COLOR, O_FIXED_BELOW, O_MATERIAL, O_NKEYS };
+static const char *const organ_keys[O_NKEYS] = {
+    [O_NAME] = "name",         [O_MESH] = "mesh",   [O_MODEL] = "model", [O_INTEGRATOR] = "integrator",
+    [O_POSITION] = "position", [O_SCALE] = "scale", [O_COLOR] = "color", [O_FIXED_BELOW] = "fixed_below",
+    [O_MATERIAL] = "material"};
+
+enum { T_NAME, T_KIND, T_RADIUS, T_LENGTH, T_STIFFNESS, T_MAX_FORCE, T_NKEYS };
+static const char *const tool_keys[T_NKEYS] = {
+    [T_NAME] = "name",     [T_KIND] = "kind",           [T_RADIUS] = "radius",
+    [T_LENGTH] = "length", [T_STIFFNESS] = "stiffness", [T_MAX_FORCE] = "max_force"};
+
+enum { S_SCENE, S_DESCRIPTION, S_PHYSICS, S_ORGANS, S_TOOLS, S_NKEYS };
+static const char *const top_keys[S_NKEYS] = {[S_SCENE] = "scene",
+                                              [S_DESCRIPTION] = "description",
+                                              [S_PHYSICS] = "physics",
+                                              [S_ORGANS] = "organs",
+                                              [S_TOOLS] = "tools"};
+
+/* get_fields() tracks the keys seen in a fixed array of SCENE_MAX_KEYS. */
+_Static_assert(P_NKEYS <= SCENE_MAX_KEYS && M_NKEYS <= SCENE_MAX_KEYS && O_NKEYS <= SCENE_MAX_KEYS &&
+                   T_NKEYS <= SCENE_MAX_KEYS && S_NKEYS <= SCENE_MAX_KEYS,
+               "raise SCENE_MAX_KEYS");
+
+static void organ_defaults(scene_organ_t *o) {
+  memset(o, 0, sizeof *o);
+  snprintf(o->model, sizeof o->model, "%s", scene_models[0]);
+  snprintf(o->integrator, sizeof o->integrator, "%s", scene_integrators[0]);
+  o->scale = 1;
+  o->color[0] = 0.8f;
+  o->color[1] = 0.35f;
+  o->color[2] = 0.3f;
+  o->material.mass = 0.1;
+  o->material.stiffness = 200;
+  o->material.damping = 0.5;
+  o->material.home_stiffness = 50;
+  o->material.home_damping = 0.05;
+}
+
+static void tool_defaults(scene_tool_t *t) {
+  memset(t, 0, sizeof *t);
+  snprintf(t->kind, sizeof t->kind, "%s", scene_tool_kinds[0]);
+  t->radius = 0.002;
+  t->length = 0.1;
+  t->stiffness = 300;
+  t->max_force = 4;
+}
+
+static int parse_physics(const ctx_t *c, const node_t *n, scene_t *s) {
+  const node_t *v[P_NKEYS];
+  static const range_t dt_range = {B_EXCL, 0, B_INCL, 0.05};
+  static const range_t hz_range = {B_INCL, 1, B_INCL, 240};
+  static const range_t quant_range = {B_INCL, 1e-7, B_INCL, 1e-2};
+  static const range_t g_range = {B_INCL, -100, B_INCL, 100};
+  if (get_fields(c, n, "physics", physics_keys, P_NKEYS, v)) return -1;
+  if (opt_number(c, v[P_DT], "physics", "dt", &dt_range, &s->dt)) return -1;
+  if (opt_number(c, v[P_PUBLISH_HZ], "physics", "publish_hz", &hz_range, &s->publish_hz)) return -1;
+  if (opt_number(c, v[P_QUANT_STEP], "physics", "quant_step", &quant_range, &s->quant_step)) return -1;
+  if (v[P_GRAVITY] && get_vec3(c, v[P_GRAVITY], "physics.gravity", &g_range, s->gravity)) return -1;
+  return 0;
+}
+
+static int parse_material(const ctx_t *c, const node_t *n, const char *path, scene_material_t *m) {
+  const node_t *v[M_NKEYS];
+  if (get_fields(c, n, path, material_keys, M_NKEYS, v)) return -1;
+  if (opt_number(c, v[M_MASS], path, "mass", &GT0, &m->mass)) return -1;
+  if (opt_number(c, v[M_STIFFNESS], path, "stiffness", &GE0, &m->stiffness)) return -1;
+  if (opt_number(c, v[M_DAMPING], path, "damping", &GE0, &m->damping)) return -1;
+  if (opt_number(c, v[M_HOME_STIFFNESS], path, "home_stiffness", &GE0, &m->home_stiffness)) return -1;
+  if (opt_number(c, v[M_HOME_DAMPING], path, "home_damping", &GE0, &m->home_damping)) return -1;
+  return 0;
+}
+
+/* Relative paths are taken from the scene's directory so a scene can be
+ * loaded from any working directory; no normalisation is needed to open it. */
+static int resolve_mesh(const ctx_t *c, const node_t *n, const char *path, const char *base_dir, char *dst,
+                        size_t size) {
+  char rel[SCENE_PATH_LEN];
+  if (get_string(c, n, path, rel, sizeof rel)) return -1;
+  if (!rel[0]) return field_err(c, n, path, "must not be empty");
+  if (rel[0] == '/' || !base_dir || !base_dir[0]) {
+    memcpy(dst, rel, strlen(rel) + 1);
+    return 0;
+  }
+  size_t bl = strlen(base_dir);
+  const char *sep = base_dir[bl - 1] == '/' ? "" : "/";
+  int w = snprintf(dst, size, "%s%s%s", base_dir, sep, rel);
+  if (w < 0 || (size_t)w >= size)
+    return field_err(c, n, path, "too long once joined to the directory '%s' (%d bytes, max %zu)", base_dir, w,
+                     size - 1);
+  return 0;
+}
+
+static int parse_organ(const ctx_t *c, const node_t *n, size_t idx, const char *base_dir, scene_t *s) {
+  scene_organ_t *o = &s->organs[idx];
+  const node_t *v[O_NKEYS];
+  char path[64], fp[128];
+  static const range_t unit = {B_INCL, 0, B_INCL, 1};
+  snprintf(path, sizeof path, "organs[%zu]", idx);
+  organ_defaults(o);
+  o->line = n->line;
+  if (get_fields(c, n, path, organ_keys, O_NKEYS, v)) return -1;
+  if (!v[O_NAME]) return missing(c, n, path, "name");
+  if (!v[O_MESH]) return missing(c, n, path, "mesh");
+  join(fp, sizeof fp, path, "name");
+  if (get_name(c, v[O_NAME], fp, o->name, sizeof o->name)) return -1;
+  for (size_t j = 0; j < idx; j++)
+    if (!strcmp(s->organs[j].name, o->name))
+      return field_err(c, v[O_NAME], fp, "duplicate organ name '%s' (first used by organs[%zu] at line %d)", o->name, j,
+                       s->organs[j].line);
+  join(fp, sizeof fp, path, "mesh");
+  if (resolve_mesh(c, v[O_MESH], fp, base_dir, o->mesh, sizeof o->mesh)) return -1;
+  join(fp, sizeof fp, path, "model");
+  if (v[O_MODEL] && get_choice(c, v[O_MODEL], fp, scene_models, COUNT(scene_models), o->model, sizeof o->model))
+    return -1;
+  join(fp, sizeof fp, path, "integrator");
+  if (v[O_INTEGRATOR] && get_choice(c, v[O_INTEGRATOR], fp, scene_integrators, COUNT(scene_integrators), o->integrator,
+                                    sizeof o->integrator))
+    return -1;
+  join(fp, sizeof fp, path, "position");
+  if (v[O_POSITION] && get_vec3(c, v[O_POSITION], fp, &ANY, o->position)) return -1;
+  if (opt_number(c, v[O_SCALE], path, "scale", &GT0, &o->scale)) return -1;
+  if (v[O_COLOR]) {
+    double rgb[3];
+    join(fp, sizeof fp, path, "color");
+    if (get_vec3(c, v[O_COLOR], fp, &unit, rgb)) return -1;
+    for (int k = 0; k < 3; k++) o->color[k] = (float)rgb[k];
+  }
+  if (v[O_FIXED_BELOW]) {
+    if (opt_number(c, v[O_FIXED_BELOW], path, "fixed_below", &ANY, &o->fixed_below)) return -1;
+    o->fixed_below_set = 1;
+  }
+  if (v[O_MATERIAL]) {
+    join(fp, sizeof fp, path, "material");
+    if (parse_material(c, v[O_MATERIAL], fp, &o->material)) return -1;
+  }
+  return 0;
+}
+
+static int parse_tool(const ctx_t *c, const node_t *n, size_t idx, scene_t *s) {
+  scene_tool_t *t = &s->tools[idx];
+  const node_t *v[T_NKEYS];
+  char path[64], fp[128];
+  static const range_t radius_range = {B_EXCL, 0, B_INCL, 0.05};
+  static const range_t stiffness_range = {B_EXCL, 0, B_INCL, 1e5};
+  static const range_t force_range = {B_EXCL, 0, B_INCL, 100};
+  snprintf(path, sizeof path, "tools[%zu]", idx);
+  tool_defaults(t);
+  t->line = n->line;
+  if (get_fields(c, n, path, tool_keys, T_NKEYS, v)) return -1;
+  if (!v[T_NAME]) return missing(c, n, path, "name");
+  join(fp, sizeof fp, path, "name");
+  if (get_name(c, v[T_NAME], fp, t->name, sizeof t->name)) return -1;
+  for (size_t j = 0; j < idx; j++)
+    if (!strcmp(s->tools[j].name, t->name))
+      return field_err(c, v[T_NAME], fp, "duplicate tool name '%s' (first used by tools[%zu] at line %d)", t->name, j,
+                       s->tools[j].line);
+  join(fp, sizeof fp, path, "kind");
+  if (v[T_KIND] && get_choice(c, v[T_KIND], fp, scene_tool_kinds, COUNT(scene_tool_kinds), t->kind, sizeof t->kind))
+    return -1;
+  if (opt_number(c, v[T_RADIUS], path, "radius", &radius_range, &t->radius)) return -1;
+  if (opt_number(c, v[T_LENGTH], path, "length", &GT0, &t->length)) return -1;
+  if (opt_number(c, v[T_STIFFNESS], path, "stiffness", &stiffness_range, &t->stiffness)) return -1;
+  if (opt_number(c, v[T_MAX_FORCE], path, "max_force", &force_range, &t->max_force)) return -1;
+  return 0;
+}
+
+/* Checks a list's length against [min, max]; an excess is reported at the
+ * first entry past the limit, where the author has to cut. */
+static int check_list(const ctx_t *c, const node_t *n, const char *path, const char *what, size_t min, size_t max) {
+  if (n->kind != N_SEQ) return field_err(c, n, path, "must be a list of %ss (got %s)", what, kind_name(n));
+  if (n->nkids < min) return field_err(c, n, path, "needs at least %zu %s (got %zu)", min, what, n->nkids);
+  if (n->nkids > max) return field_err(c, n->kids[max], path, "too many %ss (%zu, max %zu)", what, n->nkids, max);
+  return 0;
+}
+
+static int parse_scene(const ctx_t *c, const node_t *root, const char *base_dir, scene_t *s) {
+  const node_t *v[S_NKEYS];
+  if (get_fields(c, root, "", top_keys, S_NKEYS, v)) return -1;
+  if (!v[S_SCENE]) return missing(c, root, "", "scene");
+  if (!v[S_ORGANS]) return missing(c, root, "", "organs");
+  if (get_name(c, v[S_SCENE], "scene", s->name, sizeof s->name)) return -1;
+  if (v[S_DESCRIPTION] && get_string(c, v[S_DESCRIPTION], "description", s->description, sizeof s->description))
+    return -1;
+  if (v[S_PHYSICS] && parse_physics(c, v[S_PHYSICS], s)) return -1;
+  if (check_list(c, v[S_ORGANS], "organs", "organ", 1, SCENE_MAX_ORGANS)) return -1;
+  for (size_t i = 0; i < v[S_ORGANS]->nkids; i++) {
+    if (parse_organ(c, v[S_ORGANS]->kids[i], i, base_dir, s)) return -1;
+    s->norgans = i + 1;
+  }
+  if (v[S_TOOLS]) {
+    if (check_list(c, v[S_TOOLS], "tools", "tool", 0, SCENE_MAX_TOOLS)) return -1;
+    for (size_t i = 0; i < v[S_TOOLS]->nkids; i++) {
+      if (parse_tool(c, v[S_TOOLS]->kids[i], i, s)) return -1;
+      s->ntools = i + 1;
+    }
+  }
+  return 0;
+}
+
+/* ---- entry points ------------------------------------------------------ */
+
+static int load_text(const char *text, size_t len, const char *name, const char *base_dir, scene_t *out, verr_t *err) {
+  ctx_t c = {name, err};
+  memset(out, 0, sizeof *out);
+  out->dt = 0.001;
+  out->publish_hz = 30;
+  out->quant_step = 1e-5;
+  if (strlen(name) >= sizeof out->path)
+    return verr_set(err, "%.*s...: scene path too long (max %zu bytes)", 64, name, sizeof out->path - 1);
+  memcpy(out->path, name, strlen(name) + 1);
+  node_t *root;
+  if (parse_tree(&c, text, len, &root)) return -1;
+  int rc;
+  if (!root || (root->kind == N_SCALAR && root->plain && root->len == 0))
+    rc = verr_set(err, "%s: empty scene file", name);
+  else if (root->kind != N_MAP)
+    rc = verr_set(err, "%s:%d: the top level must be a mapping of scene fields (got %s)", name, root->line,
+                  kind_name(root));
+  else
+    rc = parse_scene(&c, root, base_dir, out);
+  node_free(root);
+  return rc;
+}
+
+int scene_load_string(const char *text, const char *name, const char *base_dir, scene_t *out, verr_t *err) {
+  if (!name) name = "<string>";
+  if (!text || !out) return verr_set(err, "%s: scene_load_string: NULL text or result", name);
+  size_t len = strnlen(text, SCENE_MAX_BYTES + 1);
+  if (len > SCENE_MAX_BYTES) return verr_set(err, "%s: scene text too large (max %u bytes)", name, SCENE_MAX_BYTES);
+  return load_text(text, len, name, base_dir, out, err);
+}
+
+static void errno_text(int e, char *buf, size_t size) {
+  /* strerror() may share a static buffer between threads. */
+  if (strerror_r(e, buf, size) != 0) snprintf(buf, size, "error %d", e);
+}
+
+int scene_load(const char *path, scene_t *out, verr_t *err) {
+  if (!path || !out) return verr_set(err, "scene_load: NULL path or result");
+  if (strlen(path) >= SCENE_PATH_LEN)
+    return verr_set(err, "%.64s...: scene path too long (max %d bytes)", path, SCENE_PATH_LEN - 1);
+  char ebuf[128];
+  FILE *f = fopen(path, "rb");
+  if (!f) {
+    errno_text(errno, ebuf, sizeof ebuf);
+    return verr_set(err, "%s: cannot open: %s", path, ebuf);
+  }
+  /* Read one byte past the cap to tell "exactly at the cap" from "over". */
+  char *buf = malloc(SCENE_MAX_BYTES + 2);
+  if (!buf) {
+    fclose(f);
+    return verr_set(err, "%s: out of memory", path);
+  }
+  size_t n = fread(buf, 1, SCENE_MAX_BYTES + 1, f);
+  int read_errno = ferror(f) ? errno : 0;
+  fclose(f);
+  if (read_errno) {
+    free(buf);
+    errno_text(read_errno, ebuf, sizeof ebuf);
+    return verr_set(err, "%s: cannot read: %s", path, ebuf);
+  }
+  if (n > SCENE_MAX_BYTES) {
+    free(buf);
+    return verr_set(err, "%s: scene file too large (max %u bytes)", path, SCENE_MAX_BYTES);
+  }
+  buf[n] = '\0';
+  /* The directory part of the path, "" for a bare file name (the cwd). */
+  char dir[SCENE_PATH_LEN];
+  const char *slash = strrchr(path, '/');
+  size_t dl = slash ? (slash == path ? 1 : (size_t)(slash - path)) : 0;
+  memcpy(dir, path, dl);
+  dir[dl] = '\0';
+  int rc = load_text(buf, n, path, dir, out, err);
+  free(buf);
+  return rc;
+}
