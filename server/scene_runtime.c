@@ -46,7 +46,7 @@ static int organ_init(organ_rt_t *o, const scene_t *sc, const scene_organ_t *cfg
     mesh_free(&o->rest);
     return verr_set(err,
                     "%s:%d: organ '%s': %s is stable only below dt = %.3g s here, which would need %.0f sub-steps of "
-                    "the %.3g s step (limit 256); lower material stiffness/damping or use symplectic_euler",
+                    "the %.3g s step (limit 256); lower material stiffness, damping or tool stiffness, or the mass",
                     sc->path, cfg->line, cfg->name, cfg->integrator, o->stable_dt, need, sc->dt);
   }
   o->substeps = need < 1 ? 1 : (int)need;

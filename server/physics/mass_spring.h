@@ -4,8 +4,7 @@
  * Every unique mesh edge is a spring with Kelvin-Voigt damping (seed 002 eq.
  * 5.3): f = k (L - L0) u + c ((v_j - v_i) . u) u. Every vertex also has a home
  * spring to its rest position with ground damping, which preserves the organ's
- * shape. Masses are lumped: total mass spread by vertex area (one third of each
- * adjacent triangle). Vertices can be fixed.
+ * shape. Masses are lumped and equal (total / vertices). Vertices can be fixed.
  *
  * State is structure-of-arrays, allocated once in mass_spring_create; stepping
  * allocates nothing. Not thread-safe: one physics thread owns a model. */
@@ -60,11 +59,11 @@ void mass_spring_destroy(mass_spring_t *ms);
 /* Fixes every vertex whose rest z is below z (zero inverse mass). Returns how many. */
 size_t mass_spring_fix_below(mass_spring_t *ms, double z);
 
-/* Largest step h for which the chosen integrator stays stable, from the
- * Gershgorin bounds l_k = max_i (sum of stiffness at i)*2/m_i and
- * l_c likewise for damping; symplectic needs h^2 l_k + 2 h l_c < 4.
- * Explicit Euler has no such bound for undamped systems: returns the damped
- * bound h <= 2 zeta / omega, which may be 0. */
+/* Largest step h for which the chosen integrator stays stable: with l_k and
+ * l_c the largest eigenvalues of M^-1 K and M^-1 C at rest (power
+ * iteration), symplectic Euler needs h^2 l_k + 2 h l_c < 4. Explicit Euler
+ * has no bound for undamped systems: returns the damped bound
+ * h <= 2 zeta / omega = l_c / l_k, which may be 0. Allocates scratch. */
 double mass_spring_stable_dt(const mass_spring_t *ms);
 
 /* Accumulates internal + home + gravity + f_ext forces for state (x, v) into f. */

@@ -1,0 +1,47 @@
+#!/usr/bin/env bash
+# Runs one complete local session on loopback: server, recorder, offscreen
+# viewer and a scripted haptic client, each a separate process talking over
+# Cyclone DDS. Used by demo.sh and by the integration tests.
+#
+# usage: deploy/session.sh BUILD_DIR OUT_DIR [SCENE] [TRAJECTORY]
+# env:   VISCERA_DOMAIN (default 7), VISCERA_PARTITION (default demo/seat01),
+#        VIEWER_ARGS, SERVER_ARGS (extra options)
+set -euo pipefail
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+BUILD="$1"
+OUT="$2"
+SCENE="${3:-$ROOT/assets/scenes/default.yaml}"
+TRAJ="${4:-$ROOT/assets/trajectories/palpate_kidney.traj}"
+DOMAIN="${VISCERA_DOMAIN:-7}"
+PART="${VISCERA_PARTITION:-demo/seat01}"
+export CYCLONEDDS_URI="${CYCLONEDDS_URI:-file://$ROOT/deploy/cyclonedds-loopback.xml}"
+
+mkdir -p "$OUT"
+rm -rf "$OUT/frames" "$OUT/session.db" "$OUT/session.db-wal" "$OUT/session.db-shm"
+common=(--domain "$DOMAIN" --partition "$PART")
+pids=()
+cleanup() {
+  for p in "${pids[@]}"; do kill -TERM "$p" 2>/dev/null || true; done
+  wait 2>/dev/null || true
+}
+trap cleanup EXIT
+
+echo "session: domain $DOMAIN, partition '$PART', output in $OUT"
+"$BUILD/server/viscera-server" --scene "$SCENE" "${common[@]}" ${SERVER_ARGS:-} >"$OUT/server.out" 2>"$OUT/server.log" &
+SERVER=$!; pids+=($SERVER)
+"$BUILD/client/recorder/viscera-recorder" "${common[@]}" --out "$OUT/session.db" --quiet \
+  >"$OUT/recorder.out" 2>"$OUT/recorder.log" &
+RECORDER=$!; pids+=($RECORDER)
+"$BUILD/client/viewer/viscera-viewer" "${common[@]}" --out "$OUT/frames" ${VIEWER_ARGS:---interval-ms 100} \
+  >"$OUT/viewer.out" 2>"$OUT/viewer.log" &
+VIEWER=$!; pids+=($VIEWER)
+# Let the viewer and recorder discover the server before the hand moves.
+sleep 1.5
+"$BUILD/client/haptic/viscera-haptic" --trajectory "$TRAJ" "${common[@]}" \
+  --force-csv "$OUT/haptic_force.csv" >"$OUT/haptic.out" 2>"$OUT/haptic.log"
+HAPTIC_RC=$?
+sleep 0.5
+for p in $VIEWER $RECORDER $SERVER; do kill -INT "$p" 2>/dev/null || true; wait "$p" 2>/dev/null || true; done
+pids=()
+trap - EXIT
+[ $HAPTIC_RC -eq 0 ] || { echo "session: haptic client failed (see $OUT/haptic.log)" >&2; exit 1; }
