@@ -428,10 +428,10 @@ static void organ_defaults(scene_organ_t *o) {
   o->color[1] = 0.35f;
   o->color[2] = 0.3f;
   o->material.mass = 0.1;
-  o->material.stiffness = 200;
-  o->material.damping = 0.5;
-  o->material.home_stiffness = 50;
-  o->material.home_damping = 0.05;
+  o->material.stiffness = 30;
+  o->material.damping = 0.02;
+  o->material.home_stiffness = 30;
+  o->material.home_damping = 0.005;
 }
 
 static void tool_defaults(scene_tool_t *t) {

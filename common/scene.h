@@ -4,7 +4,7 @@
  * and the README for every field. scene_load() reads the whole file, checks
  * every field (type, range, known names, unknown keys refused) and fails on
  * the first problem with "FILE:LINE: field 'organs[0].material.stiffness':
- * must be > 0 (got -3)". Relative mesh paths are resolved against the scene
+ * must be >= 0 (got -3)". Relative mesh paths are resolved against the scene
  * file's directory. Nothing is allocated: the result is plain data. */
 #ifndef VISCERA_SCENE_H
 #define VISCERA_SCENE_H
@@ -20,10 +20,10 @@
 
 typedef struct scene_material {
   double mass;           /* kg, total organ mass, spread over vertices (default 0.1) */
-  double stiffness;      /* N/m, edge spring stiffness (default 200) */
-  double damping;        /* N s/m, Kelvin-Voigt edge damping (default 0.5) */
-  double home_stiffness; /* N/m, spring from each vertex to its rest position (default 50) */
-  double home_damping;   /* N s/m, damping relative to the ground (default 0.05) */
+  double stiffness;      /* N/m, edge spring stiffness (default 30) */
+  double damping;        /* N s/m, Kelvin-Voigt edge damping (default 0.02) */
+  double home_stiffness; /* N/m, spring from each vertex to its rest position (default 30) */
+  double home_damping;   /* N s/m, damping relative to the ground (default 0.005) */
 } scene_material_t;
 
 typedef struct scene_organ {

@@ -95,9 +95,11 @@ dds_entity_t vdds_writer(vdds_t *v, vdds_topic_id_t t, verr_t *err) {
   return w;
 }
 
-dds_entity_t vdds_reader(vdds_t *v, vdds_topic_id_t t, verr_t *err) {
+dds_entity_t vdds_reader(vdds_t *v, vdds_topic_id_t t, verr_t *err) { return vdds_reader_listener(v, t, NULL, err); }
+
+dds_entity_t vdds_reader_listener(vdds_t *v, vdds_topic_id_t t, const dds_listener_t *l, verr_t *err) {
   dds_qos_t *q = make_qos(TOPICS[t].qos);
-  dds_entity_t r = dds_create_reader(v->subscriber, v->topics[t], q, NULL);
+  dds_entity_t r = dds_create_reader(v->subscriber, v->topics[t], q, l);
   dds_delete_qos(q);
   if (r < 0) verr_set(err, "DDS: cannot create reader for %s: %s", TOPICS[t].name, dds_strretcode(r));
   return r;

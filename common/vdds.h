@@ -43,6 +43,8 @@ const char *vdds_topic_name(vdds_topic_id_t t);
 /* Writer / reader with the table's QoS; negative DDS return code on failure. */
 dds_entity_t vdds_writer(vdds_t *v, vdds_topic_id_t t, verr_t *err);
 dds_entity_t vdds_reader(vdds_t *v, vdds_topic_id_t t, verr_t *err);
+/* Same with a listener (callbacks run on a DDS thread; may be NULL). */
+dds_entity_t vdds_reader_listener(vdds_t *v, vdds_topic_id_t t, const dds_listener_t *l, verr_t *err);
 
 /* Parses a domain id string (0..230); -1 on bad input. */
 int vdds_parse_domain(const char *s);

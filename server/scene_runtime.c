@@ -67,7 +67,16 @@ int runtime_init(runtime_t *rt, const scene_t *scene, verr_t *err) {
     }
     rt->norgans++;
     organ_rt_t *o = &rt->organs[i];
-    rt->surfaces[i] = (proxy_surface_t){.x = o->ms.x, .tris = o->rest.tris, .ntris = o->rest.ntris};
+    /* Edges may stretch while deformed; 3x the longest rest edge is far
+     * beyond what the home springs allow and keeps the proxy cull exact. */
+    double max_edge = 0, mean_edge = 0, tool_r = 0;
+    for (size_t s = 0; s < o->ms.nsprings; s++) {
+      max_edge = fmax(max_edge, o->ms.springs[s].rest);
+      mean_edge += o->ms.springs[s].rest / (double)o->ms.nsprings;
+    }
+    for (size_t t = 0; t < scene->ntools; t++) tool_r = fmax(tool_r, scene->tools[t].radius);
+    o->patch_radius = fmax(2 * tool_r, 1.5 * mean_edge);
+    rt->surfaces[i] = (proxy_surface_t){.x = o->ms.x, .tris = o->rest.tris, .ntris = o->rest.ntris, .max_edge = 3 * max_edge, .x_rest = o->ms.x_rest};
     double lo[3], hi[3];
     mesh_bounds(&o->rest, lo, hi);
     for (int k = 0; k < 3; k++) {
@@ -131,13 +140,44 @@ static void apply_contacts(mass_spring_t *ms, void *vctx) {
     proxy_follow_surface(p, rt->surfaces, rt->norgans);
     double f[3];
     proxy_spring_force(p, tool->device, tool->cfg->stiffness, tool->max_force, f);
-    const uint32_t *tri = rt->organs[c->organ].rest.tris + 3 * p->tri;
-    for (int k = 0; k < 3; k++) {
+    for (size_t j = 0; j < tool->npatch; j++) {
       double fk[3];
-      v3_scale(fk, f, -p->bary[k]);
-      mass_spring_add_force(ms, tri[k], fk);
+      v3_scale(fk, f, -tool->patch_w[j]);
+      mass_spring_add_force(ms, tool->patch[j], fk);
     }
   }
+}
+
+/* The vertices within the patch radius of the proxy, weighted by a smooth
+ * kernel (1 - d/r)^2; the contact triangle's vertices always belong, so a
+ * patch is never empty. Keeps the TOOL_PATCH_MAX heaviest if more qualify. */
+static void build_patch(runtime_t *rt, tool_rt_t *tool) {
+  tool->npatch = 0;
+  if (!tool->proxy.in_contact) return;
+  const organ_rt_t *o = &rt->organs[tool->proxy.surface];
+  double r = fmax(o->patch_radius, 1e-6), sum = 0;
+  const uint32_t *tri = o->rest.tris + 3 * tool->proxy.tri;
+  for (size_t i = 0; i < o->ms.n; i++) {
+    double d = v3_dist(o->ms.x + 3 * i, tool->proxy.pos);
+    int in_tri = i == tri[0] || i == tri[1] || i == tri[2];
+    if (d >= r && !in_tri) continue;
+    double w = d < r ? (1 - d / r) * (1 - d / r) : 0;
+    if (in_tri) w = fmax(w, 1e-3);
+    size_t slot = tool->npatch;
+    if (slot == TOOL_PATCH_MAX) { /* full: replace the lightest if this is heavier */
+      size_t lightest = 0;
+      for (size_t j = 1; j < TOOL_PATCH_MAX; j++)
+        if (tool->patch_w[j] < tool->patch_w[lightest]) lightest = j;
+      if (tool->patch_w[lightest] >= w) continue;
+      slot = lightest;
+    } else {
+      tool->npatch++;
+    }
+    tool->patch[slot] = (uint32_t)i;
+    tool->patch_w[slot] = w;
+  }
+  for (size_t j = 0; j < tool->npatch; j++) sum += tool->patch_w[j];
+  for (size_t j = 0; j < tool->npatch; j++) tool->patch_w[j] /= sum;
 }
 
 int runtime_step(runtime_t *rt) {
@@ -147,6 +187,7 @@ int runtime_step(runtime_t *rt) {
     if (!tool->active) continue;
     proxy_update(&tool->proxy, tool->device, rt->surfaces, rt->norgans, tool->cfg->stiffness, tool->max_force,
                  tool->force);
+    build_patch(rt, tool);
   }
   int rolled = 0;
   for (size_t i = 0; i < rt->norgans; i++) {

@@ -23,9 +23,12 @@ typedef struct organ_rt {
   mesh_t rest;       /* the imported mesh after scale and position */
   mass_spring_t ms;  /* v1: the only model */
   int substeps;      /* per scene step, from the stability bound */
+  double patch_radius; /* m, contact patch radius: max(2 tool radius, 1.5 mean edge) */
   double stable_dt;  /* s, the integrator's bound including tool stiffness */
   uint64_t rollbacks;
 } organ_rt_t;
+
+#define TOOL_PATCH_MAX 128
 
 typedef struct tool_rt {
   const scene_tool_t *cfg;
@@ -35,6 +38,12 @@ typedef struct tool_rt {
   proxy_t proxy;
   double force[3];     /* N on the tool, last step */
   double peak_force;   /* N since start */
+  /* Contact patch: the tissue vertices that share the reaction force, with
+   * weights summing to 1. A rigid tip presses an area, not three vertices;
+   * spreading the load keeps the dent smooth and the contact normal steady. */
+  size_t npatch;
+  uint32_t patch[TOOL_PATCH_MAX];
+  double patch_w[TOOL_PATCH_MAX];
 } tool_rt_t;
 
 typedef struct runtime {

@@ -12,6 +12,7 @@
 
 #include "contact_model.h"
 #include "device.h"
+#include "feedback_slot.h"
 #include "vdds.h"
 #include "viscera.h"
 #include "vmath.h"
@@ -40,10 +41,10 @@ static void usage(FILE *f) {
 }
 
 typedef struct stats {
-  double *period_us, *latency_us;
-  size_t nperiod, nlat, cap;
+  double *period_us;
+  size_t nperiod, cap;
   double peak_force, force_sum;
-  uint64_t ticks, contact_ticks, late_ticks, feedback;
+  uint64_t ticks, contact_ticks, late_ticks;
 } stats_t;
 
 int main(int argc, char **argv) {
@@ -117,7 +118,13 @@ int main(int argc, char **argv) {
     return 1;
   }
   dds_entity_t w_cmd = vdds_writer(&dds, VT_TOOL_COMMAND, &err);
-  dds_entity_t r_fb = vdds_reader(&dds, VT_CONTACT_FEEDBACK, &err);
+  static feedback_slot_t slot;
+  double cap_s = duration >= 0 ? duration + 1 : 600;
+  if (feedback_slot_init(&slot, tool, (size_t)fmin(1e7, fmax(1000, rate * cap_s)))) {
+    fprintf(stderr, "viscera-haptic: out of memory\n");
+    return 1;
+  }
+  dds_entity_t r_fb = feedback_slot_attach(&slot, &dds, &err);
   dds_entity_t r_scene = vdds_reader(&dds, VT_SCENE_INFO, &err);
   if (w_cmd < 0 || r_fb < 0 || r_scene < 0) {
     fprintf(stderr, "viscera-haptic: %s\n", err.msg);
@@ -171,15 +178,14 @@ int main(int argc, char **argv) {
   uint64_t period_ns = (uint64_t)(1e9 / rate);
   stats_t st = {0};
   double run_for = duration >= 0 ? duration : 1e300;
-  st.cap = (size_t)fmin(1e7, fmax(1000, rate * (duration >= 0 ? duration + 1 : 600)));
+  st.cap = (size_t)fmin(1e7, fmax(1000, rate * cap_s));
   st.period_us = malloc(st.cap * sizeof(double));
-  st.latency_us = malloc(st.cap * sizeof(double));
-  if (!st.period_us || !st.latency_us) {
+  if (!st.period_us) {
     fprintf(stderr, "viscera-haptic: out of memory\n");
     return 1;
   }
   contact_model_t model = {0};
-  uint64_t last_fb_seq = 0, last_fb_mono = 0, seq = 0;
+  uint64_t seq = 0;
   int server_lost_reported = 0;
   uint64_t start = vtime_mono_ns(), next = start, prev_tick = 0;
   double finished_at = -1;
@@ -207,38 +213,14 @@ int main(int argc, char **argv) {
     cmd.max_force = (float)dev.max_force;
     dds_write(w_cmd, &cmd);
 
-    /* Latest feedback for our tool; keep-last 1 so this is at most a few. */
-    void *samples[4] = {0};
-    dds_sample_info_t infos[4];
-    int n = dds_take(r_fb, samples, infos, 4, 4);
-    for (int i = 0; i < n; i++) {
-      const viscera_ContactFeedback *fb = samples[i];
-      if (!infos[i].valid_data || fb->tool_id != tool) continue;
-      int finite = isfinite(fb->stiffness);
-      for (int k = 0; k < 3; k++) finite = finite && isfinite(fb->proxy_position[k]) && isfinite(fb->normal[k]);
-      if (!finite || fb->stiffness < 0) continue; /* untrusted: never render a corrupt plane */
-      model.in_contact = fb->in_contact;
-      model.stiffness = fb->stiffness;
-      for (int k = 0; k < 3; k++) {
-        model.proxy[k] = fb->proxy_position[k];
-        model.normal[k] = fb->normal[k];
-      }
-      v3_normalize(model.normal);
-      last_fb_mono = now;
-      st.feedback++;
-      if (fb->cmd_seq != last_fb_seq && fb->cmd_client_mono_ns > 0 && fb->cmd_client_mono_ns <= now) {
-        last_fb_seq = fb->cmd_seq;
-        if (st.nlat < st.cap) st.latency_us[st.nlat++] = (double)(now - fb->cmd_client_mono_ns) * 1e-3;
-      }
-      if (server_lost_reported) {
-        fprintf(stderr, "haptic: server back\n");
-        server_lost_reported = 0;
-      }
+    uint64_t last_fb_mono = feedback_slot_read(&slot, &model);
+    if (last_fb_mono && server_lost_reported && now - last_fb_mono < 50000000ull) {
+      fprintf(stderr, "haptic: server back\n");
+      server_lost_reported = 0;
     }
-    if (n > 0) dds_return_loan(r_fb, samples, n);
     /* No feedback for 50 ms: the server is gone or stalled, so render nothing
      * rather than a stale wall. */
-    if (last_fb_mono && now - last_fb_mono > 50000000ull) {
+    if (last_fb_mono && now > last_fb_mono + 50000000ull) {
       model.in_contact = 0;
       if (!server_lost_reported) {
         fprintf(stderr, "haptic: server lost (no feedback for 50 ms), force set to zero\n");
@@ -265,7 +247,10 @@ int main(int argc, char **argv) {
   if (csv) fclose(csv);
   double elapsed = (double)(vtime_mono_ns() - start) * 1e-9;
   vstats_summary_t per = vstats_summarise(st.period_us, st.nperiod);
-  vstats_summary_t lat = vstats_summarise(st.latency_us, st.nlat);
+  pthread_mutex_lock(&slot.lock);
+  vstats_summary_t lat = vstats_summarise(slot.latency_us, slot.nlatency);
+  uint64_t feedback = slot.received;
+  pthread_mutex_unlock(&slot.lock);
   double jitter_p99 = fmax(fabs(per.p99 - 1e6 / rate), fabs(per.min - 1e6 / rate));
   fprintf(stderr,
           "haptic: %" PRIu64 " ticks in %.2f s (%.1f Hz); period median %.1f us, p99 %.1f us, max %.1f us; "
@@ -273,7 +258,7 @@ int main(int argc, char **argv) {
           st.ticks, elapsed, (double)st.ticks / elapsed, per.median, per.p99, per.max, st.late_ticks);
   fprintf(stderr, "haptic: force peak %.3f N, mean in contact %.3f N, %" PRIu64 " ticks in contact, %" PRIu64
                   " feedback samples\n",
-          st.peak_force, st.contact_ticks ? st.force_sum / (double)st.contact_ticks : 0.0, st.contact_ticks, st.feedback);
+          st.peak_force, st.contact_ticks ? st.force_sum / (double)st.contact_ticks : 0.0, st.contact_ticks, feedback);
   fprintf(stderr, "haptic: command->feedback latency median %.1f us, p99 %.1f us (%zu samples)\n", lat.median, lat.p99,
           lat.n);
   printf("SUMMARY ticks=%" PRIu64 " rate_hz=%.1f peak_force=%.4f contact_ticks=%" PRIu64 " latency_us_median=%.1f "
@@ -281,8 +266,8 @@ int main(int argc, char **argv) {
          st.ticks, (double)st.ticks / elapsed, st.peak_force, st.contact_ticks, lat.median, lat.p99, per.p99, jitter_p99,
          st.late_ticks);
   free(st.period_us);
-  free(st.latency_us);
-  vdds_close(&dds);
+  vdds_close(&dds); /* stops the listener before the slot goes */
+  feedback_slot_destroy(&slot);
   dev.ops->close(&dev);
   return 0;
 }

@@ -32,20 +32,28 @@ void proxy_follow_surface(proxy_t *p, const proxy_surface_t *surfaces, size_t ns
   const double *a, *b, *c;
   tri_vertices(s, p->tri, &a, &b, &c);
   for (int k = 0; k < 3; k++) p->pos[k] = p->bary[0] * a[k] + p->bary[1] * b[k] + p->bary[2] * c[k];
-  tri_normal(s, p->tri, p->normal);
+  proxy_surface_t rest = *s;
+  if (s->x_rest) rest.x = s->x_rest;
+  tri_normal(&rest, p->tri, p->normal);
 }
 
-/* Nearest surface point to q over all triangles of all surfaces. */
+/* Nearest surface point to q over all triangles of all surfaces. Every point
+ * of a triangle lies within its longest edge of its first vertex, so a
+ * triangle whose first vertex is farther than best + max_edge cannot win:
+ * one dot product skips the exact test for almost every triangle. */
 static void nearest_on_surfaces(const double q[3], const proxy_surface_t *surfaces, size_t nsurfaces, proxy_t *p) {
   double best = INFINITY;
   for (size_t si = 0; si < nsurfaces; si++) {
     const proxy_surface_t *s = &surfaces[si];
     for (size_t t = 0; t < s->ntris; t++) {
       const double *a, *b, *c;
-      double cp[3], bary[3];
       tri_vertices(s, (uint32_t)t, &a, &b, &c);
+      double da[3];
+      v3_sub(da, a, q);
+      double reach = sqrt(best) + s->max_edge;
+      if (s->max_edge > 0 && isfinite(best) && v3_dot(da, da) > reach * reach) continue;
+      double cp[3], bary[3], d[3];
       tri_closest_point(q, a, b, c, cp, bary);
-      double d[3];
       v3_sub(d, cp, q);
       double d2 = v3_dot(d, d);
       if (d2 < best) {
@@ -62,14 +70,25 @@ static void nearest_on_surfaces(const double q[3], const proxy_surface_t *surfac
 /* First triangle the device path enters from outside. */
 static int find_entry(const double p0[3], const double p1[3], const proxy_surface_t *surfaces, size_t nsurfaces,
                       proxy_t *p) {
-  double best_t = INFINITY, dir[3];
+  double best_t = INFINITY, dir[3], seg_lo[3], seg_hi[3];
   v3_sub(dir, p1, p0);
+  for (int k = 0; k < 3; k++) {
+    seg_lo[k] = fmin(p0[k], p1[k]);
+    seg_hi[k] = fmax(p0[k], p1[k]);
+  }
   for (size_t si = 0; si < nsurfaces; si++) {
     const proxy_surface_t *s = &surfaces[si];
     for (size_t t = 0; t < s->ntris; t++) {
       const double *a, *b, *c;
       double tt, bary[3], n[3];
       tri_vertices(s, (uint32_t)t, &a, &b, &c);
+      /* Box test first: the segment's bounds against the triangle's. */
+      int apart = 0;
+      for (int k = 0; k < 3 && !apart; k++) {
+        double lo = fmin(a[k], fmin(b[k], c[k])), hi = fmax(a[k], fmax(b[k], c[k]));
+        apart = hi < seg_lo[k] || lo > seg_hi[k];
+      }
+      if (apart) continue;
       if (!seg_tri_intersect(p0, p1, a, b, c, &tt, bary) || tt >= best_t) continue;
       tri_normal(s, (uint32_t)t, n);
       if (v3_dot(dir, n) >= 0) continue; /* leaving, not entering */
@@ -106,7 +125,10 @@ int proxy_update(proxy_t *p, const double device[3], const proxy_surface_t *surf
   double d[3];
   v3_sub(d, device, p->pos);
   double depth = v3_dot(d, p->normal);
-  if (depth >= 0) { /* device back above the tangent plane: release */
+  /* Released only once clearly above the surface: tissue pushed by the tool
+   * can move away faster than a slow hand follows, and a release then
+   * would leave the device inside the organ with no entry crossing. */
+  if (depth > PROXY_RELEASE_MARGIN) {
     p->in_contact = 0;
     p->surface = -1;
     v3_copy(p->pos, device);
@@ -128,6 +150,10 @@ double proxy_spring_force(const proxy_t *p, const double device[3], double stiff
     return 0;
   }
   v3_sub(f, p->pos, device);
+  if (v3_dot(f, p->normal) <= 0) { /* touching from above: a surface only pushes */
+    v3_set(f, 0, 0, 0);
+    return 0;
+  }
   v3_scale(f, f, stiffness);
   double mag = v3_norm(f);
   if (mag > max_force && mag > 0) {

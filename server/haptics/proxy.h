@@ -6,10 +6,14 @@
  * clamped to max_force; the tissue feels -f at the contact triangle.
  * Contact starts when the device path crosses a triangle from outside (so a
  * tool pushed 10 cm inside keeps its proxy on the entry surface) and ends when
- * the device is back above the tangent plane at the proxy. The proxy slides
+ * the device is more than PROXY_RELEASE_MARGIN above the tangent plane at the
+ * proxy (within it the tool touches with zero force). The proxy slides
  * frictionlessly: each tick it moves to the surface point nearest the device
  * projected onto the current tangent plane.
- * v1 treats the tool tip as a point; brute-force over triangles (an AABB tree
+ * The contact normal is the contact triangle's rest normal when rest
+ * positions are given: the dented surface's own triangles tilt wildly under
+ * a probe, while the organ's undeformed orientation is what the hand pushes
+ * against. v1 treats the tool tip as a point; brute-force over triangles (an AABB tree
  * replaces this with the collision work). */
 #ifndef VISCERA_PROXY_H
 #define VISCERA_PROXY_H
@@ -17,10 +21,15 @@
 #include <stddef.h>
 #include <stdint.h>
 
+/* m: the device must rise this far above the tangent plane to release. */
+#define PROXY_RELEASE_MARGIN 1e-3
+
 typedef struct proxy_surface {
   const double *x;       /* 3 per vertex, current positions */
   const uint32_t *tris;  /* 3 per triangle, outward CCW */
   size_t ntris;
+  double max_edge;       /* m, bound on any edge length while deformed (0: no culling) */
+  const double *x_rest;  /* rest positions for contact normals, or NULL for current */
 } proxy_surface_t;
 
 typedef struct proxy {

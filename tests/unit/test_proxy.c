@@ -11,7 +11,7 @@
 int main(void) {
   double x[] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0};
   uint32_t tris[] = {0, 1, 2, 0, 2, 3};
-  proxy_surface_t s = {x, tris, 2};
+  proxy_surface_t s = {x, tris, 2, 0, NULL};
   proxy_t p;
   proxy_reset(&p);
   double f[3];
@@ -34,6 +34,9 @@ int main(void) {
   CHECK_NEAR(p.pos[1], -0.3, 1e-12);
   CHECK_NEAR(f[2], 2.0, 1e-9);
   CHECK(proxy_spring_force(&p, (double[]){0.5, -0.3, -0.02}, 100, 1e9, f) > 0);
+  /* Just above the plane (within the release margin): still touching, zero force. */
+  CHECK(proxy_update(&p, (double[]){0.5, -0.3, 0.5 * PROXY_RELEASE_MARGIN}, &s, 1, 100, 1e9, f) == 1);
+  CHECK(v3_norm(f) == 0);
   /* Back above: released, zero force. */
   CHECK(proxy_update(&p, (double[]){0.5, -0.3, 0.01}, &s, 1, 100, 1e9, f) == 0);
   CHECK(v3_norm(f) == 0);

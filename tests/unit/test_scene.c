@@ -110,7 +110,7 @@ static void test_full_scene(void) {
   CHECK(!strcmp(o->integrator, "symplectic_euler"));
   CHECK(o->line == 24);
   CHECK(o->fixed_below_set == 0);
-  CHECK_NEAR(o->material.stiffness, 200, 0);
+  CHECK_NEAR(o->material.stiffness, 30, 0);
   CHECK(s.ntools == 2);
   const scene_tool_t *t = &s.tools[0];
   CHECK(!strcmp(t->name, "probe1"));
@@ -143,10 +143,10 @@ static void test_defaults(void) {
   CHECK_NEAR(o->color[2], 0.3, 1e-6);
   CHECK(o->fixed_below_set == 0);
   CHECK_NEAR(o->material.mass, 0.1, 0);
-  CHECK_NEAR(o->material.stiffness, 200, 0);
-  CHECK_NEAR(o->material.damping, 0.5, 0);
-  CHECK_NEAR(o->material.home_stiffness, 50, 0);
-  CHECK_NEAR(o->material.home_damping, 0.05, 0);
+  CHECK_NEAR(o->material.stiffness, 30, 0);
+  CHECK_NEAR(o->material.damping, 0.02, 0);
+  CHECK_NEAR(o->material.home_stiffness, 30, 0);
+  CHECK_NEAR(o->material.home_damping, 0.005, 0);
   CHECK(o->line == 3);
 
   CHECK(loads(HEAD "tools:\n  - name: p\n", NULL));
@@ -478,10 +478,10 @@ static void test_default_asset(void) {
   CHECK(!strcmp(o->model, "mass_spring_surface"));
   CHECK(!strcmp(o->integrator, "symplectic_euler"));
   CHECK_NEAR(o->material.mass, 0.15, 1e-15);
-  CHECK_NEAR(o->material.stiffness, 400, 0);
-  CHECK_NEAR(o->material.damping, 0.8, 1e-15);
-  CHECK_NEAR(o->material.home_stiffness, 80, 0);
-  CHECK_NEAR(o->material.home_damping, 0.1, 1e-15);
+  CHECK_NEAR(o->material.stiffness, 30, 0);
+  CHECK_NEAR(o->material.damping, 0.02, 1e-15);
+  CHECK_NEAR(o->material.home_stiffness, 30, 0);
+  CHECK_NEAR(o->material.home_damping, 0.005, 1e-15);
   CHECK(o->color[0] > o->color[1] && o->color[0] > o->color[2]); /* reddish */
   const scene_tool_t *t = &s.tools[0];
   CHECK(!strcmp(t->kind, "probe"));

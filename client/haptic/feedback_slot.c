@@ -1,0 +1,77 @@
+#include "feedback_slot.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "viscera.h"
+#include "vmath.h"
+#include "vtime.h"
+
+int feedback_slot_init(feedback_slot_t *s, uint32_t tool_id, size_t latency_capacity) {
+  memset(s, 0, sizeof *s);
+  s->tool_id = tool_id;
+  s->cap = latency_capacity;
+  s->latency_us = malloc((latency_capacity + 1) * sizeof(double));
+  if (!s->latency_us) return -1;
+  pthread_mutex_init(&s->lock, NULL);
+  return 0;
+}
+
+void feedback_slot_destroy(feedback_slot_t *s) {
+  pthread_mutex_destroy(&s->lock);
+  free(s->latency_us);
+  s->latency_us = NULL;
+}
+
+static void on_data(dds_entity_t reader, void *arg) {
+  feedback_slot_t *s = arg;
+  void *samples[8] = {0};
+  dds_sample_info_t infos[8];
+  int n = dds_take(reader, samples, infos, 8, 8);
+  uint64_t now = vtime_mono_ns();
+  for (int i = 0; i < n; i++) {
+    const viscera_ContactFeedback *fb = samples[i];
+    if (!infos[i].valid_data || fb->tool_id != s->tool_id) continue;
+    /* Untrusted: never render a plane built from NaN or a negative stiffness. */
+    int ok = isfinite(fb->stiffness) && fb->stiffness >= 0;
+    for (int k = 0; k < 3; k++) ok = ok && isfinite(fb->proxy_position[k]) && isfinite(fb->normal[k]);
+    pthread_mutex_lock(&s->lock);
+    if (!ok) {
+      s->rejected++;
+      pthread_mutex_unlock(&s->lock);
+      continue;
+    }
+    s->model.in_contact = fb->in_contact;
+    s->model.stiffness = fb->stiffness;
+    for (int k = 0; k < 3; k++) {
+      s->model.proxy[k] = fb->proxy_position[k];
+      s->model.normal[k] = fb->normal[k];
+    }
+    v3_normalize(s->model.normal);
+    s->arrival_mono_ns = now;
+    s->received++;
+    if (fb->cmd_seq != s->last_cmd_seq && fb->cmd_client_mono_ns > 0 && fb->cmd_client_mono_ns <= now) {
+      s->last_cmd_seq = fb->cmd_seq;
+      if (s->nlatency < s->cap) s->latency_us[s->nlatency++] = (double)(now - fb->cmd_client_mono_ns) * 1e-3;
+    }
+    pthread_mutex_unlock(&s->lock);
+  }
+  if (n > 0) dds_return_loan(reader, samples, n);
+}
+
+dds_entity_t feedback_slot_attach(feedback_slot_t *s, vdds_t *v, verr_t *err) {
+  dds_listener_t *l = dds_create_listener(s);
+  dds_lset_data_available(l, on_data);
+  dds_entity_t r = vdds_reader_listener(v, VT_CONTACT_FEEDBACK, l, err);
+  dds_delete_listener(l);
+  return r;
+}
+
+uint64_t feedback_slot_read(feedback_slot_t *s, contact_model_t *out) {
+  pthread_mutex_lock(&s->lock);
+  *out = s->model;
+  uint64_t t = s->arrival_mono_ns;
+  pthread_mutex_unlock(&s->lock);
+  return t;
+}
