@@ -102,22 +102,28 @@ int main(int argc, char **argv) {
   uint64_t seq = 0;
   /* Bad commands. Had the server accepted any, it would answer with feedback. */
   int feedback_from_bad = 0, dummy = 0;
-  for (int round = 0; round < 50; round++) {
+  /* One per 2 ms: ToolCommand is keep-last 1 per tool, so a burst would
+   * leave the server only the last of it. */
+  for (int round = 0; round < 30; round++) {
     float nanpos[3] = {NAN, inside[1], inside[2]};
     float infpos[3] = {inside[0], INFINITY, inside[2]};
     float absurd[3] = {inside[0], inside[1], 1e9f};
     float badq[4] = {3, 0, 0, 0};
     float nanq[4] = {NAN, 0, 0, 0};
-    send(w, 0, nanpos, unit, 4, &seq);
-    send(w, 0, infpos, unit, 4, &seq);
-    send(w, 0, absurd, unit, 4, &seq);
-    send(w, 0, inside, badq, 4, &seq);
-    send(w, 0, inside, nanq, 4, &seq);
-    send(w, 0, inside, unit, NAN, &seq);
-    send(w, 0, inside, unit, -5, &seq);
-    send(w, 7, inside, unit, 4, &seq);
-    send(w, 0xffffffffu, inside, unit, 4, &seq);
-    watch_force(r_fb, 2, &feedback_from_bad, &dummy);
+    for (int kind = 0; kind < 9; kind++) {
+      switch (kind) {
+      case 0: send(w, 0, nanpos, unit, 4, &seq); break;
+      case 1: send(w, 0, infpos, unit, 4, &seq); break;
+      case 2: send(w, 0, absurd, unit, 4, &seq); break;
+      case 3: send(w, 0, inside, badq, 4, &seq); break;
+      case 4: send(w, 0, inside, nanq, 4, &seq); break;
+      case 5: send(w, 0, inside, unit, NAN, &seq); break;
+      case 6: send(w, 0, inside, unit, -5, &seq); break;
+      case 7: send(w, 7, inside, unit, 4, &seq); break;
+      default: send(w, 0xffffffffu, inside, unit, 4, &seq); break;
+      }
+      watch_force(r_fb, 2, &feedback_from_bad, &dummy);
+    }
   }
   watch_force(r_fb, 100, &feedback_from_bad, &dummy);
   /* A valid push: approach from above, then go 1 cm inside. */
