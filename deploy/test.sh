@@ -17,9 +17,7 @@ echo "test: running the suite"
 if [ "${VISCERA_SKIP_ASAN:-0}" != "1" ]; then
   echo "test: building (build-asan/, address + undefined sanitizers)"
   bash "$ROOT/deploy/build.sh" "$ROOT/build-asan" -DVISCERA_WERROR=ON -DVISCERA_SANITIZE=ON -DVISCERA_BUILD_BENCH=OFF
-  # Cyclone DDS keeps some process-lifetime allocations; leaks are checked
-  # in the product's own code by the unit tests' clean exits instead.
-  export ASAN_OPTIONS="detect_leaks=0:abort_on_error=1"
+  export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1"
   export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
   (cd "$ROOT/build-asan" && ctest --output-on-failure -j"$JOBS" --timeout 300 -L "unit|integration")
 fi

@@ -20,7 +20,7 @@ static double *load(const char *path, size_t *n, char *first, size_t first_len) 
   first[0] = 0;
   while (v && fgets(line, sizeof line, f)) {
     if (line[0] == '#' && !first[0]) {
-      snprintf(first, first_len, "%s", line);
+      snprintf(first, first_len, "%.200s", line);
       first[strcspn(first, "\n")] = 0;
     }
     double x, y, z;
