@@ -1,0 +1,28 @@
+/* options: the viscera-viewer command line (getopt_long). */
+#ifndef VISCERA_VIEWER_OPTIONS_H
+#define VISCERA_VIEWER_OPTIONS_H
+
+#include <stdio.h>
+
+#include "verr.h"
+
+typedef struct viewer_opts {
+  int domain;            /* DDS domain id */
+  const char *partition; /* session partition */
+  const char *out_dir;   /* frames and frames.csv go here */
+  int interval_ms;       /* wall-time frame period; 0 = only on SIGUSR1 */
+  int width, height;     /* frame size in pixels */
+  int tools;             /* draw tools, proxy and force bar */
+  double duration_s;     /* stop after this long; 0 = until SIGINT/SIGTERM */
+  long max_frames;       /* stop after this many frames; 0 = no limit */
+  const char *dump_mesh; /* OBJ path written on exit, or NULL */
+  int quiet;             /* no progress lines on stdout */
+} viewer_opts_t;
+
+/* Defaults, then the environment (VISCERA_DOMAIN), then argv. Returns 0 to
+ * run, 1 when --help was printed (exit 0), -1 with err set on bad usage.
+ * Strings point into argv or static storage. */
+int options_parse(viewer_opts_t *o, int argc, char **argv, verr_t *err);
+void options_usage(FILE *f, const char *prog);
+
+#endif
