@@ -158,7 +158,8 @@ int main(int argc, char **argv) {
   CHECK(q_int("SELECT reliability='reliable' AND durability='transient_local' FROM topics WHERE name=?1",
               "viscera_MeshState") == 1);
 
-  const char *count_kind = "SELECT count(*) FROM samples s JOIN topics t ON t.id=s.topic_id WHERE t.name=?1 AND s.kind=";
+  const char *count_kind =
+      "SELECT count(*) FROM samples s JOIN topics t ON t.id=s.topic_id WHERE t.name=?1 AND s.kind=";
   char sql[256];
 
   /* late-join keyframes: both organs, written before the session started */

@@ -9,7 +9,11 @@
  *      samples at --rate Hz (values from rec_values.h) with a MeshDelta
  *      for organ (k % 2) after every 25th;
  *   3. a dispose of MeshDelta organ 1;
- * then waits for the reliable writers' acknowledgements and exits. */
+ * then waits for the reliable writers' acknowledgements and exits.
+ * With --untyped it also writes a topic whose writer announces no XTypes
+ * type information (a non-XTypes DDS, or an old Cyclone): the recorder
+ * cannot resolve its type and must say so and record the rest. */
+#include <dds/ddsc/dds_opcodes.h>
 #include <getopt.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -19,6 +23,27 @@
 #include "vdds.h"
 #include "viscera.h"
 #include "vtime.h"
+
+#define UNTYPED_TOPIC "rectest_Untyped"
+
+/* ToolCommand's layout under another type name, without the XTypes type
+ * information and mapping, so discovery carries no type for it. */
+static dds_entity_t untyped_writer(vdds_t *v) {
+  const dds_topic_descriptor_t *d = &viscera_ToolCommand_desc;
+  static dds_topic_descriptor_t untyped;
+  dds_topic_descriptor_t tmp = {d->m_size,  d->m_align,         d->m_flagset & ~DDS_TOPIC_XTYPES_METADATA,
+                                d->m_nkeys, "rectest::Untyped", d->m_keys,
+                                d->m_nops,  d->m_ops,           d->m_meta,
+                                {NULL, 0},  {NULL, 0},          d->restrict_data_representation};
+  memcpy(&untyped, &tmp, sizeof untyped);
+  dds_entity_t t = dds_create_topic(v->participant, &untyped, UNTYPED_TOPIC, NULL, NULL);
+  if (t < 0) return t;
+  dds_qos_t *q = dds_create_qos();
+  dds_qset_reliability(q, DDS_RELIABILITY_BEST_EFFORT, 0);
+  dds_entity_t w = dds_create_writer(v->publisher, t, q, NULL);
+  dds_delete_qos(q);
+  return w;
+}
 
 static int wait_matched(dds_entity_t w, const char *what, double timeout_s) {
   uint64_t end = vtime_mono_ns() + (uint64_t)(timeout_s * 1e9);
@@ -39,21 +64,40 @@ int main(int argc, char **argv) {
   const char *ready = NULL;
   long tools = 500, deltas_every = 25;
   double rate = 2000;
+  int untyped = 0;
   static const struct option longopts[] = {
-      {"domain", required_argument, 0, 'd'}, {"partition", required_argument, 0, 'p'},
-      {"ready", required_argument, 0, 'r'},  {"tools", required_argument, 0, 'n'},
-      {"rate", required_argument, 0, 'z'},   {0, 0, 0, 0},
+      {"domain", required_argument, 0, 'd'},
+      {"partition", required_argument, 0, 'p'},
+      {"ready", required_argument, 0, 'r'},
+      {"tools", required_argument, 0, 'n'},
+      {"rate", required_argument, 0, 'z'},
+      {"untyped", no_argument, 0, 'u'},
+      {0, 0, 0, 0},
   };
   int c;
-  while ((c = getopt_long(argc, argv, "d:p:r:n:z:", longopts, NULL)) != -1) {
+  while ((c = getopt_long(argc, argv, "d:p:r:n:z:u", longopts, NULL)) != -1) {
     switch (c) {
-    case 'd': domain = vdds_parse_domain(optarg); break;
-    case 'p': partition = optarg; break;
-    case 'r': ready = optarg; break;
-    case 'n': tools = atol(optarg); break;
-    case 'z': rate = atof(optarg); break;
+    case 'd':
+      domain = vdds_parse_domain(optarg);
+      break;
+    case 'p':
+      partition = optarg;
+      break;
+    case 'r':
+      ready = optarg;
+      break;
+    case 'n':
+      tools = atol(optarg);
+      break;
+    case 'z':
+      rate = atof(optarg);
+      break;
+    case 'u':
+      untyped = 1;
+      break;
     default:
-      fprintf(stderr, "usage: rec_pub [--domain N] [--partition P] [--ready FILE] [--tools N] [--rate HZ]\n");
+      fprintf(stderr,
+              "usage: rec_pub [--domain N] [--partition P] [--ready FILE] [--tools N] [--rate HZ] [--untyped]\n");
       return 2;
     }
   }
@@ -74,6 +118,11 @@ int main(int argc, char **argv) {
   dds_entity_t w_tool = vdds_writer(&v, VT_TOOL_COMMAND, &err);
   if (w_state < 0 || w_delta < 0 || w_tool < 0) {
     fprintf(stderr, "rec_pub: %s\n", err.msg);
+    goto out;
+  }
+  dds_entity_t w_untyped = 0;
+  if (untyped && (w_untyped = untyped_writer(&v)) < 0) {
+    fprintf(stderr, "rec_pub: cannot create the untyped writer: %s\n", dds_strretcode(w_untyped));
     goto out;
   }
 
@@ -120,6 +169,10 @@ int main(int argc, char **argv) {
     viscera_ToolCommand tc = rec_test_tool_command((uint32_t)i);
     if (dds_write(w_tool, &tc) < 0) {
       fprintf(stderr, "rec_pub: ToolCommand write failed\n");
+      goto out;
+    }
+    if (w_untyped > 0 && i % 50 == 0 && dds_write(w_untyped, &tc) < 0) {
+      fprintf(stderr, "rec_pub: untyped write failed\n");
       goto out;
     }
     if ((i + 1) % deltas_every == 0) {

@@ -2,8 +2,10 @@
 # Recorder integration test driver (registered by recorder.cmake).
 # usage: recorder_test.sh RECORDER RECINFO REC_PUB REC_CHECK WORKDIR DOMAIN
 #   1. late join + normal stop: rec_pub writes MeshState keyframes, then the
-#      recorder starts, then 500 ToolCommand, MeshDelta and a dispose; SIGINT
-#      stops the recorder; recinfo --check-monotonic and rec_check verify;
+#      recorder starts, then 500 ToolCommand, MeshDelta and a dispose, plus a
+#      topic without XTypes type information that the recorder must report
+#      and skip; SIGINT stops the recorder; recinfo --check-monotonic and
+#      rec_check verify;
 #   2. the recorder refuses to overwrite an existing recording;
 #   3. kill -9 of the recorder mid-session leaves a file recinfo reads;
 #   4. recinfo on garbage, a truncated copy and a missing file: clear error
@@ -48,7 +50,7 @@ rm -rf "$WORK"
 mkdir -p "$WORK" || fail "cannot create $WORK"
 
 echo "== 1. late join, streams, dispose, SIGINT"
-"$PUB" --domain "$DOMAIN" --partition "$PART" --ready "$WORK/ready1" --tools $TOOLS \
+"$PUB" --domain "$DOMAIN" --partition "$PART" --ready "$WORK/ready1" --tools $TOOLS --untyped \
   >"$WORK/pub1.out" 2>"$WORK/pub1.err" &
 PUB_PID=$!
 PIDS="$PIDS $PUB_PID"
@@ -72,6 +74,8 @@ cat "$WORK/rec1.out"
 grep -q '^SUMMARY samples=[0-9]* topics=3 bytes=[0-9]*$' "$WORK/rec1.out" || fail "no SUMMARY line with 3 topics"
 grep -q "^recorder: wrote [0-9]* samples of 3 topics to $WORK/session.db\$" "$WORK/rec1.err" ||
   fail "no 'wrote' line"
+grep -q "^recorder: topic rectest_Untyped: NOT recorded: writer sent no XTypes type information" "$WORK/rec1.err" ||
+  fail "the topic without type information was not reported"
 [ ! -e "$WORK/session.db-wal" ] || fail "WAL left behind after a clean stop"
 "$RECINFO" "$WORK/session.db" --check-monotonic >"$WORK/info1.txt" 2>"$WORK/info1.err" ||
   fail "recinfo --check-monotonic failed on the recording"

@@ -1,0 +1,9 @@
+# Recording files: the store writes what recfile reads, and viscera-recinfo
+# turns missing, garbage, non-recording, truncated and corrupted files into
+# a clear error naming the file and exit status 1, never a crash.
+if(TARGET viscera_recording AND TARGET viscera-recinfo)
+  viscera_unit_test(NAME test_recinfo_files SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_recinfo_files.c
+    LIBS viscera_recording)
+  target_compile_definitions(test_recinfo_files PRIVATE RECINFO_EXE="$<TARGET_FILE:viscera-recinfo>")
+  add_dependencies(test_recinfo_files viscera-recinfo)
+endif()
