@@ -41,7 +41,9 @@ int main(int argc, char **argv) {
                  "contact_step_us_median,delta_bytes_mean,full_bytes,ratio\n");
   printf("%-13s %7s %7s %7s %4s %9s %11s %9s %10s %12s %11s %10s %7s\n", "organ", "verts", "tris", "springs", "sub",
          "stable_ms", "step_med_us", "p99_us", "substep_us", "contact_med", "delta_B", "full_B", "ratio");
-  for (size_t oi = 0; oi < sizeof ORGANS / sizeof ORGANS[0]; oi++) {
+  /* The quick setting (CI smoke) leaves out the 23k-vertex liver. */
+  size_t norgans = sizeof ORGANS / sizeof ORGANS[0] - (quick ? 1 : 0);
+  for (size_t oi = 0; oi < norgans; oi++) {
     char yaml[2048];
     snprintf(yaml, sizeof yaml,
              "scene: bench\norgans:\n  - name: %s\n    mesh: %s/meshes/%s.obj\n    material: {mass: 0.15}\n"
