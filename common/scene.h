@@ -24,13 +24,45 @@ typedef struct scene_material {
   double damping;        /* N s/m, Kelvin-Voigt edge damping (default 0.02) */
   double home_stiffness; /* N/m, spring from each vertex to its rest position (default 30) */
   double home_damping;   /* N s/m, damping relative to the ground (default 0.005) */
+  /* molecular (seed 000 eq. 6-11); the scene is refused unless
+   * bond_k * angle_k > 2 * stretch_bend_k^2. */
+  double bond_k;         /* N/m, bond stretch k_r [30] */
+  double angle_k;        /* J (N m), bond angle k_theta, cosine form [1e-3] */
+  double stretch_bend_k; /* N, stretch-bend coupling k_sb [0] */
+  /* PBD / XPBD (seed 003 §4): stiffness in 0..1 for PBD, compliance
+   * (m/N for distance, 1/(N m^2)... per constraint) for XPBD. */
+  double distance_stiffness;   /* PBD [1] */
+  double volume_stiffness;     /* PBD [1] */
+  double distance_compliance;  /* XPBD [1e-4] */
+  double volume_compliance;    /* XPBD [1e-6] */
+  /* vertex_based (seed 002 ch. 4): slopes of the slope-intercept rule for
+   * the touched node and its first and second rings, m1 > m2 > m3 > 0. */
+  double slope_m1, slope_m2, slope_m3; /* [1, 0.6, 0.3] */
+  /* adaptive_mass_spring (seed 002 ch. 5): one-ring faces larger than
+   * refine_area are subdivided, up to refine_levels levels. */
+  double refine_area;    /* m^2 [2e-5] */
+  int refine_levels;     /* [2] */
 } scene_material_t;
+
+/* Model-specific settings (key `solver:` and extra `material:` keys in the
+ * scene file). Each model reads only its own fields; defaults in brackets. */
+typedef struct scene_solver {
+  int substeps;          /* sub-steps per scene step; 0 = automatic from the stability bound [0] */
+  int iterations;        /* PBD/XPBD constraint iterations per sub-step [10] */
+  double cg_tolerance;   /* implicit Euler: relative CG residual [1e-3] */
+  int cg_max_iterations; /* implicit Euler [200] */
+  double tet_size;       /* m, target tetrahedron edge when a volume mesh is built [0: auto] */
+} scene_solver_t;
 
 typedef struct scene_organ {
   char name[SCENE_NAME_LEN];
   char mesh[SCENE_PATH_LEN]; /* resolved path */
-  char model[32];            /* "mass_spring_surface" (v1) */
-  char integrator[32];       /* "symplectic_euler" (v1), "explicit_euler" */
+  /* One of: mass_spring_surface, mass_spring_tet, molecular, pbd, xpbd,
+   * vertex_based, adaptive_mass_spring. */
+  char model[32];
+  /* Force-based models: explicit_euler, symplectic_euler, verlet, rk4, implicit_euler. */
+  char integrator[32];
+  scene_solver_t solver;
   double position[3];        /* m, translation applied after scale (default 0) */
   double scale;              /* applied to the mesh coordinates (default 1) */
   float color[3];            /* RGB 0..1 (default 0.8 0.35 0.3) */

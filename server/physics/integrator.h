@@ -1,0 +1,55 @@
+/* integrator: time integrators for force_system_t (one sub-step each).
+ *
+ *   explicit_euler    x += h v; v += h M^-1 F(x, v)           (1st order, unstable undamped)
+ *   symplectic_euler  v += h M^-1 F(x, v); x += h v            (1st order, h < 2/omega)
+ *   verlet            velocity Verlet, kick-drift-kick         (2nd order, h < 2/omega)
+ *   rk4               classical Runge-Kutta                    (4th order, h < 2.78/omega)
+ *   implicit_euler    one linearised backward Euler step:
+ *                     (M + h C + h^2 K) dv = h (F + h K v), CG to cg_tolerance
+ *                                                              (unconditionally stable, damps)
+ * Scratch buffers are allocated once in integrator_init for n nodes; a step
+ * allocates nothing. Fixed nodes (inv_mass 0) never move. */
+#ifndef VISCERA_INTEGRATOR_H
+#define VISCERA_INTEGRATOR_H
+
+#include <stddef.h>
+
+#include "force_system.h"
+#include "verr.h"
+
+typedef enum integrator_kind {
+  INT_EXPLICIT_EULER,
+  INT_SYMPLECTIC_EULER,
+  INT_VERLET,
+  INT_RK4,
+  INT_IMPLICIT_EULER,
+  INT_COUNT
+} integrator_kind_t;
+
+typedef struct integrator {
+  integrator_kind_t kind;
+  size_t n;
+  double cg_tolerance;
+  int cg_max_iterations;
+  int last_cg_iterations;   /* diagnostics of the last implicit step */
+  double last_cg_residual;
+  double *buf[8];           /* scratch, 3n each */
+} integrator_t;
+
+/* Name as in scene files ("rk4"); -1 if unknown. */
+int integrator_parse(const char *name);
+const char *integrator_name(integrator_kind_t k);
+
+int integrator_init(integrator_t *it, integrator_kind_t kind, size_t n, double cg_tolerance, int cg_max_iterations,
+                    verr_t *err);
+void integrator_destroy(integrator_t *it);
+
+/* One sub-step of length h (calls s->pre_substep first). */
+void integrator_substep(integrator_t *it, force_system_t *s, double h);
+
+/* Largest stable h for the scheme given the largest eigenvalues of M^-1 K
+ * (lambda_k = omega_max^2) and M^-1 C (lambda_c). INFINITY for implicit Euler;
+ * for explicit Euler the damped bound lambda_c / lambda_k. */
+double integrator_stable_dt(integrator_kind_t k, double lambda_k, double lambda_c);
+
+#endif
