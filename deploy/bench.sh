@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Benchmarks (figures, not pass/fail): server step time per generated organ
-# and MeshDelta size (bench_server), then command->feedback latency and the
-# haptic tick on loopback over a 10 s palpation session.
+# and MeshDelta size (bench_server), then the haptic tick and command->feedback
+# latency on loopback over 60 s of palpation.
 # Output: out/bench/server_steps.csv, out/bench/latency/*.
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -11,12 +11,12 @@ OUT="$ROOT/out/bench"; mkdir -p "$OUT/latency"
 echo "== server step time and MeshDelta size (one core, Release build)"
 "$ROOT/build-bench/tests/bench/bench_server" "$ROOT/assets" "$OUT/server_steps.csv"
 echo
-echo "== command->feedback latency on loopback (server + scripted haptic client, 10 s)"
+echo "== haptic tick and command->feedback latency on loopback (server + scripted haptic client, 60 s, SCHED_FIFO when allowed)"
 export CYCLONEDDS_URI="file://$ROOT/deploy/cyclonedds-loopback.xml"
 D="${VISCERA_DOMAIN:-9}"
 "$ROOT/build-bench/server/viscera-server" --scene "$ROOT/assets/scenes/default.yaml" --domain "$D" \
   --partition bench/latency >"$OUT/latency/server.out" 2>"$OUT/latency/server.log" & S=$!
 "$ROOT/build-bench/client/haptic/viscera-haptic" --trajectory "$ROOT/assets/trajectories/palpate_kidney.traj" \
-  --domain "$D" --partition bench/latency --duration 10 >"$OUT/latency/haptic.out" 2>"$OUT/latency/haptic.log"
+  --domain "$D" --partition bench/latency --duration 60 --rt-priority 80 >"$OUT/latency/haptic.out" 2>"$OUT/latency/haptic.log"
 kill -INT $S; wait $S || true
 cat "$OUT/latency/haptic.log" "$OUT/latency/server.log" | grep -E "haptic:|step time"
