@@ -38,7 +38,7 @@ VIEWER=$!; pids+=($VIEWER)
 # Let the viewer and recorder discover the server before the hand moves.
 sleep 1.5
 "$BUILD/client/haptic/viscera-haptic" --trajectory "$TRAJ" "${common[@]}" \
-  --force-csv "$OUT/haptic_force.csv" >"$OUT/haptic.out" 2>"$OUT/haptic.log"
+  --force-csv "$OUT/haptic_force.csv" --rt-priority 50 >"$OUT/haptic.out" 2>"$OUT/haptic.log"
 HAPTIC_RC=$?
 sleep 0.5
 for p in $VIEWER $RECORDER $SERVER; do kill -INT "$p" 2>/dev/null || true; wait "$p" 2>/dev/null || true; done
