@@ -91,7 +91,8 @@ int mesh_validate(const mesh_t *m, const char *what, verr_t *err) {
       return verr_set(err, "%s: vertex %zu has a non-finite coordinate (%g)", what, i / 3, m->pos[i]);
   for (size_t i = 0; i < m->ntris * 3; i++)
     if (m->tris[i] >= m->nverts)
-      return verr_set(err, "%s: triangle %zu references vertex %u but the mesh has %zu", what, i / 3, m->tris[i], m->nverts);
+      return verr_set(err, "%s: triangle %zu references vertex %u but the mesh has %zu", what, i / 3, m->tris[i],
+                      m->nverts);
   return 0;
 }
 

@@ -71,7 +71,8 @@ void tri_closest_point(const double *p, const double *a, const double *b, const 
 
 /* Moller-Trumbore, two-sided; a near-zero determinant (segment parallel to the
  * plane or a degenerate triangle) is a miss rather than a division by zero. */
-int seg_tri_intersect(const double *p0, const double *p1, const double *a, const double *b, const double *c, double *t, double *bary) {
+int seg_tri_intersect(const double *p0, const double *p1, const double *a, const double *b, const double *c, double *t,
+                      double *bary) {
   double dir[3], e1[3], e2[3], pv[3], tv[3], qv[3];
   v3_sub(dir, p1, p0);
   v3_sub(e1, b, a);

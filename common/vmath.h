@@ -5,17 +5,43 @@
 
 #include <math.h>
 
-static inline void v3_set(double *r, double x, double y, double z) { r[0] = x; r[1] = y; r[2] = z; }
-static inline void v3_copy(double *r, const double *a) { r[0] = a[0]; r[1] = a[1]; r[2] = a[2]; }
-static inline void v3_add(double *r, const double *a, const double *b) { r[0] = a[0] + b[0]; r[1] = a[1] + b[1]; r[2] = a[2] + b[2]; }
-static inline void v3_sub(double *r, const double *a, const double *b) { r[0] = a[0] - b[0]; r[1] = a[1] - b[1]; r[2] = a[2] - b[2]; }
-static inline void v3_scale(double *r, const double *a, double s) { r[0] = a[0] * s; r[1] = a[1] * s; r[2] = a[2] * s; }
+static inline void v3_set(double *r, double x, double y, double z) {
+  r[0] = x;
+  r[1] = y;
+  r[2] = z;
+}
+static inline void v3_copy(double *r, const double *a) {
+  r[0] = a[0];
+  r[1] = a[1];
+  r[2] = a[2];
+}
+static inline void v3_add(double *r, const double *a, const double *b) {
+  r[0] = a[0] + b[0];
+  r[1] = a[1] + b[1];
+  r[2] = a[2] + b[2];
+}
+static inline void v3_sub(double *r, const double *a, const double *b) {
+  r[0] = a[0] - b[0];
+  r[1] = a[1] - b[1];
+  r[2] = a[2] - b[2];
+}
+static inline void v3_scale(double *r, const double *a, double s) {
+  r[0] = a[0] * s;
+  r[1] = a[1] * s;
+  r[2] = a[2] * s;
+}
 /* r += a * s */
-static inline void v3_axpy(double *r, const double *a, double s) { r[0] += a[0] * s; r[1] += a[1] * s; r[2] += a[2] * s; }
+static inline void v3_axpy(double *r, const double *a, double s) {
+  r[0] += a[0] * s;
+  r[1] += a[1] * s;
+  r[2] += a[2] * s;
+}
 static inline double v3_dot(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 static inline void v3_cross(double *r, const double *a, const double *b) {
   double x = a[1] * b[2] - a[2] * b[1], y = a[2] * b[0] - a[0] * b[2], z = a[0] * b[1] - a[1] * b[0];
-  r[0] = x; r[1] = y; r[2] = z;
+  r[0] = x;
+  r[1] = y;
+  r[2] = z;
 }
 static inline double v3_norm(const double *a) { return sqrt(v3_dot(a, a)); }
 static inline double v3_dist(const double *a, const double *b) {
@@ -38,6 +64,7 @@ void tri_closest_point(const double *p, const double *a, const double *b, const 
 
 /* Segment p0->p1 against triangle (a,b,c), two-sided. Returns 1 and the
  * segment parameter t in [0,1] and barycentrics on a hit, else 0. */
-int seg_tri_intersect(const double *p0, const double *p1, const double *a, const double *b, const double *c, double *t, double *bary);
+int seg_tri_intersect(const double *p0, const double *p1, const double *a, const double *b, const double *c, double *t,
+                      double *bary);
 
 #endif

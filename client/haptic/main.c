@@ -63,14 +63,19 @@ int main(int argc, char **argv) {
     fprintf(stderr, "viscera-haptic: VISCERA_DOMAIN='%s' is not a domain id 0..230\n", env_domain);
     return 2;
   }
-  static const struct option lo[] = {
-      {"trajectory", required_argument, 0, 'j'}, {"tool", required_argument, 0, 'n'},
-      {"domain", required_argument, 0, 'd'},     {"partition", required_argument, 0, 'p'},
-      {"rate", required_argument, 0, 'r'},       {"max-force", required_argument, 0, 'm'},
-      {"wait-server", required_argument, 0, 'w'}, {"duration", required_argument, 0, 't'},
-      {"force-csv", required_argument, 0, 'f'},  {"quiet", no_argument, 0, 'q'},
-      {"rt-priority", required_argument, 0, 'R'},
-      {"help", no_argument, 0, 'h'},             {0, 0, 0, 0}};
+  static const struct option lo[] = {{"trajectory", required_argument, 0, 'j'},
+                                     {"tool", required_argument, 0, 'n'},
+                                     {"domain", required_argument, 0, 'd'},
+                                     {"partition", required_argument, 0, 'p'},
+                                     {"rate", required_argument, 0, 'r'},
+                                     {"max-force", required_argument, 0, 'm'},
+                                     {"wait-server", required_argument, 0, 'w'},
+                                     {"duration", required_argument, 0, 't'},
+                                     {"force-csv", required_argument, 0, 'f'},
+                                     {"quiet", no_argument, 0, 'q'},
+                                     {"rt-priority", required_argument, 0, 'R'},
+                                     {"help", no_argument, 0, 'h'},
+                                     {0, 0, 0, 0}};
   int c;
   while ((c = getopt_long(argc, argv, "j:n:d:p:r:m:w:t:f:R:qh", lo, NULL)) != -1) {
     char *end = NULL;
@@ -90,20 +95,36 @@ int main(int argc, char **argv) {
       }
     }
     switch (c) {
-    case 'j': traj = optarg; break;
-    case 'n': tool = (unsigned)v; break;
+    case 'j':
+      traj = optarg;
+      break;
+    case 'n':
+      tool = (unsigned)v;
+      break;
     case 'd':
       if ((domain = vdds_parse_domain(optarg)) < 0) {
         fprintf(stderr, "viscera-haptic: --domain '%s' is not a domain id 0..230\n", optarg);
         return 2;
       }
       break;
-    case 'p': partition = optarg; break;
-    case 'r': rate = v; break;
-    case 'm': max_force = v; break;
-    case 'w': wait_server = v; break;
-    case 't': duration = v; break;
-    case 'f': force_csv = optarg; break;
+    case 'p':
+      partition = optarg;
+      break;
+    case 'r':
+      rate = v;
+      break;
+    case 'm':
+      max_force = v;
+      break;
+    case 'w':
+      wait_server = v;
+      break;
+    case 't':
+      duration = v;
+      break;
+    case 'f':
+      force_csv = optarg;
+      break;
     case 'R':
       rt_priority = (int)v;
       if (rt_priority < 1 || rt_priority > 99) {
@@ -111,9 +132,15 @@ int main(int argc, char **argv) {
         return 2;
       }
       break;
-    case 'q': quiet = 1; break;
-    case 'h': usage(stdout); return 0;
-    default: usage(stderr); return 2;
+    case 'q':
+      quiet = 1;
+      break;
+    case 'h':
+      usage(stdout);
+      return 0;
+    default:
+      usage(stderr);
+      return 2;
     }
   }
   if (!traj) {
@@ -200,9 +227,13 @@ int main(int argc, char **argv) {
      * keep the period. DDS threads stay at normal priority. */
     struct sched_param sp = {.sched_priority = rt_priority};
     int rc = pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp);
-    if (rc != 0) fprintf(stderr, "haptic: warning: SCHED_FIFO %d refused (%s); running at normal priority\n", rt_priority, strerror(rc));
-    else if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0) fprintf(stderr, "haptic: warning: mlockall failed (%s)\n", strerror(errno));
-    else if (!quiet) fprintf(stderr, "haptic: loop at SCHED_FIFO priority %d, memory locked\n", rt_priority);
+    if (rc != 0)
+      fprintf(stderr, "haptic: warning: SCHED_FIFO %d refused (%s); running at normal priority\n", rt_priority,
+              strerror(rc));
+    else if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0)
+      fprintf(stderr, "haptic: warning: mlockall failed (%s)\n", strerror(errno));
+    else if (!quiet)
+      fprintf(stderr, "haptic: loop at SCHED_FIFO priority %d, memory locked\n", rt_priority);
   }
   uint64_t period_ns = (uint64_t)(1e9 / rate);
   stats_t st = {0};
@@ -263,7 +294,9 @@ int main(int argc, char **argv) {
     if (mag > 0) st.contact_ticks++;
     st.force_sum += mag;
     if (mag > st.peak_force) st.peak_force = mag;
-    if (csv) fprintf(csv, "%.4f,%.6f,%.6f,%.6f,%.5f,%.5f,%.5f,%d\n", t, pos[0], pos[1], pos[2], f[0], f[1], f[2], model.in_contact);
+    if (csv)
+      fprintf(csv, "%.4f,%.6f,%.6f,%.6f,%.5f,%.5f,%.5f,%d\n", t, pos[0], pos[1], pos[2], f[0], f[1], f[2],
+              model.in_contact);
 
     if (t >= run_for) break;
     if (duration < 0 && dev.ops->finished(&dev, t)) {
@@ -288,15 +321,16 @@ int main(int argc, char **argv) {
           "haptic: %" PRIu64 " ticks in %.2f s (%.1f Hz); period median %.1f us, p99 %.1f us, max %.1f us; "
           "%" PRIu64 " ticks over 1 ms late; jitter p99 %.1f us\n",
           st.ticks, elapsed, (double)st.ticks / elapsed, per.median, per.p99, per.max, st.late_ticks, jitter_p99);
-  fprintf(stderr, "haptic: force peak %.3f N, mean in contact %.3f N, %" PRIu64 " ticks in contact, %" PRIu64
-                  " feedback samples\n",
+  fprintf(stderr,
+          "haptic: force peak %.3f N, mean in contact %.3f N, %" PRIu64 " ticks in contact, %" PRIu64
+          " feedback samples\n",
           st.peak_force, st.contact_ticks ? st.force_sum / (double)st.contact_ticks : 0.0, st.contact_ticks, feedback);
   fprintf(stderr, "haptic: command->feedback latency median %.1f us, p99 %.1f us (%zu samples)\n", lat.median, lat.p99,
           lat.n);
   printf("SUMMARY ticks=%" PRIu64 " rate_hz=%.1f peak_force=%.4f contact_ticks=%" PRIu64 " latency_us_median=%.1f "
          "latency_us_p99=%.1f period_us_p99=%.1f jitter_us_p99=%.1f late_ticks=%" PRIu64 "\n",
-         st.ticks, (double)st.ticks / elapsed, st.peak_force, st.contact_ticks, lat.median, lat.p99, per.p99, jitter_p99,
-         st.late_ticks);
+         st.ticks, (double)st.ticks / elapsed, st.peak_force, st.contact_ticks, lat.median, lat.p99, per.p99,
+         jitter_p99, st.late_ticks);
   free(st.period_us);
   vdds_close(&dds); /* stops the listener before the slot goes */
   feedback_slot_destroy(&slot);

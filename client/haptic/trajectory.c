@@ -107,8 +107,10 @@ void trajectory_eval(const trajectory_t *tr, double t, double pos[3], uint32_t *
   size_t lo = 0, hi = tr->n - 1; /* s[lo].t <= t < s[hi].t */
   while (hi - lo > 1) {
     size_t mid = (lo + hi) / 2;
-    if (s[mid].t <= t) lo = mid;
-    else hi = mid;
+    if (s[mid].t <= t)
+      lo = mid;
+    else
+      hi = mid;
   }
   double a = (t - s[lo].t) / (s[hi].t - s[lo].t);
   for (int k = 0; k < 3; k++) pos[k] = s[lo].pos[k] + a * (s[hi].pos[k] - s[lo].pos[k]);

@@ -112,15 +112,33 @@ int main(int argc, char **argv) {
     float nanq[4] = {NAN, 0, 0, 0};
     for (int kind = 0; kind < 9; kind++) {
       switch (kind) {
-      case 0: send(w, 0, nanpos, unit, 4, &seq); break;
-      case 1: send(w, 0, infpos, unit, 4, &seq); break;
-      case 2: send(w, 0, absurd, unit, 4, &seq); break;
-      case 3: send(w, 0, inside, badq, 4, &seq); break;
-      case 4: send(w, 0, inside, nanq, 4, &seq); break;
-      case 5: send(w, 0, inside, unit, NAN, &seq); break;
-      case 6: send(w, 0, inside, unit, -5, &seq); break;
-      case 7: send(w, 7, inside, unit, 4, &seq); break;
-      default: send(w, 0xffffffffu, inside, unit, 4, &seq); break;
+      case 0:
+        send(w, 0, nanpos, unit, 4, &seq);
+        break;
+      case 1:
+        send(w, 0, infpos, unit, 4, &seq);
+        break;
+      case 2:
+        send(w, 0, absurd, unit, 4, &seq);
+        break;
+      case 3:
+        send(w, 0, inside, badq, 4, &seq);
+        break;
+      case 4:
+        send(w, 0, inside, nanq, 4, &seq);
+        break;
+      case 5:
+        send(w, 0, inside, unit, NAN, &seq);
+        break;
+      case 6:
+        send(w, 0, inside, unit, -5, &seq);
+        break;
+      case 7:
+        send(w, 7, inside, unit, 4, &seq);
+        break;
+      default:
+        send(w, 0xffffffffu, inside, unit, 4, &seq);
+        break;
       }
       watch_force(r_fb, 2, &feedback_from_bad, &dummy);
     }

@@ -54,7 +54,8 @@ int main(int argc, char **argv) {
         nout++;
       }
     }
-  printf("window_mean=%.3f outside_mean=%.3f window_changed=%ld\n", nwin ? win / nwin : 0, nout ? out / nout : 0, changed);
+  printf("window_mean=%.3f outside_mean=%.3f window_changed=%ld\n", nwin ? win / nwin : 0, nout ? out / nout : 0,
+         changed);
   free(a);
   free(b);
   return 0;

@@ -23,8 +23,8 @@ int main(void) {
   int16_t dq[3 * N];
   for (int trial = 0; trial < 300; trial++) {
     float q = (float)(1e-6 + rnd(&seed) * 1e-4);
-    double amp = q * 32000.0 * rnd(&seed);    /* up to the edge of the int16 range */
-    double frac = rnd(&seed);                 /* share of vertices that move */
+    double amp = q * 32000.0 * rnd(&seed); /* up to the edge of the int16 range */
+    double frac = rnd(&seed);              /* share of vertices that move */
     for (int i = 0; i < 3 * N; i++) key[i] = (float)(rnd(&seed) * 0.2 - 0.1);
     for (int i = 0; i < N; i++)
       for (int k = 0; k < 3; k++)
