@@ -21,14 +21,16 @@
 #define SCENE_MAX_BYTES (1u << 20)
 #define SCENE_MAX_DEPTH 16 /* the schema needs 4 */
 #define SCENE_MAX_NODES 20000
-#define SCENE_MAX_KEYS 16 /* most keys any one mapping of the schema has */
+#define SCENE_MAX_KEYS 24 /* most keys any one mapping of the schema has */
 #define SHOW_LEN 48       /* longest excerpt of user text quoted in a message */
 #define COUNT(a) (sizeof(a) / sizeof((a)[0]))
 
 /* The accepted names for each choice field, the first being the default.
  * Adding a model, integrator or tool kind means adding it here only. */
-static const char *const scene_models[] = {"mass_spring_surface"};
-static const char *const scene_integrators[] = {"symplectic_euler", "explicit_euler"};
+static const char *const scene_models[] = {"mass_spring_surface", "mass_spring_tet", "molecular", "pbd",
+                                           "xpbd", "vertex_based", "adaptive_mass_spring"};
+static const char *const scene_integrators[] = {"symplectic_euler", "explicit_euler", "verlet", "rk4",
+                                                "implicit_euler"};
 static const char *const scene_tool_kinds[] = {"probe"};
 
 /* ---- the tree ---------------------------------------------------------- */
@@ -298,6 +300,23 @@ static int opt_number(const ctx_t *c, const node_t *n, const char *prefix, const
   return get_number(c, n, path, r, out);
 }
 
+/* A whole number in r (the range is checked first, so the message for 1e9
+ * is the range, not the type). */
+static int get_int(const ctx_t *c, const node_t *n, const char *path, const range_t *r, int *out) {
+  double v;
+  if (get_number(c, n, path, r, &v)) return -1;
+  if (v != floor(v) || fabs(v) > 1e9) return field_err(c, n, path, "must be a whole number (got %.*s%s)", SHOW(n));
+  *out = (int)v;
+  return 0;
+}
+
+static int opt_int(const ctx_t *c, const node_t *n, const char *prefix, const char *key, const range_t *r, int *out) {
+  if (!n) return 0;
+  char path[128];
+  join(path, sizeof path, prefix, key);
+  return get_int(c, n, path, r, out);
+}
+
 static int get_vec3(const ctx_t *c, const node_t *n, const char *path, const range_t *r, double out[3]) {
   if (n->kind != N_SEQ || n->nkids != 3) {
     if (n->kind == N_SEQ)
@@ -366,7 +385,7 @@ static int get_fields(const ctx_t *c, const node_t *n, const char *path, const c
     size_t i = 0;
     while (i < nkeys && !(strlen(keys[i]) == k->len && !memcmp(keys[i], k->text, k->len))) i++;
     if (i == nkeys) {
-      char allowed[256];
+      char allowed[400];
       list_names(allowed, sizeof allowed, keys, nkeys);
       return field_err(c, k, kpath, "unknown key (allowed: %s)", allowed);
     }
@@ -389,18 +408,47 @@ enum { P_DT, P_PUBLISH_HZ, P_QUANT_STEP, P_GRAVITY, P_NKEYS };
 static const char *const physics_keys[P_NKEYS] = {
     [P_DT] = "dt", [P_PUBLISH_HZ] = "publish_hz", [P_QUANT_STEP] = "quant_step", [P_GRAVITY] = "gravity"};
 
-enum { M_MASS, M_STIFFNESS, M_DAMPING, M_HOME_STIFFNESS, M_HOME_DAMPING, M_NKEYS };
+enum {
+  M_MASS, M_STIFFNESS, M_DAMPING, M_HOME_STIFFNESS, M_HOME_DAMPING,
+  M_BOND_K, M_ANGLE_K, M_STRETCH_BEND_K,
+  M_DISTANCE_STIFFNESS, M_VOLUME_STIFFNESS, M_DISTANCE_COMPLIANCE, M_VOLUME_COMPLIANCE,
+  M_SLOPE_M1, M_SLOPE_M2, M_SLOPE_M3,
+  M_REFINE_AREA, M_REFINE_LEVELS,
+  M_NKEYS
+};
 static const char *const material_keys[M_NKEYS] = {[M_MASS] = "mass",
                                                    [M_STIFFNESS] = "stiffness",
                                                    [M_DAMPING] = "damping",
                                                    [M_HOME_STIFFNESS] = "home_stiffness",
-                                                   [M_HOME_DAMPING] = "home_damping"};
+                                                   [M_HOME_DAMPING] = "home_damping",
+                                                   [M_BOND_K] = "bond_k",
+                                                   [M_ANGLE_K] = "angle_k",
+                                                   [M_STRETCH_BEND_K] = "stretch_bend_k",
+                                                   [M_DISTANCE_STIFFNESS] = "distance_stiffness",
+                                                   [M_VOLUME_STIFFNESS] = "volume_stiffness",
+                                                   [M_DISTANCE_COMPLIANCE] = "distance_compliance",
+                                                   [M_VOLUME_COMPLIANCE] = "volume_compliance",
+                                                   [M_SLOPE_M1] = "slope_m1",
+                                                   [M_SLOPE_M2] = "slope_m2",
+                                                   [M_SLOPE_M3] = "slope_m3",
+                                                   [M_REFINE_AREA] = "refine_area",
+                                                   [M_REFINE_LEVELS] = "refine_levels"};
 
-enum { O_NAME, O_MESH, O_MODEL, O_INTEGRATOR, O_POSITION, O_SCALE, O_COLOR, O_FIXED_BELOW, O_MATERIAL, O_NKEYS };
+enum { V_SUBSTEPS, V_ITERATIONS, V_CG_TOLERANCE, V_CG_MAX_ITERATIONS, V_TET_SIZE, V_NKEYS };
+static const char *const solver_keys[V_NKEYS] = {[V_SUBSTEPS] = "substeps",
+                                                 [V_ITERATIONS] = "iterations",
+                                                 [V_CG_TOLERANCE] = "cg_tolerance",
+                                                 [V_CG_MAX_ITERATIONS] = "cg_max_iterations",
+                                                 [V_TET_SIZE] = "tet_size"};
+
+enum {
+  O_NAME, O_MESH, O_MODEL, O_INTEGRATOR, O_SOLVER, O_POSITION, O_SCALE, O_COLOR, O_FIXED_BELOW, O_MATERIAL,
+  O_NKEYS
+};
 static const char *const organ_keys[O_NKEYS] = {
-    [O_NAME] = "name",         [O_MESH] = "mesh",   [O_MODEL] = "model", [O_INTEGRATOR] = "integrator",
-    [O_POSITION] = "position", [O_SCALE] = "scale", [O_COLOR] = "color", [O_FIXED_BELOW] = "fixed_below",
-    [O_MATERIAL] = "material"};
+    [O_NAME] = "name",         [O_MESH] = "mesh",          [O_MODEL] = "model", [O_INTEGRATOR] = "integrator",
+    [O_SOLVER] = "solver",     [O_POSITION] = "position",  [O_SCALE] = "scale", [O_COLOR] = "color",
+    [O_FIXED_BELOW] = "fixed_below", [O_MATERIAL] = "material"};
 
 enum { T_NAME, T_KIND, T_RADIUS, T_LENGTH, T_STIFFNESS, T_MAX_FORCE, T_NKEYS };
 static const char *const tool_keys[T_NKEYS] = {
@@ -415,7 +463,8 @@ static const char *const top_keys[S_NKEYS] = {[S_SCENE] = "scene",
                                               [S_TOOLS] = "tools"};
 
 /* get_fields() tracks the keys seen in a fixed array of SCENE_MAX_KEYS. */
-_Static_assert(P_NKEYS <= SCENE_MAX_KEYS && M_NKEYS <= SCENE_MAX_KEYS && O_NKEYS <= SCENE_MAX_KEYS &&
+_Static_assert(P_NKEYS <= SCENE_MAX_KEYS && M_NKEYS <= SCENE_MAX_KEYS && V_NKEYS <= SCENE_MAX_KEYS &&
+                   O_NKEYS <= SCENE_MAX_KEYS &&
                    T_NKEYS <= SCENE_MAX_KEYS && S_NKEYS <= SCENE_MAX_KEYS,
                "raise SCENE_MAX_KEYS");
 
@@ -432,6 +481,23 @@ static void organ_defaults(scene_organ_t *o) {
   o->material.damping = 0.02;
   o->material.home_stiffness = 30;
   o->material.home_damping = 0.005;
+  o->material.bond_k = 30;
+  o->material.angle_k = 1e-3;
+  o->material.stretch_bend_k = 0;
+  o->material.distance_stiffness = 1;
+  o->material.volume_stiffness = 1;
+  o->material.distance_compliance = 1e-4;
+  o->material.volume_compliance = 1e-6;
+  o->material.slope_m1 = 1;
+  o->material.slope_m2 = 0.6;
+  o->material.slope_m3 = 0.3;
+  o->material.refine_area = 2e-5;
+  o->material.refine_levels = 2;
+  o->solver.substeps = 0;
+  o->solver.iterations = 10;
+  o->solver.cg_tolerance = 1e-3;
+  o->solver.cg_max_iterations = 200;
+  o->solver.tet_size = 0;
 }
 
 static void tool_defaults(scene_tool_t *t) {
@@ -457,14 +523,93 @@ static int parse_physics(const ctx_t *c, const node_t *n, scene_t *s) {
   return 0;
 }
 
-static int parse_material(const ctx_t *c, const node_t *n, const char *path, scene_material_t *m) {
-  const node_t *v[M_NKEYS];
+/* v[] receives the value nodes so the model-specific checks in parse_organ
+ * can point at the line of the value they complain about. */
+static int parse_material(const ctx_t *c, const node_t *n, const char *path, scene_material_t *m,
+                          const node_t **v) {
+  static const range_t unit = {B_INCL, 0, B_INCL, 1};
+  static const range_t levels = {B_INCL, 1, B_INCL, 4};
   if (get_fields(c, n, path, material_keys, M_NKEYS, v)) return -1;
   if (opt_number(c, v[M_MASS], path, "mass", &GT0, &m->mass)) return -1;
   if (opt_number(c, v[M_STIFFNESS], path, "stiffness", &GE0, &m->stiffness)) return -1;
   if (opt_number(c, v[M_DAMPING], path, "damping", &GE0, &m->damping)) return -1;
   if (opt_number(c, v[M_HOME_STIFFNESS], path, "home_stiffness", &GE0, &m->home_stiffness)) return -1;
   if (opt_number(c, v[M_HOME_DAMPING], path, "home_damping", &GE0, &m->home_damping)) return -1;
+  if (opt_number(c, v[M_BOND_K], path, "bond_k", &GE0, &m->bond_k)) return -1;
+  if (opt_number(c, v[M_ANGLE_K], path, "angle_k", &GE0, &m->angle_k)) return -1;
+  /* The coupling may have either sign; only its square enters the
+   * definiteness condition checked in parse_organ. */
+  if (opt_number(c, v[M_STRETCH_BEND_K], path, "stretch_bend_k", &ANY, &m->stretch_bend_k)) return -1;
+  if (opt_number(c, v[M_DISTANCE_STIFFNESS], path, "distance_stiffness", &unit, &m->distance_stiffness)) return -1;
+  if (opt_number(c, v[M_VOLUME_STIFFNESS], path, "volume_stiffness", &unit, &m->volume_stiffness)) return -1;
+  if (opt_number(c, v[M_DISTANCE_COMPLIANCE], path, "distance_compliance", &GE0, &m->distance_compliance)) return -1;
+  if (opt_number(c, v[M_VOLUME_COMPLIANCE], path, "volume_compliance", &GE0, &m->volume_compliance)) return -1;
+  if (opt_number(c, v[M_SLOPE_M1], path, "slope_m1", &GT0, &m->slope_m1)) return -1;
+  if (opt_number(c, v[M_SLOPE_M2], path, "slope_m2", &GT0, &m->slope_m2)) return -1;
+  if (opt_number(c, v[M_SLOPE_M3], path, "slope_m3", &GT0, &m->slope_m3)) return -1;
+  if (opt_number(c, v[M_REFINE_AREA], path, "refine_area", &GT0, &m->refine_area)) return -1;
+  if (opt_int(c, v[M_REFINE_LEVELS], path, "refine_levels", &levels, &m->refine_levels)) return -1;
+  return 0;
+}
+
+static int parse_solver(const ctx_t *c, const node_t *n, const char *path, scene_solver_t *sv) {
+  const node_t *v[V_NKEYS];
+  static const range_t substeps = {B_INCL, 0, B_INCL, 256};
+  static const range_t iterations = {B_INCL, 1, B_INCL, 1000};
+  static const range_t tolerance = {B_INCL, 1e-12, B_INCL, 1e-1};
+  static const range_t cg_iterations = {B_INCL, 1, B_INCL, 10000};
+  static const range_t tet_size = {B_INCL, 0, B_INCL, 0.1};
+  if (get_fields(c, n, path, solver_keys, V_NKEYS, v)) return -1;
+  if (opt_int(c, v[V_SUBSTEPS], path, "substeps", &substeps, &sv->substeps)) return -1;
+  if (opt_int(c, v[V_ITERATIONS], path, "iterations", &iterations, &sv->iterations)) return -1;
+  if (opt_number(c, v[V_CG_TOLERANCE], path, "cg_tolerance", &tolerance, &sv->cg_tolerance)) return -1;
+  if (opt_int(c, v[V_CG_MAX_ITERATIONS], path, "cg_max_iterations", &cg_iterations, &sv->cg_max_iterations))
+    return -1;
+  if (opt_number(c, v[V_TET_SIZE], path, "tet_size", &tet_size, &sv->tet_size)) return -1;
+  /* 0 asks for the automatic size; anything else below 0.1 mm would build
+   * millions of tetrahedra for an organ. */
+  if (sv->tet_size != 0 && sv->tet_size < 1e-4) {
+    char fp[128];
+    join(fp, sizeof fp, path, "tet_size");
+    return field_err(c, v[V_TET_SIZE], fp, "must be 0 (automatic) or >= 0.0001 and <= 0.1 (got %.*s%s)",
+                     SHOW(v[V_TET_SIZE]));
+  }
+  return 0;
+}
+
+/* Checks that need the model and the material together. `mv` holds the
+ * material's value nodes (all NULL when no material was given); a complaint
+ * points at the value to change, or at the model line for defaults. */
+static int check_model_material(const ctx_t *c, const node_t *model_node, const node_t *organ_node,
+                                const node_t *const *mv, const char *path, const scene_organ_t *o) {
+  const scene_material_t *m = &o->material;
+  char fp[128];
+  if (!strcmp(o->model, "molecular")) {
+    /* Seed 000 eq. 11: the stretch-bend energy is positive definite only if
+     * k_r k_theta > 2 k_sb^2 (NUMERICS.md §6). */
+    double lhs = m->bond_k * m->angle_k, rhs = 2 * m->stretch_bend_k * m->stretch_bend_k;
+    if (!(lhs > rhs)) {
+      int key = mv[M_STRETCH_BEND_K] ? M_STRETCH_BEND_K : mv[M_ANGLE_K] ? M_ANGLE_K : M_BOND_K;
+      const node_t *at = mv[key] ? mv[key] : model_node ? model_node : organ_node;
+      join(fp, sizeof fp, path, material_keys[key]);
+      char sb[40]; /* a negative coupling in brackets, so its square reads right */
+      snprintf(sb, sizeof sb, m->stretch_bend_k < 0 ? "(%g)" : "%g", m->stretch_bend_k);
+      return field_err(c, at, fp,
+                       "the molecular model needs bond_k * angle_k > 2 * stretch_bend_k^2 for a positive-definite "
+                       "energy (got %g * %g = %g <= 2 * %s^2 = %g)",
+                       m->bond_k, m->angle_k, lhs, sb, rhs);
+    }
+  }
+  if (!strcmp(o->model, "vertex_based") && !(m->slope_m1 > m->slope_m2 && m->slope_m2 > m->slope_m3)) {
+    /* The touched node moves most, its rings less: point at the first
+     * slope out of order. */
+    int key = !(m->slope_m1 > m->slope_m2) ? (mv[M_SLOPE_M2] ? M_SLOPE_M2 : M_SLOPE_M1)
+                                           : (mv[M_SLOPE_M3] ? M_SLOPE_M3 : M_SLOPE_M2);
+    const node_t *at = mv[key] ? mv[key] : model_node ? model_node : organ_node;
+    join(fp, sizeof fp, path, material_keys[key]);
+    return field_err(c, at, fp, "the vertex_based model needs slope_m1 > slope_m2 > slope_m3 (got %g, %g, %g)",
+                     m->slope_m1, m->slope_m2, m->slope_m3);
+  }
   return 0;
 }
 
@@ -514,6 +659,10 @@ static int parse_organ(const ctx_t *c, const node_t *n, size_t idx, const char *
   if (v[O_INTEGRATOR] && get_choice(c, v[O_INTEGRATOR], fp, scene_integrators, COUNT(scene_integrators), o->integrator,
                                     sizeof o->integrator))
     return -1;
+  if (v[O_SOLVER]) {
+    join(fp, sizeof fp, path, "solver");
+    if (parse_solver(c, v[O_SOLVER], fp, &o->solver)) return -1;
+  }
   join(fp, sizeof fp, path, "position");
   if (v[O_POSITION] && get_vec3(c, v[O_POSITION], fp, &ANY, o->position)) return -1;
   if (opt_number(c, v[O_SCALE], path, "scale", &GT0, &o->scale)) return -1;
@@ -527,11 +676,10 @@ static int parse_organ(const ctx_t *c, const node_t *n, size_t idx, const char *
     if (opt_number(c, v[O_FIXED_BELOW], path, "fixed_below", &ANY, &o->fixed_below)) return -1;
     o->fixed_below_set = 1;
   }
-  if (v[O_MATERIAL]) {
-    join(fp, sizeof fp, path, "material");
-    if (parse_material(c, v[O_MATERIAL], fp, &o->material)) return -1;
-  }
-  return 0;
+  const node_t *mv[M_NKEYS] = {0};
+  join(fp, sizeof fp, path, "material");
+  if (v[O_MATERIAL] && parse_material(c, v[O_MATERIAL], fp, &o->material, mv)) return -1;
+  return check_model_material(c, v[O_MODEL], n, mv, fp, o);
 }
 
 static int parse_tool(const ctx_t *c, const node_t *n, size_t idx, scene_t *s) {

@@ -1,55 +1,49 @@
 #include "scene_runtime.h"
 
+#include "physics/adaptive.h"
+
 #include <math.h>
 #include <string.h>
 
 #include "mesh_import.h"
 #include "vmath.h"
 
-static int organ_init(organ_rt_t *o, const scene_t *sc, const scene_organ_t *cfg, uint32_t id, double tool_k,
+static void apply_contacts(model_t *m, void *vctx);
+
+static int organ_init(organ_rt_t *o, runtime_t *rt, const scene_organ_t *cfg, uint32_t id, double tool_k,
                       verr_t *err) {
+  const scene_t *sc = &rt->scene;
   memset(o, 0, sizeof *o);
   o->cfg = cfg;
   o->id = id;
+  o->rt = rt;
   verr_t e;
   if (mesh_import(cfg->mesh, &o->rest, &e))
     return verr_set(err, "%s:%d: organ '%s': %s", sc->path, cfg->line, cfg->name, e.msg);
   for (size_t i = 0; i < o->rest.nverts; i++)
     for (int k = 0; k < 3; k++) o->rest.pos[3 * i + k] = o->rest.pos[3 * i + k] * cfg->scale + cfg->position[k];
-  if (strcmp(cfg->model, "mass_spring_surface") != 0) {
+  /* The proxy spring acts on the contact vertices like an extra home
+   * spring, so explicit schemes include the stiffest tool in their bound. */
+  model_params_t mp = {.cfg = cfg, .surface = &o->rest, .dt = sc->dt, .tool_stiffness = tool_k};
+  v3_copy(mp.gravity, sc->gravity);
+  o->model = model_create(&mp, &e);
+  if (!o->model) {
     mesh_free(&o->rest);
-    return verr_set(err, "%s:%d: organ '%s': model '%s' is not available in this build", sc->path, cfg->line, cfg->name,
-                    cfg->model);
+    return verr_set(err, "%s:%d: %s", sc->path, cfg->line, e.msg);
   }
-  ms_params_t p = {.mass = cfg->material.mass,
-                   .stiffness = cfg->material.stiffness,
-                   .damping = cfg->material.damping,
-                   .home_stiffness = cfg->material.home_stiffness,
-                   .home_damping = cfg->material.home_damping,
-                   .integrator = strcmp(cfg->integrator, "explicit_euler") == 0 ? MS_EXPLICIT_EULER : MS_SYMPLECTIC_EULER};
-  v3_copy(p.gravity, sc->gravity);
-  if (mass_spring_create(&o->ms, &o->rest, &p, &e)) {
-    mesh_free(&o->rest);
-    return verr_set(err, "%s:%d: organ '%s': %s", sc->path, cfg->line, cfg->name, e.msg);
-  }
-  if (cfg->fixed_below_set) mass_spring_fix_below(&o->ms, cfg->fixed_below);
-  /* The proxy spring acts on the contact vertices like an extra home spring,
-   * so the stability bound includes the stiffest tool. */
-  double saved = o->ms.p.home_stiffness;
-  o->ms.p.home_stiffness += tool_k;
-  o->stable_dt = mass_spring_stable_dt(&o->ms);
-  o->ms.p.home_stiffness = saved;
-  double safe = 0.9 * o->stable_dt;
-  double need = safe > 0 ? ceil(sc->dt / safe) : INFINITY;
-  if (!(need <= 256)) {
-    mass_spring_destroy(&o->ms);
+  if (model_adaptive_of(o->model)) {
+    /* Its surface changes topology while it runs; the publisher and the
+     * contact proxies do not follow topology changes yet. */
+    model_destroy(o->model);
+    o->model = NULL;
     mesh_free(&o->rest);
     return verr_set(err,
-                    "%s:%d: organ '%s': %s is stable only below dt = %.3g s here, which would need %.0f sub-steps of "
-                    "the %.3g s step (limit 256); lower material stiffness, damping or tool stiffness, or the mass",
-                    sc->path, cfg->line, cfg->name, cfg->integrator, o->stable_dt, need, sc->dt);
+                    "%s:%d: organ '%s': model 'adaptive_mass_spring' runs in tests and benchmarks only; the live server "
+                    "cannot stream its topology changes yet",
+                    sc->path, cfg->line, cfg->name);
   }
-  o->substeps = need < 1 ? 1 : (int)need;
+  o->model->hook = apply_contacts;
+  o->model->hook_ctx = o;
   return 0;
 }
 
@@ -61,22 +55,37 @@ int runtime_init(runtime_t *rt, const scene_t *scene, verr_t *err) {
     if (scene->tools[t].stiffness > tool_k) tool_k = scene->tools[t].stiffness;
   double bmin[3] = {INFINITY, INFINITY, INFINITY}, bmax[3] = {-INFINITY, -INFINITY, -INFINITY};
   for (size_t i = 0; i < scene->norgans; i++) {
-    if (organ_init(&rt->organs[i], &rt->scene, &rt->scene.organs[i], (uint32_t)i, tool_k, err)) {
+    if (organ_init(&rt->organs[i], rt, &rt->scene.organs[i], (uint32_t)i, tool_k, err)) {
       runtime_destroy(rt);
       return -1;
     }
     rt->norgans++;
     organ_rt_t *o = &rt->organs[i];
+    const model_t *m = o->model;
     /* Edges may stretch while deformed; 3x the longest rest edge is far
-     * beyond what the home springs allow and keeps the proxy cull exact. */
+     * beyond what the home springs allow and keeps the proxy cull exact.
+     * Each triangle edge counts once per triangle: a closed mesh counts
+     * every edge twice, which leaves the mean as it is. */
     double max_edge = 0, mean_edge = 0, tool_r = 0;
-    for (size_t s = 0; s < o->ms.nsprings; s++) {
-      max_edge = fmax(max_edge, o->ms.springs[s].rest);
-      mean_edge += o->ms.springs[s].rest / (double)o->ms.nsprings;
-    }
+    for (size_t t = 0; t < m->nsurf_tris; t++)
+      for (int k = 0; k < 3; k++) {
+        const uint32_t *tri = m->surf_tris + 3 * t;
+        double len = v3_dist(m->surf_rest + 3 * tri[k], m->surf_rest + 3 * tri[(k + 1) % 3]);
+        max_edge = fmax(max_edge, len);
+        mean_edge += len;
+      }
+    if (m->nsurf_tris) mean_edge /= 3.0 * (double)m->nsurf_tris;
     for (size_t t = 0; t < scene->ntools; t++) tool_r = fmax(tool_r, scene->tools[t].radius);
     o->patch_radius = fmax(2 * tool_r, 1.5 * mean_edge);
-    rt->surfaces[i] = (proxy_surface_t){.x = o->ms.x, .tris = o->rest.tris, .ntris = o->rest.ntris, .max_edge = 3 * max_edge, .x_rest = o->ms.x_rest};
+    rt->surfaces[i] = (proxy_surface_t){.x = m->surf_x, .tris = m->surf_tris, .ntris = m->nsurf_tris,
+                                        .max_edge = 3 * max_edge, .x_rest = m->surf_rest};
+    verr_t te;
+    if (aabb_tree_build(&o->tree, m->surf_x, m->nsurf, m->surf_tris, m->nsurf_tris, &te)) {
+      verr_set(err, "%s:%d: organ '%s': %s", rt->scene.path, o->cfg->line, o->cfg->name, te.msg);
+      runtime_destroy(rt);
+      return -1;
+    }
+    rt->surfaces[i].tree = &o->tree;
     double lo[3], hi[3];
     mesh_bounds(&o->rest, lo, hi);
     for (int k = 0; k < 3; k++) {
@@ -101,7 +110,9 @@ int runtime_init(runtime_t *rt, const scene_t *scene, verr_t *err) {
 
 void runtime_destroy(runtime_t *rt) {
   for (size_t i = 0; i < rt->norgans; i++) {
-    mass_spring_destroy(&rt->organs[i].ms);
+    model_destroy(rt->organs[i].model);
+    rt->organs[i].model = NULL;
+    aabb_tree_destroy(&rt->organs[i].tree);
     mesh_free(&rt->organs[i].rest);
   }
   rt->norgans = 0;
@@ -122,28 +133,23 @@ void runtime_release_tool(runtime_t *rt, size_t t) {
   v3_set(rt->tools[t].force, 0, 0, 0);
 }
 
-typedef struct contact_ctx {
-  runtime_t *rt;
-  size_t organ;
-} contact_ctx_t;
-
-/* Re-evaluates every proxy spring attached to this organ at the sub-step's
- * positions and applies the reaction -f to the contact triangle's vertices
- * by barycentric weight. */
-static void apply_contacts(mass_spring_t *ms, void *vctx) {
-  contact_ctx_t *c = vctx;
-  runtime_t *rt = c->rt;
+/* The model's hook, before every sub-step: re-evaluates every proxy spring
+ * attached to this organ at the sub-step's surface positions and spreads
+ * the reaction -f over the contact patch. */
+static void apply_contacts(model_t *m, void *vctx) {
+  organ_rt_t *o = vctx;
+  runtime_t *rt = o->rt;
   for (size_t t = 0; t < rt->ntools; t++) {
     tool_rt_t *tool = &rt->tools[t];
     proxy_t *p = &tool->proxy;
-    if (!tool->active || !p->in_contact || (size_t)p->surface != c->organ) continue;
+    if (!tool->active || !p->in_contact || (size_t)p->surface != o->id) continue;
     proxy_follow_surface(p, rt->surfaces, rt->norgans);
     double f[3];
     proxy_spring_force(p, tool->device, tool->cfg->stiffness, tool->max_force, f);
     for (size_t j = 0; j < tool->npatch; j++) {
       double fk[3];
       v3_scale(fk, f, -tool->patch_w[j]);
-      mass_spring_add_force(ms, tool->patch[j], fk);
+      m->ops->add_surface_force(m, tool->patch[j], fk);
     }
   }
 }
@@ -155,10 +161,11 @@ static void build_patch(runtime_t *rt, tool_rt_t *tool) {
   tool->npatch = 0;
   if (!tool->proxy.in_contact) return;
   const organ_rt_t *o = &rt->organs[tool->proxy.surface];
+  const model_t *m = o->model;
   double r = fmax(o->patch_radius, 1e-6), sum = 0;
-  const uint32_t *tri = o->rest.tris + 3 * tool->proxy.tri;
-  for (size_t i = 0; i < o->ms.n; i++) {
-    double d = v3_dist(o->ms.x + 3 * i, tool->proxy.pos);
+  const uint32_t *tri = m->surf_tris + 3 * tool->proxy.tri;
+  for (size_t i = 0; i < m->nsurf; i++) {
+    double d = v3_dist(m->surf_x + 3 * i, tool->proxy.pos);
     int in_tri = i == tri[0] || i == tri[1] || i == tri[2];
     if (d >= r && !in_tri) continue;
     double w = d < r ? (1 - d / r) * (1 - d / r) : 0;
@@ -192,11 +199,12 @@ int runtime_step(runtime_t *rt) {
   int rolled = 0;
   for (size_t i = 0; i < rt->norgans; i++) {
     organ_rt_t *o = &rt->organs[i];
-    contact_ctx_t ctx = {rt, i};
-    if (mass_spring_step(&o->ms, dt, o->substeps, apply_contacts, &ctx) < 0) {
+    if (o->model->ops->step(o->model, dt) < 0) {
       o->rollbacks++;
       rolled++;
     }
+    /* Every step, rolled back or not: the proxy trusts the boxes. */
+    aabb_tree_refit(&o->tree, o->model->surf_x);
   }
   /* Report the force at the end of the step, with the proxy on the moved surface. */
   for (size_t t = 0; t < rt->ntools; t++) {

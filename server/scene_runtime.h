@@ -10,21 +10,27 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "collision/aabb_tree.h"
 #include "haptics/proxy.h"
 #include "mesh.h"
-#include "physics/mass_spring.h"
+#include "physics/model.h"
 #include "scene.h"
 #include "tool_input.h"
 #include "verr.h"
 
+/* An organ: its model (model.h) owns the state. Everything that touches
+ * the organ from outside (proxies, contact patch, publishing) uses the
+ * model's surface: surf_x, surf_rest, surf_tris, nsurf. */
+struct runtime;
+
 typedef struct organ_rt {
   const scene_organ_t *cfg;
   uint32_t id;
-  mesh_t rest;       /* the imported mesh after scale and position */
-  mass_spring_t ms;  /* v1: the only model */
-  int substeps;      /* per scene step, from the stability bound */
-  double patch_radius; /* m, contact patch radius: max(2 tool radius, 1.5 mean edge) */
-  double stable_dt;  /* s, the integrator's bound including tool stiffness */
+  struct runtime *rt;  /* back pointer for the model's contact hook */
+  mesh_t rest;         /* the imported mesh after scale and position */
+  model_t *model;      /* sub-steps and stable dt live in the model */
+  double patch_radius; /* m, contact patch radius: max(2 tool radius, 1.5 mean surface edge) */
+  aabb_tree_t tree;    /* over the model's contact surface, refit after every step */
   uint64_t rollbacks;
 } organ_rt_t;
 
@@ -57,8 +63,9 @@ typedef struct runtime {
   double sim_time; /* s */
 } runtime_t;
 
-/* Imports every organ mesh, builds its model and chooses sub-steps so the
- * integrator is stable at the scene's dt. Errors name the organ and file. */
+/* Imports every organ mesh and builds its model (model_create: the model
+ * chooses its sub-steps from the scene's dt and the stiffest tool). Errors
+ * name the scene file, the organ's line and the organ. */
 int runtime_init(runtime_t *rt, const scene_t *scene, verr_t *err);
 void runtime_destroy(runtime_t *rt);
 

@@ -63,8 +63,8 @@ static void publish_scene_info(server_t *s) {
     snprintf(organs[i].name, sizeof organs[i].name, "%s", o->cfg->name);
     snprintf(organs[i].model, sizeof organs[i].model, "%s", o->cfg->model);
     snprintf(organs[i].integrator, sizeof organs[i].integrator, "%s", o->cfg->integrator);
-    organs[i].vertex_count = (uint32_t)o->rest.nverts;
-    organs[i].triangle_count = (uint32_t)o->rest.ntris;
+    organs[i].vertex_count = (uint32_t)o->model->nsurf;
+    organs[i].triangle_count = (uint32_t)o->model->nsurf_tris;
     memcpy(organs[i].color, o->cfg->color, sizeof organs[i].color);
   }
   for (size_t t = 0; t < s->rt.ntools; t++) {
@@ -99,7 +99,7 @@ static int setup(server_t *s, const scene_t *scene, verr_t *err) {
     return -1;
   for (size_t i = 0; i < s->rt.norgans; i++) {
     organ_rt_t *o = &s->rt.organs[i];
-    if (mesh_publisher_init(&s->pubs[i], o->id, o->rest.nverts, o->rest.tris, o->rest.ntris,
+    if (mesh_publisher_init(&s->pubs[i], o->id, o->model->nsurf, o->model->surf_tris, o->model->nsurf_tris,
                             (float)scene->quant_step, s->w_state, s->w_delta, err))
       return -1;
   }
@@ -207,8 +207,9 @@ static void publish_metrics(server_t *s, uint64_t window_steps) {
     m.step_time_us_median = st.median;
     m.step_time_us_p99 = st.p99;
     m.steps_per_s = (double)take;
-    m.error_estimate = mass_spring_max_strain(&s->rt.organs[i].ms);
-    snprintf(m.error_kind, sizeof m.error_kind, "%s", "max_edge_strain");
+    const model_t *model = s->rt.organs[i].model;
+    m.error_estimate = model->ops->error_estimate(model);
+    snprintf(m.error_kind, sizeof m.error_kind, "%s", model->error_kind ? model->error_kind : "");
     m.peak_force = peak;
     m.rejected_commands = s->stats->rejected_total;
     dds_write(s->w_metrics, &m);
@@ -216,7 +217,8 @@ static void publish_metrics(server_t *s, uint64_t window_steps) {
 }
 
 static void publish_frames(server_t *s) {
-  for (size_t i = 0; i < s->rt.norgans; i++) mesh_publisher_frame(&s->pubs[i], s->rt.organs[i].ms.x, sim_ns(s));
+  for (size_t i = 0; i < s->rt.norgans; i++)
+    mesh_publisher_frame(&s->pubs[i], s->rt.organs[i].model->surf_x, sim_ns(s));
 }
 
 static void write_final_mesh(server_t *s) {
@@ -228,8 +230,9 @@ static void write_final_mesh(server_t *s) {
       snprintf(path, sizeof path, "%s", s->opts->final_mesh);
     else
       snprintf(path, sizeof path, "%s.%zu", s->opts->final_mesh, i);
-    mesh_t m = s->rt.organs[i].rest;
-    m.pos = s->rt.organs[i].ms.x;
+    const model_t *model = s->rt.organs[i].model;
+    mesh_t m = {.nverts = model->nsurf, .ntris = model->nsurf_tris, .pos = model->surf_x,
+                .tris = (uint32_t *)model->surf_tris};
     char comment[160];
     snprintf(comment, sizeof comment, "organ %zu topology %u keyframe %u frame %u", i, s->pubs[i].topology_version,
              s->pubs[i].keyframe_seq, s->pubs[i].frame_seq);
@@ -252,17 +255,22 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
   if (!opts->quiet) {
     for (size_t i = 0; i < s.rt.norgans; i++) {
       const organ_rt_t *o = &s.rt.organs[i];
+      const model_t *m = o->model;
       fprintf(stderr,
-              "server: organ '%s': %zu vertices, %zu triangles, %zu springs, %s, %d sub-step(s) per %.3g ms "
-              "(stable below %.3g ms)\n",
-              o->cfg->name, o->rest.nverts, o->rest.ntris, o->ms.nsprings, o->cfg->integrator, o->substeps,
-              scene->dt * 1e3, o->stable_dt * 1e3);
+              "server: organ '%s': %s, %s, %zu nodes, %zu tetrahedra, surface %zu vertices / %zu triangles, "
+              "%d sub-step(s) per %.3g ms (stable below %.3g ms)\n",
+              o->cfg->name, m->ops->name, o->cfg->integrator, m->nnodes, m->ntets, m->nsurf, m->nsurf_tris,
+              m->substeps, scene->dt * 1e3, m->stable_dt * 1e3);
+      if (m->substeps > 0 && scene->dt / m->substeps > m->stable_dt)
+        fprintf(stderr, "server: organ '%s': warning: solver.substeps %d gives %.3g ms sub-steps, above the "
+                        "stable %.3g ms: expect rollbacks\n",
+                o->cfg->name, m->substeps, scene->dt / m->substeps * 1e3, m->stable_dt * 1e3);
     }
     fprintf(stderr, "server: scene '%s' running on domain %d, partition '%s'\n", scene->name, opts->domain,
             opts->partition ? opts->partition : VDDS_DEFAULT_PARTITION);
   }
   publish_scene_info(&s);
-  for (size_t i = 0; i < s.rt.norgans; i++) mesh_publisher_keyframe(&s.pubs[i], s.rt.organs[i].ms.x, 0);
+  for (size_t i = 0; i < s.rt.norgans; i++) mesh_publisher_keyframe(&s.pubs[i], s.rt.organs[i].model->surf_x, 0);
   publish_event(&s, viscera_EVENT_SESSION_STARTED, -1, -1, 0, scene->name);
 
   uint64_t dt_ns = (uint64_t)(scene->dt * 1e9);

@@ -3,6 +3,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "collision/aabb_tree.h"
 #include "vmath.h"
 
 static void tri_vertices(const proxy_surface_t *s, uint32_t t, const double **a, const double **b, const double **c) {
@@ -37,14 +38,37 @@ void proxy_follow_surface(proxy_t *p, const proxy_surface_t *surfaces, size_t ns
   tri_normal(&rest, p->tri, p->normal);
 }
 
-/* Nearest surface point to q over all triangles of all surfaces. Every point
+/* The surface's tree, if it describes this surface: a tree refit from
+ * another array (or built over another triangle list) would answer for a
+ * different surface, so the scan runs instead. */
+static const aabb_tree_t *usable_tree(const proxy_surface_t *s) {
+  const aabb_tree_t *t = s->tree;
+  return t && t->x == s->x && t->ntris == s->ntris ? t : NULL;
+}
+
+/* Nearest surface point to q over all triangles of all surfaces; ties go to
+ * the first surface, then the lowest triangle. Every point
  * of a triangle lies within its longest edge of its first vertex, so a
  * triangle whose first vertex is farther than best + max_edge cannot win:
- * one dot product skips the exact test for almost every triangle. */
+ * one dot product skips the exact test for almost every triangle. A tree
+ * finds the same triangle by branch and bound, seeded with the best distance
+ * of the surfaces before it so it only reports a strictly nearer one. */
 static void nearest_on_surfaces(const double q[3], const proxy_surface_t *surfaces, size_t nsurfaces, proxy_t *p) {
   double best = INFINITY;
   for (size_t si = 0; si < nsurfaces; si++) {
     const proxy_surface_t *s = &surfaces[si];
+    const aabb_tree_t *tree = usable_tree(s);
+    if (tree) {
+      aabb_nearest_t r;
+      if (aabb_tree_nearest(tree, q, best, &r)) {
+        best = r.dist2;
+        p->surface = (int)si;
+        p->tri = r.tri;
+        v3_copy(p->bary, r.bary);
+        v3_copy(p->pos, r.point);
+      }
+      continue;
+    }
     for (size_t t = 0; t < s->ntris; t++) {
       const double *a, *b, *c;
       tri_vertices(s, (uint32_t)t, &a, &b, &c);
@@ -67,7 +91,8 @@ static void nearest_on_surfaces(const double q[3], const proxy_surface_t *surfac
   }
 }
 
-/* First triangle the device path enters from outside. */
+/* First triangle the device path enters from outside (smallest segment
+ * parameter; ties to the first surface, then the lowest triangle). */
 static int find_entry(const double p0[3], const double p1[3], const proxy_surface_t *surfaces, size_t nsurfaces,
                       proxy_t *p) {
   double best_t = INFINITY, dir[3], seg_lo[3], seg_hi[3];
@@ -78,6 +103,17 @@ static int find_entry(const double p0[3], const double p1[3], const proxy_surfac
   }
   for (size_t si = 0; si < nsurfaces; si++) {
     const proxy_surface_t *s = &surfaces[si];
+    const aabb_tree_t *tree = usable_tree(s);
+    if (tree) {
+      aabb_hit_t h;
+      if (aabb_tree_segment_first(tree, p0, p1, AABB_SEG_ENTERING, best_t, &h)) {
+        best_t = h.t;
+        p->surface = (int)si;
+        p->tri = h.tri;
+        v3_copy(p->bary, h.bary);
+      }
+      continue;
+    }
     for (size_t t = 0; t < s->ntris; t++) {
       const double *a, *b, *c;
       double tt, bary[3], n[3];

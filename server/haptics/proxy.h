@@ -13,8 +13,8 @@
  * The contact normal is the contact triangle's rest normal when rest
  * positions are given: the dented surface's own triangles tilt wildly under
  * a probe, while the organ's undeformed orientation is what the hand pushes
- * against. v1 treats the tool tip as a point; brute-force over triangles (an AABB tree
- * replaces this with the collision work). */
+ * against. The tool tip is a point. Queries scan every triangle, or use the
+ * surface's AABB tree when one is given (same results, see below). */
 #ifndef VISCERA_PROXY_H
 #define VISCERA_PROXY_H
 
@@ -30,6 +30,12 @@ typedef struct proxy_surface {
   size_t ntris;
   double max_edge;       /* m, bound on any edge length while deformed (0: no culling) */
   const double *x_rest;  /* rest positions for contact normals, or NULL for current */
+  /* Optional AABB tree over (x, tris) (collision/aabb_tree.h), or NULL to scan
+   * every triangle. It must be refit from x after every change of x (each
+   * physics step) before the next proxy_update; with it the proxy gives the
+   * same results as the scan. It is used only while it was last refit from
+   * this very x array and has ntris triangles; otherwise the scan runs. */
+  const struct aabb_tree *tree;
 } proxy_surface_t;
 
 typedef struct proxy {

@@ -22,7 +22,9 @@ struct force_system {
   /* out = (a K(x) + b C(x)) y, K = -dF/dx, C = -dF/dv, evaluated at x. May be
    * NULL: the implicit integrator is then unavailable for the model. */
   void (*stiffness_mul)(force_system_t *s, const double *x, double a, double b, const double *y, double *out);
-  /* Called before every sub-step (contact hooks); may be NULL. */
+  /* Called before EVERY force evaluation (Verlet: 2 per sub-step, RK4: 4),
+   * so it must set the external forces (contact hooks), not add to them;
+   * may be NULL. */
   void (*pre_substep)(force_system_t *s);
   void *ctx; /* the owning model */
 };

@@ -3,9 +3,9 @@
  *   explicit_euler    x += h v; v += h M^-1 F(x, v)           (1st order, unstable undamped)
  *   symplectic_euler  v += h M^-1 F(x, v); x += h v            (1st order, h < 2/omega)
  *   verlet            velocity Verlet, kick-drift-kick         (2nd order, h < 2/omega)
- *   rk4               classical Runge-Kutta                    (4th order, h < 2.78/omega)
+ *   rk4               classical Runge-Kutta                    (4th order, h < 2.83/omega undamped)
  *   implicit_euler    one linearised backward Euler step:
- *                     (M + h C + h^2 K) dv = h (F + h K v), CG to cg_tolerance
+ *                     (M + h C + h^2 K) dv = h (F - h K v), K = -dF/dx, CG to cg_tolerance
  *                                                              (unconditionally stable, damps)
  * Scratch buffers are allocated once in integrator_init for n nodes; a step
  * allocates nothing. Fixed nodes (inv_mass 0) never move. */

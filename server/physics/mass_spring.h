@@ -1,35 +1,48 @@
-/* mass_spring: mass-spring model on a triangle surface (seed 002 §4.2.3, §5.2.4;
- * seed 000 eq. 1-5).
+/* mass_spring: mass-spring forces as a force_system_t (seed 002 §4.2.3,
+ * §5.2.4; seed 000 eq. 1-5), for the integrators in integrator.h.
  *
- * Every unique mesh edge is a spring with Kelvin-Voigt damping (seed 002 eq.
- * 5.3): f = k (L - L0) u + c ((v_j - v_i) . u) u. Every vertex also has a home
- * spring to its rest position with ground damping, which preserves the organ's
- * shape. Masses are lumped and equal (total / vertices). Vertices can be fixed.
+ * Springs are the unique edges of a triangle surface (surface variant) or of
+ * a tetrahedral mesh (volume variant). Every spring has Kelvin-Voigt damping
+ * (seed 002 eq. 5.3): the force on i is f = k (L - L0) u + c ((v_j - v_i) . u) u
+ * with u the unit vector from i to j. Every node also has a home spring to
+ * its rest position with ground damping (the surrounding tissue holding the
+ * organ's shape), and gravity acts on the lumped masses, which are equal
+ * (total / nodes: area or volume weighting would give the tiny elements of
+ * real meshes tiny masses and with them a much smaller stable step). Nodes
+ * can be fixed (inverse mass 0).
  *
- * State is structure-of-arrays, allocated once in mass_spring_create; stepping
- * allocates nothing. Not thread-safe: one physics thread owns a model. */
+ * Jacobians (stiffness_mul). K = -dF/dx is exact for the conservative forces:
+ * per spring k [u u^T + (1 - L0/L)(I - u u^T)] (the second part is the
+ * geometric term), plus home_stiffness I. C = -dF/dv is exact: c u u^T per
+ * spring plus home_damping I. The damping force also turns with u, a
+ * dependence on x that needs v and is not symmetric; it is left out of K,
+ * as is usual for the implicit solve (it vanishes at v = 0). A compressed
+ * spring (L < L0) has a negative geometric term and can make K indefinite,
+ * which conjugate gradients cannot solve: with `definite_jacobian` set,
+ * stiffness_mul clamps (1 - L0/L) at 0, the standard positive semi-definite
+ * approximation (exact for stretched springs).
+ *
+ * Arrays are allocated once in mass_spring_create_*; forces, stiffness_mul,
+ * energy and strain allocate nothing. Not thread-safe: one physics thread
+ * owns the object. */
 #ifndef VISCERA_MASS_SPRING_H
 #define VISCERA_MASS_SPRING_H
 
 #include <stddef.h>
 #include <stdint.h>
 
+#include "force_system.h"
 #include "mesh.h"
+#include "tet_mesh.h"
 #include "verr.h"
-
-typedef enum ms_integrator {
-  MS_SYMPLECTIC_EULER, /* v += h a(x, v); x += h v   (stable for h^2 l_k + 2 h l_c < 4) */
-  MS_EXPLICIT_EULER    /* x += h v; v += h a(x, v)   (unstable undamped at any h) */
-} ms_integrator_t;
 
 typedef struct ms_params {
   double mass;           /* kg, total */
   double stiffness;      /* N/m per edge spring */
   double damping;        /* N s/m per edge spring */
-  double home_stiffness; /* N/m per vertex */
-  double home_damping;   /* N s/m per vertex */
+  double home_stiffness; /* N/m per node */
+  double home_damping;   /* N s/m per node */
   double gravity[3];     /* m/s^2 */
-  ms_integrator_t integrator;
 } ms_params_t;
 
 typedef struct ms_spring {
@@ -38,57 +51,61 @@ typedef struct ms_spring {
 } ms_spring_t;
 
 typedef struct mass_spring {
-  size_t n;            /* vertices */
+  force_system_t fs; /* first member; x, v, mass, inv_mass point into this object. ctx and
+                      * pre_substep are left NULL for the owner (the model) to set */
+  size_t n;          /* nodes */
   size_t nsprings;
   ms_params_t p;
-  double *x, *v;       /* 3n, current state */
-  double *x_rest;      /* 3n, home positions */
-  double *f;           /* 3n, force scratch */
-  double *f_ext;       /* 3n, external forces for the next step (cleared by step) */
-  double *inv_mass;    /* n, 0 for fixed vertices */
-  double *mass;        /* n */
-  double *x_prev, *v_prev; /* 3n, last good state for rollback */
+  double *x, *v;    /* 3n, current state */
+  double *x_rest;   /* 3n, home positions */
+  double *f_ext;    /* 3n, external forces, included by forces() until cleared */
+  double *mass;     /* n */
+  double *inv_mass; /* n, 0 for fixed nodes */
   ms_spring_t *springs;
+  int definite_jacobian; /* see above; 0 after create */
 } mass_spring_t;
 
-/* Builds springs from the unique edges of `surface` and lumps masses.
- * Returns 0, or -1 with err (bad parameters, OOM, zero-area mesh). */
-int mass_spring_create(mass_spring_t *ms, const mesh_t *surface, const ms_params_t *p, verr_t *err);
+/* Springs from the unique edges of the triangles of `surface` (nodes = its
+ * vertices). Returns 0, or -1 with err (bad parameters, OOM, zero area). */
+int mass_spring_create_surface(mass_spring_t *ms, const mesh_t *surface, const ms_params_t *p, verr_t *err);
+/* Springs from the unique edges of the tetrahedra of `t` (nodes = its nodes). */
+int mass_spring_create_tets(mass_spring_t *ms, const tet_mesh_t *t, const ms_params_t *p, verr_t *err);
 void mass_spring_destroy(mass_spring_t *ms);
 
-/* Fixes every vertex whose rest z is below z (zero inverse mass). Returns how many. */
+/* Fixes every node whose rest z is below z (zero inverse mass). Returns how many. */
 size_t mass_spring_fix_below(mass_spring_t *ms, double z);
 
-/* Largest step h for which the chosen integrator stays stable: with l_k and
- * l_c the largest eigenvalues of M^-1 K and M^-1 C at rest (power
- * iteration), symplectic Euler needs h^2 l_k + 2 h l_c < 4. Explicit Euler
- * has no bound for undamped systems: returns the damped bound
- * h <= 2 zeta / omega = l_c / l_k, which may be 0. Allocates scratch. */
-double mass_spring_stable_dt(const mass_spring_t *ms);
-
-/* Accumulates internal + home + gravity + f_ext forces for state (x, v) into f. */
+/* f = F(x, v): edge springs and dampers, home springs and dampers, gravity
+ * and f_ext. Forces stay finite for coincident nodes (a zero-length spring
+ * has no direction and pushes nothing). */
 void mass_spring_forces(const mass_spring_t *ms, const double *x, const double *v, double *f);
+/* out = (a K(x) + b C(x)) y, as described above. */
+void mass_spring_stiffness_mul(const mass_spring_t *ms, const double *x, double a, double b, const double *y,
+                               double *out);
 
-/* Adds an external force (N) at vertex i for the next step. */
+/* Largest eigenvalues of M^-1 K and M^-1 C at the rest state over the free
+ * nodes, with extra_home_k (N/m) added to every node's home spring (the
+ * stiffest tool spring that may touch it). Power iteration with the
+ * M-weighted Rayleigh quotient, scaled up 2 % for the unconverged remainder
+ * and capped by the block-Gershgorin bound max_i (2 sum_j k_ij + k_home) / m_i,
+ * which can never be exceeded. Allocates scratch (construction time only).
+ * Returns 0, or -1 on OOM. */
+int mass_spring_eigen_bounds(const mass_spring_t *ms, double extra_home_k, double *lambda_k, double *lambda_c);
+
+/* Adds an external force (N) at node i; forces() includes it until cleared. */
 static inline void mass_spring_add_force(mass_spring_t *ms, uint32_t i, const double f[3]) {
   ms->f_ext[3 * i] += f[0];
   ms->f_ext[3 * i + 1] += f[1];
   ms->f_ext[3 * i + 2] += f[2];
 }
 
-/* Called before each sub-step's force evaluation, so stiff couplings (the
- * haptic proxy spring) are re-evaluated at the sub-step rate; it may add to
- * f_ext, which is cleared after every sub-step. */
-typedef void (*ms_substep_fn)(mass_spring_t *ms, void *ctx);
-
-/* Advances by h with `substeps` equal sub-steps (pre may be NULL). If any
- * coordinate becomes non-finite, restores the state from before the call and
- * returns -1 (the step is rolled back); otherwise 0. */
-int mass_spring_step(mass_spring_t *ms, double h, int substeps, ms_substep_fn pre, void *ctx);
-
-/* Kinetic + elastic (edge and home springs) energy, J. */
+/* Kinetic + elastic (edge and home springs) + gravitational potential
+ * energy, J; f_ext does no bookkeeping here. */
 double mass_spring_energy(const mass_spring_t *ms);
-/* Largest |L/L0 - 1| over springs: the live strain figure. */
+/* Potential energy at positions x: edge and home springs plus gravity, so
+ * that F(x, 0) = -grad U(x) + f_ext. */
+double mass_spring_potential(const mass_spring_t *ms, const double *x);
+/* Largest |L/L0 - 1| over springs with L0 > 0: the live strain figure. */
 double mass_spring_max_strain(const mass_spring_t *ms);
 
 #endif

@@ -206,7 +206,12 @@ static void test_empty(void) {
 
 static void test_unknown_and_duplicate_keys(void) {
   CHECK(fails_with(HEAD "    colour: [1, 0, 0]\n", "t.yaml:5: field 'organs[0].colour': unknown key",
-                   "allowed: name, mesh, model, integrator, position, scale, color, fixed_below, material"));
+                   "allowed: name, mesh, model, integrator, solver, position, scale, color, fixed_below, material"));
+  CHECK(fails_with(HEAD "    solver:\n      substep: 3\n", "t.yaml:6: field 'organs[0].solver.substep': unknown key",
+                   "allowed: substeps, iterations, cg_tolerance, cg_max_iterations, tet_size"));
+  CHECK(fails_with(HEAD "    material: {bond: 3}\n", "organs[0].material.bond': unknown key",
+                   "bond_k, angle_k, stretch_bend_k, distance_stiffness, volume_stiffness, distance_compliance, "
+                   "volume_compliance, slope_m1, slope_m2, slope_m3, refine_area, refine_levels)"));
   CHECK(fails_with(HEAD "physic:\n  dt: 0.001\n", "t.yaml:5: field 'physic': unknown key",
                    "allowed: scene, description, physics, organs, tools"));
   CHECK(fails_with(HEAD "    material:\n      springiness: 3\n", "t.yaml:6:", "organs[0].material.springiness"));
@@ -237,8 +242,14 @@ static void test_wrong_types(void) {
   CHECK(fails_with(HEAD "description: \"a\\0b\"\n", "field 'description': must not contain NUL bytes", NULL));
   CHECK(fails_with(HEAD "    model: fem\n", "t.yaml:5: field 'organs[0].model': must be one of: mass_spring_surface",
                    "(got 'fem')"));
-  CHECK(fails_with(HEAD "    integrator: rk4\n",
-                   "t.yaml:5:", "organs[0].integrator': must be one of: symplectic_euler, explicit_euler (got 'rk4')"));
+  CHECK(fails_with(HEAD "    integrator: leapfrog\n", "t.yaml:5:",
+                   "organs[0].integrator': must be one of: symplectic_euler, explicit_euler, verlet, rk4, "
+                   "implicit_euler (got 'leapfrog')"));
+  CHECK(fails_with(HEAD "    model: fem\n", "mass_spring_surface, mass_spring_tet, molecular, pbd, xpbd, vertex_based, "
+                   "adaptive_mass_spring (got 'fem')", NULL));
+  CHECK(fails_with(HEAD "    solver: 4\n", "t.yaml:5: field 'organs[0].solver': must be a mapping", NULL));
+  CHECK(fails_with(HEAD "    solver: {substeps: two}\n", "organs[0].solver.substeps': must be a number (got 'two')",
+                   NULL));
   CHECK(fails_with(HEAD "    integrator: [a]\n", "organs[0].integrator': must be one of", "(got a list)"));
   CHECK(fails_with(HEAD "tools:\n  - name: s\n    kind: scalpel\n", "t.yaml:7: field 'tools[0].kind'",
                    "must be one of: probe (got 'scalpel')"));
@@ -284,6 +295,174 @@ static void test_out_of_range(void) {
       fails_with(HEAD "tools: [{name: p, stiffness: 2e5}]\n", "tools[0].stiffness': must be > 0 and <= 100000", NULL));
   CHECK(fails_with(HEAD "tools: [{name: p, max_force: 0}]\n", "tools[0].max_force'", NULL));
   CHECK(fails_with(HEAD "tools: [{name: p, max_force: 101}]\n", "tools[0].max_force'", NULL));
+}
+
+
+/* The model-specific fields: solver settings and the extra material keys,
+ * with their defaults (scene.h) and every range. */
+static const char models_yaml[] = "scene: models\n"                  /* 1 */
+                                  "organs:\n"                        /* 2 */
+                                  "  - name: liver\n"                /* 3 */
+                                  "    mesh: l.obj\n"                /* 4 */
+                                  "    model: mass_spring_tet\n"     /* 5 */
+                                  "    integrator: implicit_euler\n" /* 6 */
+                                  "    solver:\n"                    /* 7 */
+                                  "      substeps: 4\n"              /* 8 */
+                                  "      iterations: 20\n"           /* 9 */
+                                  "      cg_tolerance: 1e-6\n"       /* 10 */
+                                  "      cg_max_iterations: 500\n"   /* 11 */
+                                  "      tet_size: 0.004\n"          /* 12 */
+                                  "    material:\n"                  /* 13 */
+                                  "      bond_k: 40\n"               /* 14 */
+                                  "      angle_k: 0.002\n"           /* 15 */
+                                  "      stretch_bend_k: -0.1\n"     /* 16 */
+                                  "      distance_stiffness: 0.5\n"  /* 17 */
+                                  "      volume_stiffness: 0\n"      /* 18 */
+                                  "      distance_compliance: 0\n"   /* 19 */
+                                  "      volume_compliance: 2e-7\n"  /* 20 */
+                                  "      slope_m1: 0.9\n"            /* 21 */
+                                  "      slope_m2: 0.95\n"           /* 22 */
+                                  "      slope_m3: 0.1\n"            /* 23 */
+                                  "      refine_area: 1e-5\n"        /* 24 */
+                                  "      refine_levels: 4\n";        /* 25 */
+
+static void test_model_fields(void) {
+  CHECK(loads(models_yaml, NULL));
+  const scene_organ_t *o = &s.organs[0];
+  CHECK(!strcmp(o->model, "mass_spring_tet"));
+  CHECK(!strcmp(o->integrator, "implicit_euler"));
+  CHECK(o->solver.substeps == 4 && o->solver.iterations == 20 && o->solver.cg_max_iterations == 500);
+  CHECK_NEAR(o->solver.cg_tolerance, 1e-6, 1e-20);
+  CHECK_NEAR(o->solver.tet_size, 0.004, 1e-18);
+  const scene_material_t *m = &o->material;
+  CHECK_NEAR(m->bond_k, 40, 0);
+  CHECK_NEAR(m->angle_k, 0.002, 1e-18);
+  CHECK_NEAR(m->stretch_bend_k, -0.1, 1e-16);
+  CHECK_NEAR(m->distance_stiffness, 0.5, 0);
+  CHECK_NEAR(m->volume_stiffness, 0, 0);
+  CHECK_NEAR(m->distance_compliance, 0, 0);
+  CHECK_NEAR(m->volume_compliance, 2e-7, 1e-22);
+  /* Slopes out of order are fine for a model that does not use them. */
+  CHECK_NEAR(m->slope_m1, 0.9, 1e-16);
+  CHECK_NEAR(m->slope_m2, 0.95, 1e-16);
+  CHECK_NEAR(m->slope_m3, 0.1, 1e-16);
+  CHECK_NEAR(m->refine_area, 1e-5, 1e-20);
+  CHECK(m->refine_levels == 4);
+  /* Defaults: every model and integrator name is accepted; the rest as in scene.h. */
+  static const char *const models[] = {"mass_spring_surface", "mass_spring_tet", "molecular", "pbd", "xpbd",
+                                       "vertex_based", "adaptive_mass_spring"};
+  static const char *const integrators[] = {"explicit_euler", "symplectic_euler", "verlet", "rk4", "implicit_euler"};
+  char yaml[256];
+  for (size_t i = 0; i < sizeof models / sizeof models[0]; i++) {
+    snprintf(yaml, sizeof yaml, HEAD "    model: %s\n", models[i]);
+    CHECK(loads(yaml, NULL) && !strcmp(s.organs[0].model, models[i]));
+  }
+  for (size_t i = 0; i < sizeof integrators / sizeof integrators[0]; i++) {
+    snprintf(yaml, sizeof yaml, HEAD "    integrator: %s\n", integrators[i]);
+    CHECK(loads(yaml, NULL) && !strcmp(s.organs[0].integrator, integrators[i]));
+  }
+  CHECK(loads(HEAD, NULL));
+  o = &s.organs[0];
+  m = &o->material;
+  CHECK(o->solver.substeps == 0 && o->solver.iterations == 10 && o->solver.cg_max_iterations == 200);
+  CHECK_NEAR(o->solver.cg_tolerance, 1e-3, 0);
+  CHECK_NEAR(o->solver.tet_size, 0, 0);
+  CHECK_NEAR(m->bond_k, 30, 0);
+  CHECK_NEAR(m->angle_k, 1e-3, 0);
+  CHECK_NEAR(m->stretch_bend_k, 0, 0);
+  CHECK_NEAR(m->distance_stiffness, 1, 0);
+  CHECK_NEAR(m->volume_stiffness, 1, 0);
+  CHECK_NEAR(m->distance_compliance, 1e-4, 0);
+  CHECK_NEAR(m->volume_compliance, 1e-6, 0);
+  CHECK_NEAR(m->slope_m1, 1, 0);
+  CHECK_NEAR(m->slope_m2, 0.6, 0);
+  CHECK_NEAR(m->slope_m3, 0.3, 0);
+  CHECK_NEAR(m->refine_area, 2e-5, 0);
+  CHECK(m->refine_levels == 2);
+  /* Limits themselves load. */
+  CHECK(loads(HEAD "    solver: {substeps: 256, iterations: 1000, cg_tolerance: 0.1, cg_max_iterations: 10000, "
+                   "tet_size: 0.1}\n", NULL));
+  CHECK(loads(HEAD "    solver: {substeps: 0, iterations: 1, cg_tolerance: 1e-12, cg_max_iterations: 1, "
+                   "tet_size: 1e-4}\n", NULL));
+  CHECK(loads(HEAD "    material: {distance_stiffness: 1, volume_stiffness: 1, refine_levels: 1}\n", NULL));
+}
+
+static void test_model_field_ranges(void) {
+  CHECK(fails_with(HEAD "    solver:\n      substeps: 257\n",
+                   "t.yaml:6: field 'organs[0].solver.substeps': must be >= 0 and <= 256 (got 257)", NULL));
+  CHECK(fails_with(HEAD "    solver: {substeps: -1}\n", "organs[0].solver.substeps': must be >= 0", NULL));
+  CHECK(fails_with(HEAD "    solver: {substeps: 2.5}\n",
+                   "t.yaml:5: field 'organs[0].solver.substeps': must be a whole number (got 2.5)", NULL));
+  CHECK(fails_with(HEAD "    solver: {iterations: 0}\n", "organs[0].solver.iterations': must be >= 1 and <= 1000",
+                   NULL));
+  CHECK(fails_with(HEAD "    solver: {iterations: 1001}\n", "organs[0].solver.iterations'", "(got 1001)"));
+  CHECK(fails_with(HEAD "    solver: {cg_tolerance: 1e-13}\n",
+                   "organs[0].solver.cg_tolerance': must be >= 1e-12 and <= 0.1 (got 1e-13)", NULL));
+  CHECK(fails_with(HEAD "    solver: {cg_tolerance: 0.2}\n", "organs[0].solver.cg_tolerance'", NULL));
+  CHECK(fails_with(HEAD "    solver: {cg_max_iterations: 0}\n",
+                   "organs[0].solver.cg_max_iterations': must be >= 1 and <= 10000", NULL));
+  CHECK(fails_with(HEAD "    solver: {cg_max_iterations: 10001}\n", "organs[0].solver.cg_max_iterations'", NULL));
+  CHECK(fails_with(HEAD "    solver: {cg_max_iterations: 1e3x}\n", "must be a number", NULL));
+  CHECK(fails_with(HEAD "    solver:\n      tet_size: 5e-5\n",
+                   "t.yaml:6: field 'organs[0].solver.tet_size': must be 0 (automatic) or >= 0.0001 and <= 0.1 "
+                   "(got 5e-5)", NULL));
+  CHECK(fails_with(HEAD "    solver: {tet_size: 0.2}\n", "organs[0].solver.tet_size': must be >= 0 and <= 0.1", NULL));
+  CHECK(fails_with(HEAD "    solver: {tet_size: -0.01}\n", "organs[0].solver.tet_size'", NULL));
+  CHECK(fails_with(HEAD "    material: {bond_k: -1}\n", "organs[0].material.bond_k': must be >= 0", NULL));
+  CHECK(fails_with(HEAD "    material: {angle_k: -1}\n", "organs[0].material.angle_k': must be >= 0", NULL));
+  CHECK(fails_with(HEAD "    material: {stretch_bend_k: .nan}\n",
+                   "organs[0].material.stretch_bend_k': must be a finite", NULL));
+  CHECK(fails_with(HEAD "    material: {distance_stiffness: 1.5}\n",
+                   "organs[0].material.distance_stiffness': must be >= 0 and <= 1 (got 1.5)", NULL));
+  CHECK(fails_with(HEAD "    material: {volume_stiffness: -0.1}\n", "organs[0].material.volume_stiffness'", NULL));
+  CHECK(fails_with(HEAD "    material: {distance_compliance: -1e-5}\n",
+                   "organs[0].material.distance_compliance': must be >= 0", NULL));
+  CHECK(fails_with(HEAD "    material: {volume_compliance: -1}\n", "organs[0].material.volume_compliance'", NULL));
+  CHECK(fails_with(HEAD "    material: {slope_m1: 0}\n", "organs[0].material.slope_m1': must be > 0", NULL));
+  CHECK(fails_with(HEAD "    material: {slope_m2: -1}\n", "organs[0].material.slope_m2': must be > 0", NULL));
+  CHECK(fails_with(HEAD "    material: {slope_m3: 0}\n", "organs[0].material.slope_m3': must be > 0", NULL));
+  CHECK(fails_with(HEAD "    material: {refine_area: 0}\n", "organs[0].material.refine_area': must be > 0", NULL));
+  CHECK(fails_with(HEAD "    material: {refine_levels: 0}\n",
+                   "organs[0].material.refine_levels': must be >= 1 and <= 4 (got 0)", NULL));
+  CHECK(fails_with(HEAD "    material: {refine_levels: 5}\n", "organs[0].material.refine_levels'", NULL));
+  CHECK(fails_with(HEAD "    material: {refine_levels: 1.5}\n", "organs[0].material.refine_levels': must be a whole",
+                   NULL));
+}
+
+/* Checks across fields: the molecular energy must be positive definite and
+ * the vertex-based slopes must fall off from the touched node outwards. */
+static void test_model_consistency(void) {
+  /* k_r k_theta = 30 * 0.001 = 0.03 <= 2 k_sb^2 = 0.08: refused at the
+   * coupling's line, with the numbers. */
+  CHECK(fails_with(HEAD "    model: molecular\n    material:\n      bond_k: 30\n      angle_k: 0.001\n"
+                        "      stretch_bend_k: 0.2\n", "", NULL));
+  CHECK(!strcmp(e.msg, "t.yaml:9: field 'organs[0].material.stretch_bend_k': the molecular model needs bond_k * "
+                       "angle_k > 2 * stretch_bend_k^2 for a positive-definite energy (got 30 * 0.001 = 0.03 <= "
+                       "2 * 0.2^2 = 0.08)"));
+  /* Equality is not enough; a negative coupling counts by its square. */
+  CHECK(fails_with(HEAD "    model: molecular\n    material: {bond_k: 8, angle_k: 0.01, stretch_bend_k: -0.2}\n",
+                   "t.yaml:6: field 'organs[0].material.stretch_bend_k'",
+                   "(got 8 * 0.01 = 0.08 <= 2 * (-0.2)^2 = 0.08)"));
+  /* Without a coupling the fault is the angle or bond term that was given. */
+  CHECK(fails_with(HEAD "    model: molecular\n    material:\n      angle_k: 0\n",
+                   "t.yaml:7: field 'organs[0].material.angle_k'", "(got 30 * 0 = 0 <= 2 * 0^2 = 0)"));
+  CHECK(fails_with(HEAD "    model: molecular\n    material:\n      bond_k: 0\n",
+                   "t.yaml:7: field 'organs[0].material.bond_k'", NULL));
+  CHECK(loads(HEAD "    model: molecular\n", NULL));
+  CHECK(loads(HEAD "    model: molecular\n    material: {bond_k: 30, angle_k: 0.001, stretch_bend_k: 0.12}\n", NULL));
+  CHECK(loads(HEAD "    model: pbd\n    material: {bond_k: 30, angle_k: 0.001, stretch_bend_k: 0.2}\n", NULL));
+  /* The material may come before the model line: still checked. */
+  CHECK(fails_with(HEAD "    material: {stretch_bend_k: 1}\n    model: molecular\n", "t.yaml:5:", "stretch_bend_k"));
+
+  CHECK(fails_with(HEAD "    model: vertex_based\n    material:\n      slope_m1: 0.5\n",
+                   "t.yaml:7: field 'organs[0].material.slope_m1': the vertex_based model needs slope_m1 > slope_m2 > "
+                   "slope_m3 (got 0.5, 0.6, 0.3)", NULL));
+  CHECK(fails_with(HEAD "    model: vertex_based\n    material: {slope_m1: 1, slope_m2: 0.5, slope_m3: 0.5}\n",
+                   "t.yaml:6: field 'organs[0].material.slope_m3'", "(got 1, 0.5, 0.5)"));
+  CHECK(fails_with(HEAD "    model: vertex_based\n    material: {slope_m2: 2}\n",
+                   "organs[0].material.slope_m2'", "(got 1, 2, 0.3)"));
+  CHECK(loads(HEAD "    model: vertex_based\n    material: {slope_m1: 2, slope_m2: 1, slope_m3: 0.5}\n", NULL));
+  CHECK(loads(HEAD "    model: vertex_based\n", NULL));
 }
 
 static void test_missing_required(void) {
@@ -500,6 +679,9 @@ int main(void) {
   test_wrong_types();
   test_not_finite();
   test_out_of_range();
+  test_model_fields();
+  test_model_field_ranges();
+  test_model_consistency();
   test_missing_required();
   test_counts_and_names();
   test_vectors();

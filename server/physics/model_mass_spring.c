@@ -1,0 +1,354 @@
+/* model_mass_spring: the mass-spring force systems of mass_spring.h as
+ * model_t, stepped by an integrator from integrator.h.
+ *
+ *   mass_spring_surface  springs on the surface mesh's edges; the surface IS
+ *                        the node set; no tetrahedra are built.
+ *                        error_kind "max_edge_strain": max |L/L0 - 1|.
+ *   mass_spring_tet      springs on the edges of a tetrahedral mesh built
+ *                        from the surface (tet_mesh_build, solver.tet_size);
+ *                        the surface is embedded barycentrically and follows
+ *                        the nodes. error_kind "volume_error": |V/V0 - 1| of
+ *                        the whole tetrahedral volume.
+ *
+ * Sub-steps: solver.substeps when given; otherwise 1 for implicit Euler
+ * (unconditionally stable) and for the explicit schemes the fewest that keep
+ * each sub-step below 0.9 x the stable dt. The stable dt comes from the
+ * largest eigenvalues of M^-1 K and M^-1 C at rest (power iteration, with
+ * the stiffest tool spring added to every node as a home spring) through
+ * integrator_stable_dt, and also from the slowest mode (the home springs
+ * alone): that one decides explicit Euler's damped bound c/omega^2 when the
+ * home damping ratio is lower than the edges'. More than 256 sub-steps are
+ * refused with the figures.
+ *
+ * Implicit Euler is one linearised step (integrator.h), which is blind to
+ * what the linearisation misses: a flat cloth let go under gravity has no
+ * out-of-plane stiffness at rest, so one 33 ms step moves its nodes straight
+ * down and stretches the springs far beyond what they would reach, creating
+ * energy that then has to be damped out again. Each implicit sub-step is
+ * therefore energy-guarded (the step-size control of Baraff & Witkin 1998,
+ * with energy as the test): it is accepted if the total energy did not grow
+ * by more than the external forces' work (f_ext . dx, exact for forces
+ * constant over the sub-step) plus 0.1 % of the kinetic and elastic energy
+ * (room for the CG tolerance); otherwise it is undone and retried at half
+ * the size, down to 1/256 of the sub-step, after which it is taken as is.
+ * After an accepted attempt the size doubles again up to the full sub-step.
+ *
+ * Rollback: each step starts by saving the state if it is finite; a step
+ * that ends non-finite restores the saved state and returns -1. That is the
+ * state before the call, or, if something outside wrote a non-finite value
+ * into the state since the last step, the state before that step: the last
+ * one known finite (saving every step's end as well would cost a second
+ * copy of the state per step for a case that should not happen). */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "integrator.h"
+#include "mass_spring.h"
+#include "model.h"
+#include "tet_mesh.h"
+
+#define MS_MAX_SUBSTEPS 256
+
+typedef struct ms_model {
+  model_t m; /* first: the model_t the caller holds */
+  mass_spring_t ms;
+  integrator_t it;
+  int tet;
+  tet_mesh_t tm;                    /* tet variant */
+  tet_embedding_t emb;              /* tet variant */
+  double volume0;                   /* tet variant: rest volume, m^3 */
+  double *good_x, *good_v;          /* 3 nnodes: last finite state */
+  double *surf_buf, *surf_rest_buf; /* tet variant: 3 nsurf */
+  uint32_t *tris;                   /* 3 nsurf_tris, the model's own copy */
+  double *try_x, *try_v;            /* implicit Euler: 3 nnodes, the state before an attempt */
+} ms_model_t;
+
+static double state_sum(const ms_model_t *mm) {
+  /* One sum instead of a test per coordinate: NaN or Inf anywhere makes it
+   * non-finite (finite values cannot overflow at any realistic size). */
+  double sum = 0;
+  for (size_t c = 0; c < 3 * mm->ms.n; c++) sum += mm->ms.x[c] + mm->ms.v[c];
+  return sum;
+}
+
+static void embed(ms_model_t *mm) {
+  if (mm->tet) tet_embedding_apply(&mm->emb, &mm->tm, mm->ms.x, mm->surf_buf);
+}
+
+/* Before every sub-step: external forces are valid for one sub-step only;
+ * the surface is brought to the sub-step's positions so the contact hook
+ * sees where the tissue is. */
+static void pre_substep(force_system_t *s) {
+  ms_model_t *mm = s->ctx;
+  memset(mm->ms.f_ext, 0, 3 * mm->ms.n * sizeof(double));
+  embed(mm);
+  if (mm->m.hook) mm->m.hook(&mm->m, mm->m.hook_ctx);
+}
+
+/* Total energy and the part that measures motion and deformation (kinetic +
+ * elastic, >= 0), which scales the guard's tolerance. */
+static double energy_parts(const ms_model_t *mm, double *active) {
+  const mass_spring_t *ms = &mm->ms;
+  double total = mass_spring_energy(ms), grav = 0;
+  for (size_t i = 0; i < ms->n; i++)
+    grav -= ms->mass[i] * (ms->p.gravity[0] * ms->x[3 * i] + ms->p.gravity[1] * ms->x[3 * i + 1] +
+                           ms->p.gravity[2] * ms->x[3 * i + 2]);
+  *active = total - grav;
+  return total;
+}
+
+/* One implicit sub-step of length h under the energy guard (file comment). */
+static void guarded_implicit(ms_model_t *mm, double h) {
+  mass_spring_t *ms = &mm->ms;
+  size_t bytes = 3 * ms->n * sizeof(double);
+  const double h_min = h / 256;
+  double t = 0, hs = h, active, e_old = energy_parts(mm, &active);
+  while (h - t > 1e-12 * h) {
+    if (hs > h - t) hs = h - t;
+    memcpy(mm->try_x, ms->x, bytes);
+    memcpy(mm->try_v, ms->v, bytes);
+    integrator_substep(&mm->it, &ms->fs, hs); /* the hook sets f_ext for this attempt */
+    double work = 0;
+    for (size_t c = 0; c < 3 * ms->n; c++) work += ms->f_ext[c] * (ms->x[c] - mm->try_x[c]);
+    double active_new, e_new = energy_parts(mm, &active_new);
+    int accept = !isfinite(e_new) /* the step's finite check rolls back */ || hs <= h_min ||
+                 e_new - e_old - work <= 1e-3 * (active + fabs(work)) + 1e-12 * fabs(e_old);
+    if (!accept) {
+      memcpy(ms->x, mm->try_x, bytes);
+      memcpy(ms->v, mm->try_v, bytes);
+      hs *= 0.5;
+      continue;
+    }
+    t += hs;
+    e_old = e_new;
+    active = active_new;
+    if (hs < h) hs *= 2;
+    if (!isfinite(e_new)) break;
+  }
+}
+
+static int ms_step(model_t *m, double h) {
+  ms_model_t *mm = (ms_model_t *)m;
+  size_t bytes = 3 * mm->ms.n * sizeof(double);
+  if (isfinite(state_sum(mm))) {
+    memcpy(mm->good_x, mm->ms.x, bytes);
+    memcpy(mm->good_v, mm->ms.v, bytes);
+  }
+  int ss = m->substeps < 1 ? 1 : m->substeps;
+  double hs = h / ss;
+  for (int s = 0; s < ss; s++) {
+    if (mm->it.kind == INT_IMPLICIT_EULER)
+      guarded_implicit(mm, hs);
+    else
+      integrator_substep(&mm->it, &mm->ms.fs, hs);
+  }
+  memset(mm->ms.f_ext, 0, bytes);
+  int ok = isfinite(state_sum(mm));
+  if (!ok) {
+    memcpy(mm->ms.x, mm->good_x, bytes);
+    memcpy(mm->ms.v, mm->good_v, bytes);
+    m->rollbacks++;
+  }
+  embed(mm);
+  return ok ? 0 : -1;
+}
+
+static void ms_destroy(model_t *m) {
+  ms_model_t *mm = (ms_model_t *)m;
+  integrator_destroy(&mm->it);
+  mass_spring_destroy(&mm->ms);
+  if (mm->tet) {
+    tet_mesh_free(&mm->tm);
+    tet_embedding_free(&mm->emb);
+  }
+  free(mm->good_x);
+  free(mm->good_v);
+  free(mm->surf_buf);
+  free(mm->surf_rest_buf);
+  free(mm->tris);
+  free(mm->try_x);
+  free(mm->try_v);
+  free(mm);
+}
+
+static double ms_energy(const model_t *m) { return mass_spring_energy(&((const ms_model_t *)m)->ms); }
+
+static double surface_error(const model_t *m) { return mass_spring_max_strain(&((const ms_model_t *)m)->ms); }
+
+static double tet_error(const model_t *m) {
+  const ms_model_t *mm = (const ms_model_t *)m;
+  double v = 0;
+  for (size_t i = 0; i < mm->tm.ntets; i++) v += tet_volume(&mm->tm, mm->ms.x, i);
+  return mm->volume0 > 0 ? fabs(v / mm->volume0 - 1) : NAN;
+}
+
+static void surface_add_force(model_t *m, uint32_t i, const double f[3]) {
+  ms_model_t *mm = (ms_model_t *)m;
+  if (i < mm->ms.n) mass_spring_add_force(&mm->ms, i, f);
+}
+
+/* The embedded vertex moves as sum_k w_k x_k, so by virtual work a force on
+ * it acts on node k with weight w_k. */
+static void tet_add_force(model_t *m, uint32_t i, const double f[3]) {
+  ms_model_t *mm = (ms_model_t *)m;
+  if (i >= mm->emb.nsurf) return;
+  const uint32_t *q = mm->tm.tets + 4 * (size_t)mm->emb.tet[i];
+  for (int k = 0; k < 4; k++) {
+    double w = mm->emb.bary[4 * (size_t)i + k], fk[3] = {w * f[0], w * f[1], w * f[2]};
+    mass_spring_add_force(&mm->ms, q[k], fk);
+  }
+}
+
+static const model_ops_t SURFACE_OPS = {.name = "mass_spring_surface",
+                                        .step = ms_step,
+                                        .destroy = ms_destroy,
+                                        .energy = ms_energy,
+                                        .error_estimate = surface_error,
+                                        .add_surface_force = surface_add_force};
+static const model_ops_t TET_OPS = {.name = "mass_spring_tet",
+                                    .step = ms_step,
+                                    .destroy = ms_destroy,
+                                    .energy = ms_energy,
+                                    .error_estimate = tet_error,
+                                    .add_surface_force = tet_add_force};
+
+/* Stable dt of the scheme for this system (see the file comment). */
+static int choose_substeps(ms_model_t *mm, const model_params_t *p, integrator_kind_t kind, verr_t *err) {
+  const scene_organ_t *cfg = p->cfg;
+  const mass_spring_t *ms = &mm->ms;
+  double lk, lc;
+  if (mass_spring_eigen_bounds(ms, p->tool_stiffness, &lk, &lc)) return verr_set(err, "out of memory");
+  double m_node = ms->p.mass / (double)ms->n;
+  double lk0 = (ms->p.home_stiffness + p->tool_stiffness) / m_node, lc0 = ms->p.home_damping / m_node;
+  double stable = fmin(integrator_stable_dt(kind, lk, lc), integrator_stable_dt(kind, lk0, lc0));
+  mm->m.stable_dt = stable;
+  if (cfg->solver.substeps > 0) {
+    mm->m.substeps = cfg->solver.substeps;
+    return 0;
+  }
+  if (kind == INT_IMPLICIT_EULER) {
+    mm->m.substeps = 1;
+    return 0;
+  }
+  if (!(stable > 0))
+    return verr_set(err,
+                    "%s is unstable at every step size here (no damping: material damping and home_damping give "
+                    "none against stiffness %g N/m and tool stiffness %g N/m); add damping or use symplectic_euler, "
+                    "verlet, rk4 or implicit_euler",
+                    integrator_name(kind), ms->p.stiffness, p->tool_stiffness);
+  double need = ceil(p->dt / (0.9 * stable));
+  if (!(need <= MS_MAX_SUBSTEPS))
+    return verr_set(err,
+                    "%s is stable only below dt = %.3g s here, which would need %.0f sub-steps of the %.3g s step "
+                    "(limit %d); lower material stiffness, damping or tool stiffness, raise the mass, or use "
+                    "implicit_euler",
+                    integrator_name(kind), stable, need, p->dt, MS_MAX_SUBSTEPS);
+  mm->m.substeps = need < 1 ? 1 : (int)need;
+  return 0;
+}
+
+static model_t *ms_create(const model_params_t *p, int tet, verr_t *err) {
+  const scene_organ_t *cfg = p->cfg;
+  int kind = integrator_parse(cfg->integrator);
+  if (kind < 0) {
+    verr_set(err, "integrator '%s' is not known", cfg->integrator);
+    return NULL;
+  }
+  if (!(p->dt > 0) || !(p->tool_stiffness >= 0)) {
+    verr_set(err, "mass-spring: dt must be > 0 and tool stiffness >= 0");
+    return NULL;
+  }
+  ms_model_t *mm = calloc(1, sizeof *mm);
+  if (!mm) {
+    verr_set(err, "out of memory");
+    return NULL;
+  }
+  mm->tet = tet;
+  const mesh_t *s = p->surface;
+  ms_params_t mp = {.mass = cfg->material.mass,
+                    .stiffness = cfg->material.stiffness,
+                    .damping = cfg->material.damping,
+                    .home_stiffness = cfg->material.home_stiffness,
+                    .home_damping = cfg->material.home_damping,
+                    .gravity = {p->gravity[0], p->gravity[1], p->gravity[2]}};
+  int rc;
+  if (tet) {
+    tet_build_report_t rep;
+    rc = tet_mesh_build(s, cfg->solver.tet_size, &mm->tm, &mm->emb, &rep, err);
+    if (rc == 0) rc = mass_spring_create_tets(&mm->ms, &mm->tm, &mp, err);
+    if (rc) {
+      tet_mesh_free(&mm->tm);
+      tet_embedding_free(&mm->emb);
+      free(mm);
+      return NULL;
+    }
+  } else if (mass_spring_create_surface(&mm->ms, s, &mp, err)) {
+    free(mm);
+    return NULL;
+  }
+  mm->ms.fs.ctx = mm;
+  mm->ms.fs.pre_substep = pre_substep;
+  /* Conjugate gradients need a definite matrix (see mass_spring.h). */
+  mm->ms.definite_jacobian = kind == INT_IMPLICIT_EULER;
+  if (cfg->fixed_below_set) mass_spring_fix_below(&mm->ms, cfg->fixed_below);
+
+  size_t n = mm->ms.n;
+  mm->good_x = malloc(3 * n * sizeof(double));
+  mm->good_v = malloc(3 * n * sizeof(double));
+  mm->tris = malloc(3 * s->ntris * sizeof(uint32_t) + 1);
+  if (tet) {
+    mm->surf_buf = malloc(3 * s->nverts * sizeof(double) + 1);
+    mm->surf_rest_buf = malloc(3 * s->nverts * sizeof(double) + 1);
+  }
+  if (kind == INT_IMPLICIT_EULER) {
+    mm->try_x = malloc(3 * n * sizeof(double));
+    mm->try_v = malloc(3 * n * sizeof(double));
+  }
+  if (!mm->good_x || !mm->good_v || !mm->tris || (tet && (!mm->surf_buf || !mm->surf_rest_buf)) ||
+      (kind == INT_IMPLICIT_EULER && (!mm->try_x || !mm->try_v))) {
+    verr_set(err, "out of memory for %zu nodes", n);
+    ms_destroy(&mm->m);
+    return NULL;
+  }
+  memcpy(mm->good_x, mm->ms.x, 3 * n * sizeof(double));
+  memcpy(mm->good_v, mm->ms.v, 3 * n * sizeof(double));
+  memcpy(mm->tris, s->tris, 3 * s->ntris * sizeof(uint32_t));
+
+  model_t *m = &mm->m;
+  m->ops = tet ? &TET_OPS : &SURFACE_OPS;
+  m->error_kind = tet ? "volume_error" : "max_edge_strain";
+  m->nnodes = n;
+  m->x = mm->ms.x;
+  m->v = mm->ms.v;
+  m->x_rest = mm->ms.x_rest;
+  m->ntets = tet ? mm->tm.ntets : 0;
+  m->nsurf = s->nverts;
+  m->nsurf_tris = s->ntris;
+  m->surf_tris = mm->tris;
+  if (tet) {
+    /* The rest surface is the embedding of the rest nodes, so surf_x starts
+     * exactly at surf_rest even where a vertex's weights extrapolate. */
+    tet_embedding_apply(&mm->emb, &mm->tm, mm->ms.x_rest, mm->surf_rest_buf);
+    memcpy(mm->surf_buf, mm->surf_rest_buf, 3 * s->nverts * sizeof(double));
+    m->surf_x = mm->surf_buf;
+    m->surf_rest = mm->surf_rest_buf;
+    for (size_t i = 0; i < mm->tm.ntets; i++) mm->volume0 += tet_volume(&mm->tm, mm->tm.x, i);
+  } else {
+    m->surf_x = mm->ms.x;
+    m->surf_rest = mm->ms.x_rest;
+  }
+  if (choose_substeps(mm, p, (integrator_kind_t)kind, err) ||
+      integrator_init(&mm->it, (integrator_kind_t)kind, n, cfg->solver.cg_tolerance, cfg->solver.cg_max_iterations,
+                      err)) {
+    ms_destroy(m);
+    return NULL;
+  }
+  return m;
+}
+
+model_t *model_mass_spring_surface_create(const model_params_t *p, verr_t *err);
+model_t *model_mass_spring_tet_create(const model_params_t *p, verr_t *err);
+
+model_t *model_mass_spring_surface_create(const model_params_t *p, verr_t *err) { return ms_create(p, 0, err); }
+model_t *model_mass_spring_tet_create(const model_params_t *p, verr_t *err) { return ms_create(p, 1, err); }

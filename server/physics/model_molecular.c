@@ -1,0 +1,230 @@
+/* model_molecular: the molecular force system (molecular.h, seed 000 eq.
+ * 6-11) as model_t for the scene model name "molecular", stepped by the
+ * scene's integrator (integrator.h).
+ *
+ * Parameters: the set is refused at load unless bond_k angle_k > 2
+ * stretch_bend_k^2 (molecular_check_params; NUMERICS.md case 13). The
+ * material's `damping` is the bonds' Kelvin-Voigt damping, as on the
+ * mass-spring edges.
+ *
+ * Sub-steps: solver.substeps when given; otherwise 1 for implicit Euler and
+ * for the explicit schemes the fewest that keep each sub-step within 0.9 x
+ * the stable dt, more than 256 refused with the figures. The stable dt is
+ * integrator_stable_dt of the largest eigenvalues of M^-1 K and M^-1 C at
+ * rest (power iteration, the stiffest tool spring added to every vertex as a
+ * home spring), and of the slowest mode (home springs alone), which decides
+ * explicit Euler's damped bound when the ground damping ratio is the lower.
+ * On organs the angle term usually sets omega_max: its stiffness is about
+ * k_theta sin^2(theta0) / l^2 per corner, which at the default 1e-3 J on
+ * 1.2 mm edges is 20 x the 30 N/m bonds.
+ *
+ * Implicit Euler gets the Gauss-Newton K (definite_jacobian) for its
+ * conjugate gradients, as the mass-spring model does.
+ *
+ * Live error figure: error_kind "max_edge_strain", the largest |r/r0 - 1|
+ * over bonds. "energy_drift" would need a conservative run, but a live organ
+ * is damped (ground and bond damping), held by home springs and pushed by
+ * tools, so its energy changes for physical reasons; bond strain means the
+ * same thing in every run and matches the mass-spring surface model.
+ *
+ * External forces: add_surface_force adds to the vertex's force for the
+ * current sub-step; f_ext is cleared after every sub-step, so the hook
+ * (called by the integrator before each sub-step) sets that sub-step's
+ * contact forces and a force added outside a step acts on the next
+ * sub-step only.
+ *
+ * Rollback: a step starts by saving the state if it is finite; a step that
+ * ends non-finite restores the saved state (the last finite one) and
+ * returns -1. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "integrator.h"
+#include "model.h"
+#include "molecular.h"
+
+#define MOL_MAX_SUBSTEPS 256
+
+model_t *model_molecular_create(const model_params_t *p, verr_t *err);
+
+typedef struct mol_model {
+  model_t m; /* first: the model_t the caller holds */
+  molecular_t mol;
+  integrator_t it;
+  double *good_x, *good_v; /* 3n: last finite state */
+} mol_model_t;
+
+static double state_sum(const molecular_t *mol) {
+  /* One sum instead of a test per coordinate: NaN or Inf anywhere makes it
+   * non-finite. */
+  double sum = 0;
+  for (size_t c = 0; c < 3 * mol->n; c++) sum += mol->x[c] + mol->v[c];
+  return sum;
+}
+
+/* Integrators call this before every force evaluation (twice per Verlet
+ * sub-step, four times per RK4 one), so external forces are set afresh each
+ * time, never accumulated. */
+static void mm_pre_substep(force_system_t *s) {
+  molecular_t *mol = s->ctx;
+  model_t *m = mol->user;
+  memset(mol->f_ext, 0, 3 * mol->n * sizeof(double));
+  if (m->hook) m->hook(m, m->hook_ctx);
+}
+
+static int mm_step(model_t *m, double h) {
+  mol_model_t *mm = (mol_model_t *)m;
+  molecular_t *mol = &mm->mol;
+  size_t bytes = 3 * mol->n * sizeof(double);
+  if (isfinite(state_sum(mol))) {
+    memcpy(mm->good_x, mol->x, bytes);
+    memcpy(mm->good_v, mol->v, bytes);
+  }
+  int sub = m->substeps < 1 ? 1 : m->substeps;
+  double hs = h / sub;
+  for (int s = 0; s < sub; s++) {
+    integrator_substep(&mm->it, &mol->fs, hs); /* calls the hook first */
+    memset(mol->f_ext, 0, bytes);              /* contact forces hold for one sub-step (model.h) */
+  }
+  if (!isfinite(state_sum(mol))) {
+    memcpy(mol->x, mm->good_x, bytes);
+    memcpy(mol->v, mm->good_v, bytes);
+    m->rollbacks++;
+    return -1;
+  }
+  return 0;
+}
+
+static void mm_destroy(model_t *m) {
+  mol_model_t *mm = (mol_model_t *)m;
+  integrator_destroy(&mm->it);
+  molecular_destroy(&mm->mol);
+  free(mm->good_x);
+  free(mm->good_v);
+  free(mm);
+}
+
+static double mm_energy(const model_t *m) { return molecular_energy(&((const mol_model_t *)m)->mol); }
+
+static double mm_error(const model_t *m) { return molecular_max_strain(&((const mol_model_t *)m)->mol); }
+
+static void mm_add_surface_force(model_t *m, uint32_t i, const double f[3]) {
+  molecular_t *mol = &((mol_model_t *)m)->mol;
+  if (i >= mol->n) return;
+  for (int k = 0; k < 3; k++) mol->f_ext[3 * (size_t)i + k] += f[k];
+}
+
+static const model_ops_t MOL_OPS = {
+    .name = "molecular",
+    .step = mm_step,
+    .destroy = mm_destroy,
+    .energy = mm_energy,
+    .error_estimate = mm_error,
+    .add_surface_force = mm_add_surface_force,
+};
+
+/* Stable dt and sub-steps (file comment). */
+static int choose_substeps(mol_model_t *mm, const model_params_t *p, integrator_kind_t kind, verr_t *err) {
+  const scene_organ_t *cfg = p->cfg;
+  const molecular_t *mol = &mm->mol;
+  double lk, lc;
+  if (molecular_rest_lambdas(mol, p->tool_stiffness, &lk, &lc)) return verr_set(err, "out of memory");
+  double m_node = mol->p.mass / (double)mol->n;
+  double lk0 = (mol->p.home_stiffness + p->tool_stiffness) / m_node, lc0 = mol->p.home_damping / m_node;
+  double stable = fmin(integrator_stable_dt(kind, lk, lc), integrator_stable_dt(kind, lk0, lc0));
+  mm->m.stable_dt = stable;
+  if (cfg->solver.substeps > 0) {
+    if (cfg->solver.substeps > MOL_MAX_SUBSTEPS)
+      return verr_set(err, "solver.substeps %d exceeds the limit of %d", cfg->solver.substeps, MOL_MAX_SUBSTEPS);
+    mm->m.substeps = cfg->solver.substeps;
+    return 0;
+  }
+  if (kind == INT_IMPLICIT_EULER) {
+    mm->m.substeps = 1;
+    return 0;
+  }
+  if (!(stable > 0))
+    return verr_set(err,
+                    "molecular model: %s is unstable at every step size here (no damping against omega_max = %.3g "
+                    "rad/s); add damping or use symplectic_euler, verlet, rk4 or implicit_euler",
+                    integrator_name(kind), sqrt(lk));
+  double need = ceil(p->dt / (0.9 * stable));
+  if (!(need <= MOL_MAX_SUBSTEPS))
+    return verr_set(err,
+                    "molecular model: %s is stable only below dt = %.3g s here (omega_max %.3g rad/s), which would "
+                    "need %.0f sub-steps of the %.3g s step (limit %d); lower angle_k, bond_k, stretch_bend_k, "
+                    "damping or tool stiffness, raise the mass, or use implicit_euler",
+                    integrator_name(kind), stable, sqrt(lk), need, p->dt, MOL_MAX_SUBSTEPS);
+  mm->m.substeps = need < 1 ? 1 : (int)need;
+  return 0;
+}
+
+model_t *model_molecular_create(const model_params_t *p, verr_t *err) {
+  const scene_organ_t *cfg = p->cfg;
+  const scene_material_t *mat = &cfg->material;
+  /* NUMERICS.md case 13: a non-positive-definite set is refused at load. */
+  if (molecular_check_params(mat->bond_k, mat->angle_k, mat->stretch_bend_k, err)) return NULL;
+  int kind = integrator_parse(cfg->integrator);
+  if (kind < 0) {
+    verr_set(err, "integrator '%s' is not known", cfg->integrator);
+    return NULL;
+  }
+  if (!(p->dt > 0) || !isfinite(p->dt) || !(p->tool_stiffness >= 0)) {
+    verr_set(err, "molecular model: dt must be > 0 and tool stiffness >= 0 (got %g, %g)", p->dt, p->tool_stiffness);
+    return NULL;
+  }
+  mol_model_t *mm = calloc(1, sizeof *mm);
+  if (!mm) {
+    verr_set(err, "out of memory");
+    return NULL;
+  }
+  mol_params_t mp = {.mass = mat->mass,
+                     .bond_k = mat->bond_k,
+                     .angle_k = mat->angle_k,
+                     .stretch_bend_k = mat->stretch_bend_k,
+                     .bond_damping = mat->damping,
+                     .home_stiffness = mat->home_stiffness,
+                     .home_damping = mat->home_damping,
+                     .gravity = {p->gravity[0], p->gravity[1], p->gravity[2]}};
+  molecular_t *mol = &mm->mol;
+  if (molecular_create(mol, p->surface, &mp, err)) {
+    free(mm);
+    return NULL;
+  }
+  mol->user = &mm->m;
+  mol->fs.pre_substep = mm_pre_substep;
+  mol->definite_jacobian = kind == INT_IMPLICIT_EULER;
+  if (cfg->fixed_below_set) molecular_fix_below(mol, cfg->fixed_below);
+  size_t n = mol->n;
+  mm->good_x = malloc(3 * n * sizeof(double));
+  mm->good_v = malloc(3 * n * sizeof(double));
+  if (!mm->good_x || !mm->good_v) {
+    verr_set(err, "out of memory for %zu vertices", n);
+    mm_destroy(&mm->m);
+    return NULL;
+  }
+  memcpy(mm->good_x, mol->x, 3 * n * sizeof(double));
+  memcpy(mm->good_v, mol->v, 3 * n * sizeof(double));
+
+  model_t *m = &mm->m;
+  m->ops = &MOL_OPS;
+  m->error_kind = "max_edge_strain";
+  m->nnodes = n;
+  m->x = mol->x;
+  m->v = mol->v;
+  m->x_rest = mol->x_rest;
+  m->ntets = 0;
+  m->nsurf = n; /* a surface model: the surface is the node set */
+  m->nsurf_tris = mol->ntris;
+  m->surf_x = mol->x;
+  m->surf_rest = mol->x_rest;
+  m->surf_tris = mol->tri_idx;
+  if (choose_substeps(mm, p, (integrator_kind_t)kind, err) ||
+      integrator_init(&mm->it, (integrator_kind_t)kind, n, cfg->solver.cg_tolerance, cfg->solver.cg_max_iterations,
+                      err)) {
+    mm_destroy(m);
+    return NULL;
+  }
+  return m;
+}

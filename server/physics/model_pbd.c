@@ -1,0 +1,188 @@
+/* model_pbd: the scene models "pbd" and "xpbd" behind model_t. The organ's
+ * surface is filled with tetrahedra (tet_mesh_build), the solver in pbd.c
+ * runs on their nodes, and the render/contact surface rides along through
+ * its barycentric embedding. Messages do not name the organ: model_create
+ * (model_registry.c) prefixes it. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "pbd.h"
+#include "tet_mesh.h"
+
+typedef struct model_pbd {
+  model_t base; /* first, so model_t * and model_pbd_t * convert */
+  pbd_t s;
+  tet_mesh_t tm;
+  tet_embedding_t emb;
+  double *surf_x, *surf_rest;
+  uint32_t *surf_tris;
+} model_pbd_t;
+
+/* Sub-steps chosen when the scene leaves solver.substeps at 0: PBD and XPBD
+ * are stable at any step, but XPBD converges better (alpha / h^2 grows) and
+ * contact is coupled more tightly with short sub-steps; 1 ms matches the
+ * haptic rate. */
+#define PBD_AUTO_SUBSTEP 1e-3
+
+static void pbd_pre_hook(pbd_t *s, void *ctx) {
+  (void)s;
+  model_t *m = ctx;
+  if (m->hook) m->hook(m, m->hook_ctx);
+}
+
+static int pbd_model_step(model_t *m, double h) {
+  model_pbd_t *mp = (model_pbd_t *)m;
+  int rc = pbd_step(&mp->s, h, pbd_pre_hook, m);
+  if (rc) m->rollbacks++;
+  /* After a rollback the restored nodes are embedded again too, so the
+   * surface always shows the state the model holds. */
+  tet_embedding_apply(&mp->emb, &mp->tm, mp->s.x, mp->surf_x);
+  return rc;
+}
+
+static void pbd_model_destroy(model_t *m) {
+  model_pbd_t *mp = (model_pbd_t *)m;
+  pbd_destroy(&mp->s);
+  tet_mesh_free(&mp->tm);
+  tet_embedding_free(&mp->emb);
+  free(mp->surf_x);
+  free(mp->surf_rest);
+  free(mp->surf_tris);
+  free(mp);
+}
+
+static double pbd_model_energy(const model_t *m) {
+  const model_pbd_t *mp = (const model_pbd_t *)m;
+  /* PBD has no energy it minimises (its constraints are rigid up to an
+   * iteration-dependent stiffness); XPBD's compliance defines one. */
+  if (mp->s.p.mode != PBD_MODE_XPBD) return NAN;
+  return pbd_energy(&mp->s);
+}
+
+static double pbd_model_error(const model_t *m) { return pbd_volume_error(&((const model_pbd_t *)m)->s); }
+
+/* A surface force acts at a point inside its tetrahedron: the barycentric
+ * weights spread it over the four nodes, the transpose of the embedding, so
+ * the work done on the surface equals the work done on the nodes. */
+static void pbd_model_add_surface_force(model_t *m, uint32_t i, const double f[3]) {
+  model_pbd_t *mp = (model_pbd_t *)m;
+  if (i >= mp->emb.nsurf || !(isfinite(f[0]) && isfinite(f[1]) && isfinite(f[2]))) return;
+  const uint32_t *q = mp->tm.tets + 4 * (size_t)mp->emb.tet[i];
+  const double *b = mp->emb.bary + 4 * (size_t)i;
+  for (int k = 0; k < 4; k++) {
+    double fk[3] = {b[k] * f[0], b[k] * f[1], b[k] * f[2]};
+    pbd_add_force(&mp->s, q[k], fk);
+  }
+}
+
+static const model_ops_t PBD_OPS = {
+    "pbd", pbd_model_step, pbd_model_destroy, pbd_model_energy, pbd_model_error, pbd_model_add_surface_force};
+static const model_ops_t XPBD_OPS = {"xpbd",           pbd_model_step,  pbd_model_destroy,
+                                     pbd_model_energy, pbd_model_error, pbd_model_add_surface_force};
+
+model_t *model_pbd_create(const model_params_t *p, verr_t *err) {
+  const scene_organ_t *cfg = p->cfg;
+  pbd_mode_t mode;
+  if (!strcmp(cfg->model, "pbd"))
+    mode = PBD_MODE_PBD;
+  else if (!strcmp(cfg->model, "xpbd"))
+    mode = PBD_MODE_XPBD;
+  else {
+    verr_set(err, "model '%s' is not pbd or xpbd", cfg->model);
+    return NULL;
+  }
+  if (!(p->dt > 0) || !isfinite(p->dt)) {
+    verr_set(err, "time step must be > 0 (got %g)", p->dt);
+    return NULL;
+  }
+  const mesh_t *surf = p->surface;
+  if (!surf || surf->nverts == 0 || surf->ntris == 0) {
+    verr_set(err, "empty surface mesh");
+    return NULL;
+  }
+  model_pbd_t *mp = calloc(1, sizeof *mp);
+  if (!mp) {
+    verr_set(err, "out of memory");
+    return NULL;
+  }
+  verr_t sub;
+  tet_build_report_t rep;
+  if (tet_mesh_build(surf, cfg->solver.tet_size, &mp->tm, &mp->emb, &rep, &sub)) {
+    verr_set(err, "cannot build a tetrahedral mesh: %s", sub.msg);
+    free(mp);
+    return NULL;
+  }
+  if (mp->emb.nsurf != surf->nverts) {
+    verr_set(err, "the embedding holds %zu of %zu surface vertices", mp->emb.nsurf, surf->nverts);
+    tet_mesh_free(&mp->tm);
+    tet_embedding_free(&mp->emb);
+    free(mp);
+    return NULL;
+  }
+  const scene_material_t *mat = &cfg->material;
+  pbd_params_t pp = {
+      .mode = mode,
+      .mass = mat->mass,
+      .distance_stiffness = mat->distance_stiffness,
+      .volume_stiffness = mat->volume_stiffness,
+      .distance_compliance = mat->distance_compliance,
+      .volume_compliance = mat->volume_compliance,
+      .home_stiffness = mat->home_stiffness,
+      .damping = mat->home_damping,
+      .gravity = {p->gravity[0], p->gravity[1], p->gravity[2]},
+      .substeps = cfg->solver.substeps,
+      .iterations = cfg->solver.iterations,
+      /* The scene's stiffness means "error left after a sub-step", not
+       * "per iteration", so it does not change with solver.iterations. */
+      .stiffness_correction = 1,
+  };
+  if (pp.substeps <= 0) {
+    double k = ceil(p->dt / PBD_AUTO_SUBSTEP - 1e-9);
+    pp.substeps = k < 1 ? 1 : (k > 1000 ? 1000 : (int)k);
+  }
+  if (pbd_create(&mp->s, mp->tm.nnodes, mp->tm.x, mp->tm.ntets, mp->tm.tets, &pp, &sub)) {
+    verr_set(err, "%s", sub.msg);
+    tet_mesh_free(&mp->tm);
+    tet_embedding_free(&mp->emb);
+    free(mp);
+    return NULL;
+  }
+  if (cfg->fixed_below_set) pbd_fix_below(&mp->s, cfg->fixed_below);
+  size_t ns = surf->nverts;
+  mp->surf_x = malloc(3 * ns * sizeof(double));
+  mp->surf_rest = malloc(3 * ns * sizeof(double));
+  mp->surf_tris = malloc(3 * surf->ntris * sizeof(uint32_t));
+  if (!mp->surf_x || !mp->surf_rest || !mp->surf_tris) {
+    verr_set(err, "out of memory for the surface");
+    pbd_model_destroy(&mp->base);
+    return NULL;
+  }
+  memcpy(mp->surf_rest, surf->pos, 3 * ns * sizeof(double));
+  memcpy(mp->surf_tris, surf->tris, 3 * surf->ntris * sizeof(uint32_t));
+  /* Affine (barycentric) weights reproduce the rest surface exactly, up to
+   * rounding, even for vertices embedded by extrapolation. */
+  tet_embedding_apply(&mp->emb, &mp->tm, mp->s.x, mp->surf_x);
+
+  model_t *m = &mp->base;
+  m->ops = mode == PBD_MODE_PBD ? &PBD_OPS : &XPBD_OPS;
+  m->error_kind = "volume_error";
+  m->nnodes = mp->s.n;
+  m->x = mp->s.x;
+  m->v = mp->s.v;
+  m->x_rest = mp->s.x_rest;
+  m->ntets = mp->s.ntets;
+  m->nsurf = ns;
+  m->nsurf_tris = surf->ntris;
+  m->surf_x = mp->surf_x;
+  m->surf_rest = mp->surf_rest;
+  m->surf_tris = mp->surf_tris;
+  m->substeps = pp.substeps;
+  m->stable_dt = INFINITY;
+  return m;
+}
+
+pbd_t *model_pbd_solver(model_t *m) {
+  if (!m || (m->ops != &PBD_OPS && m->ops != &XPBD_OPS)) return NULL;
+  return &((model_pbd_t *)m)->s;
+}
