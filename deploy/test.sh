@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs what is missing, builds with warnings as errors, and runs the whole
 # test suite (unit, integration over DDS on loopback, stability, fuzz), then
-# the unit and integration tests again under AddressSanitizer +
+# the unit, integration and stability tests again under AddressSanitizer +
 # UndefinedBehaviorSanitizer. Build trees: build-test/ and build-asan/.
 # Set VISCERA_SKIP_ASAN=1 to skip the sanitizer pass.
 set -euo pipefail
@@ -19,6 +19,6 @@ if [ "${VISCERA_SKIP_ASAN:-0}" != "1" ]; then
   bash "$ROOT/deploy/build.sh" "$ROOT/build-asan" -DVISCERA_WERROR=ON -DVISCERA_SANITIZE=ON -DVISCERA_BUILD_BENCH=OFF
   export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1"
   export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
-  (cd "$ROOT/build-asan" && ctest --output-on-failure -j"$JOBS" --timeout 300 -L "unit|integration")
+  (cd "$ROOT/build-asan" && ctest --output-on-failure -j"$JOBS" --timeout 300 -L "unit|integration|stability")
 fi
 echo "test: all passed"
