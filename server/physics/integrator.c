@@ -365,3 +365,30 @@ double integrator_stable_dt(integrator_kind_t k, double lambda_k, double lambda_
     return 0;
   }
 }
+
+int integrator_choose_substeps(integrator_kind_t kind, double dt, int requested, double lk, double lc, double lk0,
+                               double lc0, const char *advice, int *substeps, double *stable_dt, verr_t *err) {
+  double stable = fmin(integrator_stable_dt(kind, lk, lc), integrator_stable_dt(kind, lk0, lc0));
+  *stable_dt = stable;
+  if (requested > 0) {
+    if (requested > INTEGRATOR_MAX_SUBSTEPS)
+      return verr_set(err, "solver.substeps %d exceeds the limit of %d", requested, INTEGRATOR_MAX_SUBSTEPS);
+    *substeps = requested;
+    return 0;
+  }
+  if (kind == INT_IMPLICIT_EULER) {
+    *substeps = 1;
+    return 0;
+  }
+  if (!(stable > 0))
+    return verr_set(err, "%s is unstable at every step size here (no damping against omega_max = %.3g rad/s); %s",
+                    integrator_name(kind), sqrt(lk), advice);
+  double need = ceil(dt / (0.9 * stable));
+  if (!(need <= INTEGRATOR_MAX_SUBSTEPS))
+    return verr_set(err,
+                    "%s is stable only below dt = %.3g s here (omega_max %.3g rad/s), which would need %.0f sub-steps "
+                    "of the %.3g s step (limit %d); %s",
+                    integrator_name(kind), stable, sqrt(lk), need, dt, INTEGRATOR_MAX_SUBSTEPS, advice);
+  *substeps = need < 1 ? 1 : (int)need;
+  return 0;
+}

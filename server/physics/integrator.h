@@ -52,4 +52,16 @@ void integrator_substep(integrator_t *it, force_system_t *s, double h);
  * for explicit Euler the damped bound lambda_c / lambda_k. */
 double integrator_stable_dt(integrator_kind_t k, double lambda_k, double lambda_c);
 
+#define INTEGRATOR_MAX_SUBSTEPS 256
+
+/* Sub-steps per scene step of length dt for a force-based model: `requested`
+ * (solver.substeps) when > 0, 1 for implicit Euler, otherwise
+ * ceil(dt / (0.9 stable)) with stable the smaller of the scheme's bounds for
+ * (lk, lc), the system's largest eigenvalues, and (lk0, lc0), its slowest
+ * (home-spring) mode. Writes *substeps and *stable_dt; refuses undamped
+ * explicit Euler and more than INTEGRATOR_MAX_SUBSTEPS, ending the message
+ * with `advice` (what to change in the scene). */
+int integrator_choose_substeps(integrator_kind_t kind, double dt, int requested, double lk, double lc, double lk0,
+                               double lc0, const char *advice, int *substeps, double *stable_dt, verr_t *err);
+
 #endif

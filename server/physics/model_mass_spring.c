@@ -48,7 +48,6 @@
 #include "model.h"
 #include "tet_mesh.h"
 
-#define MS_MAX_SUBSTEPS 256
 
 typedef struct ms_model {
   model_t m; /* first: the model_t the caller holds */
@@ -221,31 +220,10 @@ static int choose_substeps(ms_model_t *mm, const model_params_t *p, integrator_k
   if (mass_spring_eigen_bounds(ms, p->tool_stiffness, &lk, &lc)) return verr_set(err, "out of memory");
   double m_node = ms->p.mass / (double)ms->n;
   double lk0 = (ms->p.home_stiffness + p->tool_stiffness) / m_node, lc0 = ms->p.home_damping / m_node;
-  double stable = fmin(integrator_stable_dt(kind, lk, lc), integrator_stable_dt(kind, lk0, lc0));
-  mm->m.stable_dt = stable;
-  if (cfg->solver.substeps > 0) {
-    mm->m.substeps = cfg->solver.substeps;
-    return 0;
-  }
-  if (kind == INT_IMPLICIT_EULER) {
-    mm->m.substeps = 1;
-    return 0;
-  }
-  if (!(stable > 0))
-    return verr_set(err,
-                    "%s is unstable at every step size here (no damping: material damping and home_damping give "
-                    "none against stiffness %g N/m and tool stiffness %g N/m); add damping or use symplectic_euler, "
-                    "verlet, rk4 or implicit_euler",
-                    integrator_name(kind), ms->p.stiffness, p->tool_stiffness);
-  double need = ceil(p->dt / (0.9 * stable));
-  if (!(need <= MS_MAX_SUBSTEPS))
-    return verr_set(err,
-                    "%s is stable only below dt = %.3g s here, which would need %.0f sub-steps of the %.3g s step "
-                    "(limit %d); lower material stiffness, damping or tool stiffness, raise the mass, or use "
-                    "implicit_euler",
-                    integrator_name(kind), stable, need, p->dt, MS_MAX_SUBSTEPS);
-  mm->m.substeps = need < 1 ? 1 : (int)need;
-  return 0;
+  return integrator_choose_substeps(kind, p->dt, cfg->solver.substeps, lk, lc, lk0, lc0,
+                                    "lower material stiffness, damping or tool stiffness, raise the mass, or use "
+                                    "implicit_euler (explicit_euler needs damping)",
+                                    &mm->m.substeps, &mm->m.stable_dt, err);
 }
 
 static model_t *ms_create(const model_params_t *p, int tet, verr_t *err) {

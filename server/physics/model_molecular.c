@@ -44,7 +44,6 @@
 #include "model.h"
 #include "molecular.h"
 
-#define MOL_MAX_SUBSTEPS 256
 
 model_t *model_molecular_create(const model_params_t *p, verr_t *err);
 
@@ -132,32 +131,10 @@ static int choose_substeps(mol_model_t *mm, const model_params_t *p, integrator_
   if (molecular_rest_lambdas(mol, p->tool_stiffness, &lk, &lc)) return verr_set(err, "out of memory");
   double m_node = mol->p.mass / (double)mol->n;
   double lk0 = (mol->p.home_stiffness + p->tool_stiffness) / m_node, lc0 = mol->p.home_damping / m_node;
-  double stable = fmin(integrator_stable_dt(kind, lk, lc), integrator_stable_dt(kind, lk0, lc0));
-  mm->m.stable_dt = stable;
-  if (cfg->solver.substeps > 0) {
-    if (cfg->solver.substeps > MOL_MAX_SUBSTEPS)
-      return verr_set(err, "solver.substeps %d exceeds the limit of %d", cfg->solver.substeps, MOL_MAX_SUBSTEPS);
-    mm->m.substeps = cfg->solver.substeps;
-    return 0;
-  }
-  if (kind == INT_IMPLICIT_EULER) {
-    mm->m.substeps = 1;
-    return 0;
-  }
-  if (!(stable > 0))
-    return verr_set(err,
-                    "molecular model: %s is unstable at every step size here (no damping against omega_max = %.3g "
-                    "rad/s); add damping or use symplectic_euler, verlet, rk4 or implicit_euler",
-                    integrator_name(kind), sqrt(lk));
-  double need = ceil(p->dt / (0.9 * stable));
-  if (!(need <= MOL_MAX_SUBSTEPS))
-    return verr_set(err,
-                    "molecular model: %s is stable only below dt = %.3g s here (omega_max %.3g rad/s), which would "
-                    "need %.0f sub-steps of the %.3g s step (limit %d); lower angle_k, bond_k, stretch_bend_k, "
-                    "damping or tool stiffness, raise the mass, or use implicit_euler",
-                    integrator_name(kind), stable, sqrt(lk), need, p->dt, MOL_MAX_SUBSTEPS);
-  mm->m.substeps = need < 1 ? 1 : (int)need;
-  return 0;
+  return integrator_choose_substeps(kind, p->dt, cfg->solver.substeps, lk, lc, lk0, lc0,
+                                    "lower angle_k, bond_k, stretch_bend_k, damping or tool stiffness, raise the "
+                                    "mass, or use implicit_euler (explicit_euler needs damping)",
+                                    &mm->m.substeps, &mm->m.stable_dt, err);
 }
 
 model_t *model_molecular_create(const model_params_t *p, verr_t *err) {
