@@ -245,6 +245,9 @@ int main(int argc, char **argv) {
     return 1;
   }
   contact_model_t model = {0};
+  double prev_pos[3] = {0, 0, 0};
+  uint64_t prev_pos_ns = 0;
+  int have_prev_pos = 0;
   uint64_t seq = 0;
   int server_lost_reported = 0;
   uint64_t start = vtime_mono_ns(), next = start, prev_tick = 0;
@@ -287,8 +290,16 @@ int main(int argc, char **argv) {
         server_lost_reported = 1;
       }
     }
+    /* Device velocity by backward difference over the actual tick. */
+    double vel[3] = {0, 0, 0};
+    if (have_prev_pos && now > prev_pos_ns)
+      for (int k = 0; k < 3; k++) vel[k] = (pos[k] - prev_pos[k]) / ((double)(now - prev_pos_ns) * 1e-9);
+    memcpy(prev_pos, pos, sizeof prev_pos);
+    prev_pos_ns = now;
+    have_prev_pos = 1;
+    model.damping = contact_model_passive_damping(model.stiffness, 1.0 / rate);
     double f[3];
-    double mag = contact_model_force(&model, pos, dev.max_force, f);
+    double mag = contact_model_force(&model, pos, vel, dev.max_force, f);
     dev.ops->write_force(&dev, f);
     st.ticks++;
     if (mag > 0) st.contact_ticks++;

@@ -174,8 +174,20 @@ int proxy_update(proxy_t *p, const double device[3], const proxy_surface_t *surf
   double target[3];
   v3_copy(target, device);
   v3_axpy(target, p->normal, -depth);
+  proxy_t before = *p;
   nearest_on_surfaces(target, surfaces, nsurfaces, p);
   proxy_follow_surface(p, surfaces, nsurfaces);
+  /* A tool pressed deep into thin tissue brings the far side's surface
+   * nearer than the entry side: the god-object never slides onto a surface
+   * facing away from the one it is on. It stays on its triangle instead. */
+  if (v3_dot(p->normal, before.normal) < 0.2) {
+    *p = before;
+    const proxy_surface_t *s = &surfaces[p->surface];
+    double cp[3];
+    tri_closest_point(target, s->x + 3 * s->tris[3 * p->tri], s->x + 3 * s->tris[3 * p->tri + 1],
+                      s->x + 3 * s->tris[3 * p->tri + 2], cp, p->bary);
+    proxy_follow_surface(p, surfaces, nsurfaces);
+  }
   proxy_spring_force(p, device, stiffness, max_force, force);
   return 1;
 }

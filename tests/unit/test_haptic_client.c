@@ -58,11 +58,16 @@ int main(void) {
   /* Local model: force grows with depth below the plane, zero above, clamped. */
   contact_model_t m = {.in_contact = 1, .proxy = {0, 0, 0}, .normal = {0, 0, 1}, .stiffness = 500};
   double f[3];
-  CHECK_NEAR(contact_model_force(&m, (double[]){0, 0, -0.002}, 4, f), 1.0, 1e-12);
+  CHECK_NEAR(contact_model_force(&m, (double[]){0, 0, -0.002}, NULL, 4, f), 1.0, 1e-12);
   CHECK_NEAR(f[2], 1.0, 1e-12);
-  CHECK(contact_model_force(&m, (double[]){0, 0, 0.001}, 4, f) == 0);
-  CHECK_NEAR(contact_model_force(&m, (double[]){0.3, 0, -0.1}, 4, f), 4, 1e-12);
+  CHECK(contact_model_force(&m, (double[]){0, 0, 0.001}, NULL, 4, f) == 0);
+  CHECK_NEAR(contact_model_force(&m, (double[]){0.3, 0, -0.1}, NULL, 4, f), 4, 1e-12);
+  /* Damping resists motion into the wall, eases motion out, never pulls. */
+  m.damping = 2;
+  CHECK_NEAR(contact_model_force(&m, (double[]){0, 0, -0.002}, (double[]){0, 0, -0.1}, 4, f), 1.2, 1e-12);
+  CHECK_NEAR(contact_model_force(&m, (double[]){0, 0, -0.002}, (double[]){0, 0, 0.1}, 4, f), 0.8, 1e-12);
+  CHECK(contact_model_force(&m, (double[]){0, 0, -0.002}, (double[]){0, 0, 5}, 4, f) == 0);
   m.in_contact = 0;
-  CHECK(contact_model_force(&m, (double[]){0, 0, -0.002}, 4, f) == 0);
+  CHECK(contact_model_force(&m, (double[]){0, 0, -0.002}, NULL, 4, f) == 0);
   return check_report("test_haptic_client");
 }
