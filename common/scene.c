@@ -450,10 +450,15 @@ static const char *const organ_keys[O_NKEYS] = {
     [O_SOLVER] = "solver",     [O_POSITION] = "position",  [O_SCALE] = "scale", [O_COLOR] = "color",
     [O_FIXED_BELOW] = "fixed_below", [O_MATERIAL] = "material"};
 
-enum { T_NAME, T_KIND, T_RADIUS, T_LENGTH, T_STIFFNESS, T_MAX_FORCE, T_NKEYS };
+enum { T_NAME, T_KIND, T_RADIUS, T_LENGTH, T_STIFFNESS, T_MAX_FORCE, T_THRESHOLDS, T_NKEYS };
 static const char *const tool_keys[T_NKEYS] = {
     [T_NAME] = "name",     [T_KIND] = "kind",           [T_RADIUS] = "radius",
-    [T_LENGTH] = "length", [T_STIFFNESS] = "stiffness", [T_MAX_FORCE] = "max_force"};
+    [T_LENGTH] = "length", [T_STIFFNESS] = "stiffness", [T_MAX_FORCE] = "max_force",
+    [T_THRESHOLDS] = "thresholds"};
+
+/* In the order they must rise: ST < MPF <= SFT (seed 002 ch. 6). */
+enum { H_ST, H_MPF, H_SFT, H_NKEYS };
+static const char *const threshold_keys[H_NKEYS] = {[H_ST] = "st", [H_MPF] = "mpf", [H_SFT] = "sft"};
 
 enum { S_SCENE, S_DESCRIPTION, S_PHYSICS, S_ORGANS, S_TOOLS, S_NKEYS };
 static const char *const top_keys[S_NKEYS] = {[S_SCENE] = "scene",
@@ -465,7 +470,7 @@ static const char *const top_keys[S_NKEYS] = {[S_SCENE] = "scene",
 /* get_fields() tracks the keys seen in a fixed array of SCENE_MAX_KEYS. */
 _Static_assert(P_NKEYS <= SCENE_MAX_KEYS && M_NKEYS <= SCENE_MAX_KEYS && V_NKEYS <= SCENE_MAX_KEYS &&
                    O_NKEYS <= SCENE_MAX_KEYS &&
-                   T_NKEYS <= SCENE_MAX_KEYS && S_NKEYS <= SCENE_MAX_KEYS,
+                   T_NKEYS <= SCENE_MAX_KEYS && H_NKEYS <= SCENE_MAX_KEYS && S_NKEYS <= SCENE_MAX_KEYS,
                "raise SCENE_MAX_KEYS");
 
 static void organ_defaults(scene_organ_t *o) {
@@ -682,6 +687,37 @@ static int parse_organ(const ctx_t *c, const node_t *n, size_t idx, const char *
   return check_model_material(c, v[O_MODEL], n, mv, fp, o);
 }
 
+/* thresholds: {st: N, mpf: N, sft: N}, each optional, checked against each
+ * other and against the tool's max_force (already parsed). */
+static int parse_thresholds(const ctx_t *c, const node_t *n, const char *path, scene_tool_t *t) {
+  const node_t *hv[H_NKEYS];
+  static const range_t thr_range = {B_EXCL, 0, B_INCL, 100};
+  double *dst[H_NKEYS] = {[H_ST] = &t->st, [H_MPF] = &t->mpf, [H_SFT] = &t->sft};
+  char fp[160];
+  if (get_fields(c, n, path, threshold_keys, H_NKEYS, hv)) return -1;
+  for (int k = 0; k < H_NKEYS; k++) {
+    if (!hv[k]) continue;
+    if (opt_number(c, hv[k], path, threshold_keys[k], &thr_range, dst[k])) return -1;
+    join(fp, sizeof fp, path, threshold_keys[k]);
+    if (*dst[k] > t->max_force)
+      return field_err(c, hv[k], fp, "must be <= the tool's max_force %g N (got %g)", t->max_force, *dst[k]);
+  }
+  /* Each given threshold must lie above every lower one given. */
+  for (int k = 1; k < H_NKEYS; k++) {
+    if (!hv[k]) continue;
+    for (int j = 0; j < k; j++) {
+      if (!hv[j]) continue;
+      int bad = (k == H_SFT && j == H_MPF) ? !(*dst[k] >= *dst[j]) : !(*dst[k] > *dst[j]);
+      if (bad) {
+        join(fp, sizeof fp, path, threshold_keys[k]);
+        return field_err(c, hv[k], fp, "must be %s %s %g N: the order is st < mpf <= sft (got %g)",
+                         k == H_SFT && j == H_MPF ? ">=" : ">", threshold_keys[j], *dst[j], *dst[k]);
+      }
+    }
+  }
+  return 0;
+}
+
 static int parse_tool(const ctx_t *c, const node_t *n, size_t idx, scene_t *s) {
   scene_tool_t *t = &s->tools[idx];
   const node_t *v[T_NKEYS];
@@ -707,6 +743,10 @@ static int parse_tool(const ctx_t *c, const node_t *n, size_t idx, scene_t *s) {
   if (opt_number(c, v[T_LENGTH], path, "length", &GT0, &t->length)) return -1;
   if (opt_number(c, v[T_STIFFNESS], path, "stiffness", &stiffness_range, &t->stiffness)) return -1;
   if (opt_number(c, v[T_MAX_FORCE], path, "max_force", &force_range, &t->max_force)) return -1;
+  if (v[T_THRESHOLDS]) {
+    join(fp, sizeof fp, path, "thresholds");
+    if (parse_thresholds(c, v[T_THRESHOLDS], fp, t)) return -1;
+  }
   return 0;
 }
 

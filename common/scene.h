@@ -79,6 +79,13 @@ typedef struct scene_tool {
   double length;    /* m, shaft length for drawing (default 0.1) */
   double stiffness; /* N/m, proxy virtual spring (default 300) */
   double max_force; /* N, clamp (default 4) */
+  /* Palpation force thresholds (seed 002 ch. 6), N on the contact force
+   * magnitude; 0 = not set (no events for it). Key `thresholds:`, each
+   * optional: st (sound threshold: the audio/visual cue to ease off),
+   * mpf (maximum palpation force: the target not to go beyond), sft
+   * (stopping force threshold: the hard upper bound). Refused unless
+   * 0 < st < mpf <= sft <= max_force for those given. */
+  double sft, st, mpf;
   int line;
 } scene_tool_t;
 

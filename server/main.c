@@ -129,5 +129,15 @@ int main(int argc, char **argv) {
   fprintf(stderr, ")\n");
   printf("SUMMARY steps=%" PRIu64 " peak_force=%.3f rejected=%" PRIu64 " rollbacks=%" PRIu64 " step_us_median=%.1f\n",
          st.steps, st.peak_force, st.rejected_total, st.rollbacks, st.step_us_median);
+  /* Trainee measures per tool (seed 002 ch. 6); levels of 0 are unset. */
+  for (size_t t = 0; t < st.ntools; t++) {
+    const thr_tracker_t *tr = &st.thr[t];
+    printf("PALPATION tool=%s contact_time=%.3f mean_contact_force=%.4f peak_force=%.4f path_length=%.4f",
+           scene.tools[t].name, tr->contact_time, thr_mean_contact_force(tr), tr->peak_force, tr->path_length);
+    for (int k = 0; k < THR_COUNT; k++)
+      printf(" %s=%.3f time_above_%s=%.3f crossings_%s=%u", thr_name((thr_id_t)k), tr->level[k], thr_name((thr_id_t)k),
+             tr->time_above[k], thr_name((thr_id_t)k), tr->crossings[k]);
+    printf("\n");
+  }
   return 0;
 }

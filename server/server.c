@@ -22,6 +22,7 @@ typedef struct server {
   mesh_publisher_t pubs[SCENE_MAX_ORGANS];
   uint64_t cmd_seq[SCENE_MAX_TOOLS], cmd_echo[SCENE_MAX_TOOLS], last_cmd_mono[SCENE_MAX_TOOLS];
   int was_contact[SCENE_MAX_TOOLS];
+  thr_tracker_t thr[SCENE_MAX_TOOLS];
   uint64_t event_seq;
   double *step_us; /* ring of recent step times */
   size_t nstep_us;
@@ -76,6 +77,9 @@ static void publish_scene_info(server_t *s) {
     tools[t].length = (float)c->length;
     tools[t].stiffness = (float)c->stiffness;
     tools[t].max_force = (float)c->max_force;
+    tools[t].st = (float)c->st;
+    tools[t].mpf = (float)c->mpf;
+    tools[t].sft = (float)c->sft;
   }
   si.organs._buffer = organs;
   si.organs._length = si.organs._maximum = (uint32_t)s->rt.norgans;
@@ -189,6 +193,27 @@ static void publish_feedback(server_t *s) {
   }
 }
 
+/* Feeds every tool's contact force and tip to its threshold tracker and
+ * publishes the crossings. */
+static void track_thresholds(server_t *s) {
+  for (size_t t = 0; t < s->rt.ntools; t++) {
+    const tool_rt_t *tool = &s->rt.tools[t];
+    double f = tool->active ? v3_norm(tool->force) : 0.0;
+    int contact = tool->active && tool->proxy.in_contact;
+    thr_event_t ev[THR_COUNT];
+    int n = thr_update(&s->thr[t], s->rt.scene.dt, f, contact, tool->active ? tool->device : NULL, ev);
+    for (int i = 0; i < n; i++) {
+      char text[200];
+      snprintf(text, sizeof text, "%s %s: tool '%s' force %.3f N %s %.3f N", thr_name(ev[i].which),
+               ev[i].up ? "crossed up" : "crossed down", tool->cfg->name, f, ev[i].up ? "above" : "back below",
+               ev[i].level);
+      if (!s->opts->quiet) fprintf(stderr, "server: %s\n", text);
+      publish_event(s, ev[i].up ? viscera_EVENT_THRESHOLD_CROSSED_UP : viscera_EVENT_THRESHOLD_CROSSED_DOWN,
+                    contact ? tool->proxy.surface : -1, (int)t, ev[i].level, text);
+    }
+  }
+}
+
 static void publish_metrics(server_t *s, uint64_t window_steps) {
   size_t n = s->nstep_us < STEP_RING ? s->nstep_us : STEP_RING;
   size_t take = window_steps < n ? window_steps : n;
@@ -199,6 +224,14 @@ static void publish_metrics(server_t *s, uint64_t window_steps) {
   free(tmp);
   double peak = 0;
   for (size_t t = 0; t < s->rt.ntools; t++) peak = fmax(peak, s->rt.tools[t].peak_force);
+  double above[THR_COUNT] = {0}, contact = 0, fint = 0, path = 0;
+  for (size_t t = 0; t < s->rt.ntools; t++) {
+    const thr_tracker_t *tr = &s->thr[t];
+    for (int k = 0; k < THR_COUNT; k++) above[k] += tr->time_above[k];
+    contact += tr->contact_time;
+    fint += tr->contact_force_integral;
+    path += tr->path_length;
+  }
   for (size_t i = 0; i < s->rt.norgans; i++) {
     viscera_Metrics m;
     memset(&m, 0, sizeof m);
@@ -212,6 +245,12 @@ static void publish_metrics(server_t *s, uint64_t window_steps) {
     snprintf(m.error_kind, sizeof m.error_kind, "%s", model->error_kind ? model->error_kind : "");
     m.peak_force = peak;
     m.rejected_commands = s->stats->rejected_total;
+    m.time_above_st = above[THR_ST];
+    m.time_above_mpf = above[THR_MPF];
+    m.time_above_sft = above[THR_SFT];
+    m.contact_time = contact;
+    m.mean_contact_force = contact > 0 ? fint / contact : 0.0;
+    m.path_length = path;
     dds_write(s->w_metrics, &m);
   }
 }
@@ -269,6 +308,10 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
     fprintf(stderr, "server: scene '%s' running on domain %d, partition '%s'\n", scene->name, opts->domain,
             opts->partition ? opts->partition : VDDS_DEFAULT_PARTITION);
   }
+  for (size_t t = 0; t < s.rt.ntools; t++) {
+    const scene_tool_t *c = s.rt.tools[t].cfg;
+    thr_init(&s.thr[t], c->st, c->mpf, c->sft);
+  }
   publish_scene_info(&s);
   for (size_t i = 0; i < s.rt.norgans; i++) mesh_publisher_keyframe(&s.pubs[i], s.rt.organs[i].model->surf_x, 0);
   publish_event(&s, viscera_EVENT_SESSION_STARTED, -1, -1, 0, scene->name);
@@ -287,6 +330,7 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
       if (!opts->quiet) fprintf(stderr, "server: step %" PRIu64 ": non-finite state, rolled back\n", s.rt.steps);
     }
     publish_feedback(&s);
+    track_thresholds(&s);
     if (s.rt.steps % publish_every == 0) publish_frames(&s);
     uint64_t t1 = vtime_mono_ns();
     s.step_us[s.nstep_us++ % STEP_RING] = (double)(t1 - t0) * 1e-3;
@@ -299,10 +343,13 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
     vtime_sleep_until(next);
   }
   publish_frames(&s);
+  publish_metrics(&s, metrics_every);
   if (opts->final_mesh) write_final_mesh(&s);
   publish_event(&s, viscera_EVENT_SESSION_STOPPED, -1, -1, 0, scene->name);
 
   stats->steps = s.rt.steps;
+  stats->ntools = s.rt.ntools;
+  memcpy(stats->thr, s.thr, sizeof stats->thr);
   for (size_t t = 0; t < s.rt.ntools; t++) stats->peak_force = fmax(stats->peak_force, s.rt.tools[t].peak_force);
   size_t n = s.nstep_us < STEP_RING ? s.nstep_us : STEP_RING;
   vstats_summary_t st = vstats_summarise(s.step_us, n);

@@ -10,6 +10,7 @@
 
 #include "mesh_publisher.h"
 #include "scene_runtime.h"
+#include "thresholds.h"
 #include "vdds.h"
 
 typedef struct server_opts {
@@ -25,6 +26,8 @@ typedef struct server_stats {
   uint64_t steps, overruns, rollbacks, rejected[TOOLCMD_VERDICT_COUNT], rejected_total, commands;
   double peak_force;
   double step_us_median, step_us_p99, step_us_max;
+  size_t ntools;
+  thr_tracker_t thr[SCENE_MAX_TOOLS]; /* palpation measures per tool at the end */
 } server_stats_t;
 
 /* Runs a whole session: set-up, loop until *stop or the duration, shutdown.

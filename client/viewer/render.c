@@ -319,6 +319,10 @@ void render_proxy(render_t *r, const float p[3], float radius) {
 }
 
 void render_force_bar(render_t *r, double force, double max_force) {
+  render_force_bar_levels(r, force, max_force, 0, 0, 0);
+}
+
+void render_force_bar_levels(render_t *r, double force, double max_force, double st, double mpf, double sft) {
   if (!(max_force > 0) || !isfinite(max_force)) max_force = 1.0;
   double frac = isfinite(force) && force > 0 ? force / max_force : 0.0;
   if (frac > 1.0) frac = 1.0;
@@ -336,10 +340,12 @@ void render_force_bar(render_t *r, double force, double max_force) {
   float bw = 12.0f, bh = 0.4f * (float)r->h;
   float x0 = (float)r->w - 16.0f - bw, y0 = 16.0f, x1 = x0 + bw, y1 = y0 + bh;
   float fill = y0 + (float)frac * bh;
-  if (frac > 0.8)
-    glColor3f(0.85f, 0.05f, 0.03f);
-  else if (frac > 0.5)
-    glColor3f(0.95f, 0.70f, 0.02f);
+  double f = isfinite(force) ? force : 0.0;
+  int levels = (isfinite(st) && st > 0) || (isfinite(mpf) && mpf > 0);
+  if (levels ? (mpf > 0 && f > mpf) : frac > 0.8)
+    glColor3f(0.85f, 0.05f, 0.03f); /* red */
+  else if (levels ? (st > 0 && f > st) : frac > 0.5)
+    glColor3f(0.95f, levels ? 0.45f : 0.70f, 0.02f); /* orange (levels) or yellow */
   else
     glColor3f(0.10f, 0.60f, 0.12f);
   glBegin(GL_QUADS);
@@ -367,6 +373,19 @@ void render_force_bar(render_t *r, double force, double max_force) {
     }
     glEnd();
   }
+  /* Threshold lines across the bar (and a little beyond on the left):
+   * ST orange, MPF red, SFT dark red. */
+  const double lv[3] = {st, mpf, sft};
+  static const float lc[3][3] = {{0.95f, 0.45f, 0.02f}, {0.85f, 0.05f, 0.03f}, {0.45f, 0.0f, 0.0f}};
+  glBegin(GL_LINES);
+  for (int k = 0; k < 3; k++) {
+    if (!(isfinite(lv[k]) && lv[k] > 0 && lv[k] <= max_force)) continue;
+    float y = y0 + (float)(lv[k] / max_force) * bh;
+    glColor3f(lc[k][0], lc[k][1], lc[k][2]);
+    glVertex2f(x0 - 8.0f, y);
+    glVertex2f(x1, y);
+  }
+  glEnd();
   glEnable(GL_DEPTH_TEST);
   glEnable(GL_LIGHTING);
 }

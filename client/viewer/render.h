@@ -66,6 +66,12 @@ void render_proxy(render_t *r, const float p[3], float radius);
  * are not too dense. Draw it last. */
 void render_force_bar(render_t *r, double force, double max_force);
 
+/* The same bar with the tool's palpation thresholds (seed 002 ch. 6), N,
+ * 0 = unset: a line across the bar at each level set; when ST or MPF is
+ * set the fill is green below ST, orange above ST and red above MPF
+ * instead of the fraction-of-max colours. */
+void render_force_bar_levels(render_t *r, double force, double max_force, double st, double mpf, double sft);
+
 /* Finishes the frame and returns width * height * 3 sRGB bytes, rows
  * bottom-up (OpenGL order). Owned by the renderer; valid until the next
  * render_begin or render_close. */

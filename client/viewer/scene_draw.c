@@ -26,7 +26,10 @@ const uint8_t *scene_draw(render_t *r, const camera_t *cam, const scene_view_t *
       if (t->have_contact && t->in_contact) render_proxy(r, t->proxy, PROXY_SCALE * t->radius);
     }
     int p = scene_view_primary_tool(sv);
-    if (p >= 0) render_force_bar(r, force_magnitude(&sv->tools[p]), sv->tools[p].max_force);
+    if (p >= 0) {
+      const sv_tool_t *t = &sv->tools[p];
+      render_force_bar_levels(r, force_magnitude(t), t->max_force, t->st, t->mpf, t->sft);
+    }
   }
   return render_end(r);
 }

@@ -30,7 +30,11 @@ static void tool_defaults(sv_tool_t *t) {
   t->radius = SCENE_VIEW_TOOL_RADIUS;
   t->length = SCENE_VIEW_TOOL_LENGTH;
   t->max_force = SCENE_VIEW_TOOL_MAX_FORCE;
+  t->st = t->mpf = t->sft = 0;
 }
+
+/* A threshold from the wire: kept only when finite and in (0, max_force]. */
+static float thr_level(float v, float max_force) { return isfinite(v) && v > 0 && v <= max_force ? v : 0.0f; }
 
 static void organ_defaults(sv_organ_t *o) {
   const float rgb[3] = SCENE_VIEW_ORGAN_RGB;
@@ -93,6 +97,9 @@ static void on_scene_info(scene_view_t *sv, const viscera_SceneInfo *s) {
     t->radius = ti->radius;
     t->length = ti->length;
     t->max_force = ti->max_force;
+    t->st = thr_level(ti->st, ti->max_force);
+    t->mpf = thr_level(ti->mpf, ti->max_force);
+    t->sft = thr_level(ti->sft, ti->max_force);
   }
 }
 

@@ -222,6 +222,33 @@ int main(void) {
     CHECK(same_px(px(tool, (int)tx, (int)ty + 12), px(bg, (int)tx, (int)ty + 12)));
   }
 
+  /* Force bar with palpation thresholds (ST 0.6, MPF 0.9, SFT 1.5 of 4 N):
+   * green below ST, orange above ST, red above MPF; a line at each level
+   * left of the bar, beyond the 1 N ticks. Bar: x from W-28 to W-16, from
+   * 16 px above the bottom, 0.4 H tall. */
+  static uint8_t bar[W * H * 3];
+  const double forces[3] = {0.5, 0.7, 1.2};
+  int bx = W - 22, by = H - 1 - 18;
+  for (int i = 0; i < 3; i++) {
+    render_begin(r, &cam);
+    render_force_bar_levels(r, forces[i], 4.0, 0.6, 0.9, 1.5);
+    memcpy(bar, render_end(r), sizeof bar);
+    const uint8_t *p = px(bar, bx, by);
+    printf("force bar at %.1f N: rgb %d %d %d\n", forces[i], p[0], p[1], p[2]);
+    if (i == 0) CHECK(p[1] > p[0] && p[1] > p[2]);                           /* green */
+    if (i == 1) CHECK(p[0] > 200 && p[1] > 110 && p[1] < 205 && p[2] < 80); /* orange */
+    if (i == 2) CHECK(p[0] > 200 && p[1] < 100 && p[2] < 80);               /* red */
+    const double lv[3] = {0.6, 0.9, 1.5};
+    for (int k = 0; k < 3; k++) {
+      int yl = H - 1 - (int)(16 + lv[k] / 4.0 * 0.4 * H), found = 0;
+      for (int dy = -1; dy <= 1; dy++) found |= !same_px(px(bar, W - 35, yl + dy), px(bg, W - 35, yl + dy));
+      CHECK(found);
+    }
+    /* Between the levels, left of the ticks: background. */
+    int ymid = H - 1 - (int)(16 + 1.2 / 4.0 * 0.4 * H);
+    CHECK(same_px(px(bar, W - 35, ymid), px(bg, W - 35, ymid)));
+  }
+
   /* Bad arguments fail with a message instead of crashing. */
   render_t *bad = NULL;
   CHECK(render_open(&bad, 0, 10, 1, &err) == -1 && bad == NULL);

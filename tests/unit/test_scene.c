@@ -667,6 +667,55 @@ static void test_default_asset(void) {
   CHECK_NEAR(t->radius, 0.003, 1e-15);
   CHECK_NEAR(t->stiffness, 400, 0);
   CHECK_NEAR(t->max_force, 4, 0);
+  CHECK_NEAR(t->st, 0.5, 1e-15);
+  CHECK_NEAR(t->mpf, 0.8, 1e-15);
+  CHECK_NEAR(t->sft, 1.5, 1e-15);
+}
+
+/* Palpation thresholds (seed 002 ch. 6): optional, each key too, in the order
+ * st < mpf <= sft <= max_force, refused at the offending line. */
+static void test_thresholds(void) {
+  /* None given: all unset. */
+  CHECK(loads(HEAD "tools: [{name: p}]\n", NULL));
+  CHECK(s.tools[0].st == 0 && s.tools[0].mpf == 0 && s.tools[0].sft == 0);
+  /* Flow and block forms. */
+  CHECK(loads(HEAD "tools: [{name: p, thresholds: {sft: 1.5, st: 0.6, mpf: 0.9}}]\n", NULL));
+  CHECK_NEAR(s.tools[0].st, 0.6, 1e-15);
+  CHECK_NEAR(s.tools[0].mpf, 0.9, 1e-15);
+  CHECK_NEAR(s.tools[0].sft, 1.5, 1e-15);
+  CHECK(loads(HEAD "tools:\n  - name: p\n    max_force: 2\n    thresholds:\n      st: 0.5\n      sft: 2\n", NULL));
+  CHECK_NEAR(s.tools[0].st, 0.5, 0);
+  CHECK(s.tools[0].mpf == 0);
+  CHECK_NEAR(s.tools[0].sft, 2, 0);
+  /* A subset is fine; mpf may equal sft. */
+  CHECK(loads(HEAD "tools: [{name: p, thresholds: {mpf: 1}}]\n", NULL) && s.tools[0].mpf == 1 && s.tools[0].st == 0);
+  CHECK(loads(HEAD "tools: [{name: p, thresholds: {mpf: 1, sft: 1}}]\n", NULL));
+  CHECK(loads(HEAD "tools: [{name: p, thresholds: {}}]\n", NULL) && s.tools[0].sft == 0);
+  /* Errors with line and field. */
+  CHECK(fails_with(HEAD "tools:\n  - name: p\n    thresholds:\n      st: 0.5\n      stf: 1\n",
+                   "t.yaml:9: field 'tools[0].thresholds.stf': unknown key", "allowed: st, mpf, sft"));
+  CHECK(fails_with(HEAD "tools:\n  - name: p\n    thresholds:\n      st: 0\n",
+                   "t.yaml:8: field 'tools[0].thresholds.st': must be > 0", NULL));
+  CHECK(fails_with(HEAD "tools:\n  - name: p\n    thresholds:\n      sft: -1\n",
+                   "t.yaml:8: field 'tools[0].thresholds.sft'", NULL));
+  CHECK(fails_with(HEAD "tools:\n  - name: p\n    thresholds:\n      st: abc\n",
+                   "t.yaml:8: field 'tools[0].thresholds.st'", NULL));
+  CHECK(fails_with(HEAD "tools:\n  - name: p\n    thresholds: 1\n",
+                   "t.yaml:7: field 'tools[0].thresholds': must be a mapping", NULL));
+  /* Above max_force, whichever order the keys come in. */
+  CHECK(fails_with(HEAD "tools:\n  - name: p\n    thresholds:\n      sft: 5\n    max_force: 4\n",
+                   "t.yaml:8: field 'tools[0].thresholds.sft': must be <= the tool's max_force 4 N (got 5)", NULL));
+  /* Out of order: reported at the higher threshold's line. */
+  CHECK(fails_with(HEAD "tools:\n  - name: p\n    thresholds:\n      st: 0.6\n      mpf: 0.5\n",
+                   "t.yaml:9: field 'tools[0].thresholds.mpf': must be > st 0.6 N", "st < mpf <= sft"));
+  CHECK(fails_with(HEAD "tools:\n  - name: p\n    thresholds:\n      st: 0.6\n      mpf: 0.6\n",
+                   "t.yaml:9: field 'tools[0].thresholds.mpf': must be > st", NULL));
+  CHECK(fails_with(HEAD "tools:\n  - name: p\n    thresholds:\n      sft: 0.8\n      mpf: 0.9\n",
+                   "t.yaml:8: field 'tools[0].thresholds.sft': must be >= mpf 0.9 N", NULL));
+  CHECK(fails_with(HEAD "tools:\n  - name: p\n    thresholds:\n      st: 1\n      sft: 1\n",
+                   "t.yaml:9: field 'tools[0].thresholds.sft': must be > st 1 N", NULL));
+  CHECK(fails_with(HEAD "tools:\n  - name: p\n    thresholds:\n      st: 1\n      st: 0.5\n",
+                   "t.yaml:9: field 'tools[0].thresholds.st': duplicate key", NULL));
 }
 
 int main(void) {
@@ -689,5 +738,6 @@ int main(void) {
   test_limits();
   test_files();
   test_default_asset();
+  test_thresholds();
   return check_report("test_scene");
 }
