@@ -111,3 +111,11 @@ int vdds_parse_domain(const char *s) {
   if (!s[0] || *end || d < 0 || d > 230) return -1;
   return (int)d;
 }
+
+int vdds_env_domain(verr_t *err) {
+  const char *env = getenv("VISCERA_DOMAIN");
+  if (!env || !*env) return 0;
+  int d = vdds_parse_domain(env);
+  if (d < 0) verr_set(err, "VISCERA_DOMAIN='%s' is not a domain id 0..230", env);
+  return d;
+}

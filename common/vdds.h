@@ -48,5 +48,8 @@ dds_entity_t vdds_reader_listener(vdds_t *v, vdds_topic_id_t t, const dds_listen
 
 /* Parses a domain id string (0..230); -1 on bad input. */
 int vdds_parse_domain(const char *s);
+/* The default domain of every binary: $VISCERA_DOMAIN if set and non-empty,
+ * else 0; -1 with err when the variable is not a domain id. */
+int vdds_env_domain(verr_t *err);
 
 #endif

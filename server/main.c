@@ -8,6 +8,7 @@
 
 #include "scene.h"
 #include "server.h"
+#include "vsignal.h"
 #include "vdds.h"
 
 static volatile sig_atomic_t g_stop = 0;
@@ -35,9 +36,9 @@ static void usage(FILE *f) {
 int main(int argc, char **argv) {
   const char *scene_path = NULL;
   server_opts_t opts = {.domain = 0, .partition = NULL, .duration = 0, .tool_timeout = 0.5};
-  const char *env_domain = getenv("VISCERA_DOMAIN");
-  if (env_domain && (opts.domain = vdds_parse_domain(env_domain)) < 0) {
-    fprintf(stderr, "viscera-server: VISCERA_DOMAIN='%s' is not a domain id 0..230\n", env_domain);
+  verr_t err;
+  if ((opts.domain = vdds_env_domain(&err)) < 0) {
+    fprintf(stderr, "viscera-server: %s\n", err.msg);
     return 2;
   }
   int check_only = 0;
@@ -85,7 +86,6 @@ int main(int argc, char **argv) {
     return 2;
   }
   static scene_t scene;
-  verr_t err;
   if (scene_load(scene_path, &scene, &err)) {
     fprintf(stderr, "viscera-server: %s\n", err.msg);
     return 1;
@@ -109,11 +109,7 @@ int main(int argc, char **argv) {
     runtime_destroy(&rt);
     return 0;
   }
-  struct sigaction sa;
-  memset(&sa, 0, sizeof sa);
-  sa.sa_handler = on_signal;
-  sigaction(SIGINT, &sa, NULL);
-  sigaction(SIGTERM, &sa, NULL);
+  vsignal_on_stop(on_signal, 0);
   server_stats_t st;
   if (server_run(&scene, &opts, &g_stop, &st, &err)) {
     fprintf(stderr, "viscera-server: %s\n", err.msg);

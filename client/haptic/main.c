@@ -17,6 +17,7 @@
 #include "contact_model.h"
 #include "device.h"
 #include "feedback_slot.h"
+#include "vsignal.h"
 #include "vdds.h"
 #include "viscera.h"
 #include "vmath.h"
@@ -58,9 +59,9 @@ int main(int argc, char **argv) {
   int domain = 0, quiet = 0, rt_priority = 0;
   unsigned tool = 0;
   double rate = 1000, max_force = 4, wait_server = 10, duration = -1;
-  const char *env_domain = getenv("VISCERA_DOMAIN");
-  if (env_domain && (domain = vdds_parse_domain(env_domain)) < 0) {
-    fprintf(stderr, "viscera-haptic: VISCERA_DOMAIN='%s' is not a domain id 0..230\n", env_domain);
+  verr_t err;
+  if ((domain = vdds_env_domain(&err)) < 0) {
+    fprintf(stderr, "viscera-haptic: %s\n", err.msg);
     return 2;
   }
   static const struct option lo[] = {{"trajectory", required_argument, 0, 'j'},
@@ -151,7 +152,6 @@ int main(int argc, char **argv) {
     fprintf(stderr, "viscera-haptic: --rate must be 10..10000 Hz and --max-force > 0\n");
     return 2;
   }
-  verr_t err;
   device_t dev;
   if (device_scripted_open(&dev, traj, max_force, &err)) {
     fprintf(stderr, "viscera-haptic: %s\n", err.msg);
@@ -176,11 +176,7 @@ int main(int argc, char **argv) {
     fprintf(stderr, "viscera-haptic: %s\n", err.msg);
     return 1;
   }
-  struct sigaction sa;
-  memset(&sa, 0, sizeof sa);
-  sa.sa_handler = on_signal;
-  sigaction(SIGINT, &sa, NULL);
-  sigaction(SIGTERM, &sa, NULL);
+  vsignal_on_stop(on_signal, 0);
 
   /* Wait for the scene so the script starts when the server can answer. */
   uint64_t wait_until = vtime_mono_ns() + (uint64_t)(wait_server * 1e9);

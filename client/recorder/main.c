@@ -3,7 +3,6 @@
  * Generic by design: it compiles in no product type. Topics and their types
  * are discovered at run time (see session.h), so topics added to the
  * product later are recorded without rebuilding the recorder. */
-#include <errno.h>
 #include <getopt.h>
 #include <math.h>
 #include <signal.h>
@@ -13,6 +12,8 @@
 
 #include "session.h"
 #include "vtime.h"
+#include "vsignal.h"
+#include "vdds.h"
 
 #ifndef VISCERA_VERSION
 #define VISCERA_VERSION "unknown"
@@ -50,25 +51,16 @@ static void usage(FILE *f) {
              "DDS configuration comes from CYCLONEDDS_URI.\n");
 }
 
-static int parse_domain(const char *s) {
-  char *end = NULL;
-  errno = 0;
-  long d = strtol(s, &end, 10);
-  if (!*s || *end || errno || d < 0 || d > 230) return -1;
-  return (int)d;
-}
-
 int main(int argc, char **argv) {
   rec_session_opts_t o = {0};
   o.partition = "viscera/local";
   o.log = stderr;
   double duration = 0;
   bool quiet = false;
-  const char *env_domain = getenv("VISCERA_DOMAIN");
-  if (env_domain && *env_domain) {
-    o.domain = parse_domain(env_domain);
-    if (o.domain < 0) {
-      fprintf(stderr, "recorder: VISCERA_DOMAIN='%s' is not a domain id 0..230\n", env_domain);
+  {
+    verr_t derr;
+    if ((o.domain = vdds_env_domain(&derr)) < 0) {
+      fprintf(stderr, "recorder: %s\n", derr.msg);
       return 2;
     }
   }
@@ -96,7 +88,7 @@ int main(int argc, char **argv) {
       o.force = true;
       break;
     case 'd':
-      if ((o.domain = parse_domain(optarg)) < 0) {
+      if ((o.domain = vdds_parse_domain(optarg)) < 0) {
         fprintf(stderr, "recorder: --domain '%s': expected an integer 0..230\n", optarg);
         return 2;
       }
@@ -151,13 +143,7 @@ int main(int argc, char **argv) {
 
   /* Install before the session exists so an early Ctrl-C still closes the
    * file cleanly; SA_RESETHAND makes a second signal kill at once. */
-  struct sigaction sa;
-  memset(&sa, 0, sizeof sa);
-  sa.sa_handler = on_signal;
-  sa.sa_flags = SA_RESETHAND;
-  sigemptyset(&sa.sa_mask);
-  sigaction(SIGINT, &sa, NULL);
-  sigaction(SIGTERM, &sa, NULL);
+  vsignal_on_stop(on_signal, SA_RESETHAND);
 
   verr_t err = {{0}};
   rec_session_t *s = NULL;

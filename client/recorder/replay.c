@@ -38,6 +38,7 @@
 #include "recording.h"
 #include "replay_serdata.h"
 #include "verr.h"
+#include "vsignal.h"
 
 typedef struct rp_topic {
   int64_t id;
@@ -597,12 +598,7 @@ int main(int argc, char **argv) {
     goto out;
   }
   find_time_range(&r);
-  struct sigaction sa;
-  memset(&sa, 0, sizeof sa);
-  sa.sa_handler = on_signal;
-  sigemptyset(&sa.sa_mask);
-  sigaction(SIGINT, &sa, NULL);
-  sigaction(SIGTERM, &sa, NULL);
+  vsignal_on_stop(on_signal, 0);
   if (!r.quiet)
     fprintf(stderr, "replay: %s: %zu topics into domain %d partition '%s' at speed %g\n", r.path, r.ntopics, r.domain,
             r.partition, r.speed);

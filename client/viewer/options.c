@@ -71,11 +71,7 @@ int options_parse(viewer_opts_t *o, int argc, char **argv, verr_t *err) {
                        .width = 640,
                        .height = 480,
                        .tools = 1};
-  const char *env = getenv("VISCERA_DOMAIN");
-  if (env && *env) {
-    o->domain = vdds_parse_domain(env);
-    if (o->domain < 0) return verr_set(err, "VISCERA_DOMAIN='%s' is not a domain id (0..230)", env);
-  }
+  if ((o->domain = vdds_env_domain(err)) < 0) return -1;
   enum {
     O_DOMAIN = 256,
     O_PARTITION,

@@ -1,0 +1,14 @@
+#include "vsignal.h"
+
+#include <signal.h>
+#include <string.h>
+
+void vsignal_on_stop(void (*handler)(int), int flags) {
+  struct sigaction sa;
+  memset(&sa, 0, sizeof sa);
+  sa.sa_handler = handler;
+  sa.sa_flags = flags;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, NULL);
+  sigaction(SIGTERM, &sa, NULL);
+}
