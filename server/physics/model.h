@@ -57,6 +57,12 @@ struct model {
   int substeps;     /* per scene step */
   double stable_dt; /* s, the bound the sub-steps were chosen from (INFINITY: unconditionally stable) */
   uint64_t rollbacks;
+  /* Topology of the surface: 0 at creation. A model that changes its surface
+   * (adaptive refinement, cutting) increments it after it has updated nsurf,
+   * nsurf_tris, surf_x, surf_rest and surf_tris (the pointers may change then,
+   * and only then). The runtime compares it after every step and rebuilds
+   * what depends on the surface (collision tree, proxies, publisher). */
+  uint32_t topology_version;
   void (*hook)(model_t *m, void *ctx);
   void *hook_ctx;
 };
