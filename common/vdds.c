@@ -5,7 +5,7 @@
 
 #include "viscera.h"
 
-typedef enum qos_kind { QOS_STATE, QOS_STREAM, QOS_EVENTS, QOS_METRICS } qos_kind_t;
+typedef enum qos_kind { QOS_STATE, QOS_STREAM, QOS_EVENTS, QOS_METRICS, QOS_CONTROL } qos_kind_t;
 
 static const struct {
   const char *name;
@@ -21,6 +21,7 @@ static const struct {
     [VT_CONTACT_FEEDBACK] = {"viscera_ContactFeedback", &viscera_ContactFeedback_desc, QOS_STREAM},
     [VT_SESSION_EVENT] = {"viscera_SessionEvent", &viscera_SessionEvent_desc, QOS_EVENTS},
     [VT_METRICS] = {"viscera_Metrics", &viscera_Metrics_desc, QOS_METRICS},
+    [VT_SESSION_CONTROL] = {"viscera_SessionControl", &viscera_SessionControl_desc, QOS_CONTROL},
 };
 
 const char *vdds_topic_name(vdds_topic_id_t t) { return t < VT_COUNT ? TOPICS[t].name : "?"; }
@@ -49,6 +50,14 @@ static dds_qos_t *make_qos(qos_kind_t k) {
     dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
     dds_qset_durability(q, DDS_DURABILITY_VOLATILE);
     dds_qset_history(q, DDS_HISTORY_KEEP_LAST, 1);
+    break;
+  case QOS_CONTROL:
+    /* Every command counts (pause then resume must both arrive), but a burst
+     * from a misbehaving station must not grow memory: keep the last 16 per
+     * station. Volatile: commands act when they arrive, never replayed. */
+    dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
+    dds_qset_durability(q, DDS_DURABILITY_VOLATILE);
+    dds_qset_history(q, DDS_HISTORY_KEEP_LAST, 16);
     break;
   }
   return q;

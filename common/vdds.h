@@ -20,6 +20,7 @@ typedef enum vdds_topic_id {
   VT_CONTACT_FEEDBACK,
   VT_SESSION_EVENT,
   VT_METRICS,
+  VT_SESSION_CONTROL,
   VT_COUNT
 } vdds_topic_id_t;
 

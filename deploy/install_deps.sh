@@ -12,6 +12,7 @@ PKGS=(
   libsqlite3-dev sqlite3                    # recordings
   libyaml-dev                               # scene files
   libcairo2-dev                             # plots in benchmarks and reports
+  openssl                                   # DDS Security PKI (deploy/pki.sh)
 )
 
 missing=()

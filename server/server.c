@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "mesh.h"
+#include "session_control.h"
 #include "viscera.h"
 #include "vmath.h"
 #include "vstats.h"
@@ -18,11 +19,12 @@ typedef struct server {
   const server_opts_t *opts;
   runtime_t rt;
   vdds_t dds;
-  dds_entity_t w_scene, w_state, w_delta, w_feedback, w_event, w_metrics, r_cmd;
+  dds_entity_t w_scene, w_state, w_delta, w_feedback, w_event, w_metrics, r_cmd, r_control;
   mesh_publisher_t pubs[SCENE_MAX_ORGANS];
   uint64_t cmd_seq[SCENE_MAX_TOOLS], cmd_echo[SCENE_MAX_TOOLS], last_cmd_mono[SCENE_MAX_TOOLS];
   int was_contact[SCENE_MAX_TOOLS];
   thr_tracker_t thr[SCENE_MAX_TOOLS];
+  session_control_t control;
   uint64_t event_seq;
   double *step_us; /* ring of recent step times */
   size_t nstep_us;
@@ -98,8 +100,9 @@ static int setup(server_t *s, const scene_t *scene, verr_t *err) {
   s->w_event = vdds_writer(&s->dds, VT_SESSION_EVENT, err);
   s->w_metrics = vdds_writer(&s->dds, VT_METRICS, err);
   s->r_cmd = vdds_reader(&s->dds, VT_TOOL_COMMAND, err);
+  s->r_control = vdds_reader(&s->dds, VT_SESSION_CONTROL, err);
   if (s->w_scene < 0 || s->w_state < 0 || s->w_delta < 0 || s->w_feedback < 0 || s->w_event < 0 ||
-      s->w_metrics < 0 || s->r_cmd < 0)
+      s->w_metrics < 0 || s->r_cmd < 0 || s->r_control < 0)
     return -1;
   for (size_t i = 0; i < s->rt.norgans; i++) {
     organ_rt_t *o = &s->rt.organs[i];
@@ -162,6 +165,26 @@ static void read_commands(server_t *s, uint64_t now) {
       if (!s->opts->quiet) fprintf(stderr, "server: tool %zu: no commands for %.1f s, released\n", t, s->opts->tool_timeout);
       publish_event(s, viscera_EVENT_CLIENT_LOST, -1, (int)t, 0, "haptic client lost: tool released");
     }
+  }
+}
+
+/* Applies pending instructor commands (session_control.h); each outcome is
+ * logged and published, so the recording shows who changed what and when. */
+static void read_controls(server_t *s) {
+  void *samples[1] = {0};
+  dds_sample_info_t info;
+  while (dds_take(s->r_control, samples, &info, 1, 1) == 1) {
+    if (info.valid_data && !session_control_duplicate(&s->control, samples[0])) {
+      const viscera_SessionControl *c = samples[0];
+      double maxf[SCENE_MAX_TOOLS];
+      for (size_t t = 0; t < s->rt.ntools; t++) maxf[t] = s->rt.tools[t].cfg->max_force;
+      char text[200];
+      int r = session_control_apply(&s->control, c, s->thr, s->rt.ntools, maxf, text, sizeof text);
+      if (!s->opts->quiet) fprintf(stderr, "server: %s\n", text);
+      publish_event(s, r == 0 ? viscera_EVENT_CONTROL_APPLIED : viscera_EVENT_INPUT_REJECTED, -1, c->tool_id,
+                    (double)c->kind, text);
+    }
+    dds_return_loan(s->r_control, samples, 1);
   }
 }
 
@@ -323,14 +346,17 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
   while (!*stop && (opts->duration <= 0 || (double)(vtime_mono_ns() - start) * 1e-9 < opts->duration)) {
     uint64_t t0 = vtime_mono_ns();
     read_commands(&s, t0);
-    int rolled = runtime_step(&s.rt);
+    read_controls(&s);
+    /* Paused: the organs and the measures freeze; commands are still read
+     * (so nothing queues up) and the last contact model keeps going out. */
+    int rolled = s.control.paused ? 0 : runtime_step(&s.rt);
     if (rolled) {
       stats->rollbacks += (uint64_t)rolled;
       publish_event(&s, viscera_EVENT_STEP_ROLLED_BACK, -1, -1, rolled, "non-finite state: step rolled back");
       if (!opts->quiet) fprintf(stderr, "server: step %" PRIu64 ": non-finite state, rolled back\n", s.rt.steps);
     }
     publish_feedback(&s);
-    track_thresholds(&s);
+    if (!s.control.paused) track_thresholds(&s);
     if (s.rt.steps % publish_every == 0) publish_frames(&s);
     uint64_t t1 = vtime_mono_ns();
     s.step_us[s.nstep_us++ % STEP_RING] = (double)(t1 - t0) * 1e-3;

@@ -1,0 +1,191 @@
+/* viscera-control: sends one instructor command (SessionControl) to a seat's
+ * server and waits for the server's answer (a SessionEvent saying it was
+ * applied or refused), so a script or an instructor sees the outcome.
+ *
+ * Only identities allowed to publish SessionControl in the seat's partition
+ * can use it when DDS Security is on (deploy/pki.sh): for anyone else the
+ * writer cannot be created and the command says so. */
+#include <getopt.h>
+#include <inttypes.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "vdds.h"
+#include "viscera.h"
+#include "vtime.h"
+
+static void usage(FILE *f) {
+  fprintf(f, "usage: viscera-control [options] pause | resume | thresholds TOOL ST MPF SFT\n"
+             "  pause                 freeze the seat's physics and measures\n"
+             "  resume                continue\n"
+             "  thresholds T ST MPF SFT   new palpation thresholds (N) for tool T (0 = not set)\n"
+             "  --domain N            DDS domain id (default: $VISCERA_DOMAIN or 0)\n"
+             "  --partition P         the seat's partition (default: " VDDS_DEFAULT_PARTITION ")\n"
+             "  --station ID          this instructor station's id (default 1)\n"
+             "  --text TEXT           who/why, kept in the recording\n"
+             "  --wait S              wait up to S s for the server's answer (default 5)\n"
+             "  --help                this text\n"
+             "Exit status: 0 applied, 1 refused or no answer, 2 usage or DDS error.\n");
+}
+
+static int parse_double(const char *s, double *out) {
+  char *end;
+  *out = strtod(s, &end);
+  return end != s && *end == 0 && isfinite(*out) ? 0 : -1;
+}
+
+int main(int argc, char **argv) {
+  static const struct option opts[] = {{"domain", required_argument, 0, 'd'}, {"partition", required_argument, 0, 'p'},
+                                        {"station", required_argument, 0, 's'}, {"text", required_argument, 0, 't'},
+                                        {"wait", required_argument, 0, 'w'},    {"help", no_argument, 0, 'h'},
+                                        {0, 0, 0, 0}};
+  verr_t err;
+  int domain = vdds_env_domain(&err);
+  if (domain < 0) {
+    fprintf(stderr, "viscera-control: %s\n", err.msg);
+    return 2;
+  }
+  const char *partition = NULL, *text = "";
+  unsigned long station = 1;
+  double wait_s = 5;
+  int c;
+  while ((c = getopt_long(argc, argv, "", opts, NULL)) != -1) {
+    switch (c) {
+    case 'd':
+      if ((domain = vdds_parse_domain(optarg)) < 0) {
+        fprintf(stderr, "viscera-control: --domain: not a domain id: '%s'\n", optarg);
+        return 2;
+      }
+      break;
+    case 'p': partition = optarg; break;
+    case 's': {
+      char *end;
+      station = strtoul(optarg, &end, 10);
+      if (*optarg == 0 || *end || station > 1000000) {
+        fprintf(stderr, "viscera-control: --station: not a station id: '%s'\n", optarg);
+        return 2;
+      }
+      break;
+    }
+    case 't': text = optarg; break;
+    case 'w':
+      if (parse_double(optarg, &wait_s) || wait_s < 0) {
+        fprintf(stderr, "viscera-control: --wait: not a duration: '%s'\n", optarg);
+        return 2;
+      }
+      break;
+    case 'h': usage(stdout); return 0;
+    default: usage(stderr); return 2;
+    }
+  }
+  viscera_SessionControl cmd;
+  memset(&cmd, 0, sizeof cmd);
+  cmd.source_id = (uint32_t)station;
+  cmd.seq = vtime_mono_ns(); /* increasing across invocations of one station */
+  cmd.tool_id = -1;
+  snprintf(cmd.text, sizeof cmd.text, "%s", text);
+  const char *verb = optind < argc ? argv[optind] : NULL;
+  if (verb && strcmp(verb, "pause") == 0 && argc - optind == 1) {
+    cmd.kind = viscera_CONTROL_PAUSE;
+  } else if (verb && strcmp(verb, "resume") == 0 && argc - optind == 1) {
+    cmd.kind = viscera_CONTROL_RESUME;
+  } else if (verb && strcmp(verb, "thresholds") == 0 && argc - optind == 5) {
+    cmd.kind = viscera_CONTROL_SET_THRESHOLDS;
+    char *end;
+    long tool = strtol(argv[optind + 1], &end, 10);
+    if (*end || tool < 0 || tool > 1000) {
+      fprintf(stderr, "viscera-control: thresholds: not a tool index: '%s'\n", argv[optind + 1]);
+      return 2;
+    }
+    cmd.tool_id = (int32_t)tool;
+    for (int k = 0; k < 3; k++)
+      if (parse_double(argv[optind + 2 + k], &cmd.values[k])) {
+        fprintf(stderr, "viscera-control: thresholds: not a force in N: '%s'\n", argv[optind + 2 + k]);
+        return 2;
+      }
+  } else {
+    usage(stderr);
+    return 2;
+  }
+
+  vdds_t dds;
+  if (vdds_open(&dds, domain, partition, &err)) {
+    fprintf(stderr, "viscera-control: %s\n", err.msg);
+    return 2;
+  }
+  int rc = 2;
+  dds_entity_t w = vdds_writer(&dds, VT_SESSION_CONTROL, &err);
+  dds_entity_t r = vdds_reader(&dds, VT_SESSION_EVENT, &err);
+  if (w < 0 || r < 0) {
+    fprintf(stderr, "viscera-control: %s (is this identity allowed to send SessionControl in this partition?)\n",
+            err.msg);
+    goto out;
+  }
+  /* The server is there once its SceneInfo (transient-local) arrives. A
+   * matched writer alone proves nothing: a recorder's reader matches too. */
+  dds_entity_t r_scene = vdds_reader(&dds, VT_SCENE_INFO, &err);
+  if (r_scene < 0) {
+    fprintf(stderr, "viscera-control: %s\n", err.msg);
+    goto out;
+  }
+  uint64_t deadline = vtime_mono_ns() + (uint64_t)(wait_s * 1e9);
+  int have_server = 0;
+  while (!have_server && vtime_mono_ns() < deadline) {
+    void *samples[1] = {0};
+    dds_sample_info_t info;
+    int n = dds_take(r_scene, samples, &info, 1, 1);
+    if (n > 0) {
+      have_server = info.valid_data;
+      dds_return_loan(r_scene, samples, n);
+    } else {
+      dds_sleepfor(DDS_MSECS(20));
+    }
+  }
+  if (!have_server) {
+    fprintf(stderr, "viscera-control: no server on domain %d partition '%s' within %.1f s\n", domain,
+            partition ? partition : VDDS_DEFAULT_PARTITION, wait_s);
+    rc = 1;
+    goto out;
+  }
+  rc = 1;
+  char mine[64];
+  snprintf(mine, sizeof mine, "[station %" PRIu32 " seq %" PRIu64 "]", cmd.source_id, cmd.seq);
+  uint64_t next_send = 0;
+  while (vtime_mono_ns() < deadline) {
+    /* Resent (same seq, the server drops copies) until answered: the
+     * server's reader may match this writer a little after its SceneInfo
+     * arrived, and a volatile write before that reaches nobody. */
+    if (vtime_mono_ns() >= next_send) {
+      if (dds_write(w, &cmd) < 0) {
+        fprintf(stderr, "viscera-control: write failed\n");
+        rc = 2;
+        break;
+      }
+      next_send = vtime_mono_ns() + 500000000ull;
+    }
+    void *samples[8] = {0};
+    dds_sample_info_t infos[8];
+    int n = dds_take(r, samples, infos, 8, 8);
+    for (int i = 0; i < n; i++) {
+      const viscera_SessionEvent *e = samples[i];
+      if (!infos[i].valid_data || !strstr(e->text, mine)) continue;
+      if (e->kind == viscera_EVENT_CONTROL_APPLIED && rc == 1) {
+        printf("applied: %s\n", e->text);
+        rc = 0;
+      } else if (e->kind == viscera_EVENT_INPUT_REJECTED && rc == 1) {
+        printf("refused: %s\n", e->text);
+        rc = 3;
+      }
+    }
+    if (n > 0) dds_return_loan(r, samples, n);
+    if (rc != 1) break;
+    dds_sleepfor(DDS_MSECS(10));
+  }
+  if (rc == 1) fprintf(stderr, "viscera-control: no answer from the server within %.1f s\n", wait_s);
+  if (rc == 3) rc = 1;
+out:
+  vdds_close(&dds);
+  return rc;
+}

@@ -1,0 +1,94 @@
+#include "session_control.h"
+
+#include <inttypes.h>
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+/* Every answer ends with the command's origin, so the station that sent it
+ * can tell its own answer from older events it receives as a late joiner. */
+static void tag(const viscera_SessionControl *c, char *text, size_t n) {
+  size_t len = strlen(text);
+  if (len < n) snprintf(text + len, n - len, " [station %" PRIu32 " seq %" PRIu64 "]", c->source_id, c->seq);
+}
+
+static int refuse(session_control_t *sc, const viscera_SessionControl *c, char *text, size_t n, const char *why) {
+  sc->refused++;
+  snprintf(text, n, "SessionControl refused: %s", why);
+  tag(c, text, n);
+  return -1;
+}
+
+/* Thresholds as the scene file accepts them (common/scene.c): each either 0
+ * (not set) or positive and finite, the set ones ordered st < mpf <= sft, none
+ * above the tool's clamp (a level the tool can never reach is a mistake). */
+static const char *check_levels(const double v[3], double max_force) {
+  for (int k = 0; k < 3; k++) {
+    if (!isfinite(v[k]) || v[k] < 0) return "threshold not a finite non-negative force";
+    if (v[k] > max_force) return "threshold above the tool's max_force";
+  }
+  if (v[0] > 0 && v[1] > 0 && !(v[0] < v[1])) return "need st < mpf";
+  if (v[1] > 0 && v[2] > 0 && !(v[1] <= v[2])) return "need mpf <= sft";
+  if (v[0] > 0 && v[2] > 0 && !(v[0] < v[2])) return "need st < sft";
+  return NULL;
+}
+
+int session_control_duplicate(session_control_t *sc, const viscera_SessionControl *c) {
+  for (size_t i = 0; i < sc->nstations; i++) {
+    if (sc->station[i] != c->source_id) continue;
+    if (c->seq <= sc->last_seq[i]) {
+      sc->duplicates++;
+      return 1;
+    }
+    sc->last_seq[i] = c->seq;
+    return 0;
+  }
+  size_t slot = sc->nstations;
+  if (slot < SESSION_CONTROL_STATIONS) {
+    sc->nstations++;
+  } else { /* table full: forget the station remembered longest */
+    slot = sc->next_evict;
+    sc->next_evict = (sc->next_evict + 1) % SESSION_CONTROL_STATIONS;
+  }
+  sc->station[slot] = c->source_id;
+  sc->last_seq[slot] = c->seq;
+  return 0;
+}
+
+int session_control_apply(session_control_t *sc, const viscera_SessionControl *c, thr_tracker_t *thr, size_t ntools,
+                          const double *tool_max_force, char *text, size_t n) {
+  switch (c->kind) {
+  case viscera_CONTROL_PAUSE:
+    sc->paused = 1;
+    sc->applied++;
+    snprintf(text, n, "paused");
+    tag(c, text, n);
+    return 0;
+  case viscera_CONTROL_RESUME:
+    sc->paused = 0;
+    sc->applied++;
+    snprintf(text, n, "resumed");
+    tag(c, text, n);
+    return 0;
+  case viscera_CONTROL_SET_THRESHOLDS: {
+    if (c->tool_id < 0 || (size_t)c->tool_id >= ntools) return refuse(sc, c, text, n, "tool id out of range");
+    const double v[3] = {c->values[0], c->values[1], c->values[2]};
+    const char *bad = check_levels(v, tool_max_force[c->tool_id]);
+    if (bad) return refuse(sc, c, text, n, bad);
+    /* New levels, same history: time above, contact time and path so far
+     * stay with the trainee. The hysteretic state restarts below every
+     * level, so a force already above a new level is reported as crossing
+     * it on the next step. */
+    thr_tracker_t *t = &thr[c->tool_id];
+    for (int k = 0; k < THR_COUNT; k++) {
+      t->level[k] = v[k];
+      t->above[k] = 0;
+    }
+    sc->applied++;
+    snprintf(text, n, "tool %" PRId32 " thresholds ST %.3g MPF %.3g SFT %.3g N", c->tool_id, v[0], v[1], v[2]);
+    tag(c, text, n);
+    return 0;
+  }
+  }
+  return refuse(sc, c, text, n, "unknown command kind");
+}

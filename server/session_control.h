@@ -1,0 +1,50 @@
+/* session_control: the instructor's commands to one seat (SessionControl
+ * topic, issue 7 roles), validated and applied to the server's state.
+ *
+ * Who may send them is not decided here: DDS Security access control lets
+ * only instructor identities publish SessionControl in a seat's partition
+ * (deploy/pki.sh). Everything in a command is still untrusted input: an
+ * unknown kind, a tool id out of range, a non-finite or mis-ordered
+ * threshold is refused with a reason and changes nothing.
+ *
+ * Plain data, no networking and no allocation: the server feeds it each
+ * command; tests drive it directly. */
+#ifndef VISCERA_SESSION_CONTROL_H
+#define VISCERA_SESSION_CONTROL_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "thresholds.h"
+#include "viscera.h"
+
+/* Stations remembered for de-duplication; a deployment has a handful of
+ * instructor stations, more only cost a forgotten duplicate. */
+#define SESSION_CONTROL_STATIONS 16
+
+typedef struct session_control {
+  int paused; /* physics and threshold tracking frozen */
+  uint64_t applied, refused, duplicates;
+  /* Last seq seen per station: a station resends a command until it hears
+   * an answer (its first copy may reach only other readers, such as a
+   * recorder, before the server's reader has matched), so a copy with a seq
+   * not above the last one from that station is dropped. */
+  uint32_t station[SESSION_CONTROL_STATIONS];
+  uint64_t last_seq[SESSION_CONTROL_STATIONS];
+  size_t nstations, next_evict;
+} session_control_t;
+
+/* Returns 1 (and does nothing else) when `c` is a resent copy of a command
+ * already handled; otherwise remembers its seq and returns 0. */
+int session_control_duplicate(session_control_t *sc, const viscera_SessionControl *c);
+
+/* Applies `c` to the seat: pause/resume, or new thresholds for one tool
+ * (thr[tool] re-initialised with the new levels; its accumulated measures
+ * are kept). Tool thresholds are checked like the scene file's:
+ * 0 <= st < mpf <= sft <= max_force for those that are non-zero.
+ * Returns 0 when applied, -1 when refused; `text` (size n) says what was
+ * done or why not, for the log and a SessionEvent. */
+int session_control_apply(session_control_t *sc, const viscera_SessionControl *c, thr_tracker_t *thr, size_t ntools,
+                          const double *tool_max_force, char *text, size_t n);
+
+#endif
