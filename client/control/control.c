@@ -37,10 +37,13 @@ static int parse_double(const char *s, double *out) {
 }
 
 int main(int argc, char **argv) {
-  static const struct option opts[] = {{"domain", required_argument, 0, 'd'}, {"partition", required_argument, 0, 'p'},
-                                        {"station", required_argument, 0, 's'}, {"text", required_argument, 0, 't'},
-                                        {"wait", required_argument, 0, 'w'},    {"help", no_argument, 0, 'h'},
-                                        {0, 0, 0, 0}};
+  static const struct option opts[] = {{"domain", required_argument, 0, 'd'},
+                                       {"partition", required_argument, 0, 'p'},
+                                       {"station", required_argument, 0, 's'},
+                                       {"text", required_argument, 0, 't'},
+                                       {"wait", required_argument, 0, 'w'},
+                                       {"help", no_argument, 0, 'h'},
+                                       {0, 0, 0, 0}};
   verr_t err;
   int domain = vdds_env_domain(&err);
   if (domain < 0) {
@@ -59,7 +62,9 @@ int main(int argc, char **argv) {
         return 2;
       }
       break;
-    case 'p': partition = optarg; break;
+    case 'p':
+      partition = optarg;
+      break;
     case 's': {
       char *end;
       station = strtoul(optarg, &end, 10);
@@ -69,15 +74,21 @@ int main(int argc, char **argv) {
       }
       break;
     }
-    case 't': text = optarg; break;
+    case 't':
+      text = optarg;
+      break;
     case 'w':
       if (parse_double(optarg, &wait_s) || wait_s < 0) {
         fprintf(stderr, "viscera-control: --wait: not a duration: '%s'\n", optarg);
         return 2;
       }
       break;
-    case 'h': usage(stdout); return 0;
-    default: usage(stderr); return 2;
+    case 'h':
+      usage(stdout);
+      return 0;
+    default:
+      usage(stderr);
+      return 2;
     }
   }
   viscera_SessionControl cmd;
