@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "checkpoint.h"
 #include "mesh.h"
 #include "session_control.h"
 #include "viscera.h"
@@ -335,9 +336,28 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
     const scene_tool_t *c = s.rt.tools[t].cfg;
     thr_init(&s.thr[t], c->st, c->mpf, c->sft);
   }
+  checkpointer_t *ckpt = NULL;
+  char resumed[300] = "";
+  if (opts->checkpoint) {
+    verr_t e;
+    int r = checkpoint_load(opts->checkpoint, &s.rt, s.thr, &e);
+    if (r < 0) {
+      fprintf(stderr, "server: %s\n", e.msg);
+    } else if (r == 1) {
+      stats->resumed = 1;
+      snprintf(resumed, sizeof resumed, "resumed from checkpoint %s at t = %.3f s (step %llu)", opts->checkpoint,
+               s.rt.sim_time, (unsigned long long)s.rt.steps);
+      if (!opts->quiet) fprintf(stderr, "server: %s\n", resumed);
+    }
+    if (!(ckpt = checkpointer_start(opts->checkpoint, err))) {
+      teardown(&s);
+      return -1;
+    }
+  }
+  uint64_t ckpt_every = (uint64_t)fmax(1.0, floor(opts->checkpoint_every / scene->dt + 0.5));
   publish_scene_info(&s);
   for (size_t i = 0; i < s.rt.norgans; i++) mesh_publisher_keyframe(&s.pubs[i], s.rt.organs[i].model->surf_x, 0);
-  publish_event(&s, viscera_EVENT_SESSION_STARTED, -1, -1, 0, scene->name);
+  publish_event(&s, viscera_EVENT_SESSION_STARTED, -1, -1, stats->resumed, resumed[0] ? resumed : scene->name);
 
   uint64_t dt_ns = (uint64_t)(scene->dt * 1e9);
   uint64_t publish_every = (uint64_t)fmax(1.0, floor(1.0 / (scene->publish_hz * scene->dt) + 0.5));
@@ -361,6 +381,7 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
     uint64_t t1 = vtime_mono_ns();
     s.step_us[s.nstep_us++ % STEP_RING] = (double)(t1 - t0) * 1e-3;
     if (s.rt.steps % metrics_every == 0) publish_metrics(&s, metrics_every);
+    if (ckpt && s.rt.steps % ckpt_every == 0) checkpointer_submit(ckpt, &s.rt, s.thr);
     next += dt_ns;
     if (t1 > next + 100 * 1000000ull) { /* far behind (debugger, overload): resynchronise */
       stats->overruns++;
@@ -370,6 +391,11 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
   }
   publish_frames(&s);
   publish_metrics(&s, metrics_every);
+  if (ckpt) {
+    checkpointer_submit(ckpt, &s.rt, s.thr);
+    verr_t e;
+    if (checkpointer_stop(ckpt, &stats->checkpoints_written, &e)) fprintf(stderr, "server: %s\n", e.msg);
+  }
   if (opts->final_mesh) write_final_mesh(&s);
   publish_event(&s, viscera_EVENT_SESSION_STOPPED, -1, -1, 0, scene->name);
 

@@ -20,9 +20,13 @@ typedef struct server_opts {
   const char *final_mesh; /* write exact positions of the last published frame here (OBJ) */
   int quiet;
   double tool_timeout;    /* s without a command before a tool is released */
+  const char *checkpoint; /* state file: resumed from at start when it fits the scene, written periodically */
+  double checkpoint_every; /* s of simulated time between checkpoints */
 } server_opts_t;
 
 typedef struct server_stats {
+  uint64_t checkpoints_written;
+  int resumed; /* started from a checkpoint */
   uint64_t steps, overruns, rollbacks, rejected[TOOLCMD_VERDICT_COUNT], rejected_total, commands;
   double peak_force;
   double step_us_median, step_us_p99, step_us_max;
