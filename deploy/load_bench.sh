@@ -1,0 +1,109 @@
+#!/usr/bin/env bash
+# Classroom load benchmark (issue 7): SEATS servers (assets/scenes/
+# classroom_kidney.yaml, meshes at 60 Hz) with a scripted trainee each
+# pressing and releasing for the whole run, SUBSCRIBERS light viewers
+# (tests/bench/delta_sub: keyframe + every MeshDelta, latency measured) spread
+# over the seats, a third of them joining late (at a third of the run).
+# Samples every server's CPU time and resident memory every 10 s; at the end
+# prints per-seat step time (median, p99), delta latency (median, p99 over all
+# subscribers), the time late joiners waited for their keyframe, and CPU /
+# memory at the start and the end of the run. Writes OUT/load.csv (samples)
+# and OUT/summary.txt.
+#
+# usage: deploy/load_bench.sh [--build DIR] [--out DIR] [--seats N] [--subscribers M] [--duration S]
+# defaults: build/, out/load, 5 seats, 30 subscribers, 600 s (the issue's setting)
+set -euo pipefail
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+BUILD="$ROOT/build" OUT="$ROOT/out/load" SEATS=5 SUBS=30 DURATION=600
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --build) BUILD="$2"; shift 2 ;;
+    --out) OUT="$2"; shift 2 ;;
+    --seats) SEATS="$2"; shift 2 ;;
+    --subscribers) SUBS="$2"; shift 2 ;;
+    --duration) DURATION="$2"; shift 2 ;;
+    -h|--help) sed -n 2,16p "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    *) echo "load_bench.sh: unknown option '$1'" >&2; exit 2 ;;
+  esac
+done
+for v in SEATS SUBS DURATION; do [[ "${!v}" =~ ^[0-9]+$ ]] && [ "${!v}" -ge 1 ] || { echo "load_bench.sh: bad ${v,,}" >&2; exit 2; }; done
+[ -x "$BUILD/tests/bench/delta_sub" ] || { echo "load_bench.sh: $BUILD/tests/bench/delta_sub missing (build with -DVISCERA_BUILD_BENCH=ON)" >&2; exit 1; }
+export CYCLONEDDS_URI="${CYCLONEDDS_URI:-file://$ROOT/deploy/cyclonedds-loopback.xml}"
+export VISCERA_DOMAIN="${VISCERA_DOMAIN:-8}"
+rm -rf "$OUT"; mkdir -p "$OUT"
+SCENE="$ROOT/assets/scenes/classroom_kidney.yaml"
+# Press 8 mm, hold, release, every 4 s, for the whole run.
+TRAJ="$OUT/press_release.traj"
+{ t=0; echo "0 0.012 0.004 0.07"; while [ $t -lt $((DURATION + 4)) ]; do
+    echo "$t.5 0.012 0.004 0.07"; echo "$((t + 1)).5 0.012 0.004 0.027"; echo "$((t + 2)).5 0.012 0.004 0.027"
+    echo "$((t + 3)).9 0.012 0.004 0.07"; t=$((t + 4)); done; } > "$TRAJ"
+pids=()
+cleanup() { for p in "${pids[@]}"; do kill -TERM "$p" 2>/dev/null || true; done; wait 2>/dev/null || true; }
+trap cleanup EXIT
+servers=()
+for i in $(seq 1 "$SEATS"); do
+  s=$(printf 'seat%02d' "$i")
+  "$BUILD/server/viscera-server" --scene "$SCENE" --partition "load/$s" --duration $((DURATION + 3)) --quiet \
+    > "$OUT/$s-server.out" 2> "$OUT/$s-server.log" &
+  servers+=($!); pids+=($!)
+done
+sleep 1
+for i in $(seq 1 "$SEATS"); do
+  s=$(printf 'seat%02d' "$i")
+  "$BUILD/client/haptic/viscera-haptic" --partition "load/$s" --trajectory "$TRAJ" --duration "$DURATION" --quiet \
+    > "$OUT/$s-haptic.log" 2>&1 & pids+=($!)
+done
+late=$((SUBS / 3)); early=$((SUBS - late))
+start_sub() { # index, duration
+  local s; s=$(printf 'seat%02d' $(( ($1 % SEATS) + 1 )))
+  "$BUILD/tests/bench/delta_sub" --partition "load/$s" --duration "$2" --name "sub$1-$s" > "$OUT/sub$1.out" 2>&1 &
+  pids+=($!)
+}
+for k in $(seq 1 "$early"); do start_sub "$k" "$DURATION"; done
+echo "load_bench: $SEATS seats, $SUBS subscribers ($late join late), $DURATION s; samples every 10 s" >&2
+echo "t_s,seat,pid,cpu_s,rss_kb" > "$OUT/load.csv"
+sample() {
+  local t=$1 i=0
+  for p in "${servers[@]}"; do
+    i=$((i + 1))
+    [ -r /proc/$p/stat ] || continue
+    # utime + stime in clock ticks (fields 14, 15 after the command name).
+    local cpu rss
+    cpu=$(awk -v hz="$(getconf CLK_TCK)" '{ sub(/^.*\) /, ""); print ($12 + $13) / hz }' /proc/$p/stat)
+    rss=$(awk '/VmRSS/ { print $2 }' /proc/$p/status)
+    echo "$t,seat$(printf %02d $i),$p,$cpu,$rss" >> "$OUT/load.csv"
+  done
+}
+t=0; late_started=0
+while [ $t -lt "$DURATION" ]; do
+  if [ $late_started = 0 ] && [ $t -ge $((DURATION / 3)) ]; then
+    for k in $(seq $((early + 1)) "$SUBS"); do start_sub "$k" $((DURATION - t)); done
+    late_started=1
+  fi
+  sample $t
+  step=$(( DURATION - t < 10 ? DURATION - t : 10 ))
+  sleep "$step"; t=$((t + step))
+done
+sample $t
+wait "${servers[@]}" 2>/dev/null || true
+sleep 1
+pids=()
+{
+  echo "load_bench: $SEATS seats x classroom_kidney (2,000 vertices, 1 kHz physics, meshes at 60 Hz), $SUBS subscribers ($late late), $DURATION s"
+  for i in $(seq 1 "$SEATS"); do
+    s=$(printf 'seat%02d' "$i")
+    sed -n 's/^server: \([0-9]*\) steps, step time median \([0-9.]*\) us p99 \([0-9.]*\) us.*/  '"$s"': \1 steps, step time median \2 us, p99 \3 us/p' "$OUT/$s-server.log"
+  done
+  field() { sed -n "s/^SUB.* $1=\([0-9.e+-]*\).*/\1/p" "$OUT"/sub*.out | sort -g; }
+  n=$(grep -h '^SUB' "$OUT"/sub*.out | wc -l)
+  got=$(grep -h '^SUB' "$OUT"/sub*.out | grep -vc ' keyframes=0 ' || true)
+  deltas=$(field deltas | awk '{ s += $1 } END { print s + 0 }')
+  mid() { awk '{ v[NR] = $1 } END { if (NR) print v[int((NR + 1) / 2)]; else print "n/a" }'; }
+  top() { awk '{ v = $1 } END { print (NR ? v : "n/a") }'; }
+  echo "  subscribers: $n of $SUBS reported, with a keyframe: $got, deltas received: $deltas"
+  echo "  delta latency: median of the subscribers' medians $(field latency_us_median | mid) us, worst p99 $(field latency_us_p99 | top) us"
+  echo "  time to first keyframe after joining: median $(field first_keyframe_ms | mid) ms, max $(field first_keyframe_ms | top) ms"
+  awk -F, 'NR > 1 { if (!($2 in c0)) { c0[$2] = $4; r0[$2] = $5; t0[$2] = $1 } c1[$2] = $4; r1[$2] = $5; t1[$2] = $1 }
+    END { for (s in c0) { dt = t1[s] - t0[s]; printf "  %s: CPU %.0f %% of a core, RSS %d kB at start, %d kB at end\n", s,
+            (dt > 0 ? 100 * (c1[s] - c0[s]) / dt : 0), r0[s], r1[s] } }' "$OUT/load.csv" | sort
+} | tee "$OUT/summary.txt"
