@@ -1,0 +1,6 @@
+# Topology changes end to end (adaptive refinement/simplification, cutting):
+# the runtime re-attaches contacts and rebuilds the collision tree, the
+# publisher sends a new keyframe per topology version, the viewer's organ
+# state follows versions.
+viscera_unit_test(NAME test_topology_runtime SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_topology_runtime.c
+                  LIBS viscera_server_core)
