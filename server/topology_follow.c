@@ -104,8 +104,9 @@ int topo_follow(runtime_t *rt, size_t organ, const topo_anchor_t anchors[SCENE_M
   if (m->nsurf_tris && aabb_tree_build(&tree, m->surf_x, m->nsurf, m->surf_tris, m->nsurf_tris, &e) == 0) {
     o->tree = tree;
   } else {
-    rc = verr_set(err, "organ '%s': collision tree rebuild after topology version %u failed (%s); proxies scan "
-                       "every triangle",
+    rc = verr_set(err,
+                  "organ '%s': collision tree rebuild after topology version %u failed (%s); proxies scan "
+                  "every triangle",
                   o->cfg->name, m->topology_version, m->nsurf_tris ? e.msg : "no triangles");
   }
   rt->surfaces[organ] = (proxy_surface_t){.x = m->surf_x,

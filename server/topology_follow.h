@@ -34,8 +34,8 @@
 
 /* Per tool, where its contact was before the organ's step. */
 typedef struct topo_anchor {
-  int in_contact;  /* the tool's proxy was on this organ */
-  uint32_t face;   /* adaptive model: coarse face of the contact triangle; else UINT32_MAX */
+  int in_contact;   /* the tool's proxy was on this organ */
+  uint32_t face;    /* adaptive model: coarse face of the contact triangle; else UINT32_MAX */
   double normal[3]; /* contact normal before the step */
 } topo_anchor_t;
 

@@ -40,13 +40,14 @@ static unsigned long long worst_step_at;
 static void check_tree(const organ_rt_t *o) {
   const model_t *m = o->model;
   CHECK(o->tree.ntris == m->nsurf_tris && o->tree.nverts == m->nsurf);
-  CHECK(rt.surfaces[0].tris == m->surf_tris && rt.surfaces[0].ntris == m->nsurf_tris &&
-        rt.surfaces[0].x == m->surf_x && rt.surfaces[0].tree == &o->tree);
+  CHECK(rt.surfaces[0].tris == m->surf_tris && rt.surfaces[0].ntris == m->nsurf_tris && rt.surfaces[0].x == m->surf_x &&
+        rt.surfaces[0].tree == &o->tree);
   srand(7 + (unsigned)m->topology_version);
   int mismatches = 0;
   for (int q = 0; q < 300; q++) {
     double p[3];
-    for (int k = 0; k < 3; k++) p[k] = o->tree.lo[k] - 0.01 + (o->tree.hi[k] - o->tree.lo[k] + 0.02) * rand() / RAND_MAX;
+    for (int k = 0; k < 3; k++)
+      p[k] = o->tree.lo[k] - 0.01 + (o->tree.hi[k] - o->tree.lo[k] + 0.02) * rand() / RAND_MAX;
     aabb_nearest_t r;
     if (!aabb_tree_nearest(&o->tree, p, INFINITY, &r)) {
       mismatches++;
@@ -183,7 +184,8 @@ int main(void) {
   printf("%d topology changes under the probe, contact kept through all; force at refinement %.3f N, at "
          "simplification %.3f N; largest force jump at a change %.2g N (at %.3f N), largest step-to-step change in "
          "contact %.2g N at step %llu (bounds %.2g N at a change, %.2g N any step)\n",
-         changes_seen, f_refined, f_simplified, worst_jump, worst_jump_force, worst_step, worst_step_at, JUMP_BOUND, DYNAMICS_BOUND);
+         changes_seen, f_refined, f_simplified, worst_jump, worst_jump_force, worst_step, worst_step_at, JUMP_BOUND,
+         DYNAMICS_BOUND);
   runtime_destroy(&rt);
   return check_report("test_topology_runtime");
 }

@@ -4,3 +4,5 @@
 # state follows versions.
 viscera_unit_test(NAME test_topology_runtime SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_topology_runtime.c
                   LIBS viscera_server_core)
+viscera_unit_test(NAME test_publisher_retopo SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_publisher_retopo.c
+                  LIBS viscera_server_core)
