@@ -13,6 +13,7 @@
 #include "check.h"
 #include "physics/adaptive.h"
 #include "scene_runtime.h"
+#include "topology_follow.h"
 #include "vmath.h"
 
 /* Largest change of the contact force (N) over the step in which the
@@ -37,11 +38,11 @@ static unsigned long long worst_step_at;
 
 /* Nearest surface point of every query: tree against a scan of the
  * model's current triangles, same per-triangle test. */
-static void check_tree(const organ_rt_t *o) {
+static void check_tree_of(const organ_rt_t *o, const runtime_t *rtp) {
   const model_t *m = o->model;
   CHECK(o->tree.ntris == m->nsurf_tris && o->tree.nverts == m->nsurf);
-  CHECK(rt.surfaces[0].tris == m->surf_tris && rt.surfaces[0].ntris == m->nsurf_tris && rt.surfaces[0].x == m->surf_x &&
-        rt.surfaces[0].tree == &o->tree);
+  CHECK(rtp->surfaces[0].tris == m->surf_tris && rtp->surfaces[0].ntris == m->nsurf_tris &&
+        rtp->surfaces[0].x == m->surf_x && rtp->surfaces[0].tree == &o->tree);
   srand(7 + (unsigned)m->topology_version);
   int mismatches = 0;
   for (int q = 0; q < 300; q++) {
@@ -66,6 +67,8 @@ static void check_tree(const organ_rt_t *o) {
   }
   CHECK(mismatches == 0);
 }
+
+static void check_tree(const organ_rt_t *o) { check_tree_of(o, &rt); }
 
 static void check_contact_refs(void) {
   const tool_rt_t *tool = &rt.tools[0];
@@ -108,6 +111,67 @@ static double step_at(const double pos[3], double *prev_force) {
   }
   *prev_force = f;
   return f;
+}
+
+/* The path a cutting model takes (no coarse-face mapping): topo_follow with
+ * anchors that carry no face re-attaches by the nearest point on the same
+ * side. Driven by hand on the adaptive kidney: the probe presses with
+ * refinement off, then the surface is refined / simplified directly and the
+ * model's counts updated the way a model does before it bumps its version. */
+static void test_generic_reattach(const char *scene_path) {
+  static scene_t sc2;
+  static runtime_t r2;
+  verr_t err;
+  if (scene_load(scene_path, &sc2, &err) || runtime_init(&r2, &sc2, &err)) {
+    CHECK(!"adaptive scene loads");
+    return;
+  }
+  model_t *m = r2.organs[0].model;
+  adaptive_model_t *am = model_adaptive_of(m);
+  am->ad.p.refine_levels = 0; /* this test changes the topology itself */
+  double dev[3] = {0.012, 0.004, 0.040};
+  for (int s = 0; s < 1500; s++) {
+    if (dev[2] > 0.029) dev[2] -= 2e-5;
+    runtime_set_tool(&r2, 0, dev, 4.0);
+    runtime_step(&r2);
+  }
+  proxy_t *p = &r2.tools[0].proxy;
+  CHECK(p->in_contact && m->topology_version == 0);
+  double f0 = v3_norm(r2.tools[0].force);
+  for (int change = 0; change < 2; change++) {
+    topo_anchor_t anchors[SCENE_MAX_TOOLS];
+    topo_capture(&r2, 0, anchors);
+    anchors[0].face = UINT32_MAX; /* as for a model without the mapping */
+    double before[3], n_before[3];
+    v3_copy(before, p->pos);
+    v3_copy(n_before, p->normal);
+    if (change == 0) {
+      am->ad.p.refine_levels = 2;
+      CHECK(adaptive_refine(&am->ad, am->ad.tris[3 * p->tri]) == 0);
+    } else {
+      adaptive_simplify(&am->ad);
+    }
+    m->nnodes = m->nsurf = am->ad.n;
+    m->nsurf_tris = am->ad.nt;
+    m->topology_version = am->ad.topology_version;
+    CHECK(topo_follow(&r2, 0, anchors, &err) == 0);
+    CHECK(r2.organs[0].topology_version == m->topology_version && r2.surfaces[0].ntris == m->nsurf_tris);
+    CHECK(p->in_contact && p->tri < m->nsurf_tris && v3_dist(p->pos, before) < 1e-12);
+    CHECK(v3_dot(p->normal, n_before) > 0.9);
+    /* The point the proxy re-attached to is the surface point nearest to
+     * where it was; refinement keeps the surface, so it is the same point. */
+    double settle = v3_norm(p->settle);
+    if (change == 0) CHECK(settle < 1e-9);
+    printf("generic re-attach after %s: triangle %u, settling offset %.3g m\n",
+           change ? "simplification" : "refinement", p->tri, settle);
+    check_tree_of(&r2.organs[0], &r2);
+    double f1 = v3_norm(r2.tools[0].force);
+    runtime_step(&r2);
+    CHECK(p->in_contact);
+    printf("  force %.4f N before, %.4f N one step after\n", f1, v3_norm(r2.tools[0].force));
+  }
+  CHECK(f0 > 0.2);
+  runtime_destroy(&r2);
 }
 
 int main(void) {
@@ -187,5 +251,6 @@ int main(void) {
          changes_seen, f_refined, f_simplified, worst_jump, worst_jump_force, worst_step, worst_step_at, JUMP_BOUND,
          DYNAMICS_BOUND);
   runtime_destroy(&rt);
+  test_generic_reattach(path);
   return check_report("test_topology_runtime");
 }
