@@ -30,6 +30,8 @@ fi
 "$BUILD/client/viewer/viscera-viewer" "${common[@]}" --out "$OUT/frames_early" --interval-ms 500 \
   --dump-mesh "$OUT/viewer_early.obj" >"$OUT/viewer_early.out" 2>"$OUT/viewer_early.log" & V1=$!; pids+=($V1)
 wait_for "$OUT/server.log" "running on domain" || fail "server did not start"
+# The recording must start at topology 0: the recorder reads MeshState before the probe moves.
+[ $have_rec = 1 ] && { wait_for "$OUT/recorder.log" "recording topic viscera_MeshState" || fail "recorder never saw MeshState"; }
 "$BUILD/client/haptic/viscera-haptic" --trajectory "$SRC/assets/trajectories/push_hold_kidney.traj" "${common[@]}" \
   --quiet >"$OUT/haptic.out" 2>"$OUT/haptic.log" & HAPTIC=$!; pids+=($HAPTIC)
 wait_for "$OUT/server.log" "topology 1:" || fail "the kidney never refined under the probe"
