@@ -6,6 +6,20 @@
 #include "mesh_delta.h"
 #include "viscera.h"
 
+/* Buffers for at least n vertices; keeps the contents' prefix. */
+static int grow(mesh_publisher_t *mp, size_t n) {
+  if (mp->key && n <= mp->cap_verts) return 0;
+  float *key = realloc(mp->key, (3 * n + 1) * sizeof *key);
+  if (key) mp->key = key;
+  uint32_t *idx = realloc(mp->idx, (n + 1) * sizeof *idx);
+  if (idx) mp->idx = idx;
+  int16_t *dq = realloc(mp->dq, (3 * n + 1) * sizeof *dq);
+  if (dq) mp->dq = dq;
+  if (!key || !idx || !dq) return -1;
+  mp->cap_verts = n;
+  return 0;
+}
+
 int mesh_publisher_init(mesh_publisher_t *mp, uint32_t organ_id, size_t nverts, const uint32_t *tris, size_t ntris,
                         float quant, dds_entity_t w_state, dds_entity_t w_delta, verr_t *err) {
   memset(mp, 0, sizeof *mp);
@@ -16,10 +30,7 @@ int mesh_publisher_init(mesh_publisher_t *mp, uint32_t organ_id, size_t nverts, 
   mp->quant = quant;
   mp->w_state = w_state;
   mp->w_delta = w_delta;
-  mp->key = calloc(3 * nverts + 1, sizeof(float));
-  mp->idx = calloc(nverts + 1, sizeof(uint32_t));
-  mp->dq = calloc(3 * nverts + 1, sizeof(int16_t));
-  if (!mp->key || !mp->idx || !mp->dq) {
+  if (grow(mp, nverts)) {
     mesh_publisher_destroy(mp);
     return verr_set(err, "mesh publisher: out of memory for %zu vertices", nverts);
   }
@@ -34,9 +45,11 @@ void mesh_publisher_destroy(mesh_publisher_t *mp) {
 }
 
 int mesh_publisher_keyframe(mesh_publisher_t *mp, const double *x, uint64_t sim_time_ns) {
+  if (mp->broken) return -1;
   for (size_t i = 0; i < 3 * mp->nverts; i++) mp->key[i] = (float)x[i];
   mp->keyframe_seq++;
   mp->keyframes++;
+  mp->keyframe_payload_bytes += mesh_publisher_keyframe_bytes(mp);
   mp->last_count = 0;
   if (!mp->w_state) return 0;
   viscera_MeshState s;
@@ -54,6 +67,7 @@ int mesh_publisher_keyframe(mesh_publisher_t *mp, const double *x, uint64_t sim_
 }
 
 int mesh_publisher_frame(mesh_publisher_t *mp, const double *x, uint64_t sim_time_ns) {
+  if (mp->broken) return -1;
   long n = mesh_delta_encode(mp->key, x, mp->nverts, mp->quant, mp->idx, mp->dq);
   int keyed = 0;
   if (n < 0) {
@@ -86,4 +100,34 @@ size_t mesh_publisher_last_delta_bytes(const mesh_publisher_t *mp) {
    * (CDR pads the int16 sequence to 4 bytes at most). */
   size_t n = (size_t)(mp->last_count > 0 ? mp->last_count : 0);
   return 5 * 4 + 8 + 4 + 2 * 4 + n * 4 + n * 6;
+}
+
+size_t mesh_publisher_keyframe_bytes(const mesh_publisher_t *mp) {
+  /* 3 x uint32 key and versions, uint64 time, two sequence lengths, payload. */
+  return 3 * 4 + 8 + 2 * 4 + mp->nverts * 3 * 4 + mp->ntris * 3 * 4;
+}
+
+int mesh_publisher_retopo(mesh_publisher_t *mp, uint32_t model_version, size_t nverts, const uint32_t *tris,
+                          size_t ntris, const double *x, uint64_t sim_time_ns, verr_t *err) {
+  for (size_t i = 0; i < 3 * ntris; i++)
+    if (tris[i] >= nverts) {
+      mp->broken = 1;
+      return verr_set(err, "mesh publisher: organ %u topology %u: triangle %zu uses vertex %u of %zu; publishing stops",
+                      mp->organ_id, model_version, i / 3, tris[i], nverts);
+    }
+  if (nverts == 0 || ntris == 0 || grow(mp, nverts)) {
+    mp->broken = 1;
+    return verr_set(err, "mesh publisher: organ %u: %s for a surface of %zu vertices, %zu triangles; publishing stops",
+                    mp->organ_id, nverts && ntris ? "out of memory" : "empty surface", nverts, ntris);
+  }
+  mp->nverts = nverts;
+  mp->ntris = ntris;
+  mp->tris = tris;
+  mp->model_version = model_version;
+  mp->topology_version++;
+  mp->retopos++;
+  if (mesh_publisher_keyframe(mp, x, sim_time_ns) < 0)
+    return verr_set(err, "mesh publisher: organ %u: writing the topology %u keyframe failed", mp->organ_id,
+                    mp->topology_version);
+  return 0;
 }

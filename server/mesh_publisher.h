@@ -1,9 +1,15 @@
 /* mesh_publisher: turns an organ's positions into MeshState keyframes and
  * cumulative MeshDelta frames (common/mesh_delta.h).
  *
- * A keyframe is published at start and whenever a displacement outgrows the
- * int16 delta range (keyframe_seq increments). Owns its buffers (allocated at
- * init, none per frame). Keeps byte counters for the delta-size benchmark. */
+ * A keyframe is published at start, whenever a displacement outgrows the
+ * int16 delta range (keyframe_seq increments) and on a topology change
+ * (mesh_publisher_retopo: topology_version increments, and keyframe_seq
+ * too). Every keyframe and delta carries both, so a receiver applies a delta
+ * only to the keyframe it was encoded against. One DDS instance per organ
+ * (organ_id key) for its whole life: a topology change is a new sample of
+ * the same instance, never a new instance. Owns its buffers (allocated at
+ * init, grown on a topology change, none per frame). Keeps byte counters
+ * for the benchmarks. */
 #ifndef VISCERA_MESH_PUBLISHER_H
 #define VISCERA_MESH_PUBLISHER_H
 
@@ -15,18 +21,21 @@
 
 typedef struct mesh_publisher {
   uint32_t organ_id;
-  uint32_t topology_version;
+  uint32_t topology_version; /* on the wire: 0 at init, +1 per retopo */
+  uint32_t model_version;    /* the model's topology_version the surface came from (model.h) */
   uint32_t keyframe_seq;
   uint32_t frame_seq;
   float quant;
   size_t nverts, ntris;
-  const uint32_t *tris; /* borrowed, lives as long as the organ */
+  size_t cap_verts;     /* the buffers below hold this many vertices */
+  const uint32_t *tris; /* borrowed from the model, until the next retopo */
+  int broken;           /* a retopo failed (out of memory): nothing more is published */
   float *key;           /* 3 nverts: the last published keyframe */
   uint32_t *idx;
   int16_t *dq;
   dds_entity_t w_state, w_delta; /* 0: encode only (benchmarks) */
   /* Counters. */
-  uint64_t frames, keyframes, delta_payload_bytes;
+  uint64_t frames, keyframes, delta_payload_bytes, keyframe_payload_bytes, retopos;
   long last_count; /* vertices in the last delta */
 } mesh_publisher_t;
 
@@ -40,5 +49,18 @@ int mesh_publisher_keyframe(mesh_publisher_t *mp, const double *x, uint64_t sim_
 int mesh_publisher_frame(mesh_publisher_t *mp, const double *x, uint64_t sim_time_ns);
 /* Wire payload of the last delta (indices + components + fixed fields), bytes. */
 size_t mesh_publisher_last_delta_bytes(const mesh_publisher_t *mp);
+/* Wire payload of a keyframe of the current surface, bytes. */
+size_t mesh_publisher_keyframe_bytes(const mesh_publisher_t *mp);
+
+/* Adopts a new surface after a topology change: nverts vertices at x,
+ * triangles tris (borrowed, like at init; indices < nverts), coming from
+ * the model's topology version model_version. Grows the buffers if needed,
+ * increments topology_version and publishes a keyframe of x at once; the
+ * next delta is encoded against it. Returns 0, or -1 with err (bad
+ * triangle index, or out of memory: then the publisher is broken and stops
+ * publishing, since it no longer describes the model's surface; or the DDS
+ * write failed). */
+int mesh_publisher_retopo(mesh_publisher_t *mp, uint32_t model_version, size_t nverts, const uint32_t *tris,
+                          size_t ntris, const double *x, uint64_t sim_time_ns, verr_t *err);
 
 #endif

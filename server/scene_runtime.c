@@ -1,6 +1,6 @@
 #include "scene_runtime.h"
 
-#include "physics/adaptive.h"
+#include "topology_follow.h"
 
 #include <math.h>
 #include <string.h>
@@ -30,17 +30,6 @@ static int organ_init(organ_rt_t *o, runtime_t *rt, const scene_organ_t *cfg, ui
   if (!o->model) {
     mesh_free(&o->rest);
     return verr_set(err, "%s:%d: %s", sc->path, cfg->line, e.msg);
-  }
-  if (model_adaptive_of(o->model)) {
-    /* Its surface changes topology while it runs; the publisher and the
-     * contact proxies do not follow topology changes yet. */
-    model_destroy(o->model);
-    o->model = NULL;
-    mesh_free(&o->rest);
-    return verr_set(err,
-                    "%s:%d: organ '%s': model 'adaptive_mass_spring' runs in tests and benchmarks only; the live server "
-                    "cannot stream its topology changes yet",
-                    sc->path, cfg->line, cfg->name);
   }
   o->model->hook = apply_contacts;
   o->model->hook_ctx = o;
@@ -86,6 +75,7 @@ int runtime_init(runtime_t *rt, const scene_t *scene, verr_t *err) {
       return -1;
     }
     rt->surfaces[i].tree = &o->tree;
+    o->topology_version = m->topology_version;
     double lo[3], hi[3];
     mesh_bounds(&o->rest, lo, hi);
     for (int k = 0; k < 3; k++) {
@@ -199,17 +189,28 @@ int runtime_step(runtime_t *rt) {
   int rolled = 0;
   for (size_t i = 0; i < rt->norgans; i++) {
     organ_rt_t *o = &rt->organs[i];
+    topo_anchor_t anchors[SCENE_MAX_TOOLS];
+    topo_capture(rt, i, anchors);
     if (o->model->ops->step(o->model, dt) < 0) {
       o->rollbacks++;
       rolled++;
     }
-    /* Every step, rolled back or not: the proxy trusts the boxes. */
-    aabb_tree_refit(&o->tree, o->model->surf_x);
+    if (o->model->topology_version != o->topology_version) {
+      /* New surface: fresh tree (its boxes are current), proxies re-attached
+       * where they were, patches from the new vertices. */
+      topo_follow(rt, i, anchors, NULL);
+      for (size_t t = 0; t < rt->ntools; t++)
+        if (anchors[t].in_contact) build_patch(rt, &rt->tools[t]);
+    } else if (o->tree.ntris) {
+      /* Every step, rolled back or not: the proxy trusts the boxes. */
+      aabb_tree_refit(&o->tree, o->model->surf_x);
+    }
   }
   /* Report the force at the end of the step, with the proxy on the moved surface. */
   for (size_t t = 0; t < rt->ntools; t++) {
     tool_rt_t *tool = &rt->tools[t];
     if (!tool->active) continue;
+    proxy_settle(&tool->proxy, dt);
     proxy_follow_surface(&tool->proxy, rt->surfaces, rt->norgans);
     double mag = proxy_spring_force(&tool->proxy, tool->device, tool->cfg->stiffness, tool->max_force, tool->force);
     if (mag > tool->peak_force) tool->peak_force = mag;

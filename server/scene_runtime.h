@@ -3,7 +3,9 @@
  * step. The server wraps it with DDS; benchmarks and tests drive it directly.
  *
  * runtime_init builds only what the scene needs (one model per organ, one
- * proxy per tool). runtime_step allocates nothing. Single-threaded. */
+ * proxy per tool). runtime_step allocates nothing, except after a step in
+ * which a model changed its surface topology (topology_follow.h: the tree
+ * is rebuilt, contacts re-attached). Single-threaded. */
 #ifndef VISCERA_SCENE_RUNTIME_H
 #define VISCERA_SCENE_RUNTIME_H
 
@@ -32,6 +34,12 @@ typedef struct organ_rt {
   double patch_radius; /* m, contact patch radius: max(2 tool radius, 1.5 mean surface edge) */
   aabb_tree_t tree;    /* over the model's contact surface, refit after every step */
   uint64_t rollbacks;
+  /* The model topology_version the tree, surface view, proxies and patches
+   * were last rebuilt for (topology_follow.h). The server polls it: when it
+   * differs from what it last published, a new keyframe is due. */
+  uint32_t topology_version;
+  uint64_t topology_changes; /* rebuilds so far */
+  double last_follow_us;     /* the last rebuild's time (tree, surface view, re-attach), us */
 } organ_rt_t;
 
 #define TOOL_PATCH_MAX 128

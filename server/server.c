@@ -284,6 +284,28 @@ static void publish_frames(server_t *s) {
     mesh_publisher_frame(&s->pubs[i], s->rt.organs[i].model->surf_x, sim_ns(s));
 }
 
+/* An organ whose runtime rebuilt for a new topology (topology_follow.h)
+ * gets a keyframe of its new surface at once and a SessionEvent. */
+static void follow_topology(server_t *s) {
+  for (size_t i = 0; i < s->rt.norgans; i++) {
+    const organ_rt_t *o = &s->rt.organs[i];
+    mesh_publisher_t *mp = &s->pubs[i];
+    if (o->topology_version == mp->model_version || mp->broken) continue;
+    const model_t *m = o->model;
+    verr_t e;
+    char text[200];
+    if (mesh_publisher_retopo(mp, o->topology_version, m->nsurf, m->surf_tris, m->nsurf_tris, m->surf_x, sim_ns(s),
+                              &e)) {
+      fprintf(stderr, "server: %s\n", e.msg);
+      continue;
+    }
+    snprintf(text, sizeof text, "organ '%s': topology %u: %zu vertices, %zu triangles", o->cfg->name,
+             mp->topology_version, m->nsurf, m->nsurf_tris);
+    if (!s->opts->quiet && mp->retopos <= 5) fprintf(stderr, "server: %s\n", text);
+    publish_event(s, viscera_EVENT_TOPOLOGY_CHANGED, (int)i, -1, (double)m->nsurf, text);
+  }
+}
+
 static void write_final_mesh(server_t *s) {
   /* Exact positions of the last published frame, so a test can compare a
    * viewer's reconstruction with the server's state at the same frame. */
@@ -375,6 +397,7 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
       publish_event(&s, viscera_EVENT_STEP_ROLLED_BACK, -1, -1, rolled, "non-finite state: step rolled back");
       if (!opts->quiet) fprintf(stderr, "server: step %" PRIu64 ": non-finite state, rolled back\n", s.rt.steps);
     }
+    follow_topology(&s);
     publish_feedback(&s);
     if (!s.control.paused) track_thresholds(&s);
     if (s.rt.steps % publish_every == 0) publish_frames(&s);

@@ -6,6 +6,14 @@
 
 #include "mesh_delta.h"
 
+/* (topology_version, keyframe_seq) of a delta against the drawn keyframe's:
+ * <0 older, 0 the same, >0 newer. */
+static int cmp_key(const organ_state_t *o, uint32_t topology_version, uint32_t keyframe_seq) {
+  if (topology_version != o->topology_version) return topology_version < o->topology_version ? -1 : 1;
+  if (keyframe_seq != o->keyframe_seq) return keyframe_seq < o->keyframe_seq ? -1 : 1;
+  return 0;
+}
+
 static int delta_matches(const organ_state_t *o) {
   return o->have_key && o->have_delta && o->delta.topology_version == o->topology_version &&
          o->delta.keyframe_seq == o->keyframe_seq;
@@ -62,6 +70,8 @@ int organ_state_set_keyframe(organ_state_t *o, uint32_t topology_version, uint32
   o->keyframe_seq = keyframe_seq;
   o->sim_time_ns = sim_time_ns;
   o->applied = 0;
+  /* A kept delta for an older keyframe (e.g. the topology before) will never apply. */
+  if (o->have_delta && cmp_key(o, o->delta.topology_version, o->delta.keyframe_seq) < 0) o->have_delta = 0;
   if (delta_matches(o) && apply_kept_delta(o, err)) return 1;
   return 0;
 }
@@ -75,6 +85,10 @@ int organ_state_delta(organ_state_t *o, const organ_delta_t *d, verr_t *err) {
     return verr_set(err, "delta has %zu indices but %zu components (expected %zu)", d->count, d->dq_len, 3 * d->count);
   if (!(d->quant_step > 0) || !isfinite(d->quant_step))
     return verr_set(err, "delta quant_step %g is not a positive finite number", (double)d->quant_step);
+  /* Encoded against a keyframe older than the drawn one: its indices may
+   * name other vertices now. Ignored, and a delta kept for a newer keyframe
+   * stays. */
+  if (o->have_key && cmp_key(o, d->topology_version, d->keyframe_seq) < 0) return 2;
   if (d->count > o->delta_cap) {
     uint32_t *idx = realloc(o->delta_idx, d->count * sizeof *idx);
     if (idx) o->delta_idx = idx;

@@ -6,9 +6,20 @@
  * here: a delta applies only when organ, topology_version and keyframe_seq
  * match the keyframe, and a delta for a keyframe not yet seen waits until
  * that keyframe arrives (DDS orders samples per topic, not across topics, and
- * a late joiner may get the delta first). Everything is untrusted input: a
- * rejected keyframe or delta leaves the drawn mesh as it was. Not
- * thread-safe; no DDS here, so it is testable on plain arrays. */
+ * a late joiner may get the delta first).
+ *
+ * Topology changes (adaptive refinement, cutting): the server publishes a
+ * keyframe with a higher topology_version (and keyframe_seq) and new vertex
+ * and triangle counts; it replaces the drawn mesh whole. Keyframes are
+ * ordered by (topology_version, keyframe_seq), and the server numbers both
+ * upwards. A delta older than the drawn keyframe in that order is stale (its
+ * vertex indices may mean other vertices now) and is ignored without
+ * touching the delta kept for a newer keyframe; a keyframe replaces the mesh
+ * whatever its numbers (MeshState arrives in order per organ, and a
+ * restarted server starts again at 0), and drops a kept delta older than
+ * itself. Everything is untrusted input: a rejected keyframe or delta leaves
+ * the drawn mesh as it was. Not thread-safe; no DDS here, so it is testable
+ * on plain arrays. */
 #ifndef VISCERA_VIEWER_ORGAN_STATE_H
 #define VISCERA_VIEWER_ORGAN_STATE_H
 
@@ -64,6 +75,7 @@ int organ_state_set_keyframe(organ_state_t *o, uint32_t topology_version, uint32
 
 /* Keeps d as the newest delta and applies it when it belongs to the current
  * keyframe. Returns 1 when applied, 0 when kept for a keyframe not seen yet,
+ * 2 when stale (older than the drawn keyframe: ignored, nothing changes),
  * -1 when rejected (malformed, or mesh_delta_apply refused it; err says why;
  * the drawn mesh is unchanged). */
 int organ_state_delta(organ_state_t *o, const organ_delta_t *d, verr_t *err);

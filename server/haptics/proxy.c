@@ -32,7 +32,7 @@ void proxy_follow_surface(proxy_t *p, const proxy_surface_t *surfaces, size_t ns
   const proxy_surface_t *s = &surfaces[p->surface];
   const double *a, *b, *c;
   tri_vertices(s, p->tri, &a, &b, &c);
-  for (int k = 0; k < 3; k++) p->pos[k] = p->bary[0] * a[k] + p->bary[1] * b[k] + p->bary[2] * c[k];
+  for (int k = 0; k < 3; k++) p->pos[k] = p->bary[0] * a[k] + p->bary[1] * b[k] + p->bary[2] * c[k] + p->settle[k];
   proxy_surface_t rest = *s;
   if (s->x_rest) rest.x = s->x_rest;
   tri_normal(&rest, p->tri, p->normal);
@@ -167,6 +167,7 @@ int proxy_update(proxy_t *p, const double device[3], const proxy_surface_t *surf
   if (depth > PROXY_RELEASE_MARGIN) {
     p->in_contact = 0;
     p->surface = -1;
+    v3_set(p->settle, 0, 0, 0);
     v3_copy(p->pos, device);
     return 0;
   }
@@ -190,6 +191,12 @@ int proxy_update(proxy_t *p, const double device[3], const proxy_surface_t *surf
   }
   proxy_spring_force(p, device, stiffness, max_force, force);
   return 1;
+}
+
+void proxy_settle(proxy_t *p, double dt) {
+  if (p->settle[0] == 0 && p->settle[1] == 0 && p->settle[2] == 0) return;
+  v3_scale(p->settle, p->settle, exp(-dt / PROXY_SETTLE_TAU));
+  if (v3_norm(p->settle) < 1e-9) v3_set(p->settle, 0, 0, 0);
 }
 
 double proxy_spring_force(const proxy_t *p, const double device[3], double stiffness, double max_force, double f[3]) {

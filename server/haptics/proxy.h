@@ -47,7 +47,17 @@ typedef struct proxy {
   double normal[3];  /* outward unit normal at the proxy (valid in contact) */
   double device_prev[3];
   int have_prev;
+  /* Settling offset (m), zero except after a topology change under the
+   * proxy (server/topology_follow.h): the proxy keeps its place in space
+   * although the surface point it re-attached to differs (a simplified mesh
+   * cannot hold the refined dent), and the offset decays with time constant
+   * PROXY_SETTLE_TAU (proxy_settle), so the force ramps instead of jumping. */
+  double settle[3];
 } proxy_t;
+
+/* s: time constant of the settling offset. The force then changes by at
+ * most K |offset| dt / tau per step (1.25 mm at 400 N/m: 10 mN per 1 ms). */
+#define PROXY_SETTLE_TAU 0.05
 
 void proxy_reset(proxy_t *p);
 
@@ -62,7 +72,12 @@ int proxy_update(proxy_t *p, const double device[3], const proxy_surface_t *surf
 double proxy_spring_force(const proxy_t *p, const double device[3], double stiffness, double max_force, double f[3]);
 
 /* Re-evaluates pos and normal from the attached triangle's current vertices
- * (call after the surface moved, e.g. after a physics step). */
+ * (call after the surface moved, e.g. after a physics step); pos includes
+ * the settling offset. */
 void proxy_follow_surface(proxy_t *p, const proxy_surface_t *surfaces, size_t nsurfaces);
+
+/* Decays the settling offset by exp(-dt / PROXY_SETTLE_TAU) (once per
+ * physics step); below 1 nm it is zeroed. No-op when it is zero. */
+void proxy_settle(proxy_t *p, double dt);
 
 #endif

@@ -231,10 +231,7 @@ uint32_t adaptive_locate(const adaptive_t *ad, uint32_t face, const double p[3],
 
 /* The scene model "adaptive_mass_spring" (model_adaptive.c). */
 typedef struct adaptive_model {
-  model_t base;
-  /* Incremented whenever surf_tris / nsurf / nsurf_tris change: the server
-   * then publishes a new keyframe and re-attaches contacts. */
-  uint32_t topology_version;
+  model_t base; /* base.topology_version follows ad.topology_version (model.h) */
   adaptive_t ad;
 } adaptive_model_t;
 

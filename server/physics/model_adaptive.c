@@ -1,9 +1,12 @@
 /* model_adaptive: the "adaptive_mass_spring" scene model (seed 002 ch. 5)
  * behind the common model interface. A surface model (surf_x == x) whose
  * surface changes: after a step that refined or simplified, nnodes, nsurf,
- * nsurf_tris and substeps are updated and topology_version is incremented.
- * The arrays behind x, v, surf_x, surf_rest and surf_tris are allocated at
- * their maximum size at create, so their addresses never change. */
+ * nsurf_tris and substeps are updated and then model_t.topology_version
+ * (model.h's contract) takes the adaptive core's counter, so it moves by one
+ * per refinement or simplification (by two when a moving contact re-centres:
+ * simplify, then refine). The arrays behind x, v, surf_x, surf_rest and
+ * surf_tris are allocated at their maximum size at create, so their
+ * addresses never change (the contract allows it; this model does not). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -24,7 +27,8 @@ static void am_sync(adaptive_model_t *am) {
   /* The bound the sub-steps follow: eq. 5.18 divides the coarse one as the
    * sub-step count grows. */
   m->stable_dt = ad->stable_dt0 * (double)ad->substeps0 / (double)ad->substeps;
-  am->topology_version = ad->topology_version;
+  /* Last: the counts above are what the new version describes. */
+  m->topology_version = ad->topology_version;
 }
 
 static int am_step(model_t *m, double h) {

@@ -1,6 +1,8 @@
 /* test_organ_state: the viewer's keyframe + delta reconstruction on plain
- * arrays: matching rules, a delta waiting for its keyframe, and untrusted
- * input never changing what is drawn. */
+ * arrays: matching rules, a delta waiting for its keyframe, untrusted input
+ * never changing what is drawn, and topology versions: a new keyframe
+ * replaces the mesh, stale deltas are ignored, a delta for a newer version
+ * waits for its keyframe even when they arrive out of order. */
 #include <math.h>
 #include <string.h>
 
@@ -11,11 +13,81 @@ static const float KEY[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
 static const uint32_t TRIS[12] = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
 
 static organ_delta_t delta(uint32_t kseq, uint32_t frame, const uint32_t *idx, size_t n, const int16_t *dq) {
-  return (organ_delta_t){.topology_version = 1, .keyframe_seq = kseq, .frame_seq = frame, .sim_time_ns = 1000 + frame,
-                         .quant_step = 0.5f, .indices = idx, .count = n, .dq = dq, .dq_len = 3 * n};
+  return (organ_delta_t){.topology_version = 1,
+                         .keyframe_seq = kseq,
+                         .frame_seq = frame,
+                         .sim_time_ns = 1000 + frame,
+                         .quant_step = 0.5f,
+                         .indices = idx,
+                         .count = n,
+                         .dq = dq,
+                         .dq_len = 3 * n};
+}
+
+/* An octahedron: what a refined version of the tetrahedron looks like to the viewer. */
+static const float OCTA[18] = {1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1};
+static const uint32_t OCTA_TRIS[24] = {0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4, 2, 0, 5, 1, 2, 5, 3, 1, 5, 0, 3, 5};
+
+static organ_delta_t vdelta(uint32_t topo, uint32_t kseq, uint32_t frame, const uint32_t *idx, size_t n,
+                            const int16_t *dq) {
+  return (organ_delta_t){.topology_version = topo,
+                         .keyframe_seq = kseq,
+                         .frame_seq = frame,
+                         .sim_time_ns = frame,
+                         .quant_step = 0.5f,
+                         .indices = idx,
+                         .count = n,
+                         .dq = dq,
+                         .dq_len = 3 * n};
+}
+
+static void test_topology(void) {
+  organ_state_t o = {0};
+  verr_t err;
+  const uint32_t i1[1] = {1}, i5[1] = {5};
+  const int16_t up[3] = {0, 0, 2}; /* z += 1.0 */
+  /* Version 0: the tetrahedron with a delta. */
+  CHECK(organ_state_set_keyframe(&o, 0, 1, 0, KEY, 12, TRIS, 12, &err) == 0);
+  organ_delta_t d = vdelta(0, 1, 10, i1, 1, up);
+  CHECK(organ_state_delta(&o, &d, &err) == 1 && o.cur[5] == 1.0f);
+  /* Version 1 (refined): the new keyframe replaces the mesh whole. */
+  CHECK(organ_state_set_keyframe(&o, 1, 2, 0, OCTA, 18, OCTA_TRIS, 24, &err) == 0);
+  CHECK(o.nverts == 6 && o.ntris == 8 && o.topology_version == 1 && organ_state_frame_seq(&o) == -1);
+  CHECK(memcmp(o.cur, OCTA, sizeof OCTA) == 0 && memcmp(o.tris, OCTA_TRIS, sizeof OCTA_TRIS) == 0);
+  /* A late delta of version 0 is stale: ignored, the mesh as it was. */
+  d = vdelta(0, 1, 11, i1, 1, up);
+  CHECK(organ_state_delta(&o, &d, &err) == 2 && memcmp(o.cur, OCTA, sizeof OCTA) == 0);
+  /* Version 1's own delta moves vertex 5, which version 0 did not have. */
+  d = vdelta(1, 2, 12, i5, 1, up);
+  CHECK(organ_state_delta(&o, &d, &err) == 1 && o.cur[17] == 0.0f && organ_state_frame_seq(&o) == 12);
+  /* Out of order across topics: version 2's delta before its keyframe
+   * waits; the drawn mesh stays version 1 with its delta. */
+  d = vdelta(2, 3, 13, i1, 1, up);
+  CHECK(organ_state_delta(&o, &d, &err) == 0 && o.nverts == 6 && organ_state_frame_seq(&o) == 12);
+  /* A stale version-1 delta naming vertex 5 is ignored, not an error, and
+   * does not displace the waiting version-2 delta. */
+  d = vdelta(1, 2, 12, i5, 1, up);
+  CHECK(organ_state_set_keyframe(&o, 2, 3, 0, KEY, 12, TRIS, 12, &err) == 0); /* version 2: simplified */
+  CHECK(o.nverts == 4 && o.ntris == 4 && organ_state_frame_seq(&o) == 13 && o.cur[5] == 1.0f);
+  CHECK(organ_state_delta(&o, &d, &err) == 2 && organ_state_frame_seq(&o) == 13);
+  /* Same version, older keyframe_seq: stale too. */
+  CHECK(organ_state_set_keyframe(&o, 2, 4, 0, KEY, 12, TRIS, 12, &err) == 0);
+  d = vdelta(2, 3, 14, i1, 1, up);
+  CHECK(organ_state_delta(&o, &d, &err) == 2 && organ_state_frame_seq(&o) == -1);
+  /* A keyframe drops a kept delta older than itself. */
+  d = vdelta(3, 5, 15, i1, 1, up);
+  CHECK(organ_state_delta(&o, &d, &err) == 0 && o.have_delta);
+  CHECK(organ_state_set_keyframe(&o, 4, 6, 0, OCTA, 18, OCTA_TRIS, 24, &err) == 0 && !o.have_delta);
+  CHECK(organ_state_frame_seq(&o) == -1 && o.nverts == 6);
+  /* A restarted server counts from 0 again: its keyframe is drawn. */
+  CHECK(organ_state_set_keyframe(&o, 0, 1, 0, KEY, 12, TRIS, 12, &err) == 0 && o.nverts == 4);
+  d = vdelta(0, 1, 1, i1, 1, up);
+  CHECK(organ_state_delta(&o, &d, &err) == 1 && o.cur[5] == 1.0f);
+  organ_state_free(&o);
 }
 
 int main(void) {
+  test_topology();
   organ_state_t o = {0};
   verr_t err;
   const uint32_t i1[1] = {1};
