@@ -12,6 +12,8 @@ PKGS=(
   libsqlite3-dev sqlite3                    # recordings
   libyaml-dev                               # scene files
   libcairo2-dev                             # plots in benchmarks and reports
+  libsdl2-dev                               # window viewer (--window, --drive)
+  xvfb xauth                                # headless X server for the window test
 )
 
 missing=()

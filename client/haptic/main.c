@@ -273,12 +273,26 @@ int main(int argc, char **argv) {
     dds_write(w_cmd, &cmd);
 
     uint64_t last_fb_mono = feedback_slot_read(&slot, &model);
-    if (last_fb_mono && server_lost_reported && now - last_fb_mono < 50000000ull) {
+    uint64_t lost_ns = 0, lost_last = 0;
+    int lost_live = feedback_slot_server_lost(&slot, &lost_ns, &lost_last);
+    if (last_fb_mono && server_lost_reported && !lost_live && now - last_fb_mono < 50000000ull) {
       fprintf(stderr, "haptic: server back\n");
       server_lost_reported = 0;
     }
-    /* No feedback for 50 ms: the server is gone or stalled, so render nothing
-     * rather than a stale wall. */
+    /* The server process is gone (its feedback writer's liveliness lapsed):
+     * the listener already cleared the slot; say so once. */
+    if (lost_live) {
+      model.in_contact = 0;
+      if (!server_lost_reported) {
+        fprintf(stderr,
+                "haptic: server lost (liveliness lost, last feedback %.0f ms before, lease %d ms), force set to "
+                "zero\n",
+                lost_last ? (double)(lost_ns - lost_last) * 1e-6 : -1.0, VDDS_FEEDBACK_LEASE_MS);
+        server_lost_reported = 1;
+      }
+    }
+    /* No feedback for 50 ms while the server is alive (stalled, or not
+     * answering this tool): render nothing rather than a stale wall. */
     if (last_fb_mono && now > last_fb_mono + 50000000ull) {
       model.in_contact = 0;
       if (!server_lost_reported) {
@@ -318,7 +332,7 @@ int main(int argc, char **argv) {
   vstats_summary_t per = vstats_summarise(st.period_us, st.nperiod);
   pthread_mutex_lock(&slot.lock);
   vstats_summary_t lat = vstats_summarise(slot.latency_us, slot.nlatency);
-  uint64_t feedback = slot.received;
+  uint64_t feedback = slot.received, live_lost = slot.lost_events, live_back = slot.regained_events;
   pthread_mutex_unlock(&slot.lock);
   /* Jitter: the p99 of |period - nominal| (early and late ticks alike). */
   for (size_t i = 0; i < st.nperiod; i++) st.period_us[i] = fabs(st.period_us[i] - 1e6 / rate);
@@ -332,6 +346,9 @@ int main(int argc, char **argv) {
           "haptic: force peak %.3f N, mean in contact %.3f N, %" PRIu64 " ticks in contact, %" PRIu64
           " feedback samples\n",
           st.peak_force, st.contact_ticks ? st.force_sum / (double)st.contact_ticks : 0.0, st.contact_ticks, feedback);
+  if (live_lost || live_back)
+    fprintf(stderr, "haptic: server liveliness lost %" PRIu64 " time(s), regained %" PRIu64 " time(s)\n", live_lost,
+            live_back);
   fprintf(stderr, "haptic: command->feedback latency median %.1f us, p99 %.1f us (%zu samples)\n", lat.median, lat.p99,
           lat.n);
   printf("SUMMARY ticks=%" PRIu64 " rate_hz=%.1f peak_force=%.4f contact_ticks=%" PRIu64 " latency_us_median=%.1f "

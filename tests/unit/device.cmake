@@ -1,0 +1,4 @@
+# Devices and loss detection (issue 4): liveliness bookkeeping of server and
+# haptic client.
+viscera_unit_test(NAME test_liveliness SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_liveliness.c
+                  LIBS viscera_haptic viscera_server_core)
