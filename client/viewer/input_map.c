@@ -9,8 +9,12 @@ static void clamp_pos(input_state_t *s) {
   for (int k = 0; k < 3; k++) s->pos[k] = fmin(s->hi[k], fmax(s->lo[k], s->pos[k]));
 }
 
-static void move(input_state_t *s, const double dir[3], double d) {
-  for (int k = 0; k < 3; k++) s->pos[k] += d * dir[k];
+/* Depth moves along the line of sight through the tip (eye -> tip), not the
+ * camera axis, so the tip stays under the cursor while it goes deeper. */
+static void move_depth(input_state_t *s, double d) {
+  double r[3] = {s->pos[0] - s->eye[0], s->pos[1] - s->eye[1], s->pos[2] - s->eye[2]};
+  double n = sqrt(dot3(r, r));
+  for (int k = 0; k < 3; k++) s->pos[k] += d * (n > 1e-9 ? r[k] / n : s->fwd[k]);
   clamp_pos(s);
 }
 
@@ -62,7 +66,7 @@ void input_map_apply(input_state_t *s, const input_event_t *e) {
     break;
   }
   case INPUT_WHEEL:
-    move(s, s->fwd, INPUT_WHEEL_STEP * e->n);
+    move_depth(s, INPUT_WHEEL_STEP * e->n);
     break;
   case INPUT_KEY_DOWN:
   case INPUT_KEY_UP: {
@@ -85,5 +89,5 @@ void input_map_advance(input_state_t *s, double dt) {
   if (!(dt > 0)) return;
   dt = fmin(dt, 0.1);
   int dir = s->key_w - s->key_s;
-  if (dir) move(s, s->fwd, dir * INPUT_KEY_SPEED * dt);
+  if (dir) move_depth(s, dir * INPUT_KEY_SPEED * dt);
 }

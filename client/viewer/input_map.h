@@ -4,8 +4,9 @@
  * tests feed them directly.
  *
  * Frames and units: scene frame, metres, z up; the view plane is the
- * camera's (camera.h): its right and up vectors span it, its forward vector
- * (eye -> target) is depth.
+ * camera's (camera.h): its right and up vectors span it; depth is the line
+ * of sight through the tip (eye -> tip), so the tip stays under the cursor
+ * while it goes deeper.
  * - Mouse motion (dx, dy pixels, x right, y down) moves the tip in the view
  *   plane by the size of a pixel at the tip's depth, so a tip that starts
  *   under the cursor stays under it.

@@ -21,5 +21,3 @@ viscera_integration_test(bad_commands 13 bad_commands_test.sh)
 viscera_integration_test(bad_input 14 bad_input_test.sh)
 viscera_integration_test(failover 15 failover_test.sh)
 viscera_integration_test(example_scenes 16 scenes_test.sh)
-# Liveliness-based loss detection of server and haptic client (issue 4).
-viscera_integration_test(liveliness 120 liveliness_test.sh)
