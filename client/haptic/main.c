@@ -31,20 +31,28 @@ static void on_signal(int sig) {
 }
 
 static void usage(FILE *f) {
-  fprintf(f, "usage: viscera-haptic --trajectory FILE [options]\n"
-             "  --trajectory FILE   scripted device: play this path (t x y z [buttons] per line)\n"
-             "  --tool N            tool index in the scene (default 0)\n"
-             "  --domain N          DDS domain id (default: $VISCERA_DOMAIN or 0)\n"
-             "  --partition P       session partition (default: " VDDS_DEFAULT_PARTITION ")\n"
-             "  --rate HZ           loop rate (default 1000)\n"
-             "  --max-force N       device capability in newtons (default 4)\n"
-             "  --wait-server S     wait up to S s for the server's scene before starting (default 10)\n"
-             "  --duration S        stop after S s (default: end of the trajectory + 0.5 s)\n"
-             "  --force-csv FILE    write t,x,y,z,fx,fy,fz,in_contact per tick\n"
-             "  --rt-priority N     run the loop thread SCHED_FIFO at priority N (1..99) with\n"
-             "                      memory locked (needs root or CAP_SYS_NICE; warns otherwise)\n"
-             "  --quiet             only the summary\n"
-             "  --help              this text\n");
+  fprintf(f,
+          "usage: viscera-haptic --trajectory FILE [options]\n"
+          "       viscera-haptic --device NAME [options]\n"
+          "  --device NAME       scripted (default), dhd, hd or falcon; this build has: %s\n"
+          "  --trajectory FILE   scripted device: play this path (t x y z [buttons] per line)\n"
+          "  --device-index N    real devices: which one of that kind (default 0)\n"
+          "  --workspace-scale S real devices: scene metres per device metre (default 1)\n"
+          "  --workspace-offset X,Y,Z  real devices: scene position (m) of the device's\n"
+          "                      workspace centre (default 0,0,0)\n"
+          "  --tool N            tool index in the scene (default 0)\n"
+          "  --domain N          DDS domain id (default: $VISCERA_DOMAIN or 0)\n"
+          "  --partition P       session partition (default: " VDDS_DEFAULT_PARTITION ")\n"
+          "  --rate HZ           loop rate (default 1000)\n"
+          "  --max-force N       device capability in newtons (default 4)\n"
+          "  --wait-server S     wait up to S s for the server's scene before starting (default 10)\n"
+          "  --duration S        stop after S s (default: end of the trajectory + 0.5 s)\n"
+          "  --force-csv FILE    write t,x,y,z,fx,fy,fz,in_contact per tick\n"
+          "  --rt-priority N     run the loop thread SCHED_FIFO at priority N (1..99) with\n"
+          "                      memory locked (needs root or CAP_SYS_NICE; warns otherwise)\n"
+          "  --quiet             only the summary\n"
+          "  --help              this text\n",
+          device_names());
 }
 
 typedef struct stats {
@@ -55,7 +63,9 @@ typedef struct stats {
 } stats_t;
 
 int main(int argc, char **argv) {
-  const char *traj = NULL, *partition = NULL, *force_csv = NULL;
+  const char *traj = NULL, *partition = NULL, *force_csv = NULL, *device = "scripted";
+  device_config_t dcfg;
+  device_config_default(&dcfg);
   int domain = 0, quiet = 0, rt_priority = 0;
   unsigned tool = 0;
   double rate = 1000, max_force = 4, wait_server = 10, duration = -1;
@@ -75,13 +85,17 @@ int main(int argc, char **argv) {
                                      {"force-csv", required_argument, 0, 'f'},
                                      {"quiet", no_argument, 0, 'q'},
                                      {"rt-priority", required_argument, 0, 'R'},
+                                     {"device", required_argument, 0, 'D'},
+                                     {"device-index", required_argument, 0, 'I'},
+                                     {"workspace-scale", required_argument, 0, 'S'},
+                                     {"workspace-offset", required_argument, 0, 'O'},
                                      {"help", no_argument, 0, 'h'},
                                      {0, 0, 0, 0}};
   int c;
-  while ((c = getopt_long(argc, argv, "j:n:d:p:r:m:w:t:f:R:qh", lo, NULL)) != -1) {
+  while ((c = getopt_long(argc, argv, "j:n:d:p:r:m:w:t:f:R:D:I:S:O:qh", lo, NULL)) != -1) {
     char *end = NULL;
     double v = 0;
-    if (c == 'r' || c == 'm' || c == 'w' || c == 't' || c == 'n' || c == 'R') {
+    if (c == 'r' || c == 'm' || c == 'w' || c == 't' || c == 'n' || c == 'R' || c == 'I' || c == 'S') {
       v = strtod(optarg, &end);
       if (*end || !isfinite(v) || v < 0) {
         fprintf(stderr, "viscera-haptic: option --%s: '%s' is not a non-negative number\n",
@@ -90,6 +104,8 @@ int main(int argc, char **argv) {
                 : c == 'w' ? "wait-server"
                 : c == 't' ? "duration"
                 : c == 'R' ? "rt-priority"
+                : c == 'I' ? "device-index"
+                : c == 'S' ? "workspace-scale"
                            : "tool",
                 optarg);
         return 2;
@@ -133,6 +149,34 @@ int main(int argc, char **argv) {
         return 2;
       }
       break;
+    case 'D':
+      device = optarg;
+      break;
+    case 'I':
+      if (v != floor(v) || v > 15) {
+        fprintf(stderr, "viscera-haptic: --device-index must be an integer 0..15\n");
+        return 2;
+      }
+      dcfg.index = (int)v;
+      break;
+    case 'S':
+      if (!(v > 0) || v > 1000) {
+        fprintf(stderr, "viscera-haptic: --workspace-scale must be > 0 and <= 1000\n");
+        return 2;
+      }
+      dcfg.scale = v;
+      break;
+    case 'O': {
+      double o[3];
+      char tail = 0;
+      if (sscanf(optarg, "%lf,%lf,%lf%c", &o[0], &o[1], &o[2], &tail) != 3 || !isfinite(o[0]) || !isfinite(o[1]) ||
+          !isfinite(o[2]) || fabs(o[0]) > 100 || fabs(o[1]) > 100 || fabs(o[2]) > 100) {
+        fprintf(stderr, "viscera-haptic: --workspace-offset '%s': expected X,Y,Z in metres (|value| <= 100)\n", optarg);
+        return 2;
+      }
+      memcpy(dcfg.offset, o, sizeof o);
+      break;
+    }
     case 'q':
       quiet = 1;
       break;
@@ -144,8 +188,11 @@ int main(int argc, char **argv) {
       return 2;
     }
   }
-  if (!traj) {
-    fprintf(stderr, "viscera-haptic: --trajectory FILE is required (the scripted device is the one built in)\n");
+  if (!traj && strcmp(device, "scripted") == 0) {
+    fprintf(stderr,
+            "viscera-haptic: --trajectory FILE is required for the scripted device (or choose --device: "
+            "this build has %s)\n",
+            device_names());
     return 2;
   }
   if (!(rate >= 10 && rate <= 10000) || !(max_force > 0)) {
@@ -153,7 +200,9 @@ int main(int argc, char **argv) {
     return 2;
   }
   device_t dev;
-  if (device_scripted_open(&dev, traj, max_force, &err)) {
+  dcfg.trajectory = traj;
+  dcfg.max_force = max_force;
+  if (device_open(&dev, device, &dcfg, &err)) {
     fprintf(stderr, "viscera-haptic: %s\n", err.msg);
     return 1;
   }

@@ -9,3 +9,9 @@ if(VISCERA_BUILD_WINDOW AND VISCERA_XVFB_RUN)
 elseif(VISCERA_BUILD_WINDOW)
   message(STATUS "window_drive test not registered: xvfb-run not found (package xvfb)")
 endif()
+# An SDK device that is not in this build: --device refuses it by name.
+if(NOT VISCERA_DEVICE_FALCON)
+  add_test(NAME haptic_device_absent COMMAND viscera-haptic --device falcon)
+  set_tests_properties(haptic_device_absent PROPERTIES LABELS integration TIMEOUT 20
+    PASS_REGULAR_EXPRESSION "device 'falcon' \\(Novint Falcon \\(libnifalcon\\)\\) is not in this build.*VISCERA_DEVICE_FALCON")
+endif()

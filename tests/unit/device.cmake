@@ -6,3 +6,5 @@ viscera_unit_test(NAME test_liveliness SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_li
 if(TARGET viscera_viewer_input)
   viscera_unit_test(NAME test_input_map SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_input_map.c LIBS viscera_viewer_input)
 endif()
+# Device registry: --device NAME, SDK devices absent from the build.
+viscera_unit_test(NAME test_devices SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_devices.c LIBS viscera_haptic)
