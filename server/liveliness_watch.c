@@ -27,11 +27,16 @@ void liveliness_watch_note(liveliness_watch_t *w, const dds_liveliness_changed_s
       e->writer = st->last_publication_handle;
       e->mono_ns = mono_ns;
       e->expired = st->not_alive_count_change > 0;
+      e->regained = 0;
       w->n++;
       w->lost_total++;
     }
   } else if (st->alive_count_change > 0) {
     w->regained_total++;
+    for (size_t i = 0; i < w->n; i++) {
+      liveliness_lost_t *e = &w->q[(w->head + i) % LIVELINESS_WATCH_CAP];
+      if (e->writer == st->last_publication_handle) e->regained = 1;
+    }
   }
   pthread_mutex_unlock(&w->lock);
 }
@@ -46,9 +51,9 @@ void liveliness_watch_listen(liveliness_watch_t *w, dds_listener_t *l) {
   dds_lset_liveliness_changed(l, on_liveliness);
 }
 
-int liveliness_watch_pop(liveliness_watch_t *w, liveliness_lost_t *out) {
+int liveliness_watch_pop(liveliness_watch_t *w, uint64_t now, uint64_t confirm_ns, liveliness_lost_t *out) {
   pthread_mutex_lock(&w->lock);
-  int got = w->n > 0;
+  int got = w->n > 0 && now >= w->q[w->head].mono_ns + confirm_ns;
   if (got) {
     *out = w->q[w->head];
     w->head = (w->head + 1) % LIVELINESS_WATCH_CAP;

@@ -123,6 +123,9 @@ int main(int argc, char **argv) {
   for (int v = 1; v < TOOLCMD_VERDICT_COUNT; v++)
     fprintf(stderr, "%s%s: %" PRIu64, v > 1 ? ", " : "", tool_command_verdict_str((tool_cmd_verdict_t)v), st.rejected[v]);
   fprintf(stderr, ")\n");
+  if (st.liveliness_blips)
+    fprintf(stderr, "server: %" PRIu64 " client liveliness lapse(s) while still sending (kept, see liveliness_watch.h)\n",
+            st.liveliness_blips);
   printf("SUMMARY steps=%" PRIu64 " peak_force=%.3f rejected=%" PRIu64 " rollbacks=%" PRIu64 " step_us_median=%.1f\n",
          st.steps, st.peak_force, st.rejected_total, st.rollbacks, st.step_us_median);
   /* Trainee measures per tool (seed 002 ch. 6); levels of 0 are unset. */

@@ -135,19 +135,29 @@ static void teardown(server_t *s) {
  * timeout. */
 static void release_lost_writers(server_t *s, uint64_t now) {
   liveliness_lost_t e;
-  while (liveliness_watch_pop(&s->lw, &e)) {
+  while (liveliness_watch_pop(&s->lw, now, LIVELINESS_CONFIRM_NS, &e)) {
     for (size_t t = 0; t < s->rt.ntools; t++) {
       if (!s->rt.tools[t].active || s->cmd_writer[t] != e.writer) continue;
+      if (e.expired && (e.regained || s->last_cmd_mono[t] > e.mono_ns)) {
+        /* Alive after all: this process was starved past the lease (see
+         * liveliness_watch.h). Keep the tool; say so a few times. */
+        if (++s->stats->liveliness_blips <= 3 && !s->opts->quiet)
+          fprintf(stderr, "server: tool %zu: client liveliness lapsed while it kept sending (machine overloaded?); "
+                          "kept\n", t);
+        continue;
+      }
       runtime_release_tool(&s->rt, t);
       s->tool_lost[t] = 1;
-      /* Listener time minus last command: how long the loss took to notice
-       * (the listener may run just before this step's last command). */
-      double ago_ms = e.mono_ns > s->last_cmd_mono[t] ? (double)(e.mono_ns - s->last_cmd_mono[t]) * 1e-6 : 0;
-      char text[160];
+      /* From the last command taken to the listener's report, and to this
+       * release (which adds the confirmation delay and the step). */
+      double heard_ms = e.mono_ns > s->last_cmd_mono[t] ? (double)(e.mono_ns - s->last_cmd_mono[t]) * 1e-6 : 0;
+      double released_ms = (double)(now - s->last_cmd_mono[t]) * 1e-6;
+      char text[200];
       if (e.expired)
         snprintf(text, sizeof text,
-                 "haptic client lost (liveliness lost, last command %.0f ms before, lease %d ms): tool released",
-                 ago_ms, VDDS_TOOL_LEASE_MS);
+                 "haptic client lost (liveliness lost %.0f ms after its last command, lease %d ms; released at "
+                 "%.0f ms): tool released",
+                 heard_ms, VDDS_TOOL_LEASE_MS, released_ms);
       else
         snprintf(text, sizeof text, "haptic client left (its command writer was deleted): tool released");
       if (!s->opts->quiet) fprintf(stderr, "server: tool %zu: %s\n", t, text);

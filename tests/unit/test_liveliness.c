@@ -19,11 +19,11 @@ static void test_watch(void) {
   liveliness_watch_t w;
   liveliness_watch_init(&w);
   liveliness_lost_t e;
-  CHECK(!liveliness_watch_pop(&w, &e));
+  CHECK(!liveliness_watch_pop(&w, 1000, 0, &e));
   /* A writer appears: nothing to release. */
   dds_liveliness_changed_status_t s = status(1, 0, 1, 0, 42);
   liveliness_watch_note(&w, &s, 100);
-  CHECK(!liveliness_watch_pop(&w, &e));
+  CHECK(!liveliness_watch_pop(&w, 1000, 0, &e));
   CHECK(w.regained_total == 1);
   /* Its lease expires: alive -> not alive. */
   s = status(0, 1, -1, 1, 42);
@@ -34,22 +34,39 @@ static void test_watch(void) {
   /* A not-alive writer is later removed altogether: not a new loss. */
   s = status(0, 0, 0, -1, 42);
   liveliness_watch_note(&w, &s, 400);
-  CHECK(liveliness_watch_pop(&w, &e));
-  CHECK(e.writer == 42 && e.mono_ns == 200 && e.expired == 1);
-  CHECK(liveliness_watch_pop(&w, &e));
+  /* Not handed out before the confirmation delay has passed. */
+  CHECK(!liveliness_watch_pop(&w, 250, 100, &e));
+  CHECK(liveliness_watch_pop(&w, 300, 100, &e));
+  CHECK(e.writer == 42 && e.mono_ns == 200 && e.expired == 1 && e.regained == 0);
+  CHECK(!liveliness_watch_pop(&w, 399, 100, &e));
+  CHECK(liveliness_watch_pop(&w, 400, 100, &e));
   CHECK(e.writer == 43 && e.mono_ns == 300 && e.expired == 0);
-  CHECK(!liveliness_watch_pop(&w, &e));
+  CHECK(!liveliness_watch_pop(&w, 1000, 0, &e));
   CHECK(w.lost_total == 2);
+  /* A lapse followed by the same writer coming back (a starved receiver
+   * catching up) is marked regained; another writer's return is not it. */
+  s = status(0, 1, -1, 1, 50);
+  liveliness_watch_note(&w, &s, 500);
+  s = status(1, 1, 1, 0, 51);
+  liveliness_watch_note(&w, &s, 505);
+  s = status(1, 0, 1, -1, 50);
+  liveliness_watch_note(&w, &s, 510);
+  s = status(0, 1, -1, 1, 52);
+  liveliness_watch_note(&w, &s, 520);
+  CHECK(liveliness_watch_pop(&w, 1000, 20, &e));
+  CHECK(e.writer == 50 && e.regained == 1);
+  CHECK(liveliness_watch_pop(&w, 1000, 20, &e));
+  CHECK(e.writer == 52 && e.regained == 0);
   /* Overflow keeps the newest entries and counts the dropped ones. */
   for (int i = 0; i < LIVELINESS_WATCH_CAP + 5; i++) {
     s = status(0, 1, -1, 1, (dds_instance_handle_t)(1000 + i));
     liveliness_watch_note(&w, &s, (uint64_t)i);
   }
   CHECK(w.dropped == 5);
-  CHECK(liveliness_watch_pop(&w, &e));
+  CHECK(liveliness_watch_pop(&w, 1000, 0, &e));
   CHECK(e.writer == 1005);
   int n = 1;
-  while (liveliness_watch_pop(&w, &e)) n++;
+  while (liveliness_watch_pop(&w, 1000, 0, &e)) n++;
   CHECK(n == LIVELINESS_WATCH_CAP);
   CHECK(e.writer == 1000 + LIVELINESS_WATCH_CAP + 4);
   liveliness_watch_destroy(&w);
