@@ -8,10 +8,11 @@
 // exchanges the newest position, buttons and force with the viscera haptic
 // thread under a mutex held for a few copies.
 //
-// Axes and units: libnifalcon is x right, y up, z along the grip axis with
-// the workspace centre near z = 0.11 m (FALCON_CENTRE_Z), metres; the scene
-// is x right, y away from the user, z up: scene = (x, z - 0.11, y), then the
-// workspace mapping (device.h). The Falcon is rated for about 9 N.
+// Axes and units: libnifalcon is x right, y up, z towards the user (along
+// the grip axis) with the workspace centre near z = 0.11 m
+// (FALCON_CENTRE_Z), metres; the scene is x right, y away from the user,
+// z up: scene = (x, 0.11 - z, y) (a rotation, no mirror), then the workspace
+// mapping (device.h). The Falcon is rated for about 9 N.
 #include <falcon/core/FalconDevice.h>
 #include <falcon/firmware/FalconFirmwareNovintSDK.h>
 #include <falcon/grip/FalconGripFourButton.h>
@@ -71,7 +72,7 @@ void falcon_read(device_t *d, double, double pos[3], double quat[4], uint32_t *b
     p = h->pos;
     b = h->buttons;
   }
-  double s[3] = {p[0], p[2] - FALCON_CENTRE_Z, p[1]};
+  double s[3] = {p[0], FALCON_CENTRE_Z - p[2], p[1]};
   device_to_scene(&h->cfg, s, pos);
   quat[0] = 1;
   quat[1] = quat[2] = quat[3] = 0;
@@ -83,7 +84,7 @@ void falcon_read(device_t *d, double, double pos[3], double quat[4], uint32_t *b
 void falcon_write_force(device_t *d, const double f[3]) {
   falcon_dev *h = static_cast<falcon_dev *>(d->impl);
   std::lock_guard<std::mutex> g(h->lock);
-  h->force = {f[0], f[2], f[1]};
+  h->force = {f[0], f[2], -f[1]};
 }
 
 int falcon_finished(const device_t *, double) { return 0; }
