@@ -65,19 +65,21 @@ pids=()
 # or more while the probe is held in (1.6..4.6 s; the new server answers
 # only after the lift). Before it the probe pressed with force nearly all the
 # time: on a heavily loaded machine a starved client may see the 30 ms lease
-# lapse for a moment and render zero for a few ticks (the safe direction),
-# so up to 5 % zero ticks are tolerated there. Then force must come back on
-# the second press.
+# lapse (or the 50 ms feedback timeout pass) for a moment and render zero
+# for a few ticks (the safe direction), so up to 10 % of that time may be
+# without force. Then force must come back on the second press.
 read -r kill_t run_len < <(awk -F, 'NR>1 && $1>1.6 && $1<4.6 { f=sqrt($5*$5+$6*$6+$7*$7);
     if (f==0) { if (s<0) s=$1; if ($1-s>=0.5) { print s, $1-s; found=1; exit } } else s=-1 }
   BEGIN { s=-1 } END { if (!found) print "none 0" }' "$OUT/force.csv")
 [ "$kill_t" != none ] || fail "force never stayed at zero for 0.5 s after the server was killed"
 awk -v k="$kill_t" 'BEGIN { exit !(k > 2.4) }' || fail "force dropped for good at t = $kill_t s, before the server was killed"
 awk -F, -v k="$kill_t" 'NR>1 { f=sqrt($5*$5+$6*$6+$7*$7); t=$1;
-  if (t>1.6 && t<k) { n++; if (f>0.1) before++ }
+  # time-weighted: a starved loop catches up with a burst of ticks
+  if (t>1.6 && t<k && pt>0) { n++; tot+=t-pt; if (f>0) before+=t-pt }
+  pt=t
   if (t>6.3 && f>0.1) after++ }
-  END { printf "force: %d of %d ticks in contact before the loss at t = %.3f s, then zero for 0.5 s, %d ticks with force after the second press\n", before, n, k, after;
-        exit !(before>=0.95*n && n>500 && after>100) }' "$OUT/force.csv" \
+  END { printf "force: present %.0f %% of the %.2f s before the loss at t = %.3f s, then zero for 0.5 s; %d ticks with force after the second press\n", 100*before/tot, tot, k, after;
+        exit !(before>=0.9*tot && tot>0.5 && after>100) }' "$OUT/force.csv" \
   || fail "force did not drop to zero and come back"
 echo "detection (last report of each): $(grep -o 'server lost (liveliness lost[^)]*)' "$OUT/haptic.log" | tail -1); $(grep -o 'haptic client lost (liveliness lost[^)]*)' "$OUT/server2.log" | tail -1)"
 echo "false alarms (machine load): client $(($(grep -c 'server lost' "$OUT/haptic.log") - 1)), server $(grep -c 'lapsed while it kept sending' "$OUT"/server*.log | awk -F: '{s+=$2} END {print s}')"
