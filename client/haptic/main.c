@@ -295,6 +295,7 @@ int main(int argc, char **argv) {
   int have_prev_pos = 0;
   uint64_t seq = 0;
   int server_lost_reported = 0;
+  uint64_t live_lost_reported_ns = 0;
   uint64_t start = vtime_mono_ns(), next = start, prev_tick = 0;
   double finished_at = -1;
   while (!g_stop) {
@@ -329,10 +330,12 @@ int main(int argc, char **argv) {
       server_lost_reported = 0;
     }
     /* The server process is gone (its feedback writer's liveliness lapsed):
-     * the listener already cleared the slot; say so once. */
+     * the listener already cleared the slot; say so once per loss, even when
+     * the feedback timeout happened to notice first on a loaded machine. */
     if (lost_live) {
       model.in_contact = 0;
-      if (!server_lost_reported) {
+      if (lost_ns != live_lost_reported_ns) {
+        live_lost_reported_ns = lost_ns;
         fprintf(stderr,
                 "haptic: server lost (liveliness lost, last feedback %.0f ms before, lease %d ms), force set to "
                 "zero\n",

@@ -13,7 +13,8 @@
  *   T button_up
  * T: seconds since the camera was fixed (first drawable frame), not
  * decreasing. Values are bounded (|DX|, |DY| <= 10000, |N| <= 1000, T <= 1e6);
- * anything else is refused naming file and line. */
+ * anything else is refused naming file and line. Without --duration the
+ * window closes SCRIPT_TAIL_S (1 s) after the last event. */
 #ifndef VISCERA_VIEWER_INPUT_SCRIPT_H
 #define VISCERA_VIEWER_INPUT_SCRIPT_H
 

@@ -22,6 +22,9 @@
 #define FRAME_NS 16666667ull           /* display-rate cap, 60 Hz */
 #define DRIVE_RATE_HZ 1000.0
 #define TITLE_EVERY_NS 200000000ull
+/* Without --duration a scripted session closes this long after its last
+ * event, so a demo or test ends by itself whatever the start-up time. */
+#define SCRIPT_TAIL_S 1.0
 
 typedef struct win {
   const viewer_opts_t *o;
@@ -229,6 +232,17 @@ static long window_snapshot(win_t *w, verr_t *err) {
   return rc ? -1 : differ;
 }
 
+/* Writes img as the next PNG frame with its frames.csv row. */
+static int write_png(win_t *w, const uint8_t *img, double wall_ms, verr_t *err) {
+  char path[FRAME_LOG_DIR_LEN + 32];
+  frame_row_t row = {.wall_ms = wall_ms};
+  scene_draw_readouts(&w->cam, &w->sv, &row);
+  if (frame_log_next_path(&w->fl, path, sizeof path, err) ||
+      png_write_rgb(path, w->o->width, w->o->height, img, 1, err) || frame_log_add(&w->fl, &row, err))
+    return -1;
+  return 0;
+}
+
 static void update_title(win_t *w, int driving) {
   char title[256];
   int p = driving ? w->o->drive_tool : scene_view_primary_tool(&w->sv);
@@ -254,10 +268,14 @@ static int run(win_t *w, volatile sig_atomic_t *stop) {
   const uint64_t interval_ns = (uint64_t)o->interval_ms * 1000000ull;
   uint64_t first_key_ns = 0, cam_ns = 0, last_ns = t0, next_png = 0, next_title = 0;
   long presented = 0;
+  const uint8_t *last_img = NULL;
   Uint32 window_id = SDL_GetWindowID(w->window);
   while (!*stop) {
     uint64_t now = vtime_mono_ns();
     if (duration_ns && now - t0 >= duration_ns) break;
+    if (!duration_ns && w->script.n && w->script.next == w->script.n &&
+        (double)(now - cam_ns) * 1e-9 >= input_script_duration(&w->script) + SCRIPT_TAIL_S)
+      break;
     if (scene_view_poll(&w->sv, &err) < 0) {
       fprintf(stderr, "viscera-viewer: %s\n", err.msg);
       return 1;
@@ -303,12 +321,9 @@ static int run(win_t *w, volatile sig_atomic_t *stop) {
         return 1;
       }
       presented++;
+      last_img = img;
       if (w->fl_open && interval_ns && now >= next_png) {
-        char path[FRAME_LOG_DIR_LEN + 32];
-        frame_row_t row = {.wall_ms = (double)(now - t0) * 1e-6};
-        scene_draw_readouts(&w->cam, &w->sv, &row);
-        if (frame_log_next_path(&w->fl, path, sizeof path, &err) ||
-            png_write_rgb(path, o->width, o->height, img, 1, &err) || frame_log_add(&w->fl, &row, &err)) {
+        if (write_png(w, img, (double)(now - t0) * 1e-6, &err)) {
           fprintf(stderr, "viscera-viewer: %s\n", err.msg);
           return 1;
         }
@@ -324,9 +339,15 @@ static int run(win_t *w, volatile sig_atomic_t *stop) {
     if (duration_ns && t0 + duration_ns < wake) wake = t0 + duration_ns;
     vtime_sleep_until(wake);
   }
-  if (w->fl_open && presented) {
-    /* Read back before the next present: what is on screen now is the last
-     * frame drawn into w->flip. */
+  if (w->fl_open && last_img) {
+    /* The state at exit as the last frame, so the index ends where the
+     * session ended whatever the interval. */
+    if (write_png(w, last_img, (double)(vtime_mono_ns() - t0) * 1e-6, &err)) {
+      fprintf(stderr, "viscera-viewer: %s\n", err.msg);
+      return 1;
+    }
+    /* Read back before any other present: what is on screen now is that
+     * same frame, drawn into w->flip. */
     long differ = window_snapshot(w, &err);
     if (differ < 0)
       fprintf(stderr, "viscera-viewer: %s\n", err.msg);

@@ -20,8 +20,9 @@ trap 'for p in "${pids[@]}"; do kill -9 "$p" 2>/dev/null || true; done' EXIT
 fail() { echo "FAIL: $*" >&2; tail -n 8 "$OUT"/*.log >&2; exit 1; }
 server() { "$BUILD/server/viscera-server" --scene "$SRC/assets/scenes/default.yaml" "${common[@]}" \
   >>"$OUT/server$1.out" 2>>"$OUT/server$1.log" & SERVER=$!; pids+=($SERVER); }
-wait_for() { # FILE PATTERN SECONDS
-  local i=0; while ! grep -q "$2" "$1" 2>/dev/null; do sleep 0.1; i=$((i+1)); [ $i -lt $(($3*10)) ] || return 1; done; }
+count() { grep -c "$2" "$1" 2>/dev/null || true; }
+wait_for() { # FILE PATTERN SECONDS [MORE_THAN]: until PATTERN occurs more than MORE_THAN (0) times
+  local i=0; while [ "$(count "$1" "$2")" -le "${4:-0}" ]; do sleep 0.1; i=$((i+1)); [ $i -lt $(($3*10)) ] || return 1; done; }
 
 # Press from 0.5 s to 1.2 s, hold; lift at 4.6-5.2 s and press again at 6 s
 # (a restarted server never pushes a hand that is already inside).
@@ -39,24 +40,28 @@ server 1
   --duration 30 --force-csv "$OUT/force.csv" >"$OUT/haptic.out" 2>"$OUT/haptic.log" & HAPTIC=$!; pids+=($HAPTIC)
 wait_for "$OUT/haptic.log" "driving tool" 10 || fail "haptic client never saw the scene"
 sleep 2.5                         # pressing since t = 1.2 s
+# On a loaded machine brief false alarms may come before the kill: count them.
+n_lost=$(count "$OUT/haptic.log" "server lost (liveliness lost")
 kill -9 $SERVER; wait $SERVER 2>/dev/null || true
-wait_for "$OUT/haptic.log" "server lost" 5 || fail "haptic client did not report the lost server"
-grep -q "server lost (liveliness lost" "$OUT/haptic.log" \
-  || fail "server loss was noticed by the feedback timeout, not by liveliness: $(grep 'server lost' "$OUT/haptic.log")"
+wait_for "$OUT/haptic.log" "server lost (liveliness lost" 5 "$n_lost" \
+  || fail "haptic client did not report the server's liveliness lost: $(grep 'server' "$OUT/haptic.log")"
 sleep 0.8
+n_back=$(count "$OUT/haptic.log" "server back")
 server 2
-wait_for "$OUT/haptic.log" "server back" 10 || fail "haptic client did not report the server's return"
-wait_for "$OUT/server2.log" "MPF crossed up" 10 || fail "no contact after the server's return"
+wait_for "$OUT/haptic.log" "server back" 10 "$n_back" || fail "haptic client did not report the server's return"
+wait_for "$OUT/server2.log" "ST crossed up" 20 || fail "no contact after the server's return"
 sleep 0.5
 
 # 2. the client vanishes mid-contact.
+n_lost=$(count "$OUT/server2.log" "haptic client lost")
 kill -9 $HAPTIC; wait $HAPTIC 2>/dev/null || true
-wait_for "$OUT/server2.log" "haptic client lost" 5 || fail "server did not release the vanished client's tool"
-grep -q "tool 0: haptic client lost (liveliness lost" "$OUT/server2.log" \
+wait_for "$OUT/server2.log" "haptic client lost" 5 "$n_lost" || fail "server did not release the vanished client's tool"
+grep "haptic client lost" "$OUT/server2.log" | tail -1 | grep -q "tool 0: haptic client lost (liveliness lost" \
   || fail "client loss was not detected by liveliness: $(grep 'client lost' "$OUT/server2.log")"
+n_back=$(count "$OUT/server2.log" "tool 0: haptic client back")
 "$BUILD/client/haptic/viscera-haptic" --trajectory "$SRC/assets/trajectories/push_hold_kidney.traj" "${common[@]}" \
   --duration 1 >"$OUT/haptic2.out" 2>"$OUT/haptic2.log" || fail "second haptic client failed"
-grep -q "tool 0: haptic client back" "$OUT/server2.log" || fail "server did not report the client's return"
+[ "$(count "$OUT/server2.log" "tool 0: haptic client back")" -gt "$n_back" ] || fail "server did not report the client's return"
 kill -0 $SERVER || fail "server died"
 kill -INT $SERVER; wait $SERVER || fail "server exited with an error"
 pids=()
@@ -79,7 +84,7 @@ awk -F, -v k="$kill_t" 'NR>1 { f=sqrt($5*$5+$6*$6+$7*$7); t=$1;
   pt=t
   if (t>6.3 && f>0.1) after++ }
   END { printf "force: present %.0f %% of the %.2f s before the loss at t = %.3f s, then zero for 0.5 s; %d ticks with force after the second press\n", 100*before/tot, tot, k, after;
-        exit !(before>=0.9*tot && tot>0.5 && after>100) }' "$OUT/force.csv" \
+        exit !(before>=0.9*tot && tot>0.5 && after>20) }' "$OUT/force.csv" \
   || fail "force did not drop to zero and come back"
 echo "detection (last report of each): $(grep -o 'server lost (liveliness lost[^)]*)' "$OUT/haptic.log" | tail -1); $(grep -o 'haptic client lost (liveliness lost[^)]*)' "$OUT/server2.log" | tail -1)"
 echo "false alarms (machine load): client $(($(grep -c 'server lost' "$OUT/haptic.log") - 1)), server $(grep -c 'lapsed while it kept sending' "$OUT"/server*.log | awk -F: '{s+=$2} END {print s}')"
