@@ -11,14 +11,16 @@ static const struct {
   const char *name;
   const dds_topic_descriptor_t *desc;
   qos_kind_t qos;
+  int lease_ms; /* AUTOMATIC liveliness lease, 0 = none (infinite) */
 } TOPICS[VT_COUNT] = {
     [VT_SCENE_INFO] = {"viscera_SceneInfo", &viscera_SceneInfo_desc, QOS_STATE},
     [VT_MESH_STATE] = {"viscera_MeshState", &viscera_MeshState_desc, QOS_STATE},
     /* Deltas are cumulative, so keep-last 1 transient-local lets a late joiner
      * draw the current mesh at once instead of waiting for the next frame. */
     [VT_MESH_DELTA] = {"viscera_MeshDelta", &viscera_MeshDelta_desc, QOS_STATE},
-    [VT_TOOL_COMMAND] = {"viscera_ToolCommand", &viscera_ToolCommand_desc, QOS_STREAM},
-    [VT_CONTACT_FEEDBACK] = {"viscera_ContactFeedback", &viscera_ContactFeedback_desc, QOS_STREAM},
+    [VT_TOOL_COMMAND] = {"viscera_ToolCommand", &viscera_ToolCommand_desc, QOS_STREAM, VDDS_TOOL_LEASE_MS},
+    [VT_CONTACT_FEEDBACK] = {"viscera_ContactFeedback", &viscera_ContactFeedback_desc, QOS_STREAM,
+                             VDDS_FEEDBACK_LEASE_MS},
     [VT_SESSION_EVENT] = {"viscera_SessionEvent", &viscera_SessionEvent_desc, QOS_EVENTS},
     [VT_METRICS] = {"viscera_Metrics", &viscera_Metrics_desc, QOS_METRICS},
     [VT_SESSION_CONTROL] = {"viscera_SessionControl", &viscera_SessionControl_desc, QOS_CONTROL},
@@ -26,8 +28,11 @@ static const struct {
 
 const char *vdds_topic_name(vdds_topic_id_t t) { return t < VT_COUNT ? TOPICS[t].name : "?"; }
 
-static dds_qos_t *make_qos(qos_kind_t k) {
+static dds_qos_t *make_qos(qos_kind_t k, int lease_ms) {
   dds_qos_t *q = dds_create_qos();
+  /* Loss detection (vdds.h): the same lease offered by writers and
+   * requested by readers, so they always match. */
+  if (lease_ms > 0) dds_qset_liveliness(q, DDS_LIVELINESS_AUTOMATIC, DDS_MSECS(lease_ms));
   switch (k) {
   case QOS_STATE:
     dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
@@ -80,7 +85,7 @@ int vdds_open(vdds_t *v, dds_domainid_t domain, const char *partition, verr_t *e
     return verr_set(err, "DDS: cannot create publisher/subscriber in partition '%s'", part);
   }
   for (int t = 0; t < VT_COUNT; t++) {
-    dds_qos_t *tq = make_qos(TOPICS[t].qos);
+    dds_qos_t *tq = make_qos(TOPICS[t].qos, TOPICS[t].lease_ms);
     v->topics[t] = dds_create_topic(v->participant, TOPICS[t].desc, TOPICS[t].name, tq, NULL);
     dds_delete_qos(tq);
     if (v->topics[t] < 0) {
@@ -97,7 +102,7 @@ void vdds_close(vdds_t *v) {
 }
 
 dds_entity_t vdds_writer(vdds_t *v, vdds_topic_id_t t, verr_t *err) {
-  dds_qos_t *q = make_qos(TOPICS[t].qos);
+  dds_qos_t *q = make_qos(TOPICS[t].qos, TOPICS[t].lease_ms);
   dds_entity_t w = dds_create_writer(v->publisher, v->topics[t], q, NULL);
   dds_delete_qos(q);
   if (w < 0) verr_set(err, "DDS: cannot create writer for %s: %s", TOPICS[t].name, dds_strretcode(w));
@@ -107,7 +112,7 @@ dds_entity_t vdds_writer(vdds_t *v, vdds_topic_id_t t, verr_t *err) {
 dds_entity_t vdds_reader(vdds_t *v, vdds_topic_id_t t, verr_t *err) { return vdds_reader_listener(v, t, NULL, err); }
 
 dds_entity_t vdds_reader_listener(vdds_t *v, vdds_topic_id_t t, const dds_listener_t *l, verr_t *err) {
-  dds_qos_t *q = make_qos(TOPICS[t].qos);
+  dds_qos_t *q = make_qos(TOPICS[t].qos, TOPICS[t].lease_ms);
   dds_entity_t r = dds_create_reader(v->subscriber, v->topics[t], q, l);
   dds_delete_qos(q);
   if (r < 0) verr_set(err, "DDS: cannot create reader for %s: %s", TOPICS[t].name, dds_strretcode(r));

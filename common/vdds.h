@@ -31,6 +31,24 @@ typedef struct vdds {
   dds_entity_t topics[VT_COUNT];
 } vdds_t;
 
+/* Liveliness leases of the hot tool topics: AUTOMATIC liveliness, so a
+ * process that dies (kill -9, crash, pulled cable) is reported lost this long
+ * after its last sign of life. Writers at 1 kHz assert liveliness with every
+ * sample, idle ones through Cyclone's lease messages (tens of bytes per
+ * lease period). A live process whose loop stalls stays alive: the data
+ * timeouts (server 0.5 s without commands, haptic client 50 ms without
+ * feedback) cover that case.
+ * - ToolCommand (haptic client -> server), 150 ms: a false "lost" on a loaded
+ *   machine would release the tool and drop a grasp, which breaks the task,
+ *   so the lease is three times the longest scheduler stall seen on the
+ *   shared 2-core machine (~50 ms), and still well below the 0.5 s timeout.
+ * - ContactFeedback (server -> haptic client), 30 ms: a false "lost" only
+ *   zeroes the force until the next sample (the safe direction for a
+ *   device), and the lease must beat the 50 ms feedback timeout or the
+ *   timeout would always be the one to notice. */
+#define VDDS_TOOL_LEASE_MS 150
+#define VDDS_FEEDBACK_LEASE_MS 30
+
 /* Default partition when none is given. */
 #define VDDS_DEFAULT_PARTITION "viscera/local"
 

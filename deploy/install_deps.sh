@@ -13,6 +13,8 @@ PKGS=(
   libyaml-dev                               # scene files
   libcairo2-dev                             # plots in benchmarks and reports
   openssl                                   # DDS Security PKI (deploy/pki.sh)
+  libsdl2-dev                               # window viewer (--window, --drive)
+  xvfb xauth                                # headless X server for the window test
 )
 
 missing=()

@@ -160,6 +160,9 @@ int main(int argc, char **argv) {
   if (opts.checkpoint)
     fprintf(stderr, "server: %" PRIu64 " checkpoint(s) written to %s%s\n", st.checkpoints_written, opts.checkpoint,
             st.resumed ? " (this run resumed from it)" : "");
+  if (st.liveliness_blips)
+    fprintf(stderr, "server: %" PRIu64 " client liveliness lapse(s) while still sending (kept, see liveliness_watch.h)\n",
+            st.liveliness_blips);
   printf("SUMMARY steps=%" PRIu64 " peak_force=%.3f rejected=%" PRIu64 " rollbacks=%" PRIu64 " step_us_median=%.1f\n",
          st.steps, st.peak_force, st.rejected_total, st.rollbacks, st.step_us_median);
   /* Trainee measures per tool (seed 002 ch. 6); levels of 0 are unset. */

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "checkpoint.h"
+#include "liveliness_watch.h"
 #include "mesh.h"
 #include "session_control.h"
 #include "viscera.h"
@@ -24,6 +25,11 @@ typedef struct server {
   mesh_publisher_t pubs[SCENE_MAX_ORGANS];
   uint64_t cmd_seq[SCENE_MAX_TOOLS], cmd_echo[SCENE_MAX_TOOLS], last_cmd_mono[SCENE_MAX_TOOLS];
   int was_contact[SCENE_MAX_TOOLS];
+  /* Loss detection: the writer driving each tool (publication handle) and
+   * whether the tool was released for a lost client (to report its return). */
+  liveliness_watch_t lw;
+  dds_instance_handle_t cmd_writer[SCENE_MAX_TOOLS];
+  int tool_lost[SCENE_MAX_TOOLS];
   thr_tracker_t thr[SCENE_MAX_TOOLS];
   session_control_t control;
   uint64_t event_seq;
@@ -92,6 +98,7 @@ static void publish_scene_info(server_t *s) {
 }
 
 static int setup(server_t *s, const scene_t *scene, verr_t *err) {
+  liveliness_watch_init(&s->lw); /* first: teardown always destroys it */
   if (runtime_init(&s->rt, scene, err)) return -1;
   if (vdds_open(&s->dds, s->opts->domain, s->opts->partition, err)) return -1;
   s->w_scene = vdds_writer(&s->dds, VT_SCENE_INFO, err);
@@ -100,7 +107,10 @@ static int setup(server_t *s, const scene_t *scene, verr_t *err) {
   s->w_feedback = vdds_writer(&s->dds, VT_CONTACT_FEEDBACK, err);
   s->w_event = vdds_writer(&s->dds, VT_SESSION_EVENT, err);
   s->w_metrics = vdds_writer(&s->dds, VT_METRICS, err);
-  s->r_cmd = vdds_reader(&s->dds, VT_TOOL_COMMAND, err);
+  dds_listener_t *l = dds_create_listener(&s->lw);
+  liveliness_watch_listen(&s->lw, l);
+  s->r_cmd = vdds_reader_listener(&s->dds, VT_TOOL_COMMAND, l, err);
+  dds_delete_listener(l);
   s->r_control = vdds_reader(&s->dds, VT_SESSION_CONTROL, err);
   if (s->w_scene < 0 || s->w_state < 0 || s->w_delta < 0 || s->w_feedback < 0 || s->w_event < 0 ||
       s->w_metrics < 0 || s->r_cmd < 0 || s->r_control < 0)
@@ -119,8 +129,45 @@ static int setup(server_t *s, const scene_t *scene, verr_t *err) {
 static void teardown(server_t *s) {
   for (size_t i = 0; i < s->rt.norgans; i++) mesh_publisher_destroy(&s->pubs[i]);
   runtime_destroy(&s->rt);
-  vdds_close(&s->dds);
+  vdds_close(&s->dds); /* stops the listener before the watch goes */
+  liveliness_watch_destroy(&s->lw);
   free(s->step_us);
+}
+
+/* Releases every tool whose commanding writer lost its liveliness (the
+ * client process died): at the next step instead of after the command
+ * timeout. */
+static void release_lost_writers(server_t *s, uint64_t now) {
+  liveliness_lost_t e;
+  while (liveliness_watch_pop(&s->lw, now, LIVELINESS_CONFIRM_NS, &e)) {
+    for (size_t t = 0; t < s->rt.ntools; t++) {
+      if (!s->rt.tools[t].active || s->cmd_writer[t] != e.writer) continue;
+      if (e.expired && (e.regained || s->last_cmd_mono[t] > e.mono_ns)) {
+        /* Alive after all: this process was starved past the lease (see
+         * liveliness_watch.h). Keep the tool; say so a few times. */
+        if (++s->stats->liveliness_blips <= 3 && !s->opts->quiet)
+          fprintf(stderr, "server: tool %zu: client liveliness lapsed while it kept sending (machine overloaded?); "
+                          "kept\n", t);
+        continue;
+      }
+      runtime_release_tool(&s->rt, t);
+      s->tool_lost[t] = 1;
+      /* From the last command taken to the listener's report, and to this
+       * release (which adds the confirmation delay and the step). */
+      double heard_ms = e.mono_ns > s->last_cmd_mono[t] ? (double)(e.mono_ns - s->last_cmd_mono[t]) * 1e-6 : 0;
+      double released_ms = (double)(now - s->last_cmd_mono[t]) * 1e-6;
+      char text[200];
+      if (e.expired)
+        snprintf(text, sizeof text,
+                 "haptic client lost (liveliness lost %.0f ms after its last command, lease %d ms; released at "
+                 "%.0f ms): tool released",
+                 heard_ms, VDDS_TOOL_LEASE_MS, released_ms);
+      else
+        snprintf(text, sizeof text, "haptic client left (its command writer was deleted): tool released");
+      if (!s->opts->quiet) fprintf(stderr, "server: tool %zu: %s\n", t, text);
+      publish_event(s, viscera_EVENT_CLIENT_LOST, -1, (int)t, (double)(now - s->last_cmd_mono[t]) * 1e-9, text);
+    }
+  }
 }
 
 /* Takes every pending ToolCommand; applies valid ones, counts and reports the rest. */
@@ -151,6 +198,11 @@ static void read_commands(server_t *s, uint64_t now) {
         continue;
       }
       double pos[3] = {c->position[0], c->position[1], c->position[2]};
+      if (s->tool_lost[c->tool_id]) {
+        s->tool_lost[c->tool_id] = 0;
+        if (!s->opts->quiet) fprintf(stderr, "server: tool %u: haptic client back\n", c->tool_id);
+      }
+      s->cmd_writer[c->tool_id] = infos[i].publication_handle;
       runtime_set_tool(&s->rt, c->tool_id, pos, c->max_force);
       s->cmd_seq[c->tool_id] = c->seq;
       s->cmd_echo[c->tool_id] = c->client_mono_ns;
@@ -160,11 +212,14 @@ static void read_commands(server_t *s, uint64_t now) {
     dds_return_loan(s->r_cmd, samples, n);
     if (n < MAXS) break;
   }
+  release_lost_writers(s, now);
   for (size_t t = 0; t < s->rt.ntools; t++) {
     if (s->rt.tools[t].active && now - s->last_cmd_mono[t] > (uint64_t)(s->opts->tool_timeout * 1e9)) {
       runtime_release_tool(&s->rt, t);
+      s->tool_lost[t] = 1;
       if (!s->opts->quiet) fprintf(stderr, "server: tool %zu: no commands for %.1f s, released\n", t, s->opts->tool_timeout);
-      publish_event(s, viscera_EVENT_CLIENT_LOST, -1, (int)t, 0, "haptic client lost: tool released");
+      publish_event(s, viscera_EVENT_CLIENT_LOST, -1, (int)t, s->opts->tool_timeout,
+                    "haptic client lost (no commands): tool released");
     }
   }
 }

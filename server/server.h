@@ -28,6 +28,7 @@ typedef struct server_stats {
   uint64_t checkpoints_written;
   int resumed; /* started from a checkpoint */
   uint64_t steps, overruns, rollbacks, rejected[TOOLCMD_VERDICT_COUNT], rejected_total, commands;
+  uint64_t liveliness_blips; /* client liveliness lapses that were not a lost client */
   double peak_force;
   double step_us_median, step_us_p99, step_us_max;
   size_t ntools;

@@ -60,9 +60,42 @@ static void on_data(dds_entity_t reader, void *arg) {
   if (n > 0) dds_return_loan(reader, samples, n);
 }
 
+void feedback_slot_liveliness(feedback_slot_t *s, const dds_liveliness_changed_status_t *st, uint64_t now) {
+  pthread_mutex_lock(&s->lock);
+  s->writers_alive = st->alive_count;
+  if (st->alive_count == 0 && st->alive_count_change < 0 && !s->server_lost) {
+    /* The server is gone: stop rendering its wall now rather than after the
+     * feedback timeout. */
+    s->model.in_contact = 0;
+    s->server_lost = 1;
+    s->lost_mono_ns = now;
+    s->lost_last_arrival = s->arrival_mono_ns;
+    s->lost_events++;
+  } else if (st->alive_count > 0 && s->server_lost) {
+    s->server_lost = 0;
+    s->regained_events++;
+  }
+  pthread_mutex_unlock(&s->lock);
+}
+
+static void on_liveliness(dds_entity_t reader, const dds_liveliness_changed_status_t status, void *arg) {
+  (void)reader;
+  feedback_slot_liveliness(arg, &status, vtime_mono_ns());
+}
+
+int feedback_slot_server_lost(feedback_slot_t *s, uint64_t *lost_ns, uint64_t *last_arrival) {
+  pthread_mutex_lock(&s->lock);
+  int lost = s->server_lost;
+  *lost_ns = s->lost_mono_ns;
+  *last_arrival = s->lost_last_arrival;
+  pthread_mutex_unlock(&s->lock);
+  return lost;
+}
+
 dds_entity_t feedback_slot_attach(feedback_slot_t *s, vdds_t *v, verr_t *err) {
   dds_listener_t *l = dds_create_listener(s);
   dds_lset_data_available(l, on_data);
+  dds_lset_liveliness_changed(l, on_liveliness);
   dds_entity_t r = vdds_reader_listener(v, VT_CONTACT_FEEDBACK, l, err);
   dds_delete_listener(l);
   return r;

@@ -3,7 +3,13 @@
  * ContactFeedback for our tool as it arrives, stamps its arrival time (so the
  * command-to-feedback latency is measured at reception, not at the next
  * tick) and overwrites the slot; the loop copies the newest value. Neither
- * side ever waits for the other longer than one short critical section. */
+ * side ever waits for the other longer than one short critical section.
+ *
+ * Server loss: the same reader's liveliness-changed listener sees the
+ * server's ContactFeedback writer lose its liveliness (lease
+ * VDDS_FEEDBACK_LEASE_MS, vdds.h) when the server process dies, and clears
+ * the slot's contact at once, so the loop renders zero force from its next
+ * tick on; the loop asks feedback_slot_server_lost to report it. */
 #ifndef VISCERA_FEEDBACK_SLOT_H
 #define VISCERA_FEEDBACK_SLOT_H
 
@@ -27,6 +33,12 @@ typedef struct feedback_slot {
   double *latency_us;
   size_t nlatency, cap;
   uint64_t last_cmd_seq;
+  /* Liveliness of the server's feedback writer(s). */
+  uint32_t writers_alive;
+  int server_lost;            /* every writer lost its liveliness */
+  uint64_t lost_mono_ns;      /* when the listener heard of it */
+  uint64_t lost_last_arrival; /* arrival of the last feedback before that */
+  uint64_t lost_events, regained_events;
 } feedback_slot_t;
 
 int feedback_slot_init(feedback_slot_t *s, uint32_t tool_id, size_t latency_capacity);
@@ -36,5 +48,11 @@ void feedback_slot_destroy(feedback_slot_t *s);
 dds_entity_t feedback_slot_attach(feedback_slot_t *s, vdds_t *v, verr_t *err);
 /* Copies the newest value; returns its arrival time (0: none yet). */
 uint64_t feedback_slot_read(feedback_slot_t *s, contact_model_t *out);
+/* 1 while the server is lost by liveliness (its feedback writer's lease
+ * expired and no writer is alive); then *lost_ns is when that was heard and
+ * *last_arrival the arrival of the last feedback before it (0: none). */
+int feedback_slot_server_lost(feedback_slot_t *s, uint64_t *lost_ns, uint64_t *last_arrival);
+/* Applies a liveliness status (the listener calls this; tests may too). */
+void feedback_slot_liveliness(feedback_slot_t *s, const dds_liveliness_changed_status_t *st, uint64_t now);
 
 #endif

@@ -31,20 +31,28 @@ static void on_signal(int sig) {
 }
 
 static void usage(FILE *f) {
-  fprintf(f, "usage: viscera-haptic --trajectory FILE [options]\n"
-             "  --trajectory FILE   scripted device: play this path (t x y z [buttons] per line)\n"
-             "  --tool N            tool index in the scene (default 0)\n"
-             "  --domain N          DDS domain id (default: $VISCERA_DOMAIN or 0)\n"
-             "  --partition P       session partition (default: " VDDS_DEFAULT_PARTITION ")\n"
-             "  --rate HZ           loop rate (default 1000)\n"
-             "  --max-force N       device capability in newtons (default 4)\n"
-             "  --wait-server S     wait up to S s for the server's scene before starting (default 10)\n"
-             "  --duration S        stop after S s (default: end of the trajectory + 0.5 s)\n"
-             "  --force-csv FILE    write t,x,y,z,fx,fy,fz,in_contact per tick\n"
-             "  --rt-priority N     run the loop thread SCHED_FIFO at priority N (1..99) with\n"
-             "                      memory locked (needs root or CAP_SYS_NICE; warns otherwise)\n"
-             "  --quiet             only the summary\n"
-             "  --help              this text\n");
+  fprintf(f,
+          "usage: viscera-haptic --trajectory FILE [options]\n"
+          "       viscera-haptic --device NAME [options]\n"
+          "  --device NAME       scripted (default), dhd, hd or falcon; this build has: %s\n"
+          "  --trajectory FILE   scripted device: play this path (t x y z [buttons] per line)\n"
+          "  --device-index N    real devices: which one of that kind (default 0)\n"
+          "  --workspace-scale S real devices: scene metres per device metre (default 1)\n"
+          "  --workspace-offset X,Y,Z  real devices: scene position (m) of the device's\n"
+          "                      workspace centre (default 0,0,0)\n"
+          "  --tool N            tool index in the scene (default 0)\n"
+          "  --domain N          DDS domain id (default: $VISCERA_DOMAIN or 0)\n"
+          "  --partition P       session partition (default: " VDDS_DEFAULT_PARTITION ")\n"
+          "  --rate HZ           loop rate (default 1000)\n"
+          "  --max-force N       device capability in newtons (default 4)\n"
+          "  --wait-server S     wait up to S s for the server's scene before starting (default 10)\n"
+          "  --duration S        stop after S s (default: end of the trajectory + 0.5 s)\n"
+          "  --force-csv FILE    write t,x,y,z,fx,fy,fz,in_contact per tick\n"
+          "  --rt-priority N     run the loop thread SCHED_FIFO at priority N (1..99) with\n"
+          "                      memory locked (needs root or CAP_SYS_NICE; warns otherwise)\n"
+          "  --quiet             only the summary\n"
+          "  --help              this text\n",
+          device_names());
 }
 
 typedef struct stats {
@@ -55,7 +63,9 @@ typedef struct stats {
 } stats_t;
 
 int main(int argc, char **argv) {
-  const char *traj = NULL, *partition = NULL, *force_csv = NULL;
+  const char *traj = NULL, *partition = NULL, *force_csv = NULL, *device = "scripted";
+  device_config_t dcfg;
+  device_config_default(&dcfg);
   int domain = 0, quiet = 0, rt_priority = 0;
   unsigned tool = 0;
   double rate = 1000, max_force = 4, wait_server = 10, duration = -1;
@@ -75,13 +85,17 @@ int main(int argc, char **argv) {
                                      {"force-csv", required_argument, 0, 'f'},
                                      {"quiet", no_argument, 0, 'q'},
                                      {"rt-priority", required_argument, 0, 'R'},
+                                     {"device", required_argument, 0, 'D'},
+                                     {"device-index", required_argument, 0, 'I'},
+                                     {"workspace-scale", required_argument, 0, 'S'},
+                                     {"workspace-offset", required_argument, 0, 'O'},
                                      {"help", no_argument, 0, 'h'},
                                      {0, 0, 0, 0}};
   int c;
-  while ((c = getopt_long(argc, argv, "j:n:d:p:r:m:w:t:f:R:qh", lo, NULL)) != -1) {
+  while ((c = getopt_long(argc, argv, "j:n:d:p:r:m:w:t:f:R:D:I:S:O:qh", lo, NULL)) != -1) {
     char *end = NULL;
     double v = 0;
-    if (c == 'r' || c == 'm' || c == 'w' || c == 't' || c == 'n' || c == 'R') {
+    if (c == 'r' || c == 'm' || c == 'w' || c == 't' || c == 'n' || c == 'R' || c == 'I' || c == 'S') {
       v = strtod(optarg, &end);
       if (*end || !isfinite(v) || v < 0) {
         fprintf(stderr, "viscera-haptic: option --%s: '%s' is not a non-negative number\n",
@@ -90,6 +104,8 @@ int main(int argc, char **argv) {
                 : c == 'w' ? "wait-server"
                 : c == 't' ? "duration"
                 : c == 'R' ? "rt-priority"
+                : c == 'I' ? "device-index"
+                : c == 'S' ? "workspace-scale"
                            : "tool",
                 optarg);
         return 2;
@@ -133,6 +149,34 @@ int main(int argc, char **argv) {
         return 2;
       }
       break;
+    case 'D':
+      device = optarg;
+      break;
+    case 'I':
+      if (v != floor(v) || v > 15) {
+        fprintf(stderr, "viscera-haptic: --device-index must be an integer 0..15\n");
+        return 2;
+      }
+      dcfg.index = (int)v;
+      break;
+    case 'S':
+      if (!(v > 0) || v > 1000) {
+        fprintf(stderr, "viscera-haptic: --workspace-scale must be > 0 and <= 1000\n");
+        return 2;
+      }
+      dcfg.scale = v;
+      break;
+    case 'O': {
+      double o[3];
+      char tail = 0;
+      if (sscanf(optarg, "%lf,%lf,%lf%c", &o[0], &o[1], &o[2], &tail) != 3 || !isfinite(o[0]) || !isfinite(o[1]) ||
+          !isfinite(o[2]) || fabs(o[0]) > 100 || fabs(o[1]) > 100 || fabs(o[2]) > 100) {
+        fprintf(stderr, "viscera-haptic: --workspace-offset '%s': expected X,Y,Z in metres (|value| <= 100)\n", optarg);
+        return 2;
+      }
+      memcpy(dcfg.offset, o, sizeof o);
+      break;
+    }
     case 'q':
       quiet = 1;
       break;
@@ -144,8 +188,11 @@ int main(int argc, char **argv) {
       return 2;
     }
   }
-  if (!traj) {
-    fprintf(stderr, "viscera-haptic: --trajectory FILE is required (the scripted device is the one built in)\n");
+  if (!traj && strcmp(device, "scripted") == 0) {
+    fprintf(stderr,
+            "viscera-haptic: --trajectory FILE is required for the scripted device (or choose --device: "
+            "this build has %s)\n",
+            device_names());
     return 2;
   }
   if (!(rate >= 10 && rate <= 10000) || !(max_force > 0)) {
@@ -153,7 +200,9 @@ int main(int argc, char **argv) {
     return 2;
   }
   device_t dev;
-  if (device_scripted_open(&dev, traj, max_force, &err)) {
+  dcfg.trajectory = traj;
+  dcfg.max_force = max_force;
+  if (device_open(&dev, device, &dcfg, &err)) {
     fprintf(stderr, "viscera-haptic: %s\n", err.msg);
     return 1;
   }
@@ -246,6 +295,7 @@ int main(int argc, char **argv) {
   int have_prev_pos = 0;
   uint64_t seq = 0;
   int server_lost_reported = 0;
+  uint64_t live_lost_reported_ns = 0;
   uint64_t start = vtime_mono_ns(), next = start, prev_tick = 0;
   double finished_at = -1;
   while (!g_stop) {
@@ -273,12 +323,28 @@ int main(int argc, char **argv) {
     dds_write(w_cmd, &cmd);
 
     uint64_t last_fb_mono = feedback_slot_read(&slot, &model);
-    if (last_fb_mono && server_lost_reported && now - last_fb_mono < 50000000ull) {
+    uint64_t lost_ns = 0, lost_last = 0;
+    int lost_live = feedback_slot_server_lost(&slot, &lost_ns, &lost_last);
+    if (last_fb_mono && server_lost_reported && !lost_live && now - last_fb_mono < 50000000ull) {
       fprintf(stderr, "haptic: server back\n");
       server_lost_reported = 0;
     }
-    /* No feedback for 50 ms: the server is gone or stalled, so render nothing
-     * rather than a stale wall. */
+    /* The server process is gone (its feedback writer's liveliness lapsed):
+     * the listener already cleared the slot; say so once per loss, even when
+     * the feedback timeout happened to notice first on a loaded machine. */
+    if (lost_live) {
+      model.in_contact = 0;
+      if (lost_ns != live_lost_reported_ns) {
+        live_lost_reported_ns = lost_ns;
+        fprintf(stderr,
+                "haptic: server lost (liveliness lost, last feedback %.0f ms before, lease %d ms), force set to "
+                "zero\n",
+                lost_last ? (double)(lost_ns - lost_last) * 1e-6 : -1.0, VDDS_FEEDBACK_LEASE_MS);
+        server_lost_reported = 1;
+      }
+    }
+    /* No feedback for 50 ms while the server is alive (stalled, or not
+     * answering this tool): render nothing rather than a stale wall. */
     if (last_fb_mono && now > last_fb_mono + 50000000ull) {
       model.in_contact = 0;
       if (!server_lost_reported) {
@@ -318,7 +384,7 @@ int main(int argc, char **argv) {
   vstats_summary_t per = vstats_summarise(st.period_us, st.nperiod);
   pthread_mutex_lock(&slot.lock);
   vstats_summary_t lat = vstats_summarise(slot.latency_us, slot.nlatency);
-  uint64_t feedback = slot.received;
+  uint64_t feedback = slot.received, live_lost = slot.lost_events, live_back = slot.regained_events;
   pthread_mutex_unlock(&slot.lock);
   /* Jitter: the p99 of |period - nominal| (early and late ticks alike). */
   for (size_t i = 0; i < st.nperiod; i++) st.period_us[i] = fabs(st.period_us[i] - 1e6 / rate);
@@ -332,6 +398,9 @@ int main(int argc, char **argv) {
           "haptic: force peak %.3f N, mean in contact %.3f N, %" PRIu64 " ticks in contact, %" PRIu64
           " feedback samples\n",
           st.peak_force, st.contact_ticks ? st.force_sum / (double)st.contact_ticks : 0.0, st.contact_ticks, feedback);
+  if (live_lost || live_back)
+    fprintf(stderr, "haptic: server liveliness lost %" PRIu64 " time(s), regained %" PRIu64 " time(s)\n", live_lost,
+            live_back);
   fprintf(stderr, "haptic: command->feedback latency median %.1f us, p99 %.1f us (%zu samples)\n", lat.median, lat.p99,
           lat.n);
   printf("SUMMARY ticks=%" PRIu64 " rate_hz=%.1f peak_force=%.4f contact_ticks=%" PRIu64 " latency_us_median=%.1f "

@@ -20,6 +20,9 @@
 #include "scene_draw.h"
 #include "scene_view.h"
 #include "vtime.h"
+#ifdef VISCERA_HAVE_WINDOW
+#include "window.h"
+#endif
 
 #define POLL_NS 10000000ull /* 10 ms */
 /* After the first keyframe, wait at most this long for the keyframes of the
@@ -99,6 +102,9 @@ int main(int argc, char **argv) {
     fprintf(stderr, "viscera-viewer: %s\nTry '%s --help'.\n", err.msg, argv[0]);
     return 2;
   }
+#ifdef VISCERA_HAVE_WINDOW
+  if (o.window) return window_main(&o, &g_stop);
+#endif
 
   frame_log_t fl;
   if (frame_log_open(&fl, o.out_dir, &err)) {

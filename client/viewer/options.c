@@ -29,6 +29,17 @@ void options_usage(FILE *f, const char *prog) {
           "                     with more than one organ, to PATH.<organ id>. First line:\n"
           "                     '# organ <id> topology <v> keyframe <k> frame <frame_seq>'\n"
           "                     (frame -1: no delta applied to the keyframe)\n"
+          "  --window           show the scene in a window (SDL2) instead of writing\n"
+          "                     frames; frames are still written when --out is given%s\n"
+          "  --drive N          with --window: drive tool N with mouse and keyboard: mouse\n"
+          "                     moves the tip in the view plane, wheel or W/S (held) in\n"
+          "                     depth, left button or space = button 0 (grasp/cut), R resets,\n"
+          "                     Esc quits; ToolCommand is published at 1 kHz\n"
+          "  --script-input F   with --drive: play timed input events from F (lines\n"
+          "                     'T motion DX DY', 'T wheel N', 'T key_down|key_up w|s|r|space',\n"
+          "                     'T button_down|button_up'; T in s since the first frame),\n"
+          "                     a demo and testing aid; without --duration the window\n"
+          "                     closes 1 s after the last event\n"
           "  --quiet            no progress lines (the summary and errors still print)\n"
           "  --help             show this help and exit\n"
           "\n"
@@ -51,7 +62,13 @@ void options_usage(FILE *f, const char *prog) {
           "rejected=M' (M: samples refused as malformed). Exit status: 0 on success or\n"
           "SIGINT/SIGTERM, 1 when OSMesa, DDS or output setup fails, 2 on bad usage.\n"
           "DDS configuration comes from CYCLONEDDS_URI.\n",
-          prog, RENDER_MAX_SIZE, RENDER_MAX_SIZE, CAMERA_AZIMUTH_DEG, CAMERA_ELEVATION_DEG);
+          prog, RENDER_MAX_SIZE, RENDER_MAX_SIZE,
+#ifdef VISCERA_HAVE_WINDOW
+          "",
+#else
+          " (not in this build:\n                     SDL2 was not found)",
+#endif
+          CAMERA_AZIMUTH_DEG, CAMERA_ELEVATION_DEG);
 }
 
 static int parse_long(const char *s, long lo, long hi, long *out) {
@@ -70,7 +87,8 @@ int options_parse(viewer_opts_t *o, int argc, char **argv, verr_t *err) {
                        .interval_ms = 100,
                        .width = 640,
                        .height = 480,
-                       .tools = 1};
+                       .tools = 1,
+                       .drive_tool = -1};
   if ((o->domain = vdds_env_domain(err)) < 0) return -1;
   enum {
     O_DOMAIN = 256,
@@ -83,6 +101,9 @@ int options_parse(viewer_opts_t *o, int argc, char **argv, verr_t *err) {
     O_DURATION,
     O_MAX,
     O_DUMP,
+    O_DRIVE,
+    O_SCRIPT,
+    O_WINDOW,
     O_QUIET,
     O_HELP
   };
@@ -96,6 +117,9 @@ int options_parse(viewer_opts_t *o, int argc, char **argv, verr_t *err) {
                                            {"duration", required_argument, NULL, O_DURATION},
                                            {"max-frames", required_argument, NULL, O_MAX},
                                            {"dump-mesh", required_argument, NULL, O_DUMP},
+                                           {"window", no_argument, NULL, O_WINDOW},
+                                           {"drive", required_argument, NULL, O_DRIVE},
+                                           {"script-input", required_argument, NULL, O_SCRIPT},
                                            {"quiet", no_argument, NULL, O_QUIET},
                                            {"help", no_argument, NULL, O_HELP},
                                            {NULL, 0, NULL, 0}};
@@ -117,6 +141,7 @@ int options_parse(viewer_opts_t *o, int argc, char **argv, verr_t *err) {
     case O_OUT:
       if (!*optarg) return verr_set(err, "--out: empty directory name");
       o->out_dir = optarg;
+      o->out_set = 1;
       break;
     case O_INTERVAL:
       if (parse_long(optarg, 0, 3600000, &v)) return verr_set(err, "--interval-ms '%s': expected 0..3600000", optarg);
@@ -149,16 +174,35 @@ int options_parse(viewer_opts_t *o, int argc, char **argv, verr_t *err) {
       if (!*optarg) return verr_set(err, "--dump-mesh: empty path");
       o->dump_mesh = optarg;
       break;
+    case O_WINDOW:
+      o->window = 1;
+      break;
+    case O_DRIVE:
+      if (parse_long(optarg, 0, 7, &v)) return verr_set(err, "--drive '%s': expected a tool id 0..7", optarg);
+      o->drive_tool = (int)v;
+      break;
+    case O_SCRIPT:
+      if (!*optarg) return verr_set(err, "--script-input: empty path");
+      o->script_input = optarg;
+      break;
     case O_QUIET:
       o->quiet = 1;
       break;
     case O_HELP:
       return 1;
     default:
-      if (optopt >= O_DOMAIN && optopt <= O_DUMP) return verr_set(err, "%s: missing value", argv[optind - 1]);
+      if ((optopt >= O_DOMAIN && optopt <= O_DUMP) || optopt == O_DRIVE || optopt == O_SCRIPT)
+        return verr_set(err, "%s: missing value", argv[optind - 1]);
       return verr_set(err, "unknown option '%s'", argv[optind - 1]);
     }
   }
   if (optind < argc) return verr_set(err, "unexpected argument '%s'", argv[optind]);
+  if (o->drive_tool >= 0 && !o->window) return verr_set(err, "--drive needs --window (input comes from the window)");
+  if (o->script_input && o->drive_tool < 0) return verr_set(err, "--script-input needs --drive N");
+#ifndef VISCERA_HAVE_WINDOW
+  if (o->window)
+    return verr_set(err, "--window: this viewer was built without SDL2 (install libsdl2-dev and rebuild with "
+                         "VISCERA_BUILD_WINDOW=ON)");
+#endif
   return 0;
 }

@@ -17,6 +17,10 @@ typedef struct viewer_opts {
   long max_frames;       /* stop after this many frames; 0 = no limit */
   const char *dump_mesh; /* OBJ path written on exit, or NULL */
   int quiet;             /* no progress lines on stdout */
+  int out_set;           /* --out was given (the window writes frames only then) */
+  int window;            /* --window: interactive SDL2 window (window.h) */
+  int drive_tool;        /* --drive N: tool driven by mouse and keyboard; -1 = none */
+  const char *script_input; /* --script-input FILE: timed input events (input_script.h) */
 } viewer_opts_t;
 
 /* Defaults, then the environment (VISCERA_DOMAIN), then argv. Returns 0 to

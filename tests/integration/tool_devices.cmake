@@ -1,0 +1,17 @@
+# Devices and loss detection (issue 4). Domains 120-124.
+# Liveliness: kill -9 of server and of haptic client, detected through the
+# DDS liveliness of their tool writers.
+viscera_integration_test(liveliness 120 liveliness_test.sh)
+# Mouse/keyboard driving through the SDL2 window, under Xvfb.
+find_program(VISCERA_XVFB_RUN xvfb-run)
+if(VISCERA_BUILD_WINDOW AND VISCERA_XVFB_RUN)
+  viscera_integration_test(window_drive 121 window_drive_test.sh)
+elseif(VISCERA_BUILD_WINDOW)
+  message(STATUS "window_drive test not registered: xvfb-run not found (package xvfb)")
+endif()
+# An SDK device that is not in this build: --device refuses it by name.
+if(NOT VISCERA_DEVICE_FALCON)
+  add_test(NAME haptic_device_absent COMMAND viscera-haptic --device falcon)
+  set_tests_properties(haptic_device_absent PROPERTIES LABELS integration TIMEOUT 20
+    PASS_REGULAR_EXPRESSION "device 'falcon' \\(Novint Falcon \\(libnifalcon\\)\\) is not in this build.*VISCERA_DEVICE_FALCON")
+endif()
