@@ -43,7 +43,10 @@ grep -q "SDL video driver x11" "$OUT/viewer.out" || fail "the window did not ope
 grep -q " 0 of [0-9]* window pixels differ" "$OUT/viewer.out" || fail "the window does not show the rendered frame"
 sent=$(grep -o '[0-9]* commands sent for tool 0' "$OUT/viewer.out" | cut -d' ' -f1)
 [ "${sent:-0}" -gt 100 ] || fail "the 1 kHz thread sent ${sent:-no} commands"
-grep -q "10 input events" "$OUT/viewer.out" || fail "not every scripted event reached the mapping"
+# The 10 scripted events must all arrive; the X server may add its own (a
+# pointer motion when the window maps), so more is fine.
+events=$(grep -o '[0-9]* input events' "$OUT/viewer.out" | cut -d' ' -f1)
+[ "${events:-0}" -ge 10 ] || fail "not every scripted event reached the mapping (${events:-no} input events)"
 # The server: commands applied, contact made with the driven probe.
 grep -q "ST crossed up: tool 'probe'" "$OUT/server.log" || fail "the driven probe never pressed the kidney"
 peak=$(grep -o 'peak_force=[0-9.]*' "$OUT/server.out" | head -1 | cut -d= -f2)
