@@ -16,6 +16,14 @@ bool rec_decode_cdr(const void *cdr, size_t len, const dds_topic_descriptor_t *d
   unsigned id = b[1];
   /* Encoding identifiers 0..3 are (PL_)CDR1, 6..11 XCDR2; others unknown. */
   if (id > 11 || id == 4 || id == 5) return false;
+  /* All zero bytes is what a zero-filled page of a damaged or truncated
+   * file holds; it would pass as a big-endian sample of zeros (a tool at
+   * the origin), so it is refused. A real writer never produces it: the
+   * encoding header alone is non-zero on little-endian hosts, and a
+   * big-endian sample of only zeros carries no information. */
+  size_t nz = 0;
+  while (nz < len && b[nz] == 0) nz++;
+  if (nz == len) return false;
   bool le = (id & 1u) != 0;
   uint32_t xcdrv = id <= 3 ? 1 : 2;
   uint32_t size = (uint32_t)(len - 4);

@@ -6,7 +6,8 @@
  * Nothing stored is trusted: every sample is normalized (all lengths, enum
  * values and string bounds checked against the type) before it is read, so
  * a garbled or foreign sample is reported as undecodable, never read out of
- * bounds. A sample whose writer used a newer type (e.g. an enum value this
+ * bounds; a blob of only zero bytes (a zero-filled page of a damaged file)
+ * is refused too. A sample whose writer used a newer type (e.g. an enum value this
  * build does not know) does not decode either; callers count and report it
  * instead of failing. Not thread-safe per sample buffer; no global state. */
 #ifndef VISCERA_REC_DECODE_H

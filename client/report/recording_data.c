@@ -188,8 +188,8 @@ static void load_topic(rep_recording_t *r, recfile_t *rf, const char *topic, con
          rep.scan.first_error[0] ? rep.scan.first_error : "invalid rows", (unsigned long long)rep.decoded);
   }
   if (rep.undecodable)
-    warn(r, "%s: %llu sample(s) do not decode with this build's type (written by a newer version?) and were skipped",
-         shortname, (unsigned long long)rep.undecodable);
+    warn(r, "%s: %llu sample(s) do not decode (damaged, or written with a newer type) and were skipped", shortname,
+         (unsigned long long)rep.undecodable);
 }
 
 static void summarise(rep_recording_t *r) {
