@@ -7,3 +7,9 @@ if(TARGET viscera_recording AND TARGET viscera-recinfo)
   target_compile_definitions(test_recinfo_files PRIVATE RECINFO_EXE="$<TARGET_FILE:viscera-recinfo>")
   add_dependencies(test_recinfo_files viscera-recinfo)
 endif()
+
+# The store on a full disk (a file-size limit stands in for it): stops
+# cleanly, keeps exactly the committed batches, leaves a readable file.
+if(TARGET viscera_recording)
+  viscera_unit_test(NAME test_store_full SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_store_full.c LIBS viscera_recording)
+endif()
