@@ -32,7 +32,8 @@ int rep_chart_force(const rep_recording_t *r, const char *path, verr_t *err) {
   for (int i = 0; i < r->ntools && ret == 0; i++) {
     const rep_tool_t *t = &r->tools[i];
     if (!t->nforce) continue;
-    double *x = malloc(t->nforce * sizeof *x), *y = malloc(t->nforce * sizeof *y);
+    /* room for a NAN break before every sample */
+    double *x = malloc(2 * t->nforce * sizeof *x), *y = malloc(2 * t->nforce * sizeof *y);
     if (!x || !y) {
       ret = verr_set(err, "%s: out of memory", path);
     } else {
@@ -44,7 +45,6 @@ int rep_chart_force(const rep_recording_t *r, const char *path, verr_t *err) {
           x[n] = t->force[k].t - t0;
           y[n++] = NAN;
         }
-        if (n >= t->nforce) break;
         x[n] = t->force[k].t - t0;
         y[n++] = t->force[k].force;
         fmax_all = fmax(fmax_all, t->force[k].force);
