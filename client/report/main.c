@@ -38,7 +38,8 @@ static void usage(FILE *f) {
           "  -l, --label NAME=FILE   a recording with the name to show (e.g. expert=a.db)\n"
           "  -q, --quiet             no progress lines\n"
           "  -h, --help              this text\n"
-          "Without --label a recording is named after its file. At most %d recordings.\n"
+          "Without --label a recording is named after its file (after its directory for\n"
+          "a file named session.db, as deploy/session.sh writes). At most %d recordings.\n"
           "Exit status: 0 all reported, 1 some recording unusable (the others are\n"
           "still reported) or output not writable, 2 usage error.\n",
           MAX_RECORDINGS);
@@ -49,12 +50,19 @@ typedef struct input {
   char label[64];
 } input_t;
 
-/* "dir/novice.db" -> "novice" */
+/* "dir/novice.db" -> "novice"; the generic name of deploy/session.sh,
+ * "out/trainee-07/session.db", -> "trainee-07" (the directory says who). */
 static void label_from_path(const char *path, char *out, size_t size) {
   const char *b = strrchr(path, '/');
   b = b ? b + 1 : path;
   size_t len = strlen(b);
   if (len > 3 && strcmp(b + len - 3, ".db") == 0) len -= 3;
+  if (len == 7 && strncmp(b, "session", 7) == 0 && b > path + 1) {
+    const char *end = b - 1, *d = end;
+    while (d > path && d[-1] != '/') d--;
+    bool dots = (end - d == 1 && d[0] == '.') || (end - d == 2 && d[0] == '.' && d[1] == '.');
+    if (end > d && !dots) b = d, len = (size_t)(end - d);
+  }
   if (len >= size) len = size - 1;
   memcpy(out, b, len);
   out[len] = 0;
