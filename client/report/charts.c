@@ -85,6 +85,7 @@ int rep_chart_compare(const rep_recording_t *const *recs, int n, int measure, co
   char ylabel[112];
   snprintf(ylabel, sizeof ylabel, "%s%s%s%s", d->title, d->unit[0] ? " (" : "", d->unit, d->unit[0] ? ")" : "");
   plot_bars_init(&b, d->title, ylabel, d->format);
+  b.integer_axis = !d->unit[0]; /* unitless measures are counts */
   for (int i = 0; i < n && i < PLOT_BARS_MAX; i++)
     plot_bars_add(&b, recs[i]->label, rep_measure_value(recs[i], measure), i);
   return plot_bars_write_png(&b, path, 440, 300, err);

@@ -224,7 +224,7 @@ int rep_write_html(const rep_recording_t *const *recs, int n, const char *const 
     if (force_png && force_png[i]) ret = html_png(f, force_png[i], "contact force over time", err);
   }
   if (n >= 2 && ret == 0) {
-    fputs("<h2>Comparison</h2>\n<table><tr><th>measure</th>", f);
+    fputs("<h2 id=comparison>Comparison</h2>\n<table><tr><th>measure</th>", f);
     for (int i = 0; i < n; i++) {
       fputs("<th>", f);
       html_text(f, recs[i]->label);

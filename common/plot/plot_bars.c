@@ -58,6 +58,7 @@ int plot_bars_write_png(const plot_bars_t *b, const char *path, int width, int h
     if (isfinite(b->value[i]) && b->value[i] > vmax) vmax = b->value[i];
   if (!(vmax > 0)) vmax = 1;
   double step = nice_step(vmax * 1.12, 5);
+  if (b->integer_axis && step < 1) step = 1;
   double top = ceil(vmax * 1.12 / step) * step; /* room for the value labels */
 
   cairo_surface_t *surf = cairo_image_surface_create(CAIRO_FORMAT_RGB24, W, H);

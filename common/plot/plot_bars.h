@@ -21,6 +21,7 @@ typedef struct plot_bars {
   double value[PLOT_BARS_MAX];
   int color[PLOT_BARS_MAX]; /* palette index (plot.h) */
   char value_format[16];    /* printf format of one double for the value labels, e.g. "%.2f" */
+  int integer_axis;         /* counts: ticks on whole numbers only */
 } plot_bars_t;
 
 void plot_bars_init(plot_bars_t *b, const char *title, const char *ylabel, const char *value_format);
