@@ -103,8 +103,8 @@ double plot_loglog_slope(size_t n, const double *x, const double *y, double ylo,
 
 typedef struct axis {
   int log;
-  double lo, hi; /* in axis units: log10(value) on log axes */
-  double p0, p1; /* pixel positions of lo and hi */
+  double lo, hi;     /* in axis units: log10(value) on log axes */
+  double p0, p1;     /* pixel positions of lo and hi */
 } axis_t;
 
 static int drawable(const axis_t *a, double v) { return isfinite(v) && (!a->log || v > 0); }
@@ -171,12 +171,8 @@ static void marker(cairo_t *cr, int shape, double x, double y, double r) {
   cairo_set_dash(cr, NULL, 0, 0);
   cairo_new_path(cr);
   switch (shape % 7) {
-  case 0:
-    cairo_arc(cr, x, y, r, 0, 2 * M_PI);
-    break;
-  case 1:
-    cairo_rectangle(cr, x - 0.85 * r, y - 0.85 * r, 1.7 * r, 1.7 * r);
-    break;
+  case 0: cairo_arc(cr, x, y, r, 0, 2 * M_PI); break;
+  case 1: cairo_rectangle(cr, x - 0.85 * r, y - 0.85 * r, 1.7 * r, 1.7 * r); break;
   case 2:
     cairo_move_to(cr, x, y - 1.15 * r);
     cairo_line_to(cr, x + r, y + 0.75 * r);
@@ -232,10 +228,8 @@ static ticklabel_t format_tick(double v, int log_axis) {
   }
   int e = (int)floor(log10(a) + 1e-9);
   double m = v / pow(10, e);
-  if (log_axis && fabs(m - 1) < 1e-6)
-    snprintf(t.base, sizeof t.base, "10");
-  else
-    snprintf(t.base, sizeof t.base, "%.3gx10", m);
+  if (log_axis && fabs(m - 1) < 1e-6) snprintf(t.base, sizeof t.base, "10");
+  else snprintf(t.base, sizeof t.base, "%.3gx10", m);
   snprintf(t.exp, sizeof t.exp, "%d", e);
   return t;
 }
@@ -297,12 +291,9 @@ static int make_ticks(const axis_t *a, tick_t *t, int cap) {
     }
   } else {
     double span = a->hi - a->lo, raw = span / 6, mag = pow(10, floor(log10(raw))), step = mag;
-    if (raw / mag > 5)
-      step = 10 * mag;
-    else if (raw / mag > 2)
-      step = 5 * mag;
-    else if (raw / mag > 1)
-      step = 2 * mag;
+    if (raw / mag > 5) step = 10 * mag;
+    else if (raw / mag > 2) step = 5 * mag;
+    else if (raw / mag > 1) step = 2 * mag;
     for (double v = ceil(a->lo / step - 1e-9) * step; v <= a->hi + 1e-9 * span && n < cap; v += step) {
       t[n].v = fabs(v) < 1e-12 * step ? 0 : v;
       t[n].major = 1;
@@ -547,10 +538,8 @@ int plot_write_png(const plot_t *p, const char *path, verr_t *err) {
           continue;
         }
         double px = to_px(&ax, s->x[j]), py = to_px(&ay, s->y[j]);
-        if (pen)
-          cairo_line_to(cr, px, py);
-        else
-          cairo_move_to(cr, px, py);
+        if (pen) cairo_line_to(cr, px, py);
+        else cairo_move_to(cr, px, py);
         pen = 1;
       }
       cairo_stroke(cr);
@@ -558,8 +547,7 @@ int plot_write_png(const plot_t *p, const char *path, verr_t *err) {
     if (s->marker >= 0) {
       set_colour(cr, s->color);
       for (size_t j = 0; j < s->n; j++)
-        if (drawable(&ax, s->x[j]) && drawable(&ay, s->y[j]))
-          marker(cr, s->marker, to_px(&ax, s->x[j]), to_px(&ay, s->y[j]), 4.2);
+        if (drawable(&ax, s->x[j]) && drawable(&ay, s->y[j])) marker(cr, s->marker, to_px(&ax, s->x[j]), to_px(&ay, s->y[j]), 4.2);
     }
     if (s->tag) {
       set_colour(cr, s->color);

@@ -38,7 +38,7 @@ typedef struct plot {
   int logx, logy;
   int nseries;
   plot_series_t s[PLOT_MAX_SERIES];
-  int pareto;            /* draw the front over the flagged series */
+  int pareto; /* draw the front over the flagged series */
   char empty_suffix[48]; /* appended to the legend of a series with nothing to draw, e.g. " (diverged)" */
   int nnotes;
   char notes[PLOT_MAX_NOTES][480]; /* printed under the legend */
