@@ -16,6 +16,7 @@
 
 #include "charts.h"
 #include "measure_table.h"
+#include "plot_cleanup.h"
 #include "recording_data.h"
 #include "report_write.h"
 
@@ -237,5 +238,6 @@ int main(int argc, char **argv) {
   for (int m = 0; m < REP_NMEASURES; m++) free(compare_png[m]);
   for (int i = 0; i < nin; i++) rep_recording_free(&recs[i]);
   free(recs);
+  plot_cleanup();
   return status;
 }
