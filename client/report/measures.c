@@ -1,6 +1,7 @@
 #include "measures.h"
 
 #include <math.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -16,7 +17,7 @@ void rep_force_measures(const rep_force_sample_t *s, size_t n, const double leve
   int was_contact = 0;
   for (size_t i = 0; i < n; i++) {
     double dt = i > 0 ? s[i].t - s[i - 1].t : dt_nominal;
-    if (!(dt > 0) || dt > gap_s) dt = dt_nominal;
+    if (!(dt > 0) || (dt > gap_s && !(s[i].in_contact && s[i - 1].in_contact))) dt = dt_nominal;
     thr_event_t ev[THR_COUNT];
     thr_update(&tr, dt, s[i].force, s[i].in_contact, NULL, ev);
     if (s[i].in_contact && isnan(m->first_contact_t)) m->first_contact_t = s[i].t;
@@ -48,7 +49,8 @@ double rep_path_length(const rep_pos_sample_t *p, size_t n, double gap_s) {
     }
     if (prev) {
       double dt = p[i].t - prev->t;
-      if (dt >= 0 && dt <= gap_s) {
+      bool lost_between = prev->seq && p[i].seq > prev->seq + 1;
+      if (dt >= 0 && (dt <= gap_s || lost_between)) {
         double dx = p[i].p[0] - prev->p[0], dy = p[i].p[1] - prev->p[1], dz = p[i].p[2] - prev->p[2];
         len += sqrt(dx * dx + dy * dy + dz * dz);
       }

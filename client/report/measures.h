@@ -7,9 +7,11 @@
  * hysteresis, "time above" and crossing rules are the server's by
  * construction, not a second implementation. Each sample stands for the
  * time since the previous one (its server step, dt_nominal when samples are
- * consecutive); a sample after a gap longer than `gap_s` (tool released,
- * recorder stalled) or out of order counts dt_nominal only, so a gap is
- * never credited to whatever state preceded it.
+ * consecutive), so samples a loaded recorder lost are made up for by the
+ * next one. A gap longer than `gap_s` counts dt_nominal only, unless the
+ * tool was in contact on both sides of it: a tool the server released
+ * (client silent) leaves the contact first, while a hole in mid-contact
+ * can only be lost samples. A sample out of order counts dt_nominal.
  *
  * Definitions (seed 002 ch. 6, seed 000 Table 2):
  *   contact (exploration) time   time in contact, as the server's Metrics;
@@ -18,7 +20,9 @@
  *   operation time               from the first tool motion to the end of
  *                                the last contact (000 Table 2, per organ);
  *   path length                  sum of |p_i - p_{i-1}| over the tool
- *                                commands, restarting after a gap;
+ *                                commands, restarting after a pause of
+ *                                the client (not after samples the
+ *                                recording lost: command seq tells);
  *   task time                    TASK_STARTED to TASK_COMPLETED of the same
  *                                task (events matched by their text). */
 #ifndef VISCERA_REPORT_MEASURES_H
@@ -38,6 +42,7 @@ typedef struct rep_force_sample {
 typedef struct rep_pos_sample {
   double t; /* s, any clock increasing with the samples (used for gaps only) */
   double p[3];
+  uint64_t seq; /* writer's sequence number (ToolCommand.seq), 0 = unknown */
 } rep_pos_sample_t;
 
 typedef struct rep_force_measures {
@@ -56,8 +61,10 @@ typedef struct rep_force_measures {
 void rep_force_measures(const rep_force_sample_t *s, size_t n, const double levels[THR_COUNT], double dt_nominal,
                         double gap_s, rep_force_measures_t *m);
 
-/* Path length, m, restarting after a gap > gap_s (or a backward step in t),
- * skipping non-finite positions. */
+/* Path length, m, skipping non-finite positions. A step back in t breaks
+ * the path; so does a silence longer than gap_s, unless seq shows the
+ * writer kept sending (samples lost in between: the straight segment is
+ * the best estimate of the way travelled). */
 double rep_path_length(const rep_pos_sample_t *p, size_t n, double gap_s);
 
 /* The time the tool first moved more than `eps` m from its first position,

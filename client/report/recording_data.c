@@ -90,7 +90,8 @@ static int on_feedback(void *arg, const void *sample, const recfile_row_t *row) 
     return 1;
   }
   t->force[t->nforce++] = (rep_force_sample_t){ts, isfinite(f) ? f : 0, fb->in_contact ? 1 : 0};
-  t->proxy[t->nproxy++] = (rep_pos_sample_t){ts, {fb->proxy_position[0], fb->proxy_position[1], fb->proxy_position[2]}};
+  t->proxy[t->nproxy++] =
+      (rep_pos_sample_t){ts, {fb->proxy_position[0], fb->proxy_position[1], fb->proxy_position[2]}, 0};
   return 0;
 }
 
@@ -103,8 +104,8 @@ static int on_command(void *arg, const void *sample, const recfile_row_t *row) {
     c->oom = true;
     return 1;
   }
-  t->cmd[t->ncmd++] =
-      (rep_pos_sample_t){(double)row->source_ts_ns * 1e-9, {cmd->position[0], cmd->position[1], cmd->position[2]}};
+  t->cmd[t->ncmd++] = (rep_pos_sample_t){
+      (double)row->source_ts_ns * 1e-9, {cmd->position[0], cmd->position[1], cmd->position[2]}, cmd->seq};
   return 0;
 }
 

@@ -55,21 +55,29 @@ static void test_ramp(void) {
   CHECK(m.time_above[THR_ST] == 0 && m.crossings[THR_ST] == 0);
 }
 
-/* A 0.6 s hole in the samples while above both thresholds: the hole is not
- * credited (only one nominal step for the first sample after it). */
+/* Holes in the samples. */
 static void test_gap(void) {
   static rep_force_sample_t s[4000];
-  size_t n = ramp(s, 1.2, 1.8);
   const double lv[THR_COUNT] = {0.5, 0.8, 1.5};
   rep_force_measures_t m;
-  rep_force_measures(s, n, lv, DT, 0.5, &m);
-  CHECK_NEAR(m.time_above[THR_ST], 2.025 - 0.6, 3.5e-3);
-  CHECK_NEAR(m.time_above[THR_MPF], 1.44 - 0.6, 3.5e-3);
-  CHECK_NEAR(m.contact_time, 2.0, 3e-3);
   /* A hole shorter than the gap limit is credited to the sample after it
    * (the lost steps are assumed to be like it): a 0.3 s hole costs nothing. */
-  n = ramp(s, 1.2, 1.5);
+  size_t n = ramp(s, 1.2, 1.5);
   rep_force_measures(s, n, lv, DT, 0.5, &m);
+  CHECK_NEAR(m.time_above[THR_ST], 2.025, 3.5e-3);
+  CHECK_NEAR(m.contact_time, 2.6, 1.5e-3);
+  /* 0.6 s in mid-contact, longer than the gap limit: still lost samples
+   * (a released tool leaves the contact first), credited. */
+  n = ramp(s, 1.2, 1.8);
+  rep_force_measures(s, n, lv, DT, 0.5, &m);
+  CHECK_NEAR(m.time_above[THR_ST], 2.025, 3.5e-3);
+  CHECK_NEAR(m.time_above[THR_MPF], 1.44, 3.5e-3);
+  CHECK_NEAR(m.contact_time, 2.6, 1.5e-3);
+  /* 0.6 s from inside the contact to outside it (a release): not credited,
+   * the contact time loses the 0.1 s of contact in the hole. */
+  n = ramp(s, 2.7, 3.3);
+  rep_force_measures(s, n, lv, DT, 0.5, &m);
+  CHECK_NEAR(m.contact_time, 2.5, 1.5e-3);
   CHECK_NEAR(m.time_above[THR_ST], 2.025, 3.5e-3);
 }
 
@@ -99,17 +107,23 @@ static void test_path(void) {
       double a = k / 1000.0;
       p[n] = (rep_pos_sample_t){n * DT,
                                 {corner[side][0] + a * (corner[side + 1][0] - corner[side][0]),
-                                 corner[side][1] + a * (corner[side + 1][1] - corner[side][1]), 0.05}};
+                                 corner[side][1] + a * (corner[side + 1][1] - corner[side][1]), 0.05},
+                                n + 1};
       n++;
     }
-  p[n] = (rep_pos_sample_t){n * DT, {0, 0, 0.05}};
+  p[n] = (rep_pos_sample_t){n * DT, {0, 0, 0.05}, n + 1};
   n++;
   CHECK_NEAR(rep_path_length(p, n, 0.5), 0.04, 1e-12);
-  /* After a 1 s silence the tool reappears 5 cm away: the jump is a gap,
-   * not travel. */
-  p[n] = (rep_pos_sample_t){n * DT + 1.0, {0, 0, 0.10}};
+  /* After a 1 s silence of the client (next seq) the tool reappears 5 cm
+   * away: the jump is a pause, not travel. */
+  p[n] = (rep_pos_sample_t){n * DT + 1.0, {0, 0, 0.10}, n + 1};
   n++;
   CHECK_NEAR(rep_path_length(p, n, 0.5), 0.04, 1e-12);
+  /* The same second, but the client sent 1000 commands the recording lost:
+   * the tool travelled, at least the straight 5 cm. */
+  p[n - 1].seq += 1000;
+  CHECK_NEAR(rep_path_length(p, n, 0.5), 0.09, 1e-12);
+  p[n - 1].seq -= 1000;
   /* A non-finite position breaks the path instead of poisoning it. */
   p[2000].p[0] = NAN;
   double len = rep_path_length(p, n, 0.5);
@@ -117,7 +131,7 @@ static void test_path(void) {
   /* First motion: the tool starts moving at once here; a tool that waits
    * 0.3 s first reports 0.3 s. */
   rep_pos_sample_t w[600];
-  for (int i = 0; i < 600; i++) w[i] = (rep_pos_sample_t){i * DT, {0, 0, i < 300 ? 0.07 : 0.07 - (i - 300) * 1e-5}};
+  for (int i = 0; i < 600; i++) w[i] = (rep_pos_sample_t){i * DT, {0, 0, i < 300 ? 0.07 : 0.07 - (i - 300) * 1e-5}, 0};
   CHECK_NEAR(rep_first_motion(w, 600, 1e-4), 0.3105, 1.01e-3); /* 1e-4 reached at 10 or 11 steps */
   for (int i = 0; i < 600; i++) w[i].p[2] = 0.07;
   CHECK(isnan(rep_first_motion(w, 600, 1e-4)));
