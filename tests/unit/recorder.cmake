@@ -13,3 +13,10 @@ endif()
 if(TARGET viscera_recording)
   viscera_unit_test(NAME test_store_full SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_store_full.c LIBS viscera_recording)
 endif()
+
+# Decoding stored samples into the compiled-in types (client/recorder/rec_decode.c).
+if(TARGET viscera_rec_decode)
+  viscera_unit_test(NAME test_rec_decode SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_rec_decode.c LIBS viscera_rec_decode)
+  # ddsi_cdrstream.h pulls in GNU `asm` (see client/recorder/CMakeLists.txt)
+  set_target_properties(test_rec_decode PROPERTIES C_EXTENSIONS ON)
+endif()
