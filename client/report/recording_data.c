@@ -43,6 +43,11 @@ typedef struct load_ctx {
   uint64_t last_event_seq[REP_MAX_TOOLS + 1];
   bool seen_event_source[REP_MAX_TOOLS + 1];
   uint64_t events_other_kind;
+  /* ContactFeedback writers: a server restarted mid-session follows its
+   * predecessor (few switches); servers of several sessions recorded into
+   * one file (a partition pattern) interleave (many). */
+  int64_t last_fb_writer;
+  uint64_t fb_writer_switches;
 } load_ctx_t;
 
 static rep_tool_t *tool_of(rep_recording_t *r, uint32_t id) {
@@ -76,8 +81,11 @@ static int on_scene(void *arg, const void *sample, const recfile_row_t *row) {
 }
 
 static int on_feedback(void *arg, const void *sample, const recfile_row_t *row) {
-  (void)row;
   load_ctx_t *c = arg;
+  if (row->writer_id > 0) {
+    if (c->last_fb_writer > 0 && row->writer_id != c->last_fb_writer) c->fb_writer_switches++;
+    c->last_fb_writer = row->writer_id;
+  }
   const viscera_ContactFeedback *fb = sample;
   rep_tool_t *t = tool_of(c->r, fb->tool_id);
   if (!t) return 0;
@@ -270,6 +278,11 @@ int rep_recording_load(rep_recording_t *r, const char *path, const char *label, 
   recfile_close(rf);
   if (c.oom) return verr_set(err, "%s: out of memory while reading", path);
   if (!r->have_scene_info) warn(r, "%s", "no SceneInfo: thresholds unknown (ST/MPF/SFT measures are 0)");
+  if (c.fb_writer_switches > 10)
+    warn(r,
+         "ContactFeedback from several servers interleaves (%llu switches): the recording holds several sessions "
+         "(recorded with a partition pattern?) and the figures mix them; record one partition per file",
+         (unsigned long long)c.fb_writer_switches);
   if (c.events_other_kind)
     warn(r, "%llu event(s) of kinds this report does not use were ignored", (unsigned long long)c.events_other_kind);
   size_t nforce = 0, ncmd = 0;
