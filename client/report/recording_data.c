@@ -41,6 +41,7 @@ typedef struct load_ctx {
   bool oom;
   int32_t task_started, task_completed; /* enum values, -1 when this build has none */
   uint64_t last_event_seq[REP_MAX_TOOLS + 1];
+  int64_t last_event_writer[REP_MAX_TOOLS + 1];
   bool seen_event_source[REP_MAX_TOOLS + 1];
   uint64_t events_other_kind;
   /* ContactFeedback writers: a server restarted mid-session follows its
@@ -128,15 +129,17 @@ static int threshold_of_text(const char *text) {
 }
 
 static int on_event(void *arg, const void *sample, const recfile_row_t *row) {
-  (void)row;
   load_ctx_t *c = arg;
   const viscera_SessionEvent *e = sample;
   rep_recording_t *r = c->r;
   /* A reliable transient-local event can reach the recorder twice (late
-   * joiner plus live); count each (source, seq) once. */
+   * joiner plus live); count each (writer, source, seq) once. A restarted
+   * server is a new writer whose seq starts again. */
   uint32_t src = e->source_id <= REP_MAX_TOOLS ? e->source_id : REP_MAX_TOOLS;
-  if (c->seen_event_source[src] && e->seq <= c->last_event_seq[src]) return 0;
+  if (c->seen_event_source[src] && row->writer_id == c->last_event_writer[src] && e->seq <= c->last_event_seq[src])
+    return 0;
   c->seen_event_source[src] = true;
+  c->last_event_writer[src] = row->writer_id;
   c->last_event_seq[src] = e->seq;
   r->nevents++;
   int32_t kind = (int32_t)e->kind;
