@@ -20,4 +20,9 @@ echo
 echo "frames:    $OUT/frames/ (index: frames.csv)"
 echo "recording: $OUT/session.db (inspect: build/client/recorder/viscera-recinfo $OUT/session.db)"
 echo "logs:      $OUT/*.log"
+# The trainee report of this session (HTML with charts, CSV).
+if [ -x "$ROOT/build/client/report/viscera-report" ] &&
+  "$ROOT/build/client/report/viscera-report" --quiet --out "$OUT/report" --label "trainee=$OUT/session.db"; then
+  echo "report:    $OUT/report/report.html (CSV: report.csv)"
+fi
 echo "summary:   peak contact force ${peak:-?} N, ${frames:-?} frames rendered, ${samples:-?} samples recorded, command->feedback latency median ${lat:-?} us"

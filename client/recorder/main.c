@@ -47,7 +47,9 @@ static void usage(FILE *f) {
              "Progress goes to stderr once per second. SIGINT/SIGTERM finish the current\n"
              "batch, write the end time and close the file; a second signal kills at once\n"
              "(the file stays readable, the last batch of at most 200 ms is lost).\n"
-             "Exit status: 0 done, 1 runtime error, 2 usage error.\n"
+             "A full disk (or file-size limit) stops the recording cleanly: the file keeps\n"
+             "every committed batch and stays readable, the recorder exits with status 1.\n"
+             "Exit status: 0 done, 1 runtime error (disk full included), 2 usage error.\n"
              "DDS configuration comes from CYCLONEDDS_URI.\n");
 }
 
@@ -144,6 +146,10 @@ int main(int argc, char **argv) {
   /* Install before the session exists so an early Ctrl-C still closes the
    * file cleanly; SA_RESETHAND makes a second signal kill at once. */
   vsignal_on_stop(on_signal, SA_RESETHAND);
+  /* Past a file-size limit (ulimit -f) a write must fail with EFBIG, which
+   * the store handles like a full disk, instead of SIGXFSZ killing the
+   * recorder mid-batch. */
+  signal(SIGXFSZ, SIG_IGN);
 
   verr_t err = {{0}};
   rec_session_t *s = NULL;
@@ -183,7 +189,14 @@ int main(int argc, char **argv) {
   }
   rec_session_stats_t st = {0};
   if (rec_session_close(s, &st, &err) < 0) {
-    fprintf(stderr, "recorder: closing %s: %s\n", o.out, err.msg);
+    if (!st.disk_full) fprintf(stderr, "recorder: closing %s: %s\n", o.out, err.msg);
+    status = 1;
+  }
+  if (st.disk_full) {
+    fprintf(stderr,
+            "recorder: disk full: recording stopped, %llu samples saved in %s (readable; no end time, the session "
+            "went on)\n",
+            (unsigned long long)st.samples, o.out);
     status = 1;
   }
   if (st.failed_topics) fprintf(stderr, "recorder: %u topic(s) could not be recorded (see above)\n", st.failed_topics);

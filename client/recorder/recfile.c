@@ -249,9 +249,13 @@ static void note_damage(recfile_t *rf, recfile_scan_report_t *rep, int64_t near_
 static int scan_from(recfile_t *rf, int64_t *after, int64_t topic_id, bool with_cdr, recfile_row_cb cb, void *arg,
                      recfile_scan_report_t *rep, bool *stopped) {
   char sql[256];
+  /* NOT INDEXED: walk the table by rowid, never through samples_by_topic.
+   * That index is built at close, so it sits at the end of the file: the
+   * first thing a truncation loses, and a damaged index would hide rows
+   * that are intact in the table. */
   snprintf(sql, sizeof sql,
            "SELECT id, topic_id, writer_id, source_ts_ns, recv_wall_ns, kind, inferred, length(cdr)%s"
-           " FROM samples WHERE id > ?1%s ORDER BY id",
+           " FROM samples NOT INDEXED WHERE id > ?1%s ORDER BY id",
            with_cdr ? ", cdr" : "", topic_id > 0 ? " AND topic_id = ?2" : "");
   sqlite3_stmt *st = NULL;
   int rc = sqlite3_prepare_v2(rf->db, sql, -1, &st, NULL);

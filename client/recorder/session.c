@@ -243,6 +243,7 @@ void rec_session_get_stats(const rec_session_t *s, rec_session_stats_t *st) {
   store_counts(s->store, &st->samples, &st->bytes);
   st->topics = (uint32_t)s->ncaps;
   st->failed_topics = s->failed_topics;
+  st->disk_full = store_disk_full(s->store);
 }
 
 int rec_session_close(rec_session_t *s, rec_session_stats_t *final, verr_t *err) {

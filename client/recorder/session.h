@@ -47,6 +47,7 @@ typedef struct rec_session_stats {
   uint64_t bytes;   /* CDR bytes stored */
   uint32_t topics;  /* topics being recorded */
   uint32_t failed_topics;
+  bool disk_full; /* recording stopped because the disk (or file-size limit) was full */
 } rec_session_stats_t;
 
 /* Creates the store first (so a bad --out fails before touching DDS), then

@@ -5,7 +5,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 #include <dds/ddsi/ddsi_cdrstream.h>
@@ -29,10 +31,80 @@ struct store {
   uint64_t batch_bytes;
   uint64_t total_samples;
   uint64_t total_bytes;
+  /* What earlier batches put in the file for good (see write_failed). */
+  uint64_t committed_samples;
+  uint64_t committed_bytes;
+  /* A write failed: the store is stopped, every later write returns
+   * fail_msg; disk_full when the cause was a full disk or file-size limit. */
+  bool failed;
+  bool disk_full;
+  char fail_msg[512];
 };
 
 static int db_fail(store_t *s, verr_t *err, const char *what) {
   return verr_set(err, "%s: %s: %s", s->path, what, sqlite3_errmsg(s->db));
+}
+
+/* Is there no room left for `path` or its WAL: the file system nearly
+ * full (< 1 MB for an unprivileged writer) or either file at the process's
+ * file-size limit (RLIMIT_FSIZE, ulimit -f)? */
+static bool no_room(const char *path) {
+  struct statvfs vfs;
+  char dir[4096];
+  snprintf(dir, sizeof dir, "%s", path);
+  char *slash = strrchr(dir, '/');
+  if (!slash)
+    snprintf(dir, sizeof dir, ".");
+  else if (slash == dir)
+    dir[1] = 0; /* "/file": the root */
+  else
+    *slash = 0;
+  if (statvfs(dir, &vfs) == 0 && (uint64_t)vfs.f_bavail * vfs.f_frsize < 1024u * 1024u) return true;
+  struct rlimit rl;
+  if (getrlimit(RLIMIT_FSIZE, &rl) == 0 && rl.rlim_cur != RLIM_INFINITY) {
+    const char *suffix[] = {"", "-wal"};
+    for (int i = 0; i < 2; i++) {
+      char f[4096];
+      struct stat sb;
+      snprintf(f, sizeof f, "%s%s", path, suffix[i]);
+      /* within one page of the limit: the next page write was refused */
+      if (stat(f, &sb) == 0 && (uint64_t)sb.st_size + 65536u >= (uint64_t)rl.rlim_cur) return true;
+    }
+  }
+  return false;
+}
+
+/* SQLITE_FULL is a write that came up short. A write refused outright
+ * (EFBIG past a file-size limit, EDQUOT) arrives as SQLITE_IOERR_WRITE, and
+ * SQLite does not reliably keep the errno (sqlite3_system_errno reads it
+ * after later calls), so the file system and the limit are asked. */
+static bool is_disk_full(store_t *s, int rc) {
+  if ((rc & 0xff) == SQLITE_FULL) return true;
+  int sys = sqlite3_system_errno(s->db);
+  if ((rc & 0xff) == SQLITE_IOERR && (sys == ENOSPC || sys == EFBIG || sys == EDQUOT)) return true;
+  return (rc & 0xff) == SQLITE_IOERR && no_room(s->path);
+}
+
+/* A write failed (rc): stop the store for good. The open batch is rolled
+ * back (SQLite may already have done so; either way the file keeps every
+ * committed batch and stays consistent), the counts go back to what is
+ * committed, and every later write fails with the same message, so a
+ * caller that keeps going cannot half-write anything. */
+static int write_failed(store_t *s, verr_t *err, const char *what, int rc) {
+  if (!s->failed) {
+    s->disk_full = is_disk_full(s, rc);
+    if (s->disk_full)
+      snprintf(s->fail_msg, sizeof s->fail_msg, "%s: disk full (%s: %s); recording stopped", s->path, what,
+               sqlite3_errmsg(s->db));
+    else
+      snprintf(s->fail_msg, sizeof s->fail_msg, "%s: %s: %s; recording stopped", s->path, what, sqlite3_errmsg(s->db));
+    if (!sqlite3_get_autocommit(s->db)) sqlite3_exec(s->db, "ROLLBACK;", NULL, NULL, NULL);
+    s->in_txn = false;
+    s->total_samples = s->committed_samples;
+    s->total_bytes = s->committed_bytes;
+    s->failed = true;
+  }
+  return verr_set(err, "%s", s->fail_msg);
 }
 
 static int exec_sql(store_t *s, const char *sql, verr_t *err) {
@@ -162,8 +234,10 @@ fail:
 void store_set_limits(store_t *s, store_batch_limits_t limits) { s->limits = limits; }
 
 static int begin_if_needed(store_t *s, verr_t *err) {
+  if (s->failed) return verr_set(err, "%s", s->fail_msg);
   if (s->in_txn) return 0;
-  if (exec_sql(s, "BEGIN;", err) < 0) return -1;
+  int rc = sqlite3_exec(s->db, "BEGIN;", NULL, NULL, NULL);
+  if (rc != SQLITE_OK) return write_failed(s, err, "cannot begin a batch", rc);
   s->in_txn = true;
   s->batch_start_ns = vtime_mono_ns();
   s->batch_samples = 0;
@@ -172,15 +246,15 @@ static int begin_if_needed(store_t *s, verr_t *err) {
 }
 
 int store_commit(store_t *s, verr_t *err) {
+  if (s->failed) return verr_set(err, "%s", s->fail_msg);
   if (!s->in_txn) return 0;
-  if (exec_sql(s, "COMMIT;", err) < 0) {
-    /* A failed COMMIT (disk full, I/O error) may leave the transaction
-     * open; roll back so the file keeps every earlier batch. */
-    if (!sqlite3_get_autocommit(s->db)) sqlite3_exec(s->db, "ROLLBACK;", NULL, NULL, NULL);
-    s->in_txn = false;
-    return -1;
-  }
+  int rc = sqlite3_exec(s->db, "COMMIT;", NULL, NULL, NULL);
+  /* A failed COMMIT (disk full, I/O error) may leave the transaction open:
+   * write_failed rolls it back so the file keeps every earlier batch. */
+  if (rc != SQLITE_OK) return write_failed(s, err, "cannot commit a batch", rc);
   s->in_txn = false;
+  s->committed_samples = s->total_samples;
+  s->committed_bytes = s->total_bytes;
   return 0;
 }
 
@@ -191,11 +265,9 @@ int store_commit_if_due(store_t *s, uint64_t now_mono_ns, verr_t *err) {
 
 static int step_reset(store_t *s, sqlite3_stmt *st, verr_t *err, const char *what) {
   int rc = sqlite3_step(st);
-  int ret = 0;
-  if (rc != SQLITE_DONE) ret = db_fail(s, err, what);
   sqlite3_reset(st);
   sqlite3_clear_bindings(st);
-  return ret;
+  return rc == SQLITE_DONE ? 0 : write_failed(s, err, what, rc);
 }
 
 static const char *reliability_name(dds_reliability_kind_t k) {
@@ -383,9 +455,23 @@ void store_counts(const store_t *s, uint64_t *samples, uint64_t *bytes) {
   if (bytes) *bytes = s->total_bytes;
 }
 
+bool store_failed(const store_t *s) { return s->failed; }
+bool store_disk_full(const store_t *s) { return s->disk_full; }
+
 int store_close(store_t *s, int64_t end_wall_ns, verr_t *err) {
   int ret = store_commit(s, err);
-  if (ret == 0 && end_wall_ns >= 0) {
+  if (s->failed) {
+    /* Stopped by a failed write (disk full): leave the file as readable as
+     * possible, best effort. The end time stays NULL (the session went on
+     * without us: readers must not take this for a complete recording).
+     * A checkpoint moves the WAL's committed batches into the main file
+     * (where a file-size limit still has room: its pages are smaller than
+     * the WAL's frames) and dropping the WAL leaves one self-contained
+     * file; on a truly full disk either may fail, and then the WAL stays
+     * next to the file, consistent, and readers use it. */
+    sqlite3_exec(s->db, "PRAGMA wal_checkpoint(TRUNCATE);", NULL, NULL, NULL);
+    sqlite3_exec(s->db, "PRAGMA journal_mode=DELETE;", NULL, NULL, NULL);
+  } else if (ret == 0 && end_wall_ns >= 0) {
     char sql[128];
     snprintf(sql, sizeof sql, "UPDATE session SET end_wall_ns=%lld;", (long long)end_wall_ns);
     ret = exec_sql(s, sql, err);

@@ -9,7 +9,11 @@
  * data rate (SQLite spills a big transaction to the WAL file).
  *
  * Not thread-safe: one thread owns a store. Every function returns 0 on
- * success or -1 with `err` naming the file and the SQLite error. */
+ * success or -1 with `err` naming the file and the SQLite error.
+ *
+ * A failed write (disk full, I/O error) stops the store cleanly: the open
+ * batch is lost, every committed one stays readable, nothing crashes; see
+ * store_failed. */
 #ifndef VISCERA_REC_STORE_H
 #define VISCERA_REC_STORE_H
 
@@ -82,9 +86,18 @@ int store_commit(store_t *s, verr_t *err);
 /* Samples and CDR bytes stored so far (including the open batch). */
 void store_counts(const store_t *s, uint64_t *samples, uint64_t *bytes);
 
+/* A write failed (e.g. disk full, file-size limit): the store has stopped.
+ * The open batch was rolled back, store_counts report what the file holds,
+ * and every later write fails with the same message. */
+bool store_failed(const store_t *s);
+/* ... and the cause was a full disk, a quota or a file-size limit. */
+bool store_disk_full(const store_t *s);
+
 /* Commits, writes the end time, builds the indexes and closes. Frees `s`
  * even on failure. With end_wall_ns < 0 the end time stays NULL (used by
- * tests to imitate a killed recorder). */
+ * tests to imitate a killed recorder). A stopped store (store_failed) is
+ * closed best effort without an end time, its WAL checkpointed into the
+ * file where there is room; it returns -1 with the failure. */
 int store_close(store_t *s, int64_t end_wall_ns, verr_t *err);
 
 /* Formats a 16-byte GUID as 32 lower-case hex digits plus NUL. */

@@ -18,6 +18,7 @@
 #include <sqlite3.h>
 
 #include "check.h"
+#include "rec_decode.h"
 #include "rec_values.h"
 #include "viscera.h"
 
@@ -34,32 +35,6 @@ static int64_t q_int(const char *sql, const char *arg) {
   if (sqlite3_step(st) == SQLITE_ROW && sqlite3_column_type(st, 0) != SQLITE_NULL) v = sqlite3_column_int64(st, 0);
   sqlite3_finalize(st);
   return v;
-}
-
-/* Decodes a stored sample (4-byte encoding header + payload) into `out`
- * with the compiled-in descriptor's ops; false when it does not decode. */
-static bool decode(const unsigned char *cdr, int len, const dds_topic_descriptor_t *desc, void *out) {
-  if (len < 4 || cdr[0] != 0) return false;
-  unsigned id = cdr[1];
-  bool le = (id & 1u) != 0;
-  uint32_t xcdrv = id <= 3 ? 1 : 2; /* CDR/PL_CDR are XCDR1, 6..11 are XCDR2 */
-  uint32_t size = (uint32_t)len - 4;
-  void *buf = malloc(size ? size : 1);
-  if (!buf) return false;
-  memcpy(buf, cdr + 4, size);
-  uint32_t off = 0;
-  bool bswap = le != (DDSRT_ENDIAN == DDSRT_LITTLE_ENDIAN);
-  /* normalize validates every length and enum against the type before the
-   * read trusts them */
-  bool ok = dds_stream_normalize_data(buf, &off, size, bswap, xcdrv, desc->m_ops) != NULL;
-  if (ok) {
-    dds_istream_t is;
-    dds_istream_init(&is, size, buf, xcdrv);
-    dds_stream_read(&is, out, desc->m_ops);
-    dds_istream_fini(&is);
-  }
-  free(buf);
-  return ok;
 }
 
 static void check_descriptor(const char *topic, const dds_topic_descriptor_t *d) {
@@ -216,7 +191,8 @@ int main(int argc, char **argv) {
   while (sqlite3_step(st) == SQLITE_ROW) {
     viscera_ToolCommand got;
     memset(&got, 0, sizeof got);
-    if (!decode(sqlite3_column_blob(st, 0), sqlite3_column_bytes(st, 0), &viscera_ToolCommand_desc, &got)) {
+    if (!rec_decode_cdr(sqlite3_column_blob(st, 0), (size_t)sqlite3_column_bytes(st, 0), &viscera_ToolCommand_desc,
+                        &got)) {
       undecodable++;
       continue;
     }

@@ -11,34 +11,10 @@
 #include <string.h>
 
 #include <dds/dds.h>
-#include <dds/ddsi/ddsi_cdrstream.h>
 #include <sqlite3.h>
 
+#include "rec_decode.h"
 #include "viscera.h"
-
-/* Decodes a stored sample (4-byte encoding header + payload) into `out`
- * with the compiled-in descriptor's ops (as rec_check does). */
-static bool decode(const unsigned char *cdr, int len, const dds_topic_descriptor_t *desc, void *out) {
-  if (len < 4 || cdr[0] != 0) return false;
-  unsigned id = cdr[1];
-  bool le = (id & 1u) != 0;
-  uint32_t xcdrv = id <= 3 ? 1 : 2;
-  uint32_t size = (uint32_t)len - 4;
-  void *buf = malloc(size ? size : 1);
-  if (!buf) return false;
-  memcpy(buf, cdr + 4, size);
-  uint32_t off = 0;
-  bool bswap = le != (DDSRT_ENDIAN == DDSRT_LITTLE_ENDIAN);
-  bool ok = dds_stream_normalize_data(buf, &off, size, bswap, xcdrv, desc->m_ops) != NULL;
-  if (ok) {
-    dds_istream_t is;
-    dds_istream_init(&is, size, buf, xcdrv);
-    dds_stream_read(&is, out, desc->m_ops);
-    dds_istream_fini(&is);
-  }
-  free(buf);
-  return ok;
-}
 
 int main(int argc, char **argv) {
   if (argc != 2) {
@@ -64,7 +40,8 @@ int main(int argc, char **argv) {
   while (sqlite3_step(st) == SQLITE_ROW) {
     viscera_SessionEvent e;
     memset(&e, 0, sizeof e);
-    if (!decode(sqlite3_column_blob(st, 0), sqlite3_column_bytes(st, 0), &viscera_SessionEvent_desc, &e)) {
+    if (!rec_decode_cdr(sqlite3_column_blob(st, 0), (size_t)sqlite3_column_bytes(st, 0), &viscera_SessionEvent_desc,
+                        &e)) {
       bad++;
       continue;
     }
@@ -84,7 +61,7 @@ int main(int argc, char **argv) {
   while (st && sqlite3_step(st) == SQLITE_ROW) {
     viscera_Metrics m;
     memset(&m, 0, sizeof m);
-    if (!decode(sqlite3_column_blob(st, 0), sqlite3_column_bytes(st, 0), &viscera_Metrics_desc, &m)) {
+    if (!rec_decode_cdr(sqlite3_column_blob(st, 0), (size_t)sqlite3_column_bytes(st, 0), &viscera_Metrics_desc, &m)) {
       bad++;
       continue;
     }

@@ -7,3 +7,16 @@ if(TARGET viscera_recording AND TARGET viscera-recinfo)
   target_compile_definitions(test_recinfo_files PRIVATE RECINFO_EXE="$<TARGET_FILE:viscera-recinfo>")
   add_dependencies(test_recinfo_files viscera-recinfo)
 endif()
+
+# The store on a full disk (a file-size limit stands in for it): stops
+# cleanly, keeps exactly the committed batches, leaves a readable file.
+if(TARGET viscera_recording)
+  viscera_unit_test(NAME test_store_full SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_store_full.c LIBS viscera_recording)
+endif()
+
+# Decoding stored samples into the compiled-in types (client/recorder/rec_decode.c).
+if(TARGET viscera_rec_decode)
+  viscera_unit_test(NAME test_rec_decode SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_rec_decode.c LIBS viscera_rec_decode)
+  # ddsi_cdrstream.h pulls in GNU `asm` (see client/recorder/CMakeLists.txt)
+  set_target_properties(test_rec_decode PROPERTIES C_EXTENSIONS ON)
+endif()

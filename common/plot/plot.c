@@ -1,4 +1,4 @@
-/* plot: cairo rendering of the numerics charts. See plot.h. */
+/* plot: cairo rendering of line charts. See plot.h. */
 #include "plot.h"
 
 #include <cairo.h>
@@ -135,13 +135,21 @@ static void axis_fit(axis_t *a, double vmin, double vmax) {
   a->hi = hi;
 }
 
-static void set_colour(cairo_t *cr, int c) {
-  if (c == PLOT_BLACK) cairo_set_source_rgb(cr, 0, 0, 0);
-  else if (c == PLOT_GREY) cairo_set_source_rgb(cr, 0.45, 0.45, 0.45);
-  else {
+void plot_colour_rgb(int c, double rgb[3]) {
+  if (c == PLOT_BLACK) {
+    rgb[0] = rgb[1] = rgb[2] = 0;
+  } else if (c == PLOT_GREY) {
+    rgb[0] = rgb[1] = rgb[2] = 0.45;
+  } else {
     const double *k = PALETTE[(c % NPALETTE + NPALETTE) % NPALETTE];
-    cairo_set_source_rgb(cr, k[0], k[1], k[2]);
+    rgb[0] = k[0], rgb[1] = k[1], rgb[2] = k[2];
   }
+}
+
+static void set_colour(cairo_t *cr, int c) {
+  double k[3];
+  plot_colour_rgb(c, k);
+  cairo_set_source_rgb(cr, k[0], k[1], k[2]);
 }
 
 static void set_line(cairo_t *cr, int style, double width) {

@@ -1,5 +1,6 @@
-/* plot: the few chart kinds the numerics benchmark draws (NUMERICS.md §4),
- * rendered with cairo into PNG files.
+/* plot: line charts rendered with cairo into PNG files: the charts of the
+ * numerics benchmark (NUMERICS.md §4) and the report tool's time series; bar
+ * charts are in plot_bars.h.
  *
  * A plot is a set of series (points joined by lines and/or marked) on linear
  * or logarithmic axes. The legend sits to the right of the plot area, outside
@@ -8,8 +9,8 @@
  * Optionally the Pareto front over the series flagged `pareto` is drawn (for
  * work-precision charts: the points no other point beats in both cost and
  * error). */
-#ifndef NUMERICS_PLOT_H
-#define NUMERICS_PLOT_H
+#ifndef VISCERA_PLOT_H
+#define VISCERA_PLOT_H
 
 #include <stddef.h>
 
@@ -59,5 +60,9 @@ void plot_free(plot_t *p);
  * [ylo, yhi] (finite, positive x); NAN when fewer than 2 qualify. `used`
  * (may be NULL) receives how many points were fitted. */
 double plot_loglog_slope(size_t n, const double *x, const double *y, double ylo, double yhi, size_t *used);
+
+/* The RGB (0..1) of a palette index or PLOT_BLACK / PLOT_GREY, so other
+ * chart kinds use the same colours. */
+void plot_colour_rgb(int color, double rgb[3]);
 
 #endif

@@ -1,0 +1,92 @@
+#include "charts.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "measure_table.h"
+#include "plot.h"
+#include "plot_bars.h"
+
+/* Threshold colours match the viewer's force bar: orange above ST, red
+ * above MPF; SFT, the hard stop, in black. */
+static const int LEVEL_COLOR[THR_COUNT] = {1, 3, PLOT_BLACK};
+
+int rep_chart_force(const rep_recording_t *r, const char *path, verr_t *err) {
+  plot_t *p = calloc(1, sizeof *p);
+  if (!p) return verr_set(err, "%s: out of memory", path);
+  char title[160];
+  snprintf(title, sizeof title, "%s: contact force%s%s", r->label, r->scene[0] ? ", scene " : "", r->scene);
+  plot_init(p, title, "simulated time since the tool first reported (s)", "contact force |F| (N)", 0, 0);
+  double t0 = INFINITY, t1 = -INFINITY, fmax_all = 0;
+  for (int i = 0; i < r->ntools; i++)
+    if (r->tools[i].nforce) {
+      t0 = fmin(t0, r->tools[i].force[0].t);
+      t1 = fmax(t1, r->tools[i].force[r->tools[i].nforce - 1].t);
+    }
+  if (!isfinite(t0)) {
+    free(p);
+    return verr_set(err, "%s: no force samples to draw", path);
+  }
+  int ret = 0;
+  for (int i = 0; i < r->ntools && ret == 0; i++) {
+    const rep_tool_t *t = &r->tools[i];
+    if (!t->nforce) continue;
+    /* room for a NAN break before every sample */
+    double *x = malloc(2 * t->nforce * sizeof *x), *y = malloc(2 * t->nforce * sizeof *y);
+    if (!x || !y) {
+      ret = verr_set(err, "%s: out of memory", path);
+    } else {
+      /* A gap (tool released, samples lost) breaks the line instead of
+       * drawing a straight segment across it. */
+      size_t n = 0;
+      for (size_t k = 0; k < t->nforce; k++) {
+        if (k > 0 && t->force[k].t - t->force[k - 1].t > REP_GAP_S) {
+          x[n] = t->force[k].t - t0;
+          y[n++] = NAN;
+        }
+        x[n] = t->force[k].t - t0;
+        y[n++] = t->force[k].force;
+        fmax_all = fmax(fmax_all, t->force[k].force);
+      }
+      char lab[112];
+      snprintf(lab, sizeof lab, "%s (peak %.2f N)", t->name, t->fm.peak_force);
+      plot_add(p, lab, n, x, y, i == 0 ? 0 : 4 + i, -1, PLOT_LINE_SOLID);
+    }
+    free(x);
+    free(y);
+  }
+  /* Threshold lines of the first tool that has them, across the plot. */
+  for (int k = 0; k < THR_COUNT && ret == 0; k++) {
+    double L = r->sum.levels[k];
+    if (!(L > 0)) continue;
+    double x[2] = {0, t1 - t0}, y[2] = {L, L};
+    char lab[112];
+    snprintf(lab, sizeof lab, "%s %.2f N (%s)", thr_name((thr_id_t)k), L, thr_long_name((thr_id_t)k));
+    plot_add(p, lab, 2, x, y, LEVEL_COLOR[k], -1, k == THR_SFT ? PLOT_LINE_DOTTED : PLOT_LINE_DASHED);
+  }
+  /* Invisible anchor: the force axis starts at zero. */
+  double ax[1] = {0}, ay[1] = {0};
+  if (ret == 0) plot_add(p, "", 1, ax, ay, PLOT_GREY, -1, PLOT_LINE_NONE);
+  if (ret == 0) {
+    plot_note(p, "time above ST %.2f s, above MPF %.2f s, above SFT %.2f s; in contact %.2f s", r->sum.time_above[0],
+              r->sum.time_above[1], r->sum.time_above[2], r->sum.contact_time);
+    ret = plot_write_png(p, path, err);
+  }
+  plot_free(p);
+  free(p);
+  return ret;
+}
+
+int rep_chart_compare(const rep_recording_t *const *recs, int n, int measure, const char *path, verr_t *err) {
+  const rep_measure_def_t *d = rep_measure(measure);
+  if (!d) return verr_set(err, "%s: no measure %d", path, measure);
+  plot_bars_t b;
+  char ylabel[112];
+  snprintf(ylabel, sizeof ylabel, "%s%s%s%s", d->title, d->unit[0] ? " (" : "", d->unit, d->unit[0] ? ")" : "");
+  plot_bars_init(&b, d->title, ylabel, d->format);
+  b.integer_axis = !d->unit[0]; /* unitless measures are counts */
+  for (int i = 0; i < n && i < PLOT_BARS_MAX; i++)
+    plot_bars_add(&b, recs[i]->label, rep_measure_value(recs[i], measure), i);
+  return plot_bars_write_png(&b, path, 440, 300, err);
+}

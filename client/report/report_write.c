@@ -1,0 +1,249 @@
+#include "report_write.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "measure_table.h"
+
+/* CSV field: quoted, inner quotes doubled (labels and paths are user text). */
+static void csv_text(FILE *f, const char *s) {
+  fputc('"', f);
+  for (; *s; s++) {
+    if (*s == '"') fputc('"', f);
+    fputc(*s == '\n' ? ' ' : *s, f);
+  }
+  fputc('"', f);
+}
+
+static void csv_num(FILE *f, const char *fmt, double v) {
+  if (isfinite(v)) fprintf(f, fmt, v);
+}
+
+static void utc_string(int64_t wall_ns, char *buf, size_t size) {
+  time_t t = (time_t)(wall_ns / 1000000000);
+  struct tm tm;
+  if (wall_ns <= 0 || !gmtime_r(&t, &tm) || !strftime(buf, size, "%Y-%m-%d %H:%M:%S UTC", &tm))
+    snprintf(buf, size, "?");
+}
+
+static size_t count_lines(const char *s) {
+  size_t n = 0;
+  for (; *s; s++) n += *s == '\n';
+  return n;
+}
+
+int rep_write_csv(const rep_recording_t *const *recs, int n, const char *path, verr_t *err) {
+  FILE *f = fopen(path, "w");
+  if (!f) return verr_set(err, "%s: cannot create: %s", path, strerror(errno));
+  fprintf(f, "label,file,scene,partition,start_utc,complete");
+  for (int m = 0; m < REP_NMEASURES; m++) fprintf(f, ",%s", rep_measure(m)->key);
+  fprintf(f, ",ST_N,MPF_N,SFT_N,crossings_source,tasks,warnings\n");
+  for (int i = 0; i < n; i++) {
+    const rep_recording_t *r = recs[i];
+    char start[40];
+    utc_string(r->session.start_wall_ns, start, sizeof start);
+    csv_text(f, r->label);
+    fputc(',', f);
+    csv_text(f, r->path);
+    fputc(',', f);
+    csv_text(f, r->scene[0] ? r->scene : r->session.scene);
+    fputc(',', f);
+    csv_text(f, r->session.partition);
+    fprintf(f, ",%s,%d", start, r->damaged || !r->session.has_end ? 0 : 1);
+    for (int m = 0; m < REP_NMEASURES; m++) {
+      fputc(',', f);
+      csv_num(f, "%.6g", rep_measure_value(r, m));
+    }
+    for (int k = 0; k < THR_COUNT; k++) {
+      fputc(',', f);
+      csv_num(f, "%.4g", r->sum.levels[k]);
+    }
+    fprintf(f, ",%s,", r->sum.crossings_from_events ? "events" : "force_trace");
+    /* tasks as name=seconds;... (unfinished: name=incomplete) */
+    char tasks[1024] = "";
+    size_t len = 0;
+    for (size_t t = 0; t < r->ntasks && len + 80 < sizeof tasks; t++) {
+      const rep_task_t *tk = &r->tasks[t];
+      if (isfinite(tk->end))
+        len +=
+            (size_t)snprintf(tasks + len, sizeof tasks - len, "%s%s=%.3f", t ? ";" : "", tk->name, tk->end - tk->start);
+      else
+        len += (size_t)snprintf(tasks + len, sizeof tasks - len, "%s%s=incomplete", t ? ";" : "", tk->name);
+    }
+    csv_text(f, tasks);
+    fprintf(f, ",%zu\n", count_lines(r->warnings));
+  }
+  if (fclose(f) != 0) return verr_set(err, "%s: write failed: %s", path, strerror(errno));
+  return 0;
+}
+
+static void html_text(FILE *f, const char *s) {
+  for (; *s; s++) {
+    switch (*s) {
+    case '<':
+      fputs("&lt;", f);
+      break;
+    case '>':
+      fputs("&gt;", f);
+      break;
+    case '&':
+      fputs("&amp;", f);
+      break;
+    case '"':
+      fputs("&quot;", f);
+      break;
+    default:
+      fputc(*s, f);
+    }
+  }
+}
+
+/* <img> with the PNG inlined as base64; false when the file is unreadable. */
+static int html_png(FILE *f, const char *png, const char *alt, verr_t *err) {
+  static const char B64[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  FILE *in = fopen(png, "rb");
+  if (!in) return verr_set(err, "%s: cannot read: %s", png, strerror(errno));
+  fputs("<img alt=\"", f);
+  html_text(f, alt);
+  fputs("\" src=\"data:image/png;base64,", f);
+  unsigned char b[3];
+  size_t k;
+  while ((k = fread(b, 1, 3, in)) > 0) {
+    if (k < 3) memset(b + k, 0, 3 - k);
+    char o[4] = {B64[b[0] >> 2], B64[((b[0] & 3) << 4) | (b[1] >> 4)], B64[((b[1] & 15) << 2) | (b[2] >> 6)],
+                 B64[b[2] & 63]};
+    if (k < 3) o[3] = '=';
+    if (k < 2) o[2] = '=';
+    fwrite(o, 1, 4, f);
+    if (k < 3) break;
+  }
+  int rd_err = ferror(in);
+  fclose(in);
+  fputs("\">\n", f);
+  if (rd_err) return verr_set(err, "%s: read error", png);
+  return 0;
+}
+
+static void html_value(FILE *f, const rep_recording_t *r, int m) {
+  const rep_measure_def_t *d = rep_measure(m);
+  double v = rep_measure_value(r, m);
+  if (!isfinite(v)) {
+    fputs("<td class=na>n/a</td>", f);
+    return;
+  }
+  fputs("<td>", f);
+  fprintf(f, d->format, v);
+  if (d->unit[0]) fprintf(f, " %s", d->unit);
+  fputs("</td>", f);
+}
+
+static const char *STYLE =
+    "body{font-family:'DejaVu Sans',Arial,sans-serif;max-width:1000px;margin:24px auto;color:#222;padding:0 12px}"
+    "h1{font-size:24px}h2{font-size:19px;border-bottom:2px solid #1f77b4;padding-bottom:3px;margin-top:34px}"
+    "table{border-collapse:collapse;margin:10px 0}td,th{border:1px solid #ccc;padding:4px 10px;text-align:right}"
+    "th{background:#eef3f8}td:first-child,th:first-child{text-align:left}td.na{color:#999}"
+    ".warn{background:#fff4e0;border-left:4px solid #e69500;padding:6px 10px;white-space:pre-wrap}"
+    ".meta td{text-align:left}.grid{display:flex;flex-wrap:wrap;gap:8px}.grid img{width:440px}"
+    "img{max-width:100%}.note{color:#555;font-size:13px}";
+
+int rep_write_html(const rep_recording_t *const *recs, int n, const char *const *force_png,
+                   const char *const *compare_png, const char *path, verr_t *err) {
+  FILE *f = fopen(path, "w");
+  if (!f) return verr_set(err, "%s: cannot create: %s", path, strerror(errno));
+  int ret = 0;
+  fprintf(f,
+          "<!DOCTYPE html>\n<html lang=en><head><meta charset=utf-8><title>viscera trainee report</title>"
+          "<style>%s</style></head><body>\n<h1>Trainee report</h1>\n",
+          STYLE);
+  fprintf(f,
+          "<p class=note>%d recording(s). Force measures replay the recorded ContactFeedback (force on the tool "
+          "at the server, every physics step) through the server's threshold tracker; times are simulated "
+          "time. Thresholds (seed 002 ch. 6): ST sound threshold, MPF maximum palpation force, SFT stopping "
+          "force threshold; crossings are upward crossings.</p>\n",
+          n);
+  for (int i = 0; i < n && ret == 0; i++) {
+    const rep_recording_t *r = recs[i];
+    fputs("<h2>", f);
+    html_text(f, r->label);
+    fputs("</h2>\n<table class=meta>", f);
+    char start[40];
+    utc_string(r->session.start_wall_ns, start, sizeof start);
+    fputs("<tr><td>recording</td><td>", f);
+    html_text(f, r->path);
+    fputs("</td></tr><tr><td>scene</td><td>", f);
+    html_text(f, r->scene[0] ? r->scene : r->session.scene);
+    fputs("</td></tr><tr><td>partition</td><td>", f);
+    html_text(f, r->session.partition);
+    fprintf(f, "</td></tr><tr><td>started</td><td>%s</td></tr>", start);
+    fprintf(f, "<tr><td>simulated time covered</td><td>%.2f s</td></tr>", r->sum.duration);
+    for (int t = 0; t < r->ntools; t++)
+      if (r->tools[t].present) {
+        fputs("<tr><td>tool ", f);
+        html_text(f, r->tools[t].name);
+        fprintf(f, "</td><td>%zu force samples, %zu commands; ST %.2f N, MPF %.2f N, SFT %.2f N</td></tr>",
+                r->tools[t].nforce, r->tools[t].ncmd, r->tools[t].levels[0], r->tools[t].levels[1],
+                r->tools[t].levels[2]);
+      }
+    fputs("</table>\n", f);
+    if (r->warnings[0]) {
+      fputs("<div class=warn><b>Warnings</b> (the figures cover what was readable):\n", f);
+      html_text(f, r->warnings);
+      fputs("</div>\n", f);
+    }
+    fputs("<table><tr><th>measure</th><th>value</th></tr>\n", f);
+    for (int m = 0; m < REP_NMEASURES; m++) {
+      fputs("<tr><td>", f);
+      html_text(f, rep_measure(m)->title);
+      fputs("</td>", f);
+      html_value(f, r, m);
+      fputs("</tr>\n", f);
+    }
+    for (size_t t = 0; t < r->ntasks; t++) {
+      const rep_task_t *tk = &r->tasks[t];
+      fputs("<tr><td>operation time, task ", f);
+      html_text(f, tk->name);
+      if (isfinite(tk->end))
+        fprintf(f, "</td><td>%.2f s%s</td></tr>\n", tk->end - tk->start,
+                tk->started_seen ? "" : " (from session start)");
+      else
+        fputs("</td><td class=na>not completed</td></tr>\n", f);
+    }
+    if (r->have_metrics)
+      fprintf(f,
+              "<tr><td class=note>server's last Metrics (about 1 Hz): above ST / MPF / SFT, contact, mean, peak, "
+              "path</td><td class=note>%.2f / %.2f / %.2f s, %.2f s, %.2f N, %.2f N, %.1f cm</td></tr>\n",
+              r->metrics_time_above[0], r->metrics_time_above[1], r->metrics_time_above[2], r->metrics_contact_time,
+              r->metrics_mean_force, r->metrics_peak, r->metrics_path * 100);
+    fprintf(f, "</table>\n<p class=note>crossings from %s.</p>\n",
+            r->sum.crossings_from_events ? "the server's SessionEvents"
+                                         : "the replayed force trace (no events recorded)");
+    if (force_png && force_png[i]) ret = html_png(f, force_png[i], "contact force over time", err);
+  }
+  if (n >= 2 && ret == 0) {
+    fputs("<h2 id=comparison>Comparison</h2>\n<table><tr><th>measure</th>", f);
+    for (int i = 0; i < n; i++) {
+      fputs("<th>", f);
+      html_text(f, recs[i]->label);
+      fputs("</th>", f);
+    }
+    fputs("</tr>\n", f);
+    for (int m = 0; m < REP_NMEASURES; m++) {
+      fputs("<tr><td>", f);
+      html_text(f, rep_measure(m)->title);
+      fputs("</td>", f);
+      for (int i = 0; i < n; i++) html_value(f, recs[i], m);
+      fputs("</tr>\n", f);
+    }
+    fputs("</table>\n<div class=grid>\n", f);
+    for (int m = 0; m < REP_NMEASURES && ret == 0; m++)
+      if (compare_png && compare_png[m]) ret = html_png(f, compare_png[m], rep_measure(m)->title, err);
+    fputs("</div>\n", f);
+  }
+  fputs("</body></html>\n", f);
+  if (fclose(f) != 0 && ret == 0) ret = verr_set(err, "%s: write failed: %s", path, strerror(errno));
+  return ret;
+}

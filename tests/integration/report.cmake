@@ -1,0 +1,7 @@
+# Report tool end to end (issue 6 part 4): two real palpation sessions
+# (expert and novice trajectories) recorded, reported, and the report's
+# figures checked against the servers' own PALPATION lines; a truncated copy,
+# a foreign SQLite file and random bytes. Domain 100.
+if(TARGET viscera-report AND TARGET viscera-viewer)
+  viscera_integration_test(report_e2e 100 report_test.sh)
+endif()
