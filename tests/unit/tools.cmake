@@ -1,0 +1,2 @@
+# Tools, objects and tasks (issue 4): scene keys, grasping, stones, tasks.
+viscera_unit_test(NAME test_scene_tools SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_scene_tools.c)
