@@ -20,6 +20,8 @@ typedef enum vdds_topic_id {
   VT_CONTACT_FEEDBACK,
   VT_SESSION_EVENT,
   VT_METRICS,
+  VT_OBJECT_STATE,
+  VT_TOOL_METRICS,
   VT_COUNT
 } vdds_topic_id_t;
 

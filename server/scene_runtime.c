@@ -5,6 +5,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "interaction/tool_actions.h"
 #include "mesh_import.h"
 #include "vmath.h"
 
@@ -105,6 +106,10 @@ int runtime_init(runtime_t *rt, const scene_t *scene, verr_t *err) {
     rt->tools[t].cfg = &rt->scene.tools[t];
     proxy_reset(&rt->tools[t].proxy);
   }
+  if (interact_init(rt, err)) {
+    runtime_destroy(rt);
+    return -1;
+  }
   return 0;
 }
 
@@ -124,10 +129,16 @@ void runtime_set_tool(runtime_t *rt, size_t t, const double pos[3], double devic
   v3_copy(tool->device, pos);
   tool->max_force = fmin(tool->cfg->max_force, device_max_force);
   tool->active = 1;
+  if (tool->first_cmd_time < 0) tool->first_cmd_time = rt->sim_time;
+}
+
+void runtime_set_buttons(runtime_t *rt, size_t t, uint32_t buttons) {
+  if (t < rt->ntools) rt->tools[t].buttons = buttons;
 }
 
 void runtime_release_tool(runtime_t *rt, size_t t) {
   if (t >= rt->ntools) return;
+  interact_release_tool(rt, t);
   rt->tools[t].active = 0;
   proxy_reset(&rt->tools[t].proxy);
   v3_set(rt->tools[t].force, 0, 0, 0);
@@ -152,6 +163,7 @@ static void apply_contacts(model_t *m, void *vctx) {
       m->ops->add_surface_force(m, tool->patch[j], fk);
     }
   }
+  interact_apply(rt, o, m);
 }
 
 /* The vertices within the patch radius of the proxy, weighted by a smooth
@@ -189,9 +201,10 @@ static void build_patch(runtime_t *rt, tool_rt_t *tool) {
 
 int runtime_step(runtime_t *rt) {
   double dt = rt->scene.dt;
+  interact_before_step(rt);
   for (size_t t = 0; t < rt->ntools; t++) {
     tool_rt_t *tool = &rt->tools[t];
-    if (!tool->active) continue;
+    if (!tool->active || !interact_uses_proxy(rt, t)) continue;
     proxy_update(&tool->proxy, tool->device, rt->surfaces, rt->norgans, tool->cfg->stiffness, tool->max_force,
                  tool->force);
     build_patch(rt, tool);
@@ -216,5 +229,6 @@ int runtime_step(runtime_t *rt) {
   }
   rt->steps++;
   rt->sim_time = (double)rt->steps * dt;
+  interact_after_step(rt);
   return rolled;
 }

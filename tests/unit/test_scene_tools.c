@@ -39,19 +39,19 @@ static int loads(const char *yaml) {
   "  - name: spleen\n"                                                                                                 \
   "    mesh: s.obj\n"
 
-static const char full[] = HEAD                                                                /* 1-6 */
-    "tools:\n"                                                                                 /* 7 */
-    "  - {name: p, kind: probe, friction: 0.4}\n"                                              /* 8 */
-    "  - {name: g, kind: grasper, radius: 0.002, grasp_radius: 0.005, jaw_opening: 0.012}\n"   /* 9 */
-    "  - {name: x, kind: extractor, radius: 0.0015}\n"                                         /* 10 */
-    "  - {name: c, kind: scalpel}\n"                                                           /* 11 */
-    "  - {name: y, kind: syringe}\n"                                                           /* 12 */
-    "objects:\n"                                                                               /* 13 */
-    "  - {name: stone, radius: 0.004, position: [0.01, 0, 0.02], organ: spleen}\n"             /* 14 */
-    "tasks:\n"                                                                                 /* 15 */
-    "  - {name: out, kind: stone_removal, tool: x, object: stone}\n"                           /* 16 */
-    "  - {name: find, kind: palpate_target, tool: p, target: [0, 0.01, 0.03]}\n"               /* 17 */
-    "  - {name: pull, kind: grasp_pull, tool: g, distance: 0.02}\n"                            /* 18 */
+static const char full[] = HEAD                                                                   /* 1-6 */
+    "tools:\n"                                                                                    /* 7 */
+    "  - {name: p, kind: probe, friction: 0.4}\n"                                                 /* 8 */
+    "  - {name: g, kind: grasper, radius: 0.002, grasp_radius: 0.005, jaw_opening: 0.012}\n"      /* 9 */
+    "  - {name: x, kind: extractor, radius: 0.0015}\n"                                            /* 10 */
+    "  - {name: c, kind: scalpel}\n"                                                              /* 11 */
+    "  - {name: y, kind: syringe}\n"                                                              /* 12 */
+    "objects:\n"                                                                                  /* 13 */
+    "  - {name: stone, radius: 0.004, position: [0.01, 0, 0.02], organ: spleen}\n"                /* 14 */
+    "tasks:\n"                                                                                    /* 15 */
+    "  - {name: out, kind: stone_removal, tool: x, object: stone}\n"                              /* 16 */
+    "  - {name: find, kind: palpate_target, tool: p, target: [0, 0.01, 0.03]}\n"                  /* 17 */
+    "  - {name: pull, kind: grasp_pull, tool: g, distance: 0.02}\n"                               /* 18 */
     "  - {name: find2, kind: palpate_target, tool: y, target: [0, 0, 0], target_radius: 0.01}\n"; /* 19 */
 
 static void test_full(void) {
@@ -139,8 +139,8 @@ static void test_task_errors(void) {
                    "t.yaml:12: field 'tasks[0].tool'", "needs an extractor (tool 'g' is a grasper)"));
   CHECK(fails_with(HEAD TOOLS "tasks:\n  - {name: t, kind: stone_removal, tool: x, object: s}\n",
                    "t.yaml:12: field 'tasks[0].object'", "no object named 's' (known: none)"));
-  CHECK(fails_with(HEAD TOOLS "tasks:\n  - {name: t, kind: stone_removal, tool: x}\n",
-                   "field 'tasks[0].object'", "required field missing"));
+  CHECK(fails_with(HEAD TOOLS "tasks:\n  - {name: t, kind: stone_removal, tool: x}\n", "field 'tasks[0].object'",
+                   "required field missing"));
   CHECK(fails_with(HEAD TOOLS "tasks:\n  - {name: t, kind: grasp_pull, tool: p}\n", "field 'tasks[0].tool'",
                    "needs a grasper (tool 'p' is a probe)"));
   CHECK(fails_with(HEAD TOOLS "tasks:\n  - {name: t, kind: palpate_target, tool: x, target: [0, 0, 0]}\n",
@@ -156,7 +156,8 @@ static void test_task_errors(void) {
   CHECK(fails_with(HEAD TOOLS "tasks:\n  - {name: t, tool: p}\n", "field 'tasks[0].kind'", "required field missing"));
   CHECK(fails_with(HEAD TOOLS "tasks:\n  - {name: t, kind: grasp_pull, tool: g, distance: 0}\n",
                    "field 'tasks[0].distance'", "must be > 0"));
-  CHECK(fails_with(HEAD TOOLS "tasks:\n  - {name: t, kind: grasp_pull, tool: g}\n  - {name: t, kind: grasp_pull, tool: g}\n",
+  CHECK(fails_with(HEAD TOOLS
+                   "tasks:\n  - {name: t, kind: grasp_pull, tool: g}\n  - {name: t, kind: grasp_pull, tool: g}\n",
                    "t.yaml:13: field 'tasks[1].name'", "duplicate task name 't'"));
 }
 

@@ -1,2 +1,4 @@
 # Tools, objects and tasks (issue 4): scene keys, grasping, stones, tasks.
 viscera_unit_test(NAME test_scene_tools SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_scene_tools.c)
+# Grasp, stone removal, tool-tool contact and tasks on the real runtime.
+viscera_unit_test(NAME test_tool_actions SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_tool_actions.c LIBS viscera_server_core)
