@@ -27,8 +27,8 @@
 
 /* The accepted names for each choice field, the first being the default.
  * Adding a model, integrator or tool kind means adding it here only. */
-static const char *const scene_models[] = {"mass_spring_surface", "mass_spring_tet", "molecular", "pbd",
-                                           "xpbd", "vertex_based", "adaptive_mass_spring"};
+static const char *const scene_models[] = {"mass_spring_surface", "mass_spring_tet",     "molecular", "pbd", "xpbd",
+                                           "vertex_based",        "adaptive_mass_spring"};
 static const char *const scene_integrators[] = {"symplectic_euler", "explicit_euler", "verlet", "rk4",
                                                 "implicit_euler"};
 static const char *const scene_tool_kinds[] = {"probe", "grasper", "scalpel", "extractor", "syringe"};
@@ -411,11 +411,23 @@ static const char *const physics_keys[P_NKEYS] = {
     [P_DT] = "dt", [P_PUBLISH_HZ] = "publish_hz", [P_QUANT_STEP] = "quant_step", [P_GRAVITY] = "gravity"};
 
 enum {
-  M_MASS, M_STIFFNESS, M_DAMPING, M_HOME_STIFFNESS, M_HOME_DAMPING,
-  M_BOND_K, M_ANGLE_K, M_STRETCH_BEND_K,
-  M_DISTANCE_STIFFNESS, M_VOLUME_STIFFNESS, M_DISTANCE_COMPLIANCE, M_VOLUME_COMPLIANCE,
-  M_SLOPE_M1, M_SLOPE_M2, M_SLOPE_M3,
-  M_REFINE_AREA, M_REFINE_LEVELS,
+  M_MASS,
+  M_STIFFNESS,
+  M_DAMPING,
+  M_HOME_STIFFNESS,
+  M_HOME_DAMPING,
+  M_BOND_K,
+  M_ANGLE_K,
+  M_STRETCH_BEND_K,
+  M_DISTANCE_STIFFNESS,
+  M_VOLUME_STIFFNESS,
+  M_DISTANCE_COMPLIANCE,
+  M_VOLUME_COMPLIANCE,
+  M_SLOPE_M1,
+  M_SLOPE_M2,
+  M_SLOPE_M3,
+  M_REFINE_AREA,
+  M_REFINE_LEVELS,
   M_NKEYS
 };
 static const char *const material_keys[M_NKEYS] = {[M_MASS] = "mass",
@@ -444,53 +456,76 @@ static const char *const solver_keys[V_NKEYS] = {[V_SUBSTEPS] = "substeps",
                                                  [V_TET_SIZE] = "tet_size"};
 
 enum {
-  O_NAME, O_MESH, O_MODEL, O_INTEGRATOR, O_SOLVER, O_POSITION, O_SCALE, O_COLOR, O_FIXED_BELOW, O_MATERIAL,
+  O_NAME,
+  O_MESH,
+  O_MODEL,
+  O_INTEGRATOR,
+  O_SOLVER,
+  O_POSITION,
+  O_SCALE,
+  O_COLOR,
+  O_FIXED_BELOW,
+  O_MATERIAL,
   O_NKEYS
 };
-static const char *const organ_keys[O_NKEYS] = {
-    [O_NAME] = "name",         [O_MESH] = "mesh",          [O_MODEL] = "model", [O_INTEGRATOR] = "integrator",
-    [O_SOLVER] = "solver",     [O_POSITION] = "position",  [O_SCALE] = "scale", [O_COLOR] = "color",
-    [O_FIXED_BELOW] = "fixed_below", [O_MATERIAL] = "material"};
+static const char *const organ_keys[O_NKEYS] = {[O_NAME] = "name",
+                                                [O_MESH] = "mesh",
+                                                [O_MODEL] = "model",
+                                                [O_INTEGRATOR] = "integrator",
+                                                [O_SOLVER] = "solver",
+                                                [O_POSITION] = "position",
+                                                [O_SCALE] = "scale",
+                                                [O_COLOR] = "color",
+                                                [O_FIXED_BELOW] = "fixed_below",
+                                                [O_MATERIAL] = "material"};
 
 enum {
-  T_NAME, T_KIND, T_RADIUS, T_LENGTH, T_STIFFNESS, T_MAX_FORCE, T_THRESHOLDS, T_FRICTION, T_GRASP_RADIUS,
-  T_JAW_OPENING, T_NKEYS
+  T_NAME,
+  T_KIND,
+  T_RADIUS,
+  T_LENGTH,
+  T_STIFFNESS,
+  T_MAX_FORCE,
+  T_THRESHOLDS,
+  T_FRICTION,
+  T_GRASP_RADIUS,
+  T_JAW_OPENING,
+  T_NKEYS
 };
-static const char *const tool_keys[T_NKEYS] = {
-    [T_NAME] = "name",     [T_KIND] = "kind",           [T_RADIUS] = "radius",
-    [T_LENGTH] = "length", [T_STIFFNESS] = "stiffness", [T_MAX_FORCE] = "max_force",
-    [T_THRESHOLDS] = "thresholds", [T_FRICTION] = "friction", [T_GRASP_RADIUS] = "grasp_radius",
-    [T_JAW_OPENING] = "jaw_opening"};
+static const char *const tool_keys[T_NKEYS] = {[T_NAME] = "name",
+                                               [T_KIND] = "kind",
+                                               [T_RADIUS] = "radius",
+                                               [T_LENGTH] = "length",
+                                               [T_STIFFNESS] = "stiffness",
+                                               [T_MAX_FORCE] = "max_force",
+                                               [T_THRESHOLDS] = "thresholds",
+                                               [T_FRICTION] = "friction",
+                                               [T_GRASP_RADIUS] = "grasp_radius",
+                                               [T_JAW_OPENING] = "jaw_opening"};
 
 enum { J_NAME, J_KIND, J_RADIUS, J_POSITION, J_ORGAN, J_COLOR, J_NKEYS };
-static const char *const object_keys[J_NKEYS] = {[J_NAME] = "name",         [J_KIND] = "kind",
-                                                  [J_RADIUS] = "radius",     [J_POSITION] = "position",
-                                                  [J_ORGAN] = "organ",       [J_COLOR] = "color"};
+static const char *const object_keys[J_NKEYS] = {[J_NAME] = "name",         [J_KIND] = "kind",   [J_RADIUS] = "radius",
+                                                 [J_POSITION] = "position", [J_ORGAN] = "organ", [J_COLOR] = "color"};
 
 enum { K_NAME, K_KIND, K_TOOL, K_OBJECT, K_TARGET, K_TARGET_RADIUS, K_DISTANCE, K_NKEYS };
-static const char *const task_keys[K_NKEYS] = {[K_NAME] = "name",       [K_KIND] = "kind",
-                                               [K_TOOL] = "tool",       [K_OBJECT] = "object",
-                                               [K_TARGET] = "target",   [K_TARGET_RADIUS] = "target_radius",
-                                               [K_DISTANCE] = "distance"};
+static const char *const task_keys[K_NKEYS] = {
+    [K_NAME] = "name",        [K_KIND] = "kind",     [K_TOOL] = "tool",
+    [K_OBJECT] = "object",    [K_TARGET] = "target", [K_TARGET_RADIUS] = "target_radius",
+    [K_DISTANCE] = "distance"};
 
 /* In the order they must rise: ST < MPF <= SFT (seed 002 ch. 6). */
 enum { H_ST, H_MPF, H_SFT, H_NKEYS };
 static const char *const threshold_keys[H_NKEYS] = {[H_ST] = "st", [H_MPF] = "mpf", [H_SFT] = "sft"};
 
 enum { S_SCENE, S_DESCRIPTION, S_PHYSICS, S_ORGANS, S_TOOLS, S_OBJECTS, S_TASKS, S_NKEYS };
-static const char *const top_keys[S_NKEYS] = {[S_SCENE] = "scene",
-                                              [S_DESCRIPTION] = "description",
-                                              [S_PHYSICS] = "physics",
-                                              [S_ORGANS] = "organs",
-                                              [S_TOOLS] = "tools",
-                                              [S_OBJECTS] = "objects",
-                                              [S_TASKS] = "tasks"};
+static const char *const top_keys[S_NKEYS] = {
+    [S_SCENE] = "scene", [S_DESCRIPTION] = "description", [S_PHYSICS] = "physics", [S_ORGANS] = "organs",
+    [S_TOOLS] = "tools", [S_OBJECTS] = "objects",         [S_TASKS] = "tasks"};
 
 /* get_fields() tracks the keys seen in a fixed array of SCENE_MAX_KEYS. */
 _Static_assert(P_NKEYS <= SCENE_MAX_KEYS && M_NKEYS <= SCENE_MAX_KEYS && V_NKEYS <= SCENE_MAX_KEYS &&
-                   O_NKEYS <= SCENE_MAX_KEYS &&
-                   T_NKEYS <= SCENE_MAX_KEYS && H_NKEYS <= SCENE_MAX_KEYS && S_NKEYS <= SCENE_MAX_KEYS &&
-                   J_NKEYS <= SCENE_MAX_KEYS && K_NKEYS <= SCENE_MAX_KEYS,
+                   O_NKEYS <= SCENE_MAX_KEYS && T_NKEYS <= SCENE_MAX_KEYS && H_NKEYS <= SCENE_MAX_KEYS &&
+                   S_NKEYS <= SCENE_MAX_KEYS && J_NKEYS <= SCENE_MAX_KEYS && K_NKEYS <= SCENE_MAX_KEYS,
                "raise SCENE_MAX_KEYS");
 
 static void organ_defaults(scene_organ_t *o) {
@@ -550,8 +585,7 @@ static int parse_physics(const ctx_t *c, const node_t *n, scene_t *s) {
 
 /* v[] receives the value nodes so the model-specific checks in parse_organ
  * can point at the line of the value they complain about. */
-static int parse_material(const ctx_t *c, const node_t *n, const char *path, scene_material_t *m,
-                          const node_t **v) {
+static int parse_material(const ctx_t *c, const node_t *n, const char *path, scene_material_t *m, const node_t **v) {
   static const range_t unit = {B_INCL, 0, B_INCL, 1};
   static const range_t levels = {B_INCL, 1, B_INCL, 4};
   if (get_fields(c, n, path, material_keys, M_NKEYS, v)) return -1;
@@ -588,8 +622,7 @@ static int parse_solver(const ctx_t *c, const node_t *n, const char *path, scene
   if (opt_int(c, v[V_SUBSTEPS], path, "substeps", &substeps, &sv->substeps)) return -1;
   if (opt_int(c, v[V_ITERATIONS], path, "iterations", &iterations, &sv->iterations)) return -1;
   if (opt_number(c, v[V_CG_TOLERANCE], path, "cg_tolerance", &tolerance, &sv->cg_tolerance)) return -1;
-  if (opt_int(c, v[V_CG_MAX_ITERATIONS], path, "cg_max_iterations", &cg_iterations, &sv->cg_max_iterations))
-    return -1;
+  if (opt_int(c, v[V_CG_MAX_ITERATIONS], path, "cg_max_iterations", &cg_iterations, &sv->cg_max_iterations)) return -1;
   if (opt_number(c, v[V_TET_SIZE], path, "tet_size", &tet_size, &sv->tet_size)) return -1;
   /* 0 asks for the automatic size; anything else below 0.1 mm would build
    * millions of tetrahedra for an organ. */
@@ -838,18 +871,16 @@ static int parse_object(const ctx_t *c, const node_t *n, size_t idx, scene_t *s)
   if (get_name(c, v[J_NAME], fp, o->name, sizeof o->name)) return -1;
   for (size_t j = 0; j < idx; j++)
     if (!strcmp(s->objects[j].name, o->name))
-      return field_err(c, v[J_NAME], fp, "duplicate object name '%s' (first used by objects[%zu] at line %d)",
-                       o->name, j, s->objects[j].line);
+      return field_err(c, v[J_NAME], fp, "duplicate object name '%s' (first used by objects[%zu] at line %d)", o->name,
+                       j, s->objects[j].line);
   join(fp, sizeof fp, path, "kind");
-  if (v[J_KIND] &&
-      get_choice(c, v[J_KIND], fp, scene_object_kinds, COUNT(scene_object_kinds), o->kind, sizeof o->kind))
+  if (v[J_KIND] && get_choice(c, v[J_KIND], fp, scene_object_kinds, COUNT(scene_object_kinds), o->kind, sizeof o->kind))
     return -1;
   if (opt_number(c, v[J_RADIUS], path, "radius", &radius_range, &o->radius)) return -1;
   join(fp, sizeof fp, path, "position");
   if (get_vec3(c, v[J_POSITION], fp, &ANY, o->position)) return -1;
   join(fp, sizeof fp, path, "organ");
-  if (find_name(c, v[J_ORGAN], fp, "organ", s->organs[0].name, sizeof s->organs[0], s->norgans, &o->organ))
-    return -1;
+  if (find_name(c, v[J_ORGAN], fp, "organ", s->organs[0].name, sizeof s->organs[0], s->norgans, &o->organ)) return -1;
   if (v[J_COLOR]) {
     double rgb[3];
     join(fp, sizeof fp, path, "color");
@@ -907,8 +938,10 @@ static int parse_task(const ctx_t *c, const node_t *n, size_t idx, scene_t *s) {
       return -1;
   } else if (!strcmp(t->kind, "palpate_target")) {
     if (!strcmp(tk, "extractor"))
-      return field_err(c, v[K_TOOL], fp, "a palpate_target task needs a tool that touches tissue (tool '%s' is an "
-                       "extractor)", s->tools[t->tool].name);
+      return field_err(c, v[K_TOOL], fp,
+                       "a palpate_target task needs a tool that touches tissue (tool '%s' is an "
+                       "extractor)",
+                       s->tools[t->tool].name);
     if (!v[K_TARGET]) return missing(c, n, path, "target");
     join(fp, sizeof fp, path, "target");
     if (get_vec3(c, v[K_TARGET], fp, &ANY, t->target)) return -1;

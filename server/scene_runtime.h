@@ -42,12 +42,12 @@ typedef struct organ_rt {
 
 typedef struct tool_rt {
   const scene_tool_t *cfg;
-  int active;          /* a valid command has been received */
-  double device[3];    /* commanded tip, m */
-  double max_force;    /* N: min(tool, device capability) */
+  int active;       /* a valid command has been received */
+  double device[3]; /* commanded tip, m */
+  double max_force; /* N: min(tool, device capability) */
   proxy_t proxy;
-  double force[3];     /* N on the tool, last step */
-  double peak_force;   /* N since start */
+  double force[3];   /* N on the tool, last step */
+  double peak_force; /* N since start */
   /* Contact patch: the tissue vertices that share the reaction force, with
    * weights summing to 1. A rigid tip presses an area, not three vertices;
    * spreading the load keeps the dent smooth and the contact normal steady. */
@@ -55,11 +55,11 @@ typedef struct tool_rt {
   uint32_t patch[TOOL_PATCH_MAX];
   double patch_w[TOOL_PATCH_MAX];
   /* Interactions (interaction/tool_actions.c). */
-  uint32_t buttons;       /* ToolCommand.buttons, bit 0 = jaws closed */
-  uint32_t prev_buttons;  /* at the previous step: grasping happens on closing */
-  grasp_t grasp;          /* grasper: tissue held */
-  int stone;              /* extractor: stone held, or -1 */
-  double first_cmd_time;  /* s of simulated time of the first command, -1 before */
+  uint32_t buttons;      /* ToolCommand.buttons, bit 0 = jaws closed */
+  uint32_t prev_buttons; /* at the previous step: grasping happens on closing */
+  grasp_t grasp;         /* grasper: tissue held */
+  int stone;             /* extractor: stone held, or -1 */
+  double first_cmd_time; /* s of simulated time of the first command, -1 before */
   /* What the tool's client is told (ContactFeedback): the tip the hand
    * feels (god-object, stone surface, grasp pull or tool-tool contact),
    * normal and whether anything touches; organ -1 for stones and tools. */
