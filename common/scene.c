@@ -27,8 +27,8 @@
 
 /* The accepted names for each choice field, the first being the default.
  * Adding a model, integrator or tool kind means adding it here only. */
-static const char *const scene_models[] = {"mass_spring_surface", "mass_spring_tet",     "molecular", "pbd", "xpbd",
-                                           "vertex_based",        "adaptive_mass_spring"};
+static const char *const scene_models[] = {"mass_spring_surface", "mass_spring_tet", "molecular", "pbd",
+                                           "xpbd", "vertex_based", "adaptive_mass_spring"};
 static const char *const scene_integrators[] = {"symplectic_euler", "explicit_euler", "verlet", "rk4",
                                                 "implicit_euler"};
 static const char *const scene_tool_kinds[] = {"probe", "grasper", "scalpel", "extractor", "syringe"};
@@ -411,23 +411,11 @@ static const char *const physics_keys[P_NKEYS] = {
     [P_DT] = "dt", [P_PUBLISH_HZ] = "publish_hz", [P_QUANT_STEP] = "quant_step", [P_GRAVITY] = "gravity"};
 
 enum {
-  M_MASS,
-  M_STIFFNESS,
-  M_DAMPING,
-  M_HOME_STIFFNESS,
-  M_HOME_DAMPING,
-  M_BOND_K,
-  M_ANGLE_K,
-  M_STRETCH_BEND_K,
-  M_DISTANCE_STIFFNESS,
-  M_VOLUME_STIFFNESS,
-  M_DISTANCE_COMPLIANCE,
-  M_VOLUME_COMPLIANCE,
-  M_SLOPE_M1,
-  M_SLOPE_M2,
-  M_SLOPE_M3,
-  M_REFINE_AREA,
-  M_REFINE_LEVELS,
+  M_MASS, M_STIFFNESS, M_DAMPING, M_HOME_STIFFNESS, M_HOME_DAMPING,
+  M_BOND_K, M_ANGLE_K, M_STRETCH_BEND_K,
+  M_DISTANCE_STIFFNESS, M_VOLUME_STIFFNESS, M_DISTANCE_COMPLIANCE, M_VOLUME_COMPLIANCE,
+  M_SLOPE_M1, M_SLOPE_M2, M_SLOPE_M3,
+  M_REFINE_AREA, M_REFINE_LEVELS,
   M_NKEYS
 };
 static const char *const material_keys[M_NKEYS] = {[M_MASS] = "mass",
@@ -456,28 +444,13 @@ static const char *const solver_keys[V_NKEYS] = {[V_SUBSTEPS] = "substeps",
                                                  [V_TET_SIZE] = "tet_size"};
 
 enum {
-  O_NAME,
-  O_MESH,
-  O_MODEL,
-  O_INTEGRATOR,
-  O_SOLVER,
-  O_POSITION,
-  O_SCALE,
-  O_COLOR,
-  O_FIXED_BELOW,
-  O_MATERIAL,
+  O_NAME, O_MESH, O_MODEL, O_INTEGRATOR, O_SOLVER, O_POSITION, O_SCALE, O_COLOR, O_FIXED_BELOW, O_MATERIAL,
   O_NKEYS
 };
-static const char *const organ_keys[O_NKEYS] = {[O_NAME] = "name",
-                                                [O_MESH] = "mesh",
-                                                [O_MODEL] = "model",
-                                                [O_INTEGRATOR] = "integrator",
-                                                [O_SOLVER] = "solver",
-                                                [O_POSITION] = "position",
-                                                [O_SCALE] = "scale",
-                                                [O_COLOR] = "color",
-                                                [O_FIXED_BELOW] = "fixed_below",
-                                                [O_MATERIAL] = "material"};
+static const char *const organ_keys[O_NKEYS] = {
+    [O_NAME] = "name",         [O_MESH] = "mesh",          [O_MODEL] = "model", [O_INTEGRATOR] = "integrator",
+    [O_SOLVER] = "solver",     [O_POSITION] = "position",  [O_SCALE] = "scale", [O_COLOR] = "color",
+    [O_FIXED_BELOW] = "fixed_below", [O_MATERIAL] = "material"};
 
 enum {
   T_NAME,
@@ -585,7 +558,8 @@ static int parse_physics(const ctx_t *c, const node_t *n, scene_t *s) {
 
 /* v[] receives the value nodes so the model-specific checks in parse_organ
  * can point at the line of the value they complain about. */
-static int parse_material(const ctx_t *c, const node_t *n, const char *path, scene_material_t *m, const node_t **v) {
+static int parse_material(const ctx_t *c, const node_t *n, const char *path, scene_material_t *m,
+                          const node_t **v) {
   static const range_t unit = {B_INCL, 0, B_INCL, 1};
   static const range_t levels = {B_INCL, 1, B_INCL, 4};
   if (get_fields(c, n, path, material_keys, M_NKEYS, v)) return -1;
@@ -622,7 +596,8 @@ static int parse_solver(const ctx_t *c, const node_t *n, const char *path, scene
   if (opt_int(c, v[V_SUBSTEPS], path, "substeps", &substeps, &sv->substeps)) return -1;
   if (opt_int(c, v[V_ITERATIONS], path, "iterations", &iterations, &sv->iterations)) return -1;
   if (opt_number(c, v[V_CG_TOLERANCE], path, "cg_tolerance", &tolerance, &sv->cg_tolerance)) return -1;
-  if (opt_int(c, v[V_CG_MAX_ITERATIONS], path, "cg_max_iterations", &cg_iterations, &sv->cg_max_iterations)) return -1;
+  if (opt_int(c, v[V_CG_MAX_ITERATIONS], path, "cg_max_iterations", &cg_iterations, &sv->cg_max_iterations))
+    return -1;
   if (opt_number(c, v[V_TET_SIZE], path, "tet_size", &tet_size, &sv->tet_size)) return -1;
   /* 0 asks for the automatic size; anything else below 0.1 mm would build
    * millions of tetrahedra for an organ. */

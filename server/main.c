@@ -18,18 +18,19 @@ static void on_signal(int sig) {
 }
 
 static void usage(FILE *f) {
-  fprintf(f, "usage: viscera-server --scene FILE [options]\n"
-             "  --scene FILE        scene file (YAML, see assets/scenes/README.md)\n"
-             "  --domain N          DDS domain id 0..230 (default: $VISCERA_DOMAIN or 0)\n"
-             "  --partition P       session partition (default: " VDDS_DEFAULT_PARTITION ")\n"
-             "  --duration S        stop after S seconds (default: run until SIGINT/SIGTERM)\n"
-             "  --tool-timeout S    release a tool after S s without commands (default 0.5)\n"
-             "  --final-mesh PATH   on exit write the last published frame's exact positions (OBJ)\n"
-             "  --check             load and validate the scene, build its models, print per organ the model,\n"
-             "                      integrator, nodes, tetrahedra, sub-steps and stable dt, exit\n"
-             "  --quiet             only errors on stderr\n"
-             "  --help              this text\n"
-             "DDS configuration comes from CYCLONEDDS_URI (deploy/cyclonedds-loopback.xml for one machine).\n");
+  fprintf(f,
+          "usage: viscera-server --scene FILE [options]\n"
+          "  --scene FILE        scene file (YAML, see assets/scenes/README.md)\n"
+          "  --domain N          DDS domain id 0..230 (default: $VISCERA_DOMAIN or 0)\n"
+          "  --partition P       session partition (default: " VDDS_DEFAULT_PARTITION ")\n"
+          "  --duration S        stop after S seconds (default: run until SIGINT/SIGTERM)\n"
+          "  --tool-timeout S    release a tool after S s without commands (default 0.5)\n"
+          "  --final-mesh PATH   on exit write the last published frame's exact positions (OBJ)\n"
+          "  --check             load and validate the scene, build its models, print per organ the model,\n"
+          "                      integrator, nodes, tetrahedra, sub-steps and stable dt, exit\n"
+          "  --quiet             only errors on stderr\n"
+          "  --help              this text\n"
+          "DDS configuration comes from CYCLONEDDS_URI (deploy/cyclonedds-loopback.xml for one machine).\n");
 }
 
 int main(int argc, char **argv) {
@@ -41,32 +42,23 @@ int main(int argc, char **argv) {
     return 2;
   }
   int check_only = 0;
-  static const struct option lo[] = {{"scene", required_argument, 0, 's'},
-                                     {"domain", required_argument, 0, 'd'},
-                                     {"partition", required_argument, 0, 'p'},
-                                     {"duration", required_argument, 0, 't'},
-                                     {"final-mesh", required_argument, 0, 'f'},
-                                     {"tool-timeout", required_argument, 0, 'T'},
-                                     {"check", no_argument, 0, 'c'},
-                                     {"quiet", no_argument, 0, 'q'},
-                                     {"help", no_argument, 0, 'h'},
-                                     {0, 0, 0, 0}};
+  static const struct option lo[] = {{"scene", required_argument, 0, 's'},     {"domain", required_argument, 0, 'd'},
+                                     {"partition", required_argument, 0, 'p'}, {"duration", required_argument, 0, 't'},
+                                     {"final-mesh", required_argument, 0, 'f'}, {"tool-timeout", required_argument, 0, 'T'},
+                                     {"check", no_argument, 0, 'c'},           {"quiet", no_argument, 0, 'q'},
+                                     {"help", no_argument, 0, 'h'},            {0, 0, 0, 0}};
   int c;
   while ((c = getopt_long(argc, argv, "s:d:p:t:f:T:cqh", lo, NULL)) != -1) {
     char *end = NULL;
     switch (c) {
-    case 's':
-      scene_path = optarg;
-      break;
+    case 's': scene_path = optarg; break;
     case 'd':
       if ((opts.domain = vdds_parse_domain(optarg)) < 0) {
         fprintf(stderr, "viscera-server: --domain '%s' is not a domain id 0..230\n", optarg);
         return 2;
       }
       break;
-    case 'p':
-      opts.partition = optarg;
-      break;
+    case 'p': opts.partition = optarg; break;
     case 't':
       opts.duration = strtod(optarg, &end);
       if (*end || !(opts.duration >= 0)) {
@@ -81,21 +73,11 @@ int main(int argc, char **argv) {
         return 2;
       }
       break;
-    case 'f':
-      opts.final_mesh = optarg;
-      break;
-    case 'c':
-      check_only = 1;
-      break;
-    case 'q':
-      opts.quiet = 1;
-      break;
-    case 'h':
-      usage(stdout);
-      return 0;
-    default:
-      usage(stderr);
-      return 2;
+    case 'f': opts.final_mesh = optarg; break;
+    case 'c': check_only = 1; break;
+    case 'q': opts.quiet = 1; break;
+    case 'h': usage(stdout); return 0;
+    default: usage(stderr); return 2;
     }
   }
   if (!scene_path) {
@@ -134,13 +116,12 @@ int main(int argc, char **argv) {
     return 1;
   }
   fprintf(stderr,
-          "server: %" PRIu64 " steps, step time median %.1f us p99 %.1f us max %.1f us, %" PRIu64 " overruns, %" PRIu64
-          " rollbacks\n",
+          "server: %" PRIu64 " steps, step time median %.1f us p99 %.1f us max %.1f us, %" PRIu64
+          " overruns, %" PRIu64 " rollbacks\n",
           st.steps, st.step_us_median, st.step_us_p99, st.step_us_max, st.overruns, st.rollbacks);
   fprintf(stderr, "server: %" PRIu64 " tool commands applied, %" PRIu64 " rejected (", st.commands, st.rejected_total);
   for (int v = 1; v < TOOLCMD_VERDICT_COUNT; v++)
-    fprintf(stderr, "%s%s: %" PRIu64, v > 1 ? ", " : "", tool_command_verdict_str((tool_cmd_verdict_t)v),
-            st.rejected[v]);
+    fprintf(stderr, "%s%s: %" PRIu64, v > 1 ? ", " : "", tool_command_verdict_str((tool_cmd_verdict_t)v), st.rejected[v]);
   fprintf(stderr, ")\n");
   printf("SUMMARY steps=%" PRIu64 " peak_force=%.3f rejected=%" PRIu64 " rollbacks=%" PRIu64 " step_us_median=%.1f\n",
          st.steps, st.peak_force, st.rejected_total, st.rollbacks, st.step_us_median);

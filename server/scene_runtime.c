@@ -11,7 +11,8 @@
 
 static void apply_contacts(model_t *m, void *vctx);
 
-static int organ_init(organ_rt_t *o, runtime_t *rt, const scene_organ_t *cfg, uint32_t id, double tool_k, verr_t *err) {
+static int organ_init(organ_rt_t *o, runtime_t *rt, const scene_organ_t *cfg, uint32_t id, double tool_k,
+                      verr_t *err) {
   const scene_t *sc = &rt->scene;
   memset(o, 0, sizeof *o);
   o->cfg = cfg;
@@ -37,11 +38,10 @@ static int organ_init(organ_rt_t *o, runtime_t *rt, const scene_organ_t *cfg, ui
     model_destroy(o->model);
     o->model = NULL;
     mesh_free(&o->rest);
-    return verr_set(
-        err,
-        "%s:%d: organ '%s': model 'adaptive_mass_spring' runs in tests and benchmarks only; the live server "
-        "cannot stream its topology changes yet",
-        sc->path, cfg->line, cfg->name);
+    return verr_set(err,
+                    "%s:%d: organ '%s': model 'adaptive_mass_spring' runs in tests and benchmarks only; the live server "
+                    "cannot stream its topology changes yet",
+                    sc->path, cfg->line, cfg->name);
   }
   o->model->hook = apply_contacts;
   o->model->hook_ctx = o;
@@ -78,8 +78,8 @@ int runtime_init(runtime_t *rt, const scene_t *scene, verr_t *err) {
     if (m->nsurf_tris) mean_edge /= 3.0 * (double)m->nsurf_tris;
     for (size_t t = 0; t < scene->ntools; t++) tool_r = fmax(tool_r, scene->tools[t].radius);
     o->patch_radius = fmax(2 * tool_r, 1.5 * mean_edge);
-    rt->surfaces[i] = (proxy_surface_t){
-        .x = m->surf_x, .tris = m->surf_tris, .ntris = m->nsurf_tris, .max_edge = 3 * max_edge, .x_rest = m->surf_rest};
+    rt->surfaces[i] = (proxy_surface_t){.x = m->surf_x, .tris = m->surf_tris, .ntris = m->nsurf_tris,
+                                        .max_edge = 3 * max_edge, .x_rest = m->surf_rest};
     verr_t te;
     if (aabb_tree_build(&o->tree, m->surf_x, m->nsurf, m->surf_tris, m->nsurf_tris, &te)) {
       verr_set(err, "%s:%d: organ '%s': %s", rt->scene.path, o->cfg->line, o->cfg->name, te.msg);

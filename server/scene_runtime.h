@@ -42,12 +42,12 @@ typedef struct organ_rt {
 
 typedef struct tool_rt {
   const scene_tool_t *cfg;
-  int active;       /* a valid command has been received */
-  double device[3]; /* commanded tip, m */
-  double max_force; /* N: min(tool, device capability) */
+  int active;          /* a valid command has been received */
+  double device[3];    /* commanded tip, m */
+  double max_force;    /* N: min(tool, device capability) */
   proxy_t proxy;
-  double force[3];   /* N on the tool, last step */
-  double peak_force; /* N since start */
+  double force[3];     /* N on the tool, last step */
+  double peak_force;   /* N since start */
   /* Contact patch: the tissue vertices that share the reaction force, with
    * weights summing to 1. A rigid tip presses an area, not three vertices;
    * spreading the load keeps the dent smooth and the contact normal steady. */

@@ -165,8 +165,7 @@ static void read_commands(server_t *s, uint64_t now) {
   for (size_t t = 0; t < s->rt.ntools; t++) {
     if (s->rt.tools[t].active && now - s->last_cmd_mono[t] > (uint64_t)(s->opts->tool_timeout * 1e9)) {
       runtime_release_tool(&s->rt, t);
-      if (!s->opts->quiet)
-        fprintf(stderr, "server: tool %zu: no commands for %.1f s, released\n", t, s->opts->tool_timeout);
+      if (!s->opts->quiet) fprintf(stderr, "server: tool %zu: no commands for %.1f s, released\n", t, s->opts->tool_timeout);
       publish_event(s, viscera_EVENT_CLIENT_LOST, -1, (int)t, 0, "haptic client lost: tool released");
     }
   }
@@ -345,8 +344,8 @@ static void write_final_mesh(server_t *s) {
     else
       snprintf(path, sizeof path, "%s.%zu", s->opts->final_mesh, i);
     const model_t *model = s->rt.organs[i].model;
-    mesh_t m = {
-        .nverts = model->nsurf, .ntris = model->nsurf_tris, .pos = model->surf_x, .tris = (uint32_t *)model->surf_tris};
+    mesh_t m = {.nverts = model->nsurf, .ntris = model->nsurf_tris, .pos = model->surf_x,
+                .tris = (uint32_t *)model->surf_tris};
     char comment[160];
     snprintf(comment, sizeof comment, "organ %zu topology %u keyframe %u frame %u", i, s->pubs[i].topology_version,
              s->pubs[i].keyframe_seq, s->pubs[i].frame_seq);
@@ -373,12 +372,11 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
       fprintf(stderr,
               "server: organ '%s': %s, %s, %zu nodes, %zu tetrahedra, surface %zu vertices / %zu triangles, "
               "%d sub-step(s) per %.3g ms (stable below %.3g ms)\n",
-              o->cfg->name, m->ops->name, o->cfg->integrator, m->nnodes, m->ntets, m->nsurf, m->nsurf_tris, m->substeps,
-              scene->dt * 1e3, m->stable_dt * 1e3);
+              o->cfg->name, m->ops->name, o->cfg->integrator, m->nnodes, m->ntets, m->nsurf, m->nsurf_tris,
+              m->substeps, scene->dt * 1e3, m->stable_dt * 1e3);
       if (m->substeps > 0 && scene->dt / m->substeps > m->stable_dt)
-        fprintf(stderr,
-                "server: organ '%s': warning: solver.substeps %d gives %.3g ms sub-steps, above the "
-                "stable %.3g ms: expect rollbacks\n",
+        fprintf(stderr, "server: organ '%s': warning: solver.substeps %d gives %.3g ms sub-steps, above the "
+                        "stable %.3g ms: expect rollbacks\n",
                 o->cfg->name, m->substeps, scene->dt / m->substeps * 1e3, m->stable_dt * 1e3);
     }
     fprintf(stderr, "server: scene '%s' running on domain %d, partition '%s'\n", scene->name, opts->domain,

@@ -19,7 +19,7 @@ typedef struct server_opts {
   double duration;        /* s of wall time; 0 = until stopped */
   const char *final_mesh; /* write exact positions of the last published frame here (OBJ) */
   int quiet;
-  double tool_timeout; /* s without a command before a tool is released */
+  double tool_timeout;    /* s without a command before a tool is released */
 } server_opts_t;
 
 typedef struct server_stats {
@@ -27,7 +27,7 @@ typedef struct server_stats {
   double peak_force;
   double step_us_median, step_us_p99, step_us_max;
   size_t ntools;
-  thr_tracker_t thr[SCENE_MAX_TOOLS];         /* palpation measures per tool at the end */
+  thr_tracker_t thr[SCENE_MAX_TOOLS]; /* palpation measures per tool at the end */
   viscera_ToolMetrics tools[SCENE_MAX_TOOLS]; /* per-tool measures at the end */
   size_t ntasks;
   task_rt_t tasks[SCENE_MAX_TASKS]; /* cfg points into the server's scene copy: use the index, not cfg */

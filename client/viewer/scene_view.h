@@ -2,8 +2,8 @@
  *
  * Subscribes to SceneInfo (organ colours, tool sizes), MeshState and
  * MeshDelta (the organ meshes, see organ_state.h), ToolCommand (tool tip),
- * ContactFeedback (contact, proxy, force) and ObjectState (stones). scene_view_poll() takes what
- * has arrived without blocking; the readers are keep-last 1 per instance,
+ * ContactFeedback (contact, proxy, force) and ObjectState (stones).
+ * scene_view_poll() takes what has arrived without blocking; the readers are keep-last 1 per instance,
  * so polling at the viewer's pace loses nothing that would be drawn.
  *
  * Every sample is untrusted: ids are bounded to the tables below, numbers
@@ -44,7 +44,7 @@ typedef struct sv_tool {
   int listed;
   char name[65];
   float radius, length, max_force; /* m, m, N */
-  float st, mpf, sft;              /* N, palpation thresholds; 0 = unset */
+  float st, mpf, sft;               /* N, palpation thresholds; 0 = unset */
   int have_pose;
   float tip[3];     /* m, from ToolCommand */
   int have_contact; /* a ContactFeedback arrived */
