@@ -3,6 +3,7 @@
 #include "physics/adaptive.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "interaction/tool_actions.h"
@@ -87,6 +88,15 @@ int runtime_init(runtime_t *rt, const scene_t *scene, verr_t *err) {
       return -1;
     }
     rt->surfaces[i].tree = &o->tree;
+    o->vn_rest = malloc(3 * m->nsurf * sizeof *o->vn_rest);
+    if (!o->vn_rest) {
+      verr_set(err, "%s:%d: organ '%s': out of memory", rt->scene.path, o->cfg->line, o->cfg->name);
+      runtime_destroy(rt);
+      return -1;
+    }
+    proxy_vertex_normals(m->nsurf, m->surf_rest, m->nsurf_tris, m->surf_tris, o->vn_rest);
+    rt->surfaces[i].vn = o->vn_rest;
+    rt->surfaces[i].nvn = m->nsurf;
     double lo[3], hi[3];
     mesh_bounds(&o->rest, lo, hi);
     for (int k = 0; k < 3; k++) {
@@ -118,6 +128,8 @@ void runtime_destroy(runtime_t *rt) {
     model_destroy(rt->organs[i].model);
     rt->organs[i].model = NULL;
     aabb_tree_destroy(&rt->organs[i].tree);
+    free(rt->organs[i].vn_rest);
+    rt->organs[i].vn_rest = NULL;
     mesh_free(&rt->organs[i].rest);
   }
   rt->norgans = 0;
@@ -205,8 +217,8 @@ int runtime_step(runtime_t *rt) {
   for (size_t t = 0; t < rt->ntools; t++) {
     tool_rt_t *tool = &rt->tools[t];
     if (!tool->active || !interact_uses_proxy(rt, t)) continue;
-    proxy_update(&tool->proxy, tool->device, rt->surfaces, rt->norgans, tool->cfg->stiffness, tool->max_force,
-                 tool->force);
+    proxy_update_friction(&tool->proxy, tool->device, rt->surfaces, rt->norgans, tool->cfg->stiffness, tool->max_force,
+                          tool->cfg->friction, tool->force);
     build_patch(rt, tool);
   }
   int rolled = 0;

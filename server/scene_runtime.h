@@ -35,6 +35,7 @@ typedef struct organ_rt {
   model_t *model;      /* sub-steps and stable dt live in the model */
   double patch_radius; /* m, contact patch radius: max(2 tool radius, 1.5 mean surface edge) */
   aabb_tree_t tree;    /* over the model's contact surface, refit after every step */
+  double *vn_rest;     /* unit vertex normals of the rest surface (force shading, proxy.h) */
   uint64_t rollbacks;
 } organ_rt_t;
 
