@@ -119,7 +119,7 @@ static void test_grasp_pull_release(int lose_client) {
   for (size_t j = 0; j < rt.tools[0].grasp.n; j++) held |= rt.tools[0].grasp.v[j] == vi;
   CHECK(held);
   drive(0, at, lifted, 1000);
-  drive(0, lifted, lifted, 500);
+  drive(0, lifted, lifted, 200);
   double dz = m->surf_x[3 * vi + 2] - z0;
   printf("grasp: %zu vertices held, nearest vertex lifted %.2f mm by a 12 mm pull, tool force %.3f N (z %.3f)\n",
          rt.tools[0].grasp.n, dz * 1e3, v3_norm(rt.tools[0].force), rt.tools[0].force[2]);
@@ -131,15 +131,15 @@ static void test_grasp_pull_release(int lose_client) {
   if (lose_client) {
     runtime_release_tool(&rt, 0);
     CHECK(!rt.tools[0].grasp.active);
-    for (int i = 0; i < 2000; i++) runtime_step(&rt);
+    for (int i = 0; i < 1000; i++) runtime_step(&rt);
   } else {
     runtime_set_buttons(&rt, 0, 0);
-    drive(0, lifted, lifted, 2000);
+    drive(0, lifted, lifted, 1000);
     CHECK(!rt.tools[0].grasp.active && v3_norm(rt.tools[0].force) < 1e-9);
   }
   CHECK(count_events(IEV_GRASP_END) == 1);
   double back = m->surf_x[3 * vi + 2] - z0;
-  printf("grasp: %s, after 2 s the vertex is %.3f mm from rest\n", lose_client ? "client lost" : "released",
+  printf("grasp: %s, after 1 s the vertex is %.3f mm from rest\n", lose_client ? "client lost" : "released",
          back * 1e3);
   CHECK(fabs(back) < 0.001); /* the tissue went home */
   runtime_destroy(&rt);
