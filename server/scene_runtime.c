@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "interaction/shaft.h"
 #include "interaction/tool_actions.h"
 #include "mesh_import.h"
 #include "vmath.h"
@@ -146,6 +147,10 @@ void runtime_set_tool(runtime_t *rt, size_t t, const double pos[3], double devic
 
 void runtime_set_buttons(runtime_t *rt, size_t t, uint32_t buttons) {
   if (t < rt->ntools) rt->tools[t].buttons = buttons;
+}
+
+void runtime_set_orientation(runtime_t *rt, size_t t, const double q[4]) {
+  if (t < rt->ntools) shaft_axis(q, rt->tools[t].axis);
 }
 
 void runtime_release_tool(runtime_t *rt, size_t t) {

@@ -61,6 +61,7 @@ typedef struct tool_rt {
   grasp_t grasp;         /* grasper: tissue held */
   int stone;             /* extractor: stone held, or -1 */
   double first_cmd_time; /* s of simulated time of the first command, -1 before */
+  double axis[3];        /* unit shaft direction from the tip (command orientation applied to +z) */
   /* What the tool's client is told (ContactFeedback): the tip the hand
    * feels (god-object, stone surface, grasp pull or tool-tool contact),
    * normal and whether anything touches; organ -1 for stones and tools. */
@@ -94,6 +95,8 @@ void runtime_destroy(runtime_t *rt);
 void runtime_set_tool(runtime_t *rt, size_t t, const double pos[3], double device_max_force);
 /* The command's buttons (bit 0: close the jaws), applied at the next step. */
 void runtime_set_buttons(runtime_t *rt, size_t t, uint32_t buttons);
+/* The command's orientation (unit quaternion w, x, y, z): the shaft axis. */
+void runtime_set_orientation(runtime_t *rt, size_t t, const double q[4]);
 /* Tool no longer driven (client gone): releases contact, stops acting. */
 void runtime_release_tool(runtime_t *rt, size_t t);
 

@@ -154,6 +154,8 @@ static void read_commands(server_t *s, uint64_t now) {
       double pos[3] = {c->position[0], c->position[1], c->position[2]};
       runtime_set_tool(&s->rt, c->tool_id, pos, c->max_force);
       runtime_set_buttons(&s->rt, c->tool_id, c->buttons);
+      double q[4] = {c->orientation[0], c->orientation[1], c->orientation[2], c->orientation[3]};
+      runtime_set_orientation(&s->rt, c->tool_id, q);
       s->cmd_seq[c->tool_id] = c->seq;
       s->cmd_echo[c->tool_id] = c->client_mono_ns;
       s->last_cmd_mono[c->tool_id] = now;

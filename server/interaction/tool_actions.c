@@ -3,6 +3,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "shaft.h"
 #include "vmath.h"
 
 /* The removal test scans the organ's rest surface (O(triangles)): every
@@ -38,6 +39,7 @@ int interact_init(runtime_t *rt, verr_t *err) {
     grasp_init(&rt->tools[t].grasp);
     rt->tools[t].stone = -1;
     rt->tools[t].first_cmd_time = -1;
+    v3_set(rt->tools[t].axis, 0, 0, 1);
   }
   rt->ntasks = sc->ntasks;
   tasks_init(rt->tasks, sc);
@@ -134,6 +136,15 @@ void interact_before_step(runtime_t *rt) {
   }
 }
 
+/* The shaft of a driven tool that meets tissue (not the extractor: it
+ * enters through its port); its tip is where the hand's tip is held. */
+static int shaft_of(const tool_rt_t *tool, double p0[3], double p1[3]) {
+  if (!tool->active || is_kind(tool, "extractor")) return 0;
+  const double *tip = tool->proxy.in_contact ? tool->proxy.pos : tool->device;
+  shaft_segment(tip, tool->axis, tool->cfg->radius, tool->cfg->length, p0, p1);
+  return 1;
+}
+
 static void add_force(void *ctx, uint32_t i, const double f[3]) {
   model_t *m = ctx;
   m->ops->add_surface_force(m, i, f);
@@ -146,6 +157,13 @@ void interact_apply(runtime_t *rt, organ_rt_t *o, model_t *m) {
     double fv[GRASP_MAX_VERTS][3], ft[3];
     grasp_force(&tool->grasp, m->surf_x, tool->device, tool->cfg->stiffness, tool->max_force, fv, ft);
     for (size_t j = 0; j < tool->grasp.n; j++) m->ops->add_surface_force(m, tool->grasp.v[j], fv[j]);
+  }
+  for (size_t t = 0; t < rt->ntools; t++) {
+    tool_rt_t *tool = &rt->tools[t];
+    double p0[3], p1[3], ft[3] = {0, 0, 0};
+    if (!shaft_of(tool, p0, p1)) continue;
+    shaft_push(p0, p1, SHAFT_RADIUS_FRACTION * tool->cfg->radius, tool->cfg->stiffness, m->surf_x, m->nsurf, add_force,
+               m, ft);
   }
   for (size_t i = 0; i < rt->nstones; i++) {
     stone_t *s = &rt->stones[i];
@@ -169,6 +187,38 @@ static void set_pulled(tool_rt_t *tool, const double f_in[3], int organ) {
   if (v3_normalize(tool->fb_normal) <= 0) v3_set(tool->fb_normal, 0, 0, 1);
   v3_copy(tool->fb_pos, tool->device);
   v3_axpy(tool->fb_pos, f, 1.0 / tool->cfg->stiffness);
+}
+
+static void add_nothing(void *ctx, uint32_t i, const double f[3]) {
+  (void)ctx;
+  (void)i;
+  (void)f;
+}
+
+/* The shaft's reaction at the end of the step: added to what the tip
+ * feels; a shaft touching while the tip is free is a contact of its own. */
+static void shaft_feedback(runtime_t *rt, tool_rt_t *tool) {
+  double p0[3], p1[3], ft[3] = {0, 0, 0};
+  if (!shaft_of(tool, p0, p1)) return;
+  size_t hits = 0;
+  int organ = -1;
+  for (size_t i = 0; i < rt->norgans; i++) {
+    const model_t *m = rt->organs[i].model;
+    size_t h = shaft_push(p0, p1, SHAFT_RADIUS_FRACTION * tool->cfg->radius, tool->cfg->stiffness, m->surf_x, m->nsurf,
+                          add_nothing, NULL, ft);
+    if (h && organ < 0) organ = (int)i;
+    hits += h;
+  }
+  if (!hits) return;
+  double f[3];
+  v3_add(f, tool->force, ft);
+  if (tool->fb_contact) {
+    double mag = v3_norm(f);
+    if (mag > tool->max_force && mag > 0) v3_scale(f, f, tool->max_force / mag);
+    v3_copy(tool->force, f);
+  } else {
+    set_pulled(tool, f, organ);
+  }
 }
 
 /* The extractor's tip against a stone it does not hold: a god-object on
@@ -264,6 +314,7 @@ void interact_after_step(runtime_t *rt) {
       v3_copy(tool->fb_pos, tool->proxy.pos);
       v3_copy(tool->fb_normal, tool->proxy.normal);
     }
+    shaft_feedback(rt, tool);
   }
   tool_tool_contact(rt);
   for (size_t t = 0; t < rt->ntools; t++) {

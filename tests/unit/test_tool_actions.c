@@ -8,7 +8,8 @@
  * - stone removal: the extractor takes the stone, carries it out, the
  *   task completes with its operation time; a stone left inside does not;
  * - two tools driven to the same point keep their tips r1 + r2 apart and
- *   feel opposite forces. */
+ *   feel opposite forces;
+ * - a shaft laid on the tissue presses it and is pushed back. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -210,6 +211,37 @@ static void test_tool_tool(void) {
   runtime_destroy(&rt);
 }
 
+/* A probe laid flat (axis +x) with its shaft 1 mm above the kidney's top:
+ * the shaft (radius 0.45 x 3 mm) presses the surface down and is pushed up;
+ * held upright at the same place the shaft touches nothing. */
+static void test_shaft(void) {
+  CHECK(load(KIDNEY "tools:\n  - {name: a, radius: 0.003, length: 0.1, stiffness: 400}\n"));
+  const model_t *m = rt.organs[0].model;
+  double top[3] = {0.012, 0.004, 0.0346};
+  size_t vi = 0;
+  for (size_t i = 1; i < m->nsurf; i++)
+    if (v3_dist(m->surf_rest + 3 * i, top) < v3_dist(m->surf_rest + 3 * vi, top)) vi = i;
+  double vz = m->surf_rest[3 * vi + 2];
+  /* Tip well outside the kidney (x < -0.055), axis along +x over the top. */
+  double tip[3] = {-0.07, m->surf_rest[3 * vi + 1], vz + 0.001};
+  const double flat[4] = {sqrt(0.5), 0, sqrt(0.5), 0}; /* +z turned to +x about y */
+  runtime_set_orientation(&rt, 0, flat);
+  CHECK_NEAR(rt.tools[0].axis[0], 1, 1e-12);
+  drive(0, tip, tip, 300);
+  double dz = m->surf_x[3 * vi + 2] - vz;
+  printf("shaft: laid 1 mm above the surface, the vertex below sinks %.3f mm, the tool is pushed up %.3f N\n",
+         -dz * 1e3, rt.tools[0].force[2]);
+  CHECK(dz < -0.0001);
+  CHECK(rt.tools[0].force[2] > 0.05 && rt.tools[0].fb_contact && rt.tools[0].fb_organ == 0);
+  CHECK(!rt.tools[0].proxy.in_contact); /* the tip itself touches nothing */
+  const double upright[4] = {1, 0, 0, 0};
+  runtime_set_orientation(&rt, 0, upright);
+  drive(0, tip, tip, 1000);
+  CHECK(!rt.tools[0].fb_contact && v3_norm(rt.tools[0].force) == 0);
+  CHECK(fabs(m->surf_x[3 * vi + 2] - vz) < 1e-5);
+  runtime_destroy(&rt);
+}
+
 int main(void) {
   if (!getenv("VISCERA_SOURCE_DIR")) {
     fprintf(stderr, "test_tool_actions: VISCERA_SOURCE_DIR not set (run through ctest)\n");
@@ -222,5 +254,6 @@ int main(void) {
   test_stone(1);
   test_stone(0);
   test_tool_tool();
+  test_shaft();
   return check_report("test_tool_actions");
 }
