@@ -31,7 +31,9 @@ static const char *const scene_models[] = {"mass_spring_surface", "mass_spring_t
                                            "xpbd", "vertex_based", "adaptive_mass_spring"};
 static const char *const scene_integrators[] = {"symplectic_euler", "explicit_euler", "verlet", "rk4",
                                                 "implicit_euler"};
-static const char *const scene_tool_kinds[] = {"probe"};
+static const char *const scene_tool_kinds[] = {"probe", "grasper", "scalpel", "extractor", "syringe"};
+static const char *const scene_object_kinds[] = {"stone"};
+static const char *const scene_task_kinds[] = {"stone_removal", "palpate_target", "grasp_pull"};
 
 /* ---- the tree ---------------------------------------------------------- */
 
@@ -450,27 +452,53 @@ static const char *const organ_keys[O_NKEYS] = {
     [O_SOLVER] = "solver",     [O_POSITION] = "position",  [O_SCALE] = "scale", [O_COLOR] = "color",
     [O_FIXED_BELOW] = "fixed_below", [O_MATERIAL] = "material"};
 
-enum { T_NAME, T_KIND, T_RADIUS, T_LENGTH, T_STIFFNESS, T_MAX_FORCE, T_THRESHOLDS, T_NKEYS };
-static const char *const tool_keys[T_NKEYS] = {
-    [T_NAME] = "name",     [T_KIND] = "kind",           [T_RADIUS] = "radius",
-    [T_LENGTH] = "length", [T_STIFFNESS] = "stiffness", [T_MAX_FORCE] = "max_force",
-    [T_THRESHOLDS] = "thresholds"};
+enum {
+  T_NAME,
+  T_KIND,
+  T_RADIUS,
+  T_LENGTH,
+  T_STIFFNESS,
+  T_MAX_FORCE,
+  T_THRESHOLDS,
+  T_FRICTION,
+  T_GRASP_RADIUS,
+  T_JAW_OPENING,
+  T_NKEYS
+};
+static const char *const tool_keys[T_NKEYS] = {[T_NAME] = "name",
+                                               [T_KIND] = "kind",
+                                               [T_RADIUS] = "radius",
+                                               [T_LENGTH] = "length",
+                                               [T_STIFFNESS] = "stiffness",
+                                               [T_MAX_FORCE] = "max_force",
+                                               [T_THRESHOLDS] = "thresholds",
+                                               [T_FRICTION] = "friction",
+                                               [T_GRASP_RADIUS] = "grasp_radius",
+                                               [T_JAW_OPENING] = "jaw_opening"};
+
+enum { J_NAME, J_KIND, J_RADIUS, J_POSITION, J_ORGAN, J_COLOR, J_NKEYS };
+static const char *const object_keys[J_NKEYS] = {[J_NAME] = "name",         [J_KIND] = "kind",   [J_RADIUS] = "radius",
+                                                 [J_POSITION] = "position", [J_ORGAN] = "organ", [J_COLOR] = "color"};
+
+enum { K_NAME, K_KIND, K_TOOL, K_OBJECT, K_TARGET, K_TARGET_RADIUS, K_DISTANCE, K_NKEYS };
+static const char *const task_keys[K_NKEYS] = {
+    [K_NAME] = "name",        [K_KIND] = "kind",     [K_TOOL] = "tool",
+    [K_OBJECT] = "object",    [K_TARGET] = "target", [K_TARGET_RADIUS] = "target_radius",
+    [K_DISTANCE] = "distance"};
 
 /* In the order they must rise: ST < MPF <= SFT (seed 002 ch. 6). */
 enum { H_ST, H_MPF, H_SFT, H_NKEYS };
 static const char *const threshold_keys[H_NKEYS] = {[H_ST] = "st", [H_MPF] = "mpf", [H_SFT] = "sft"};
 
-enum { S_SCENE, S_DESCRIPTION, S_PHYSICS, S_ORGANS, S_TOOLS, S_NKEYS };
-static const char *const top_keys[S_NKEYS] = {[S_SCENE] = "scene",
-                                              [S_DESCRIPTION] = "description",
-                                              [S_PHYSICS] = "physics",
-                                              [S_ORGANS] = "organs",
-                                              [S_TOOLS] = "tools"};
+enum { S_SCENE, S_DESCRIPTION, S_PHYSICS, S_ORGANS, S_TOOLS, S_OBJECTS, S_TASKS, S_NKEYS };
+static const char *const top_keys[S_NKEYS] = {
+    [S_SCENE] = "scene", [S_DESCRIPTION] = "description", [S_PHYSICS] = "physics", [S_ORGANS] = "organs",
+    [S_TOOLS] = "tools", [S_OBJECTS] = "objects",         [S_TASKS] = "tasks"};
 
 /* get_fields() tracks the keys seen in a fixed array of SCENE_MAX_KEYS. */
 _Static_assert(P_NKEYS <= SCENE_MAX_KEYS && M_NKEYS <= SCENE_MAX_KEYS && V_NKEYS <= SCENE_MAX_KEYS &&
-                   O_NKEYS <= SCENE_MAX_KEYS &&
-                   T_NKEYS <= SCENE_MAX_KEYS && H_NKEYS <= SCENE_MAX_KEYS && S_NKEYS <= SCENE_MAX_KEYS,
+                   O_NKEYS <= SCENE_MAX_KEYS && T_NKEYS <= SCENE_MAX_KEYS && H_NKEYS <= SCENE_MAX_KEYS &&
+                   S_NKEYS <= SCENE_MAX_KEYS && J_NKEYS <= SCENE_MAX_KEYS && K_NKEYS <= SCENE_MAX_KEYS,
                "raise SCENE_MAX_KEYS");
 
 static void organ_defaults(scene_organ_t *o) {
@@ -718,6 +746,30 @@ static int parse_thresholds(const ctx_t *c, const node_t *n, const char *path, s
   return 0;
 }
 
+/* Friction for every kind; grasp_radius and jaw_opening only for the kinds
+ * that have jaws: a key a kind cannot use is refused, not ignored, so a
+ * scene never promises a capability the tool does not have. */
+static int parse_capability(const ctx_t *c, const node_t *const *v, const char *path, scene_tool_t *t) {
+  static const range_t mu_range = {B_INCL, 0, B_INCL, 2};
+  static const range_t grasp_range = {B_EXCL, 0, B_INCL, 0.05};
+  char fp[128];
+  if (opt_number(c, v[T_FRICTION], path, "friction", &mu_range, &t->friction)) return -1;
+  int jaws = !strcmp(t->kind, "grasper") || !strcmp(t->kind, "extractor");
+  if (v[T_GRASP_RADIUS] && !jaws) {
+    join(fp, sizeof fp, path, "grasp_radius");
+    return field_err(c, v[T_GRASP_RADIUS], fp, "only a grasper or an extractor grasps (this tool is a %s)", t->kind);
+  }
+  if (v[T_JAW_OPENING] && strcmp(t->kind, "grasper")) {
+    join(fp, sizeof fp, path, "jaw_opening");
+    return field_err(c, v[T_JAW_OPENING], fp, "only a grasper has jaws to open (this tool is a %s)", t->kind);
+  }
+  if (jaws) t->grasp_radius = 2 * t->radius;
+  if (!strcmp(t->kind, "grasper")) t->jaw_opening = 4 * t->radius;
+  if (opt_number(c, v[T_GRASP_RADIUS], path, "grasp_radius", &grasp_range, &t->grasp_radius)) return -1;
+  if (opt_number(c, v[T_JAW_OPENING], path, "jaw_opening", &grasp_range, &t->jaw_opening)) return -1;
+  return 0;
+}
+
 static int parse_tool(const ctx_t *c, const node_t *n, size_t idx, scene_t *s) {
   scene_tool_t *t = &s->tools[idx];
   const node_t *v[T_NKEYS];
@@ -746,6 +798,138 @@ static int parse_tool(const ctx_t *c, const node_t *n, size_t idx, scene_t *s) {
   if (v[T_THRESHOLDS]) {
     join(fp, sizeof fp, path, "thresholds");
     if (parse_thresholds(c, v[T_THRESHOLDS], fp, t)) return -1;
+  }
+  return parse_capability(c, v, path, t);
+}
+
+/* Looks `n` up among `count` names spaced `stride` bytes apart; -1 with a
+ * message listing them when absent. */
+static int find_name(const ctx_t *c, const node_t *n, const char *path, const char *what, const char *names,
+                     size_t stride, size_t count, int *out) {
+  char want[SCENE_NAME_LEN];
+  if (get_string(c, n, path, want, sizeof want)) return -1;
+  char known[400] = "";
+  size_t k = 0;
+  for (size_t i = 0; i < count; i++) {
+    const char *nm = names + i * stride;
+    if (!strcmp(nm, want)) {
+      *out = (int)i;
+      return 0;
+    }
+    if (k < sizeof known) {
+      int w = snprintf(known + k, sizeof known - k, "%s%s", i ? ", " : "", nm);
+      if (w > 0) k += (size_t)w;
+    }
+  }
+  return field_err(c, n, path, "no %s named '%.*s%s' (known: %s)", what, SHOW(n), count ? known : "none");
+}
+
+static int parse_object(const ctx_t *c, const node_t *n, size_t idx, scene_t *s) {
+  scene_object_t *o = &s->objects[idx];
+  const node_t *v[J_NKEYS];
+  char path[64], fp[128];
+  static const range_t radius_range = {B_EXCL, 0, B_INCL, 0.05};
+  static const range_t unit = {B_INCL, 0, B_INCL, 1};
+  snprintf(path, sizeof path, "objects[%zu]", idx);
+  memset(o, 0, sizeof *o);
+  snprintf(o->kind, sizeof o->kind, "%s", scene_object_kinds[0]);
+  o->color[0] = 0.85f;
+  o->color[1] = 0.8f;
+  o->color[2] = 0.55f;
+  o->line = n->line;
+  if (get_fields(c, n, path, object_keys, J_NKEYS, v)) return -1;
+  if (!v[J_NAME]) return missing(c, n, path, "name");
+  if (!v[J_RADIUS]) return missing(c, n, path, "radius");
+  if (!v[J_POSITION]) return missing(c, n, path, "position");
+  if (!v[J_ORGAN]) return missing(c, n, path, "organ");
+  join(fp, sizeof fp, path, "name");
+  if (get_name(c, v[J_NAME], fp, o->name, sizeof o->name)) return -1;
+  for (size_t j = 0; j < idx; j++)
+    if (!strcmp(s->objects[j].name, o->name))
+      return field_err(c, v[J_NAME], fp, "duplicate object name '%s' (first used by objects[%zu] at line %d)", o->name,
+                       j, s->objects[j].line);
+  join(fp, sizeof fp, path, "kind");
+  if (v[J_KIND] && get_choice(c, v[J_KIND], fp, scene_object_kinds, COUNT(scene_object_kinds), o->kind, sizeof o->kind))
+    return -1;
+  if (opt_number(c, v[J_RADIUS], path, "radius", &radius_range, &o->radius)) return -1;
+  join(fp, sizeof fp, path, "position");
+  if (get_vec3(c, v[J_POSITION], fp, &ANY, o->position)) return -1;
+  join(fp, sizeof fp, path, "organ");
+  if (find_name(c, v[J_ORGAN], fp, "organ", s->organs[0].name, sizeof s->organs[0], s->norgans, &o->organ)) return -1;
+  if (v[J_COLOR]) {
+    double rgb[3];
+    join(fp, sizeof fp, path, "color");
+    if (get_vec3(c, v[J_COLOR], fp, &unit, rgb)) return -1;
+    for (int k = 0; k < 3; k++) o->color[k] = (float)rgb[k];
+  }
+  return 0;
+}
+
+/* A key given to a task kind that does not read it is refused. */
+static int task_key_unused(const ctx_t *c, const node_t *const *v, int key, const char *path, const char *kind) {
+  if (!v[key]) return 0;
+  char fp[128];
+  join(fp, sizeof fp, path, task_keys[key]);
+  return field_err(c, v[key], fp, "a %s task does not use this key", kind);
+}
+
+static int parse_task(const ctx_t *c, const node_t *n, size_t idx, scene_t *s) {
+  scene_task_t *t = &s->tasks[idx];
+  const node_t *v[K_NKEYS];
+  char path[64], fp[128];
+  static const range_t radius_range = {B_EXCL, 0, B_INCL, 0.1};
+  static const range_t distance_range = {B_EXCL, 0, B_INCL, 0.5};
+  snprintf(path, sizeof path, "tasks[%zu]", idx);
+  memset(t, 0, sizeof *t);
+  t->object = -1;
+  t->target_radius = 0.005;
+  t->distance = 0.01;
+  t->line = n->line;
+  if (get_fields(c, n, path, task_keys, K_NKEYS, v)) return -1;
+  if (!v[K_NAME]) return missing(c, n, path, "name");
+  if (!v[K_KIND]) return missing(c, n, path, "kind");
+  if (!v[K_TOOL]) return missing(c, n, path, "tool");
+  join(fp, sizeof fp, path, "name");
+  if (get_name(c, v[K_NAME], fp, t->name, sizeof t->name)) return -1;
+  for (size_t j = 0; j < idx; j++)
+    if (!strcmp(s->tasks[j].name, t->name))
+      return field_err(c, v[K_NAME], fp, "duplicate task name '%s' (first used by tasks[%zu] at line %d)", t->name, j,
+                       s->tasks[j].line);
+  join(fp, sizeof fp, path, "kind");
+  if (get_choice(c, v[K_KIND], fp, scene_task_kinds, COUNT(scene_task_kinds), t->kind, sizeof t->kind)) return -1;
+  join(fp, sizeof fp, path, "tool");
+  if (find_name(c, v[K_TOOL], fp, "tool", s->tools[0].name, sizeof s->tools[0], s->ntools, &t->tool)) return -1;
+  const char *tk = s->tools[t->tool].kind;
+  if (!strcmp(t->kind, "stone_removal")) {
+    if (strcmp(tk, "extractor"))
+      return field_err(c, v[K_TOOL], fp, "a stone_removal task needs an extractor (tool '%s' is a %s)",
+                       s->tools[t->tool].name, tk);
+    if (!v[K_OBJECT]) return missing(c, n, path, "object");
+    join(fp, sizeof fp, path, "object");
+    if (find_name(c, v[K_OBJECT], fp, "object", s->objects[0].name, sizeof s->objects[0], s->nobjects, &t->object))
+      return -1;
+    if (task_key_unused(c, v, K_TARGET, path, t->kind) || task_key_unused(c, v, K_TARGET_RADIUS, path, t->kind) ||
+        task_key_unused(c, v, K_DISTANCE, path, t->kind))
+      return -1;
+  } else if (!strcmp(t->kind, "palpate_target")) {
+    if (!strcmp(tk, "extractor"))
+      return field_err(c, v[K_TOOL], fp,
+                       "a palpate_target task needs a tool that touches tissue (tool '%s' is an "
+                       "extractor)",
+                       s->tools[t->tool].name);
+    if (!v[K_TARGET]) return missing(c, n, path, "target");
+    join(fp, sizeof fp, path, "target");
+    if (get_vec3(c, v[K_TARGET], fp, &ANY, t->target)) return -1;
+    if (opt_number(c, v[K_TARGET_RADIUS], path, "target_radius", &radius_range, &t->target_radius)) return -1;
+    if (task_key_unused(c, v, K_OBJECT, path, t->kind) || task_key_unused(c, v, K_DISTANCE, path, t->kind)) return -1;
+  } else { /* grasp_pull */
+    if (strcmp(tk, "grasper"))
+      return field_err(c, v[K_TOOL], fp, "a grasp_pull task needs a grasper (tool '%s' is a %s)",
+                       s->tools[t->tool].name, tk);
+    if (opt_number(c, v[K_DISTANCE], path, "distance", &distance_range, &t->distance)) return -1;
+    if (task_key_unused(c, v, K_OBJECT, path, t->kind) || task_key_unused(c, v, K_TARGET, path, t->kind) ||
+        task_key_unused(c, v, K_TARGET_RADIUS, path, t->kind))
+      return -1;
   }
   return 0;
 }
@@ -778,6 +962,21 @@ static int parse_scene(const ctx_t *c, const node_t *root, const char *base_dir,
     for (size_t i = 0; i < v[S_TOOLS]->nkids; i++) {
       if (parse_tool(c, v[S_TOOLS]->kids[i], i, s)) return -1;
       s->ntools = i + 1;
+    }
+  }
+  /* Objects name organs and tasks name tools and objects: parsed after them. */
+  if (v[S_OBJECTS]) {
+    if (check_list(c, v[S_OBJECTS], "objects", "object", 0, SCENE_MAX_OBJECTS)) return -1;
+    for (size_t i = 0; i < v[S_OBJECTS]->nkids; i++) {
+      if (parse_object(c, v[S_OBJECTS]->kids[i], i, s)) return -1;
+      s->nobjects = i + 1;
+    }
+  }
+  if (v[S_TASKS]) {
+    if (check_list(c, v[S_TASKS], "tasks", "task", 0, SCENE_MAX_TASKS)) return -1;
+    for (size_t i = 0; i < v[S_TASKS]->nkids; i++) {
+      if (parse_task(c, v[S_TASKS]->kids[i], i, s)) return -1;
+      s->ntasks = i + 1;
     }
   }
   return 0;

@@ -15,6 +15,8 @@
 
 #define SCENE_MAX_ORGANS 16
 #define SCENE_MAX_TOOLS 8
+#define SCENE_MAX_OBJECTS 8
+#define SCENE_MAX_TASKS 16
 #define SCENE_NAME_LEN 64
 #define SCENE_PATH_LEN 1024
 
@@ -72,9 +74,21 @@ typedef struct scene_organ {
   int line;                  /* line of the organ entry, for later messages */
 } scene_organ_t;
 
+/* Tool kinds and what each can do (key `kind:`):
+ *   probe      palpation: touches and pushes through the god-object proxy.
+ *   grasper    touches like a probe; closing the jaws (ToolCommand.buttons
+ *              bit 0) within grasp_radius of the surface grabs a small
+ *              patch of tissue and holds it to the tip until they open.
+ *   scalpel    touches like a probe; the cutting issue (5) reads it.
+ *   extractor  laparoscopic stone extractor: enters through an assumed port,
+ *              so it does not collide with organs; closing the jaws within
+ *              grasp_radius of a stone's surface grabs the stone and carries it.
+ *   syringe    touches like a probe; injection is not simulated yet.
+ * grasp_radius is accepted (and required to be meaningful) only for
+ * grasper and extractor; jaw_opening only for grasper. */
 typedef struct scene_tool {
   char name[SCENE_NAME_LEN];
-  char kind[32];    /* "probe" (v1); later "grasper", "scalpel", ... */
+  char kind[32];    /* probe | grasper | scalpel | extractor | syringe (default probe) */
   double radius;    /* m, tip radius (default 0.002) */
   double length;    /* m, shaft length for drawing (default 0.1) */
   double stiffness; /* N/m, proxy virtual spring (default 300) */
@@ -86,8 +100,51 @@ typedef struct scene_tool {
    * (stopping force threshold: the hard upper bound). Refused unless
    * 0 < st < mpf <= sft <= max_force for those given. */
   double sft, st, mpf;
+  /* Coulomb friction coefficient mu of the tip on tissue, >= 0 and <= 2
+   * (default 0: frictionless proxy). */
+  double friction;
+  /* grasper, extractor: m, how far from the tip the jaws reach when they
+   * close (default 2 x radius). 0 for the other kinds. */
+  double grasp_radius;
+  /* grasper: m, jaw opening when open, for drawing (default 4 x radius). */
+  double jaw_opening;
   int line;
 } scene_tool_t;
+
+/* A rigid object inside an organ (key `objects:`). Only kind "stone" (a
+ * rigid sphere, seed 000 kidney-stone removal) so far. The scene file does
+ * not open meshes, so "inside the organ" is checked by the runtime. */
+typedef struct scene_object {
+  char name[SCENE_NAME_LEN];
+  char kind[16];      /* "stone" */
+  double radius;      /* m, > 0 and <= 0.05 (required) */
+  double position[3]; /* m, centre in the scene frame (required) */
+  int organ;          /* index of the organ it sits in (key `organ:` names it, required) */
+  float color[3];     /* default [0.85, 0.8, 0.55] */
+  int line;
+} scene_object_t;
+
+/* A task the trainee performs (key `tasks:`). Its operation time runs from
+ * the first command of its tool to the completion criterion:
+ *   stone_removal   tool: an extractor; object: a stone; completes when the
+ *                   stone's centre is outside its organ's rest surface by
+ *                   more than the stone's radius.
+ *   palpate_target  tool: any kind that touches (not an extractor); target,
+ *                   target_radius; completes at the first contact within
+ *                   target_radius of target (its time is the exploration
+ *                   time to the target, seed 002 ch. 6).
+ *   grasp_pull      tool: a grasper; distance; completes when the tool,
+ *                   holding tissue, is `distance` from where it grasped. */
+typedef struct scene_task {
+  char name[SCENE_NAME_LEN];
+  char kind[32];
+  int tool;             /* tool index */
+  int object;           /* object index, -1 if none */
+  double target[3];     /* m (palpate_target) */
+  double target_radius; /* m (palpate_target, default 0.005) */
+  double distance;      /* m (grasp_pull, default 0.01) */
+  int line;
+} scene_task_t;
 
 typedef struct scene {
   char path[SCENE_PATH_LEN];
@@ -101,12 +158,18 @@ typedef struct scene {
   scene_organ_t organs[SCENE_MAX_ORGANS];
   size_t ntools;
   scene_tool_t tools[SCENE_MAX_TOOLS];
+  size_t nobjects;
+  scene_object_t objects[SCENE_MAX_OBJECTS];
+  size_t ntasks;
+  scene_task_t tasks[SCENE_MAX_TASKS];
 } scene_t;
 
 /* Fills *out with defaults, then the file's values. 0 on success; -1 with a
  * message naming file, line and field on any problem (missing or unreadable
  * file, YAML syntax error, unknown key, wrong type, out-of-range value,
- * missing required field, too many organs/tools, duplicate names). Does not
+ * missing required field, too many organs/tools/objects/tasks, duplicate
+ * names, a capability key the tool kind does not have, a task whose tool
+ * kind or object does not fit it). Does not
  * open the mesh files: the server imports them and reports their problems. */
 int scene_load(const char *path, scene_t *out, verr_t *err);
 

@@ -24,6 +24,8 @@ static const struct {
     [VT_SESSION_EVENT] = {"viscera_SessionEvent", &viscera_SessionEvent_desc, QOS_EVENTS},
     [VT_METRICS] = {"viscera_Metrics", &viscera_Metrics_desc, QOS_METRICS},
     [VT_SESSION_CONTROL] = {"viscera_SessionControl", &viscera_SessionControl_desc, QOS_CONTROL},
+    [VT_OBJECT_STATE] = {"viscera_ObjectState", &viscera_ObjectState_desc, QOS_STATE},
+    [VT_TOOL_METRICS] = {"viscera_ToolMetrics", &viscera_ToolMetrics_desc, QOS_METRICS},
 };
 
 const char *vdds_topic_name(vdds_topic_id_t t) { return t < VT_COUNT ? TOPICS[t].name : "?"; }

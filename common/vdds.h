@@ -21,6 +21,8 @@ typedef enum vdds_topic_id {
   VT_SESSION_EVENT,
   VT_METRICS,
   VT_SESSION_CONTROL,
+  VT_OBJECT_STATE,
+  VT_TOOL_METRICS,
   VT_COUNT
 } vdds_topic_id_t;
 

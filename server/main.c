@@ -175,5 +175,24 @@ int main(int argc, char **argv) {
              tr->time_above[k], thr_name((thr_id_t)k), tr->crossings[k]);
     printf("\n");
   }
+  /* Per tool and per task (issue 4; seed 000 Table 2 operation times). */
+  for (size_t t = 0; t < st.ntools; t++) {
+    const viscera_ToolMetrics *m = &st.tools[t];
+    printf("TOOL tool=%s kind=%s peak_force=%.4f contact_time=%.3f path_length=%.4f exploration_time=%.3f grasps=%u "
+           "grasp_time=%.3f tasks=%u/%u operation_time=%.3f\n",
+           scene.tools[t].name, scene.tools[t].kind, m->peak_force, m->contact_time, m->path_length,
+           m->exploration_time, m->grasps, m->grasp_time, m->tasks_completed, m->tasks_total, m->operation_time);
+  }
+  for (size_t i = 0; i < st.ntasks; i++) {
+    const task_rt_t *k = &st.tasks[i];
+    printf("TASK task=%s kind=%s tool=%s state=%s operation_time=%.3f\n", scene.tasks[i].name, scene.tasks[i].kind,
+           scene.tools[scene.tasks[i].tool].name,
+           k->completed ? "completed"
+           : k->started ? "started"
+                        : "not_started",
+           task_operation_time(k, st.sim_time));
+  }
+  for (size_t i = 0; i < scene.nobjects; i++)
+    printf("OBJECT object=%s removed=%d\n", scene.objects[i].name, st.stone_removed[i]);
   return 0;
 }

@@ -3,8 +3,11 @@
 #include "topology_follow.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
+#include "interaction/shaft.h"
+#include "interaction/tool_actions.h"
 #include "mesh_import.h"
 #include "vmath.h"
 
@@ -76,6 +79,15 @@ int runtime_init(runtime_t *rt, const scene_t *scene, verr_t *err) {
     }
     rt->surfaces[i].tree = &o->tree;
     o->topology_version = m->topology_version;
+    o->vn_rest = malloc(3 * m->nsurf * sizeof *o->vn_rest);
+    if (!o->vn_rest) {
+      verr_set(err, "%s:%d: organ '%s': out of memory", rt->scene.path, o->cfg->line, o->cfg->name);
+      runtime_destroy(rt);
+      return -1;
+    }
+    proxy_vertex_normals(m->nsurf, m->surf_rest, m->nsurf_tris, m->surf_tris, o->vn_rest);
+    rt->surfaces[i].vn = o->vn_rest;
+    rt->surfaces[i].nvn = m->nsurf;
     double lo[3], hi[3];
     mesh_bounds(&o->rest, lo, hi);
     for (int k = 0; k < 3; k++) {
@@ -95,6 +107,10 @@ int runtime_init(runtime_t *rt, const scene_t *scene, verr_t *err) {
     rt->tools[t].cfg = &rt->scene.tools[t];
     proxy_reset(&rt->tools[t].proxy);
   }
+  if (interact_init(rt, err)) {
+    runtime_destroy(rt);
+    return -1;
+  }
   return 0;
 }
 
@@ -103,6 +119,8 @@ void runtime_destroy(runtime_t *rt) {
     model_destroy(rt->organs[i].model);
     rt->organs[i].model = NULL;
     aabb_tree_destroy(&rt->organs[i].tree);
+    free(rt->organs[i].vn_rest);
+    rt->organs[i].vn_rest = NULL;
     mesh_free(&rt->organs[i].rest);
   }
   rt->norgans = 0;
@@ -114,10 +132,20 @@ void runtime_set_tool(runtime_t *rt, size_t t, const double pos[3], double devic
   v3_copy(tool->device, pos);
   tool->max_force = fmin(tool->cfg->max_force, device_max_force);
   tool->active = 1;
+  if (tool->first_cmd_time < 0) tool->first_cmd_time = rt->sim_time;
+}
+
+void runtime_set_buttons(runtime_t *rt, size_t t, uint32_t buttons) {
+  if (t < rt->ntools) rt->tools[t].buttons = buttons;
+}
+
+void runtime_set_orientation(runtime_t *rt, size_t t, const double q[4]) {
+  if (t < rt->ntools) shaft_axis(q, rt->tools[t].axis);
 }
 
 void runtime_release_tool(runtime_t *rt, size_t t) {
   if (t >= rt->ntools) return;
+  interact_release_tool(rt, t);
   rt->tools[t].active = 0;
   proxy_reset(&rt->tools[t].proxy);
   v3_set(rt->tools[t].force, 0, 0, 0);
@@ -142,6 +170,7 @@ static void apply_contacts(model_t *m, void *vctx) {
       m->ops->add_surface_force(m, tool->patch[j], fk);
     }
   }
+  interact_apply(rt, o, m);
 }
 
 /* The vertices within the patch radius of the proxy, weighted by a smooth
@@ -179,11 +208,12 @@ static void build_patch(runtime_t *rt, tool_rt_t *tool) {
 
 int runtime_step(runtime_t *rt) {
   double dt = rt->scene.dt;
+  interact_before_step(rt);
   for (size_t t = 0; t < rt->ntools; t++) {
     tool_rt_t *tool = &rt->tools[t];
-    if (!tool->active) continue;
-    proxy_update(&tool->proxy, tool->device, rt->surfaces, rt->norgans, tool->cfg->stiffness, tool->max_force,
-                 tool->force);
+    if (!tool->active || !interact_uses_proxy(rt, t)) continue;
+    proxy_update_friction(&tool->proxy, tool->device, rt->surfaces, rt->norgans, tool->cfg->stiffness, tool->max_force,
+                          tool->cfg->friction, tool->force);
     build_patch(rt, tool);
   }
   int rolled = 0;
@@ -199,8 +229,22 @@ int runtime_step(runtime_t *rt) {
       /* New surface: fresh tree (its boxes are current), proxies re-attached
        * where they were, patches from the new vertices. */
       topo_follow(rt, i, anchors, NULL);
-      for (size_t t = 0; t < rt->ntools; t++)
+      for (size_t t = 0; t < rt->ntools; t++) {
         if (anchors[t].in_contact) build_patch(rt, &rt->tools[t]);
+        /* Held tissue is a list of vertex indices of the old surface: the
+         * jaws let go (the trainee closes them again) rather than hold
+         * vertices that now mean something else. */
+        if (rt->tools[t].grasp.active && rt->tools[t].grasp.organ == (int)o->id) grasp_release(&rt->tools[t].grasp);
+      }
+      /* Force-shading normals of the new surface (rest shape); if memory
+       * runs out shading stays off for this organ (facet normals). */
+      double *vn = o->model->nsurf ? realloc(o->vn_rest, 3 * o->model->nsurf * sizeof *vn) : NULL;
+      if (vn) {
+        o->vn_rest = vn;
+        proxy_vertex_normals(o->model->nsurf, o->model->surf_rest, o->model->nsurf_tris, o->model->surf_tris, vn);
+        rt->surfaces[i].vn = vn;
+        rt->surfaces[i].nvn = o->model->nsurf;
+      }
     } else if (o->tree.ntris) {
       /* Every step, rolled back or not: the proxy trusts the boxes. */
       aabb_tree_refit(&o->tree, o->model->surf_x);
@@ -217,5 +261,6 @@ int runtime_step(runtime_t *rt) {
   }
   rt->steps++;
   rt->sim_time = (double)rt->steps * dt;
+  interact_after_step(rt);
   return rolled;
 }

@@ -14,6 +14,10 @@
 
 #include "collision/aabb_tree.h"
 #include "haptics/proxy.h"
+#include "interaction/events.h"
+#include "interaction/grasp.h"
+#include "interaction/stone.h"
+#include "interaction/tasks.h"
 #include "mesh.h"
 #include "physics/model.h"
 #include "scene.h"
@@ -33,6 +37,7 @@ typedef struct organ_rt {
   model_t *model;      /* sub-steps and stable dt live in the model */
   double patch_radius; /* m, contact patch radius: max(2 tool radius, 1.5 mean surface edge) */
   aabb_tree_t tree;    /* over the model's contact surface, refit after every step */
+  double *vn_rest;     /* unit vertex normals of the rest surface (force shading, proxy.h) */
   uint64_t rollbacks;
   /* The model topology_version the tree, surface view, proxies and patches
    * were last rebuilt for (topology_follow.h). The server polls it: when it
@@ -58,6 +63,18 @@ typedef struct tool_rt {
   size_t npatch;
   uint32_t patch[TOOL_PATCH_MAX];
   double patch_w[TOOL_PATCH_MAX];
+  /* Interactions (interaction/tool_actions.c). */
+  uint32_t buttons;      /* ToolCommand.buttons, bit 0 = jaws closed */
+  uint32_t prev_buttons; /* at the previous step: grasping happens on closing */
+  grasp_t grasp;         /* grasper: tissue held */
+  int stone;             /* extractor: stone held, or -1 */
+  double first_cmd_time; /* s of simulated time of the first command, -1 before */
+  double axis[3];        /* unit shaft direction from the tip (command orientation applied to +z) */
+  /* What the tool's client is told (ContactFeedback): the tip the hand
+   * feels (god-object, stone surface, grasp pull or tool-tool contact),
+   * normal and whether anything touches; organ -1 for stones and tools. */
+  int fb_contact, fb_organ;
+  double fb_pos[3], fb_normal[3];
 } tool_rt_t;
 
 typedef struct runtime {
@@ -67,6 +84,11 @@ typedef struct runtime {
   tool_rt_t tools[SCENE_MAX_TOOLS];
   proxy_surface_t surfaces[SCENE_MAX_ORGANS];
   tool_workspace_t workspace;
+  size_t nstones;
+  stone_t stones[SCENE_MAX_OBJECTS];
+  size_t ntasks;
+  task_rt_t tasks[SCENE_MAX_TASKS];
+  iev_queue_t events; /* interaction events; the caller drains (clears n) */
   uint64_t steps;
   double sim_time; /* s */
 } runtime_t;
@@ -79,6 +101,10 @@ void runtime_destroy(runtime_t *rt);
 
 /* Applies a validated command for tool `t`. */
 void runtime_set_tool(runtime_t *rt, size_t t, const double pos[3], double device_max_force);
+/* The command's buttons (bit 0: close the jaws), applied at the next step. */
+void runtime_set_buttons(runtime_t *rt, size_t t, uint32_t buttons);
+/* The command's orientation (unit quaternion w, x, y, z): the shaft axis. */
+void runtime_set_orientation(runtime_t *rt, size_t t, const double q[4]);
 /* Tool no longer driven (client gone): releases contact, stops acting. */
 void runtime_release_tool(runtime_t *rt, size_t t);
 

@@ -10,6 +10,7 @@
 #include "liveliness_watch.h"
 #include "mesh.h"
 #include "session_control.h"
+#include "tool_metrics.h"
 #include "viscera.h"
 #include "vmath.h"
 #include "vstats.h"
@@ -22,6 +23,8 @@ typedef struct server {
   runtime_t rt;
   vdds_t dds;
   dds_entity_t w_scene, w_state, w_delta, w_feedback, w_event, w_metrics, r_cmd, r_control;
+  dds_entity_t w_objects, w_tool_metrics;
+  tool_tally_t tally[SCENE_MAX_TOOLS];
   mesh_publisher_t pubs[SCENE_MAX_ORGANS];
   uint64_t cmd_seq[SCENE_MAX_TOOLS], cmd_echo[SCENE_MAX_TOOLS], last_cmd_mono[SCENE_MAX_TOOLS];
   int was_contact[SCENE_MAX_TOOLS];
@@ -112,8 +115,10 @@ static int setup(server_t *s, const scene_t *scene, verr_t *err) {
   s->r_cmd = vdds_reader_listener(&s->dds, VT_TOOL_COMMAND, l, err);
   dds_delete_listener(l);
   s->r_control = vdds_reader(&s->dds, VT_SESSION_CONTROL, err);
-  if (s->w_scene < 0 || s->w_state < 0 || s->w_delta < 0 || s->w_feedback < 0 || s->w_event < 0 ||
-      s->w_metrics < 0 || s->r_cmd < 0 || s->r_control < 0)
+  s->w_objects = vdds_writer(&s->dds, VT_OBJECT_STATE, err);
+  s->w_tool_metrics = vdds_writer(&s->dds, VT_TOOL_METRICS, err);
+  if (s->w_scene < 0 || s->w_state < 0 || s->w_delta < 0 || s->w_feedback < 0 || s->w_event < 0 || s->w_metrics < 0 ||
+      s->r_cmd < 0 || s->r_control < 0 || s->w_objects < 0 || s->w_tool_metrics < 0)
     return -1;
   for (size_t i = 0; i < s->rt.norgans; i++) {
     organ_rt_t *o = &s->rt.organs[i];
@@ -204,6 +209,9 @@ static void read_commands(server_t *s, uint64_t now) {
       }
       s->cmd_writer[c->tool_id] = infos[i].publication_handle;
       runtime_set_tool(&s->rt, c->tool_id, pos, c->max_force);
+      runtime_set_buttons(&s->rt, c->tool_id, c->buttons);
+      double q[4] = {c->orientation[0], c->orientation[1], c->orientation[2], c->orientation[3]};
+      runtime_set_orientation(&s->rt, c->tool_id, q);
       s->cmd_seq[c->tool_id] = c->seq;
       s->cmd_echo[c->tool_id] = c->client_mono_ns;
       s->last_cmd_mono[c->tool_id] = now;
@@ -254,16 +262,18 @@ static void publish_feedback(server_t *s) {
     fb.cmd_seq = s->cmd_seq[t];
     fb.cmd_client_mono_ns = s->cmd_echo[t];
     fb.sim_time_ns = sim_ns(s);
-    fb.in_contact = tool->proxy.in_contact != 0;
-    fb.organ_id = tool->proxy.in_contact ? tool->proxy.surface : -1;
+    /* fb_*: the god-object, or what a grasp, a stone or another tool
+     * makes the hand feel (interaction/tool_actions.c). */
+    fb.in_contact = tool->fb_contact != 0;
+    fb.organ_id = tool->fb_contact ? tool->fb_organ : -1;
     fb.stiffness = (float)tool->cfg->stiffness;
     for (int k = 0; k < 3; k++) {
-      fb.proxy_position[k] = (float)tool->proxy.pos[k];
-      fb.normal[k] = (float)tool->proxy.normal[k];
+      fb.proxy_position[k] = (float)tool->fb_pos[k];
+      fb.normal[k] = (float)tool->fb_normal[k];
       fb.force[k] = (float)tool->force[k];
     }
     dds_write(s->w_feedback, &fb);
-    int c = tool->proxy.in_contact != 0;
+    int c = tool->fb_contact != 0;
     if (c != s->was_contact[t]) {
       publish_event(s, c ? viscera_EVENT_CONTACT_BEGIN : viscera_EVENT_CONTACT_END, fb.organ_id, (int)t, 0,
                     c ? "contact begins" : "contact ends");
@@ -278,7 +288,7 @@ static void track_thresholds(server_t *s) {
   for (size_t t = 0; t < s->rt.ntools; t++) {
     const tool_rt_t *tool = &s->rt.tools[t];
     double f = tool->active ? v3_norm(tool->force) : 0.0;
-    int contact = tool->active && tool->proxy.in_contact;
+    int contact = tool->active && tool->fb_contact;
     thr_event_t ev[THR_COUNT];
     int n = thr_update(&s->thr[t], s->rt.scene.dt, f, contact, tool->active ? tool->device : NULL, ev);
     for (int i = 0; i < n; i++) {
@@ -288,7 +298,7 @@ static void track_thresholds(server_t *s) {
                ev[i].level);
       if (!s->opts->quiet) fprintf(stderr, "server: %s\n", text);
       publish_event(s, ev[i].up ? viscera_EVENT_THRESHOLD_CROSSED_UP : viscera_EVENT_THRESHOLD_CROSSED_DOWN,
-                    contact ? tool->proxy.surface : -1, (int)t, ev[i].level, text);
+                    contact ? tool->fb_organ : -1, (int)t, ev[i].level, text);
     }
   }
 }
@@ -334,7 +344,73 @@ static void publish_metrics(server_t *s, uint64_t window_steps) {
   }
 }
 
+/* Grasp and task events from the runtime's queue, as SessionEvents. */
+static void publish_interactions(server_t *s) {
+  const scene_t *sc = &s->rt.scene;
+  for (size_t i = 0; i < s->rt.events.n; i++) {
+    const iev_t *e = &s->rt.events.ev[i];
+    const char *tool = e->tool >= 0 ? sc->tools[e->tool].name : "?";
+    char text[200];
+    viscera_EventKind kind = viscera_EVENT_GRASP_BEGIN;
+    switch (e->kind) {
+    case IEV_GRASP_BEGIN:
+    case IEV_GRASP_END:
+      kind = e->kind == IEV_GRASP_BEGIN ? viscera_EVENT_GRASP_BEGIN : viscera_EVENT_GRASP_END;
+      if (e->object >= 0)
+        snprintf(text, sizeof text, "tool '%s' %s stone '%s'", tool, e->kind == IEV_GRASP_BEGIN ? "grasps" : "releases",
+                 sc->objects[e->object].name);
+      else
+        snprintf(text, sizeof text, "tool '%s' %s organ '%s'%s", tool,
+                 e->kind == IEV_GRASP_BEGIN ? "grasps" : "releases", e->organ >= 0 ? sc->organs[e->organ].name : "?",
+                 e->kind == IEV_GRASP_BEGIN ? " tissue" : "");
+      break;
+    case IEV_TASK_STARTED:
+      kind = viscera_EVENT_TASK_STARTED;
+      snprintf(text, sizeof text, "task '%s' started (tool '%s')", sc->tasks[e->task].name, tool);
+      break;
+    case IEV_TASK_COMPLETED:
+      kind = viscera_EVENT_TASK_COMPLETED;
+      snprintf(text, sizeof text, "task '%s' completed in %.3f s (tool '%s')", sc->tasks[e->task].name, e->value, tool);
+      break;
+    }
+    if (!s->opts->quiet) fprintf(stderr, "server: %s\n", text);
+    publish_event(s, kind, e->organ, e->tool, e->value, text);
+  }
+  s->rt.events.n = 0;
+}
+
+static void publish_objects(server_t *s) {
+  for (size_t i = 0; i < s->rt.nstones; i++) {
+    const stone_t *st = &s->rt.stones[i];
+    const scene_object_t *c = &s->rt.scene.objects[i];
+    viscera_ObjectState o;
+    memset(&o, 0, sizeof o);
+    o.object_id = (uint32_t)i;
+    o.sim_time_ns = sim_ns(s);
+    snprintf(o.name, sizeof o.name, "%s", c->name);
+    snprintf(o.kind, sizeof o.kind, "%s", c->kind);
+    for (int k = 0; k < 3; k++) {
+      o.position[k] = (float)st->pos[k];
+      o.color[k] = c->color[k];
+    }
+    o.radius = (float)st->radius;
+    o.organ_id = st->organ;
+    o.held_by = st->held_by;
+    o.removed = st->removed != 0;
+    dds_write(s->w_objects, &o);
+  }
+}
+
+static void publish_tool_metrics(server_t *s) {
+  for (size_t t = 0; t < s->rt.ntools; t++) {
+    viscera_ToolMetrics m;
+    tool_metrics_fill(&m, &s->rt, t, &s->thr[t], &s->tally[t], sim_ns(s));
+    dds_write(s->w_tool_metrics, &m);
+  }
+}
+
 static void publish_frames(server_t *s) {
+  publish_objects(s);
   for (size_t i = 0; i < s->rt.norgans; i++)
     mesh_publisher_frame(&s->pubs[i], s->rt.organs[i].model->surf_x, sim_ns(s));
 }
@@ -454,11 +530,18 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
     }
     follow_topology(&s);
     publish_feedback(&s);
-    if (!s.control.paused) track_thresholds(&s);
+    if (!s.control.paused) {
+      track_thresholds(&s);
+      for (size_t t = 0; t < s.rt.ntools; t++) tool_tally_update(&s.tally[t], &s.rt.tools[t], scene->dt);
+      publish_interactions(&s); /* the events of the step just taken */
+    }
     if (s.rt.steps % publish_every == 0) publish_frames(&s);
     uint64_t t1 = vtime_mono_ns();
     s.step_us[s.nstep_us++ % STEP_RING] = (double)(t1 - t0) * 1e-3;
-    if (s.rt.steps % metrics_every == 0) publish_metrics(&s, metrics_every);
+    if (s.rt.steps % metrics_every == 0) {
+      publish_metrics(&s, metrics_every);
+      publish_tool_metrics(&s);
+    }
     if (ckpt && s.rt.steps % ckpt_every == 0) checkpointer_submit(ckpt, &s.rt, s.thr);
     next += dt_ns;
     if (t1 > next + 100 * 1000000ull) { /* far behind (debugger, overload): resynchronise */
@@ -469,6 +552,7 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
   }
   publish_frames(&s);
   publish_metrics(&s, metrics_every);
+  publish_tool_metrics(&s);
   if (ckpt) {
     checkpointer_submit(ckpt, &s.rt, s.thr);
     verr_t e;
@@ -480,6 +564,12 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
   stats->steps = s.rt.steps;
   stats->ntools = s.rt.ntools;
   memcpy(stats->thr, s.thr, sizeof stats->thr);
+  for (size_t t = 0; t < s.rt.ntools; t++)
+    tool_metrics_fill(&stats->tools[t], &s.rt, t, &s.thr[t], &s.tally[t], sim_ns(&s));
+  stats->ntasks = s.rt.ntasks;
+  stats->sim_time = s.rt.sim_time;
+  memcpy(stats->tasks, s.rt.tasks, sizeof stats->tasks);
+  for (size_t i = 0; i < s.rt.nstones; i++) stats->stone_removed[i] = s.rt.stones[i].removed;
   for (size_t t = 0; t < s.rt.ntools; t++) stats->peak_force = fmax(stats->peak_force, s.rt.tools[t].peak_force);
   size_t n = s.nstep_us < STEP_RING ? s.nstep_us : STEP_RING;
   vstats_summary_t st = vstats_summarise(s.step_us, n);

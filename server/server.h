@@ -33,6 +33,11 @@ typedef struct server_stats {
   double step_us_median, step_us_p99, step_us_max;
   size_t ntools;
   thr_tracker_t thr[SCENE_MAX_TOOLS]; /* palpation measures per tool at the end */
+  viscera_ToolMetrics tools[SCENE_MAX_TOOLS]; /* per-tool measures at the end */
+  size_t ntasks;
+  task_rt_t tasks[SCENE_MAX_TASKS]; /* cfg points into the server's scene copy: use the index, not cfg */
+  int stone_removed[SCENE_MAX_OBJECTS];
+  double sim_time; /* s simulated */
 } server_stats_t;
 
 /* Runs a whole session: set-up, loop until *stop or the duration, shutdown.

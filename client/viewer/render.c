@@ -321,6 +321,12 @@ void render_proxy(render_t *r, const float p[3], float radius) {
   draw_ghosted(r, PROXY, p, radius, 0);
 }
 
+void render_object(render_t *r, const float centre[3], float radius, const float rgb[3]) {
+  /* Stone: hard and dry, a modest highlight. */
+  set_material(0.4f, 50.0f);
+  draw_ghosted(r, rgb, centre, radius, 0);
+}
+
 void render_force_bar(render_t *r, double force, double max_force) {
   render_force_bar_levels(r, force, max_force, 0, 0, 0);
 }

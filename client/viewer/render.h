@@ -60,6 +60,9 @@ void render_tool(render_t *r, const float tip[3], float tip_radius, float length
 /* A small green sphere marking the contact proxy (god-object) point; its
  * hidden part shows through faintly like the tool's. */
 void render_proxy(render_t *r, const float p[3], float radius);
+/* A rigid object (a stone): a sphere in its colour, ghosted where tissue
+ * hides it, since a stone inside an organ is what the trainee looks for. */
+void render_object(render_t *r, const float centre[3], float radius, const float rgb[3]);
 
 /* Overlay: a vertical bar at the right edge filled to force / max_force,
  * green, then yellow above half, red above 80 %, with 1 N ticks when they

@@ -19,6 +19,10 @@ const uint8_t *scene_draw(render_t *r, const camera_t *cam, const scene_view_t *
     if (!o->mesh.have_key) continue;
     if (render_mesh(r, o->mesh.cur, o->mesh.nverts, o->mesh.tris, o->mesh.ntris, o->rgb, err)) return NULL;
   }
+  for (int i = 0; i < SCENE_VIEW_MAX_OBJECTS; i++) {
+    const sv_object_t *o = &sv->objects[i];
+    if (o->have) render_object(r, o->pos, o->radius, o->rgb);
+  }
   if (tools) {
     for (int i = 0; i < SCENE_VIEW_MAX_TOOLS; i++) {
       const sv_tool_t *t = &sv->tools[i];

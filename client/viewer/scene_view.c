@@ -173,6 +173,32 @@ static void on_contact(scene_view_t *sv, const viscera_ContactFeedback *s) {
   memcpy(t->force, s->force, sizeof t->force);
 }
 
+static void on_object(scene_view_t *sv, const viscera_ObjectState *s) {
+  if (s->object_id >= SCENE_VIEW_MAX_OBJECTS) {
+    reject(sv, "ObjectState: object_id %u out of range (0..%d)", s->object_id, SCENE_VIEW_MAX_OBJECTS - 1);
+    return;
+  }
+  unsigned char removed;
+  memcpy(&removed, &s->removed, 1);
+  int colour_ok = 1;
+  for (int k = 0; k < 3; k++) colour_ok &= s->color[k] >= 0 && s->color[k] <= 1;
+  /* A stone is millimetres; anything beyond 10 cm is a corrupt sample. */
+  if (removed > 1 || !finite3(s->position) || !(s->radius > 0 && s->radius <= 0.1f) || !colour_ok) {
+    reject(sv,
+           "ObjectState object %u: position not finite, radius not in (0, 0.1] m, colour outside 0..1 or "
+           "removed byte %u",
+           s->object_id, removed);
+    return;
+  }
+  sv_object_t *o = &sv->objects[s->object_id];
+  o->have = 1;
+  memcpy(o->pos, s->position, sizeof o->pos);
+  o->radius = s->radius;
+  memcpy(o->rgb, s->color, sizeof o->rgb);
+  o->held = s->held_by >= 0;
+  o->removed = removed;
+}
+
 int scene_view_open(scene_view_t *sv, int domain, const char *partition, scene_view_log_fn log, void *log_ctx,
                     verr_t *err) {
   memset(sv, 0, sizeof *sv);
@@ -188,7 +214,8 @@ int scene_view_open(scene_view_t *sv, int domain, const char *partition, scene_v
              {&sv->rd_state, VT_MESH_STATE},
              {&sv->rd_delta, VT_MESH_DELTA},
              {&sv->rd_cmd, VT_TOOL_COMMAND},
-             {&sv->rd_contact, VT_CONTACT_FEEDBACK}};
+             {&sv->rd_contact, VT_CONTACT_FEEDBACK},
+             {&sv->rd_object, VT_OBJECT_STATE}};
   for (size_t i = 0; i < sizeof rds / sizeof rds[0]; i++) {
     *rds[i].rd = vdds_reader(&sv->dds, rds[i].topic, err);
     if (*rds[i].rd < 0) {
@@ -247,6 +274,7 @@ static void h_cmd(scene_view_t *sv, const void *s) { on_tool_command(sv, s); }
 static void h_contact(scene_view_t *sv, const void *s) { on_contact(sv, s); }
 static void h_tool_gone(scene_view_t *sv, const void *s) { on_tool_gone(sv, s); }
 static void h_contact_gone(scene_view_t *sv, const void *s) { on_contact_gone(sv, s); }
+static void h_object(scene_view_t *sv, const void *s) { on_object(sv, s); }
 
 int scene_view_poll(scene_view_t *sv, verr_t *err) {
   /* SceneInfo first (colours), keyframes before deltas so that a keyframe
@@ -259,7 +287,8 @@ int scene_view_poll(scene_view_t *sv, verr_t *err) {
                {sv->rd_state, h_state, NULL, "MeshState"},
                {sv->rd_delta, h_delta, NULL, "MeshDelta"},
                {sv->rd_cmd, h_cmd, h_tool_gone, "ToolCommand"},
-               {sv->rd_contact, h_contact, h_contact_gone, "ContactFeedback"}};
+               {sv->rd_contact, h_contact, h_contact_gone, "ContactFeedback"},
+               {sv->rd_object, h_object, NULL, "ObjectState"}};
   int total = 0;
   for (size_t i = 0; i < sizeof order / sizeof order[0]; i++) {
     int n = take_all(sv, order[i].rd, order[i].h, order[i].gone, order[i].name, err);

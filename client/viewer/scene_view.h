@@ -1,9 +1,9 @@
 /* scene_view: what the viewer knows of a running scene, taken from DDS.
  *
  * Subscribes to SceneInfo (organ colours, tool sizes), MeshState and
- * MeshDelta (the organ meshes, see organ_state.h), ToolCommand (tool tip)
- * and ContactFeedback (contact, proxy, force). scene_view_poll() takes what
- * has arrived without blocking; the readers are keep-last 1 per instance,
+ * MeshDelta (the organ meshes, see organ_state.h), ToolCommand (tool tip),
+ * ContactFeedback (contact, proxy, force) and ObjectState (stones).
+ * scene_view_poll() takes what has arrived without blocking; the readers are keep-last 1 per instance,
  * so polling at the viewer's pace loses nothing that would be drawn.
  *
  * Every sample is untrusted: ids are bounded to the tables below, numbers
@@ -24,6 +24,7 @@
 /* Bounded like the wire contract (viscera.idl MAX_ORGANS, MAX_TOOLS). */
 #define SCENE_VIEW_MAX_ORGANS 16
 #define SCENE_VIEW_MAX_TOOLS 8
+#define SCENE_VIEW_MAX_OBJECTS 8 /* viscera.idl MAX_OBJECTS */
 
 /* Drawing defaults until SceneInfo says otherwise (the scene file's). */
 #define SCENE_VIEW_ORGAN_RGB                                                                                           \
@@ -52,22 +53,33 @@ typedef struct sv_tool {
   float force[3]; /* N */
 } sv_tool_t;
 
+/* A rigid object (stone) from ObjectState. */
+typedef struct sv_object {
+  int have;
+  float pos[3]; /* m, centre */
+  float radius; /* m */
+  float rgb[3];
+  int held; /* held by a tool */
+  int removed;
+} sv_object_t;
+
 /* Receives one line describing a rejected sample (no trailing newline). */
 typedef void (*scene_view_log_fn)(void *ctx, const char *msg);
 
 typedef struct scene_view {
   vdds_t dds;
-  dds_entity_t rd_scene, rd_state, rd_delta, rd_cmd, rd_contact;
+  dds_entity_t rd_scene, rd_state, rd_delta, rd_cmd, rd_contact, rd_object;
   int have_scene;
   char scene_name[65];
   sv_organ_t organs[SCENE_VIEW_MAX_ORGANS];
   sv_tool_t tools[SCENE_VIEW_MAX_TOOLS];
+  sv_object_t objects[SCENE_VIEW_MAX_OBJECTS];
   unsigned long rejected;
   scene_view_log_fn log;
   void *log_ctx;
 } scene_view_t;
 
-/* Joins `domain` / `partition` (vdds_open) and creates the five readers.
+/* Joins `domain` / `partition` (vdds_open) and creates the six readers.
  * log may be NULL. Returns 0, or -1 with err set (nothing left open). */
 int scene_view_open(scene_view_t *sv, int domain, const char *partition, scene_view_log_fn log, void *log_ctx,
                     verr_t *err);

@@ -36,6 +36,27 @@ void proxy_follow_surface(proxy_t *p, const proxy_surface_t *surfaces, size_t ns
   proxy_surface_t rest = *s;
   if (s->x_rest) rest.x = s->x_rest;
   tri_normal(&rest, p->tri, p->normal);
+  const uint32_t *tri = s->tris + 3 * p->tri;
+  if (s->vn && tri[0] < s->nvn && tri[1] < s->nvn && tri[2] < s->nvn) {
+    /* Force shading: interpolated vertex normals; fall back to the face
+     * normal where they cancel (a knife edge) or point away from it. */
+    double n[3] = {0, 0, 0};
+    for (int k = 0; k < 3; k++) v3_axpy(n, s->vn + 3 * tri[k], p->bary[k]);
+    if (v3_normalize(n) > 1e-9 && v3_dot(n, p->normal) > 0.2) v3_copy(p->normal, n);
+  }
+}
+
+void proxy_vertex_normals(size_t nverts, const double *x, size_t ntris, const uint32_t *tris, double *vn) {
+  memset(vn, 0, 3 * nverts * sizeof *vn);
+  for (size_t t = 0; t < ntris; t++) {
+    const uint32_t *tri = tris + 3 * t;
+    double e1[3], e2[3], n[3];
+    v3_sub(e1, x + 3 * tri[1], x + 3 * tri[0]);
+    v3_sub(e2, x + 3 * tri[2], x + 3 * tri[0]);
+    v3_cross(n, e1, e2); /* length = twice the area: area weighting for free */
+    for (int k = 0; k < 3; k++) v3_add(vn + 3 * tri[k], vn + 3 * tri[k], n);
+  }
+  for (size_t i = 0; i < nverts; i++) v3_normalize(vn + 3 * i);
 }
 
 /* The surface's tree, if it describes this surface: a tree refit from
@@ -139,6 +160,11 @@ static int find_entry(const double p0[3], const double p1[3], const proxy_surfac
 
 int proxy_update(proxy_t *p, const double device[3], const proxy_surface_t *surfaces, size_t nsurfaces,
                  double stiffness, double max_force, double force[3]) {
+  return proxy_update_friction(p, device, surfaces, nsurfaces, stiffness, max_force, 0, force);
+}
+
+int proxy_update_friction(proxy_t *p, const double device[3], const proxy_surface_t *surfaces, size_t nsurfaces,
+                          double stiffness, double max_force, double mu, double force[3]) {
   v3_set(force, 0, 0, 0);
   if (!p->have_prev) {
     v3_copy(p->device_prev, device);
@@ -175,6 +201,20 @@ int proxy_update(proxy_t *p, const double device[3], const proxy_surface_t *surf
   double target[3];
   v3_copy(target, device);
   v3_axpy(target, p->normal, -depth);
+  if (mu > 0) {
+    /* Friction cone: the spring's tangential part K |target - proxy| against
+     * mu times its normal part K (-depth); K cancels. */
+    double tang[3];
+    v3_sub(tang, target, p->pos);
+    v3_axpy(tang, p->normal, -v3_dot(tang, p->normal));
+    double dist = v3_norm(tang), cone = mu * fmax(0.0, -depth);
+    if (dist <= cone) { /* sticks: stays on its triangle */
+      proxy_spring_force(p, device, stiffness, max_force, force);
+      return 1;
+    }
+    v3_copy(target, p->pos);
+    v3_axpy(target, tang, (dist - cone) / dist);
+  }
   proxy_t before = *p;
   nearest_on_surfaces(target, surfaces, nsurfaces, p);
   proxy_follow_surface(p, surfaces, nsurfaces);

@@ -36,6 +36,14 @@ typedef struct proxy_surface {
    * same results as the scan. It is used only while it was last refit from
    * this very x array and has ntris triangles; otherwise the scan runs. */
   const struct aabb_tree *tree;
+  /* Force shading: unit vertex normals (3 per vertex, of x_rest if given,
+   * see proxy_vertex_normals) or NULL. With them the contact normal is the
+   * normal interpolated with the proxy's barycentric coordinates, so it
+   * turns smoothly across edges and the hand does not feel the facets.
+   * nvn: vertices in vn; a triangle indexing beyond it (the surface changed
+   * topology and vn was not rebuilt) gets its face normal. */
+  const double *vn;
+  size_t nvn;
 } proxy_surface_t;
 
 typedef struct proxy {
@@ -70,6 +78,18 @@ int proxy_update(proxy_t *p, const double device[3], const proxy_surface_t *surf
  * x = device - proxy), clamped to max_force; zero when not in contact.
  * Returns |f|. */
 double proxy_spring_force(const proxy_t *p, const double device[3], double stiffness, double max_force, double f[3]);
+
+/* The same tick with Coulomb friction mu >= 0 on the proxy's motion: the
+ * proxy sticks while the tangential spring force K |tangential offset|
+ * stays within the cone mu * normal force, and beyond it slides only as
+ * far as keeps the offset on the cone (static = dynamic coefficient).
+ * mu = 0 is proxy_update. */
+int proxy_update_friction(proxy_t *p, const double device[3], const proxy_surface_t *surfaces, size_t nsurfaces,
+                          double stiffness, double max_force, double mu, double force[3]);
+
+/* Area-weighted unit vertex normals of (x, tris) into vn (3 per vertex;
+ * zero for a vertex in no triangle), for proxy_surface_t.vn. */
+void proxy_vertex_normals(size_t nverts, const double *x, size_t ntris, const uint32_t *tris, double *vn);
 
 /* Re-evaluates pos and normal from the attached triangle's current vertices
  * (call after the surface moved, e.g. after a physics step); pos includes

@@ -181,7 +181,7 @@ static void tree_vs_scan(const char *dir) {
 int main(void) {
   double x[] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0};
   uint32_t tris[] = {0, 1, 2, 0, 2, 3};
-  proxy_surface_t s = {x, tris, 2, 0, NULL, NULL};
+  proxy_surface_t s = {x, tris, 2, 0, NULL, NULL, NULL, 0};
   proxy_t p;
   proxy_reset(&p);
   double f[3];

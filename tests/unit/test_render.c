@@ -249,6 +249,26 @@ int main(void) {
     CHECK(same_px(px(bar, W - 35, ymid), px(bg, W - 35, ymid)));
   }
 
+  /* A stone (render_object) inside the organ shows through as a ghost in
+   * its colour; outside it is drawn solid. */
+  static uint8_t organ_only[W * H * 3], with_stone[W * H * 3];
+  const float stone_rgb[3] = {0.9f, 0.85f, 0.2f};
+  render_begin(r, &cam);
+  CHECK(render_mesh(r, s.pos, s.nverts, s.tris, s.ntris, colour, &err) == 0);
+  memcpy(organ_only, render_end(r), sizeof organ_only);
+  render_begin(r, &cam);
+  CHECK(render_mesh(r, s.pos, s.nverts, s.tris, s.ntris, colour, &err) == 0);
+  render_object(r, CENTRE, 0.3f * RADIUS, stone_rgb);
+  memcpy(with_stone, render_end(r), sizeof with_stone);
+  const uint8_t *ghost = px(with_stone, (int)cx, (int)cy), *org = px(organ_only, (int)cx, (int)cy);
+  printf("stone inside: rgb %d %d %d over organ %d %d %d\n", ghost[0], ghost[1], ghost[2], org[0], org[1], org[2]);
+  CHECK(ghost[1] > org[1] + 20); /* tinted towards the stone's yellow */
+  render_begin(r, &cam);
+  render_object(r, tip, 0.3f * RADIUS, stone_rgb);
+  memcpy(with_stone, render_end(r), sizeof with_stone);
+  const uint8_t *out = px(with_stone, (int)tx, (int)ty);
+  CHECK(out[0] > out[2] + 60 && out[1] > out[2] + 60); /* solid yellow */
+
   /* Bad arguments fail with a message instead of crashing. */
   render_t *bad = NULL;
   CHECK(render_open(&bad, 0, 10, 1, &err) == -1 && bad == NULL);

@@ -251,8 +251,8 @@ static void test_wrong_types(void) {
   CHECK(fails_with(HEAD "    solver: {substeps: two}\n", "organs[0].solver.substeps': must be a number (got 'two')",
                    NULL));
   CHECK(fails_with(HEAD "    integrator: [a]\n", "organs[0].integrator': must be one of", "(got a list)"));
-  CHECK(fails_with(HEAD "tools:\n  - name: s\n    kind: scalpel\n", "t.yaml:7: field 'tools[0].kind'",
-                   "must be one of: probe (got 'scalpel')"));
+  CHECK(fails_with(HEAD "tools:\n  - name: s\n    kind: lancet\n", "t.yaml:7: field 'tools[0].kind'",
+                   "must be one of: probe, grasper, scalpel, extractor, syringe (got 'lancet')"));
 }
 
 static void test_not_finite(void) {
