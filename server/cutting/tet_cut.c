@@ -196,7 +196,7 @@ int tet_cut_create(tet_cut_t *c, size_t n, const double *x_rest, const double *x
     if (!isfinite(x_rest[k]) || (x && !isfinite(x[k])) || (v && !isfinite(v[k])))
       return verr_set(err, "tet_cut: node %zu has a non-finite coordinate", k / 3);
   c->priv = calloc(1, sizeof *c->priv);
-  c->snap = 0.15;
+  c->snap = 0.25;
   if (!c->priv || reserve(c, 2 * n, 2 * ntets)) {
     tet_cut_destroy(c);
     return verr_set(err, "tet_cut: out of memory for %zu nodes", n);
@@ -215,6 +215,13 @@ int tet_cut_create(tet_cut_t *c, size_t n, const double *x_rest, const double *x
     memset(c->fixed, 0, n);
   memcpy(c->tet, tets, 4 * ntets * sizeof(uint32_t));
   memset(c->tflag, 0, ntets);
+  double lsum = 0;
+  for (size_t t = 0; t < ntets; t++)
+    for (int e = 0; e < 6; e++)
+      lsum += v3_dist(x_rest + 3 * (size_t)tets[4 * t + TET_SPLIT_EDGE[e][0]],
+                      x_rest + 3 * (size_t)tets[4 * t + TET_SPLIT_EDGE[e][1]]);
+  c->min_edge = 0.5 * lsum / (6.0 * (double)ntets);
+  c->min_quality = 0.1;
   /* Planar projection on the two largest extents: a texture coordinate
    * every node has, so the incision's new vertices carry interpolated ones. */
   double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
@@ -377,10 +384,15 @@ static int sweep(tet_cut_t *c, const double *t0, const double *h0, const double 
         j = s;
       }
       if (edge_find(p, i, j)) continue;
+      if (v3_dist(c->x_rest + 3 * (size_t)i, c->x_rest + 3 * (size_t)j) < c->min_edge) continue;
       double s;
       if (!edge_hits_tri(c->x + 3 * (size_t)i, c->x + 3 * (size_t)j, tri[0][0], tri[0][1], tri[0][2], &s) &&
           !edge_hits_tri(c->x + 3 * (size_t)i, c->x + 3 * (size_t)j, tri[1][0], tri[1][1], tri[1][2], &s))
         continue;
+      int poor = 0;
+      for (uint32_t k = p->n2t_start[i]; k < p->n2t_start[i + 1] && !poor; k++)
+        poor = tet_has(c->tet + 4 * (size_t)p->n2t[k], j) && tet_cut_quality(c, c->x_rest, p->n2t[k]) < c->min_quality;
+      if (poor) continue;
       eslot_t *sl = edge_insert(p, i, j);
       if (!sl) return -1;
       sl->t = fmin(fmax(s, c->snap), 1 - c->snap);

@@ -50,10 +50,25 @@
  *     length counts as on the positive side (symbolic perturbation), so a
  *     cut through a node or along a face is decided consistently;
  *   - the intersection parameter along an edge is clamped to
- *     [snap, 1 - snap] (default 0.15): no new point lies closer than 15 % of
- *     an edge to a node, which bounds the leaves' shape relative to their
- *     parent. A cut through a node thus passes 15 % of an edge beside it;
- *   - a blade that did not move (zero-area quad) cuts nothing.
+ *     [snap, 1 - snap] (default 0.25, the field `snap`): no new point lies
+ *     closer than a quarter of an edge to a node, which bounds the leaves'
+ *     shape relative to their parent (on the spleen at 7 mm, one cut leaves
+ *     a minimum radius ratio of 0.004 with 0.15, 0.031 with 0.25, 0.066
+ *     with 0.33). A cut through a node thus passes a quarter edge beside it,
+ *     and the incision deviates from the blade by up to snap x edge length;
+ *   - a blade that did not move (zero-area quad) cuts nothing;
+ *   - an edge shorter at rest than `min_edge` (default: half the mean rest
+ *     edge of the mesh at create) is never cut: a tetrahedron whose cut
+ *     would need it stays partial and the incision does not open there.
+ *     This is the resolution limit that bounds refinement: without it each
+ *     cut through already cut tissue crosses several times more (smaller,
+ *     flatter) elements than the last, and 30 random incisions on the spleen
+ *     grew it from 2,305 to 283,000 tetrahedra with radius ratios below
+ *     1e-4. With it, an edge is bisected at most about three times;
+ *   - likewise an edge of a tetrahedron whose rest radius ratio is below
+ *     `min_quality` (default 0.1) is never cut: poor elements are not split
+ *     again, which bounds the quality loss over many cuts (each split of a
+ *     tetrahedron of quality q leaves leaves of about q / 10 at worst).
  *
  * New nodes: rest position, position, velocity and attribute interpolated
  * linearly along the edge with the cut parameter (the seed's edge rule for
@@ -89,6 +104,8 @@ typedef struct tet_cut {
   uint32_t *tet;          /* 4 cap_t, positive orientation at rest */
   uint8_t *tflag;         /* cap_t, internal */
   double snap;
+  double min_edge;    /* m, rest length below which an edge is never cut (see the header) */
+  double min_quality; /* an edge of a tetrahedron of lower rest radius ratio is never cut */
   uint32_t version;
   tet_cut_stats_t stats;
   struct tet_cut_priv *priv; /* edge table, state table, adjacency, session */
