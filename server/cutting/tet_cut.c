@@ -185,8 +185,8 @@ static int build_n2t(tet_cut_t *c) {
 
 static int tet_has(const uint32_t *q, uint32_t a) { return q[0] == a || q[1] == a || q[2] == a || q[3] == a; }
 
-int tet_cut_create(tet_cut_t *c, size_t n, const double *x_rest, const double *x, const double *v,
-                   const uint8_t *fixed, size_t ntets, const uint32_t *tets, verr_t *err) {
+int tet_cut_create(tet_cut_t *c, size_t n, const double *x_rest, const double *x, const double *v, const uint8_t *fixed,
+                   size_t ntets, const uint32_t *tets, verr_t *err) {
   memset(c, 0, sizeof *c);
   if (n == 0 || ntets == 0) return verr_set(err, "tet_cut: empty mesh (%zu nodes, %zu tetrahedra)", n, ntets);
   if (n >= TC_MAX_NODES / 2) return verr_set(err, "tet_cut: too many nodes (%zu, at most %zu)", n, TC_MAX_NODES / 2);
@@ -542,8 +542,7 @@ static int open_incision(tet_cut_t *c, int final) {
         int nc = 0;
         for (int k = 0; k < 4; k++)
           if (tet_has(qb, qa[k])) common[nc++] = qa[k];
-        if (nc == 3 && !face_has(p, face_key(common[0], common[1], common[2])))
-          par[uf_find(par, a)] = uf_find(par, b);
+        if (nc == 3 && !face_has(p, face_key(common[0], common[1], common[2]))) par[uf_find(par, a)] = uf_find(par, b);
       }
     }
     /* Settle every root first, then give each group but the first its

@@ -88,11 +88,11 @@
 #include "verr.h"
 
 typedef struct tet_cut_stats {
-  size_t cut_edges;                /* intersection points created (all sessions) */
-  size_t split_general[2];         /* G1 (1|3), G2 (2|2) */
-  size_t split_partial[3];         /* P1, P2, P3 */
-  size_t duplicated;               /* node copies made to open the incision */
-  double intersect_s, topology_s;  /* wall time in intersection, in splitting + duplication */
+  size_t cut_edges;               /* intersection points created (all sessions) */
+  size_t split_general[2];        /* G1 (1|3), G2 (2|2) */
+  size_t split_partial[3];        /* P1, P2, P3 */
+  size_t duplicated;              /* node copies made to open the incision */
+  double intersect_s, topology_s; /* wall time in intersection, in splitting + duplication */
 } tet_cut_stats_t;
 
 typedef struct tet_cut {
@@ -115,8 +115,8 @@ typedef struct tet_cut {
  * fixed may be NULL = none) and gives every node the attribute of a planar
  * projection of its rest position on the two largest extents of the mesh,
  * scaled to [0, 1]. Returns 0, or -1 with err. */
-int tet_cut_create(tet_cut_t *c, size_t n, const double *x_rest, const double *x, const double *v,
-                   const uint8_t *fixed, size_t ntets, const uint32_t *tets, verr_t *err);
+int tet_cut_create(tet_cut_t *c, size_t n, const double *x_rest, const double *x, const double *v, const uint8_t *fixed,
+                   size_t ntets, const uint32_t *tets, verr_t *err);
 void tet_cut_destroy(tet_cut_t *c);
 
 /* The blade at its new position. The first call after create or end starts

@@ -72,7 +72,7 @@ static void panel(cairo_t *cr, double x0, double y0, double w, double h, const c
   for (int k = 0; k <= 4; k++) {
     double v = lo + (hi - lo) * k / 4, yy = py + ph - ph * k / 4;
     if (logy)
-      snprintf(lab, sizeof lab, "1e%.1f", v);
+      snprintf(lab, sizeof lab, "%.2g", pow(10, v));
     else
       snprintf(lab, sizeof lab, "%.4g", v);
     cairo_move_to(cr, x0 + 2, yy + 3);
@@ -152,7 +152,9 @@ int main(int argc, char **argv) {
   double isum = 0, tsum = 0;
   FILE *csv = csv_path ? fopen(csv_path, "w") : NULL;
   if (csv_path && !csv) fprintf(stderr, "bench_tet_cut: cannot write %s\n", csv_path);
-  if (csv) fprintf(csv, "cut,nodes,tets,surf_tris,min_quality_rest,min_quality_now,cut_ms,intersect_ms,topology_ms,rebuild_ms,step_ms,finite\n");
+  if (csv)
+    fprintf(csv, "cut,nodes,tets,surf_tris,min_quality_rest,min_quality_now,cut_ms,intersect_ms,topology_ms,rebuild_ms,"
+                 "step_ms,finite\n");
   for (int k = 0; k < cuts; k++) {
     cut_random(m, lo, hi, &seed, &rec[k]);
     const cut_record_t *r = &rec[k];
@@ -171,9 +173,10 @@ int main(int argc, char **argv) {
   const tet_cut_t *c = model_pbd_cutter(m);
   double phys1 = step_median(m, 50);
   double calls = CALLS_PER_CUT * cuts;
-  printf("bench_tet_cut: seed 003 Table 1 style, spleen (assets/meshes/spleen.obj, tetrahedra of 7 mm), XPBD, dt %.0f ms, "
-         "1 sub-step x 10 iterations\n",
-         1e3 * CUT_DT);
+  printf(
+      "bench_tet_cut: seed 003 Table 1 style, spleen (assets/meshes/spleen.obj, tetrahedra of 7 mm), XPBD, dt %.0f ms, "
+      "1 sub-step x 10 iterations\n",
+      1e3 * CUT_DT);
   printf("%-22s %7s %7s %11s %13s %15s\n", "model", "nodes", "tets", "physics_ms", "topology_ms", "intersection_ms");
   printf("%-22s %7zu %7zu %11.3f %13s %15s\n", "spleen uncut", nodes0, tets0, phys0, "-", "-");
   printf("%-22s %7zu %7zu %11.3f %13.3f %15.3f\n", "spleen cutting", c->n, c->ntets, phys1, tsum / calls, isum / calls);

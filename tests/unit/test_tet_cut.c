@@ -31,8 +31,8 @@ static double rest_volume(const tet_cut_t *c) {
   for (size_t t = 0; t < c->ntets; t++) {
     const uint32_t *q = c->tet + 4 * t;
     double g[4][3];
-    v += pbd_volume_constraint(c->x_rest + 3 * (size_t)q[0], c->x_rest + 3 * (size_t)q[1],
-                               c->x_rest + 3 * (size_t)q[2], c->x_rest + 3 * (size_t)q[3], 0, g) /
+    v += pbd_volume_constraint(c->x_rest + 3 * (size_t)q[0], c->x_rest + 3 * (size_t)q[1], c->x_rest + 3 * (size_t)q[2],
+                               c->x_rest + 3 * (size_t)q[3], 0, g) /
          6.0;
   }
   return v;
@@ -160,7 +160,7 @@ static void test_classify(void) {
   CHECK(tet_split_classify(0, NULL) == TET_SPLIT_NONE);
   CHECK(tet_split_classify(1u << 0 | 1u << 1 | 1u << 2, side) == TET_SPLIT_G1); /* node 0 alone */
   CHECK(side[0] != side[1] && side[1] == side[2] && side[2] == side[3]);
-  CHECK(tet_split_classify(1u << 2 | 1u << 4 | 1u << 5, side) == TET_SPLIT_G1); /* node 3 alone */
+  CHECK(tet_split_classify(1u << 2 | 1u << 4 | 1u << 5, side) == TET_SPLIT_G1);           /* node 3 alone */
   CHECK(tet_split_classify(1u << 1 | 1u << 2 | 1u << 3 | 1u << 4, side) == TET_SPLIT_G2); /* 01 | 23 */
   CHECK(side[0] == side[1] && side[2] == side[3] && side[0] != side[2]);
   CHECK(tet_split_classify(1u << 0, NULL) == TET_SPLIT_P1);
@@ -229,7 +229,8 @@ static void test_partial_cases(void) {
    * z; x = 0.25 + u / 2, y = 0.25 - u / 2. */
   one_tet(&c);
   {
-#define P(u, z) {0.25 + 0.5 * (u), 0.25 - 0.5 * (u), (z)}
+#define P(u, z)                                                                                                        \
+  { 0.25 + 0.5 * (u), 0.25 - 0.5 * (u), (z) }
     double tip[2][3] = {P(-1, 0.8), P(1, -0.2)};
     double han[2][3] = {P(-1, -0.5), P(-1, -0.5)};
 #undef P
@@ -314,8 +315,7 @@ static void test_rest_rules(void) {
   CHECK_NEAR(tet_cut_rest_edge(d, 1.7 * t * d, 1.7 * (1 - t) * d), t * d, 1e-14);
   double l[3] = {0.2, 0.5, 0.3}, P[3];
   for (int k = 0; k < 3; k++) P[k] = l[0] * A[k] + l[1] * B[k] + l[2] * C[k];
-  CHECK_NEAR(tet_cut_rest_face(v3_dist(A, B), v3_dist(B, C), v3_dist(A, C), l[0], l[1], l[2]), v3_dist(A, P),
-             1e-14);
+  CHECK_NEAR(tet_cut_rest_face(v3_dist(A, B), v3_dist(B, C), v3_dist(A, C), l[0], l[1], l[2]), v3_dist(A, P), 1e-14);
 }
 
 /* ---- the PBD model with cutting ------------------------------------------- */
@@ -324,8 +324,7 @@ static void box_surface(mesh_t *m, double lx, double ly, double lz) {
   static const uint32_t T[12][3] = {{0, 2, 1}, {0, 3, 2}, {4, 5, 6}, {4, 6, 7}, {0, 1, 5}, {0, 5, 4},
                                     {1, 2, 6}, {1, 6, 5}, {2, 3, 7}, {2, 7, 6}, {3, 0, 4}, {3, 4, 7}};
   mesh_alloc(m, 8, 12, NULL);
-  for (int i = 0; i < 8; i++)
-    v3_set(m->pos + 3 * i, lx * ((i & 1) ^ (i >> 1 & 1)), ly * (i >> 1 & 1), lz * (i >> 2));
+  for (int i = 0; i < 8; i++) v3_set(m->pos + 3 * i, lx * ((i & 1) ^ (i >> 1 & 1)), ly * (i >> 1 & 1), lz * (i >> 2));
   memcpy(m->tris, T, sizeof T);
 }
 
