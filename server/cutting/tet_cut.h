@@ -19,7 +19,7 @@
  *     neighbour that shares a cut edge only): any other non-empty set of cut
  *     edges (P1: one edge, P2: two, P3: three or more without a separation);
  *     split at tet_cut_end() only.
- * Faces points of the seed are not generated: the cut surface inside one
+ * Face points of the seed are not generated: the cut surface inside one
  * tetrahedron is the piecewise-planar surface through its edge points, so
  * the seed's five general cases reduce to G1 and G2 here (the three with a
  * face point differ only below the element size).
