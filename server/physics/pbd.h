@@ -203,8 +203,8 @@ model_t *model_pbd_create(const model_params_t *p, verr_t *err);
 pbd_t *model_pbd_solver(model_t *m);
 
 /* Cutting such a model with a scalpel (server/cutting/tet_cut.h). One call
- * per scene step with the blade segment (tip, handle; metres, the organ's
- * frame), one to end the cut. When tetrahedra split, the model rebuilds its
+ * per scene step with the blade segment (tip, handle; metres, in the
+ * model's coordinates: the scene frame), one to end the cut. When tetrahedra split, the model rebuilds its
  * solver (new nodes, distance constraints with rest lengths measured on the
  * interpolated rest configuration, volume constraints with rest volumes from
  * it, colouring, masses equal again with the total kept, fixed nodes kept,
