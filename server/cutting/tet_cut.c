@@ -221,7 +221,11 @@ int tet_cut_create(tet_cut_t *c, size_t n, const double *x_rest, const double *x
       lsum += v3_dist(x_rest + 3 * (size_t)tets[4 * t + TET_SPLIT_EDGE[e][0]],
                       x_rest + 3 * (size_t)tets[4 * t + TET_SPLIT_EDGE[e][1]]);
   c->min_edge = 0.5 * lsum / (6.0 * (double)ntets);
-  c->min_quality = 0.1;
+  /* Meshes whose elements are all poorer than 0.1 still cut: the gate is
+   * then half the mesh's own worst element. */
+  double qmin = INFINITY;
+  for (size_t t = 0; t < ntets; t++) qmin = fmin(qmin, tet_cut_quality(c, c->x_rest, t));
+  c->min_quality = fmin(0.1, 0.5 * qmin);
   /* Planar projection on the two largest extents: a texture coordinate
    * every node has, so the incision's new vertices carry interpolated ones. */
   double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};

@@ -66,7 +66,8 @@
  *     grew it from 2,305 to 283,000 tetrahedra with radius ratios below
  *     1e-4. With it, an edge is bisected at most about three times;
  *   - likewise an edge of a tetrahedron whose rest radius ratio is below
- *     `min_quality` (default 0.1) is never cut: poor elements are not split
+ *     `min_quality` (default 0.1, or half the worst element's at create if
+ *     that is lower) is never cut: poor elements are not split
  *     again, which bounds the quality loss over many cuts (each split of a
  *     tetrahedron of quality q leaves leaves of about q / 10 at worst).
  *

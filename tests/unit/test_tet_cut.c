@@ -198,6 +198,21 @@ static void test_general_cases(void) {
   CHECK(c.stats.duplicated == 4);
   check_mesh(&c, v0, "G2 (2|2)");
   tet_cut_destroy(&c);
+  /* Through two nodes: the plane x = y holds nodes 0 and 3 and crosses edge
+   * 12. Nodes on the plane count as on its positive side, so node 2 (x < y)
+   * is cut off alone (G1) and the points on its edges to nodes 0 and 3 sit
+   * a quarter edge from them (the snap), never on them. */
+  one_tet(&c);
+  {
+    double tip[2][3] = {{-1, -1, -1}, {2, 2, -1}};
+    double han[2][3] = {{-1, -1, 2}, {2, 2, 2}};
+    run_blade(&c, (const double(*)[3])tip, (const double(*)[3])han, 2);
+  }
+  CHECK(c.stats.split_general[0] == 1 && pieces(&c) == 2);
+  for (size_t i = 4; i < c.n; i++)
+    for (size_t j = 0; j < 4; j++) CHECK(v3_dist(c.x_rest + 3 * i, TET_X + 3 * j) > 0.2);
+  check_mesh(&c, v0, "G1 through two nodes");
+  tet_cut_destroy(&c);
 }
 
 static void test_partial_cases(void) {
