@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "pbd.h"
+#include "tet_cut.h"
 #include "tet_mesh.h"
 
 typedef struct model_pbd {
@@ -17,6 +18,13 @@ typedef struct model_pbd {
   tet_embedding_t emb;
   double *surf_x, *surf_rest;
   uint32_t *surf_tris;
+  /* Cutting: NULL until enabled or a cut starts. After the first split the
+   * surface is the tetrahedral boundary: surf_node maps its vertices to
+   * nodes (and replaces the embedding), surf_attr holds their attribute. */
+  tet_cut_t *cut;
+  uint32_t *surf_node;
+  double *surf_attr;
+  int cut_broken; /* a rebuild failed: the solver no longer matches the cutter */
 } model_pbd_t;
 
 /* Sub-steps chosen when the scene leaves solver.substeps at 0: PBD and XPBD
@@ -37,7 +45,11 @@ static int pbd_model_step(model_t *m, double h) {
   if (rc) m->rollbacks++;
   /* After a rollback the restored nodes are embedded again too, so the
    * surface always shows the state the model holds. */
-  tet_embedding_apply(&mp->emb, &mp->tm, mp->s.x, mp->surf_x);
+  if (mp->surf_node)
+    for (size_t i = 0; i < m->nsurf; i++)
+      memcpy(mp->surf_x + 3 * i, mp->s.x + 3 * (size_t)mp->surf_node[i], 3 * sizeof(double));
+  else
+    tet_embedding_apply(&mp->emb, &mp->tm, mp->s.x, mp->surf_x);
   return rc;
 }
 
@@ -49,6 +61,10 @@ static void pbd_model_destroy(model_t *m) {
   free(mp->surf_x);
   free(mp->surf_rest);
   free(mp->surf_tris);
+  free(mp->surf_node);
+  free(mp->surf_attr);
+  if (mp->cut) tet_cut_destroy(mp->cut);
+  free(mp->cut);
   free(mp);
 }
 
@@ -67,7 +83,12 @@ static double pbd_model_error(const model_t *m) { return pbd_volume_error(&((con
  * the work done on the surface equals the work done on the nodes. */
 static void pbd_model_add_surface_force(model_t *m, uint32_t i, const double f[3]) {
   model_pbd_t *mp = (model_pbd_t *)m;
-  if (i >= mp->emb.nsurf || !(isfinite(f[0]) && isfinite(f[1]) && isfinite(f[2]))) return;
+  if (!(isfinite(f[0]) && isfinite(f[1]) && isfinite(f[2]))) return;
+  if (mp->surf_node) {
+    if (i < m->nsurf) pbd_add_force(&mp->s, mp->surf_node[i], f);
+    return;
+  }
+  if (i >= mp->emb.nsurf) return;
   const uint32_t *q = mp->tm.tets + 4 * (size_t)mp->emb.tet[i];
   const double *b = mp->emb.bary + 4 * (size_t)i;
   for (int k = 0; k < 4; k++) {
@@ -185,4 +206,144 @@ model_t *model_pbd_create(const model_params_t *p, verr_t *err) {
 pbd_t *model_pbd_solver(model_t *m) {
   if (!m || (m->ops != &PBD_OPS && m->ops != &XPBD_OPS)) return NULL;
   return &((model_pbd_t *)m)->s;
+}
+
+/* ---- cutting ---------------------------------------------------------------- */
+
+int model_pbd_enable_cutting(model_t *m, verr_t *err) {
+  pbd_t *s = model_pbd_solver(m);
+  if (!s) return verr_set(err, "cutting needs a pbd or xpbd model");
+  model_pbd_t *mp = (model_pbd_t *)m;
+  if (mp->cut) return 0;
+  uint8_t *fixed = malloc(s->n);
+  mp->cut = calloc(1, sizeof *mp->cut);
+  if (!fixed || !mp->cut) {
+    free(fixed);
+    free(mp->cut);
+    mp->cut = NULL;
+    return verr_set(err, "out of memory for the cutter");
+  }
+  for (size_t i = 0; i < s->n; i++) fixed[i] = s->inv_mass[i] == 0;
+  int rc = tet_cut_create(mp->cut, s->n, s->x_rest, s->x, s->v, fixed, s->ntets, s->tet, err);
+  free(fixed);
+  if (rc) {
+    free(mp->cut);
+    mp->cut = NULL;
+    return -1;
+  }
+  return 0;
+}
+
+/* The solver and the surface from the cutter's mesh (see pbd.h). Everything
+ * new is built first; the model changes only when all of it succeeded. */
+static int rebuild(model_pbd_t *mp, verr_t *err) {
+  tet_cut_t *c = mp->cut;
+  model_t *m = &mp->base;
+  pbd_t ns;
+  verr_t sub;
+  if (pbd_create(&ns, c->n, c->x_rest, c->ntets, c->tet, &mp->s.p, &sub)) {
+    mp->cut_broken = 1;
+    return verr_set(err, "rebuilding the solver after a cut: %s", sub.msg);
+  }
+  uint32_t *tris = NULL;
+  size_t nt = tet_cut_boundary(c, &tris);
+  uint32_t *map = malloc(c->n * sizeof *map);
+  if (nt == (size_t)-1 || !map) {
+    free(tris);
+    free(map);
+    pbd_destroy(&ns);
+    mp->cut_broken = 1;
+    return verr_set(err, "out of memory for the surface after a cut");
+  }
+  size_t nv = 0;
+  for (size_t i = 0; i < c->n; i++) map[i] = UINT32_MAX;
+  for (size_t k = 0; k < 3 * nt; k++)
+    if (map[tris[k]] == UINT32_MAX) map[tris[k]] = (uint32_t)nv++;
+  uint32_t *node = malloc((nv ? nv : 1) * sizeof *node);
+  double *sx = malloc((nv ? nv : 1) * 3 * sizeof(double)), *sr = malloc((nv ? nv : 1) * 3 * sizeof(double));
+  double *sa = malloc((nv ? nv : 1) * 2 * sizeof(double));
+  if (!node || !sx || !sr || !sa) {
+    free(tris);
+    free(map);
+    free(node);
+    free(sx);
+    free(sr);
+    free(sa);
+    pbd_destroy(&ns);
+    mp->cut_broken = 1;
+    return verr_set(err, "out of memory for the surface after a cut");
+  }
+  for (size_t i = 0; i < c->n; i++)
+    if (map[i] != UINT32_MAX) node[map[i]] = (uint32_t)i;
+  for (size_t k = 0; k < 3 * nt; k++) tris[k] = map[tris[k]];
+  free(map);
+  memcpy(ns.x, c->x, 3 * c->n * sizeof(double));
+  memcpy(ns.v, c->v, 3 * c->n * sizeof(double));
+  for (size_t i = 0; i < c->n; i++)
+    if (c->fixed[i]) pbd_fix_node(&ns, i);
+  ns.rollbacks = mp->s.rollbacks;
+  for (size_t v = 0; v < nv; v++) {
+    memcpy(sx + 3 * v, c->x + 3 * (size_t)node[v], 3 * sizeof(double));
+    memcpy(sr + 3 * v, c->x_rest + 3 * (size_t)node[v], 3 * sizeof(double));
+    memcpy(sa + 2 * v, c->attr + 2 * (size_t)node[v], 2 * sizeof(double));
+  }
+  pbd_destroy(&mp->s);
+  mp->s = ns;
+  free(mp->surf_x);
+  free(mp->surf_rest);
+  free(mp->surf_tris);
+  free(mp->surf_node);
+  free(mp->surf_attr);
+  mp->surf_x = sx;
+  mp->surf_rest = sr;
+  mp->surf_tris = tris;
+  mp->surf_node = node;
+  mp->surf_attr = sa;
+  m->nnodes = mp->s.n;
+  m->x = mp->s.x;
+  m->v = mp->s.v;
+  m->x_rest = mp->s.x_rest;
+  m->ntets = mp->s.ntets;
+  m->nsurf = nv;
+  m->nsurf_tris = nt;
+  m->surf_x = sx;
+  m->surf_rest = sr;
+  m->surf_tris = tris;
+  m->topology_version++;
+  return 0;
+}
+
+/* Runs one cutter call on the solver's current state. */
+static int cut_call(model_t *m, const double *tip, const double *handle, verr_t *err) {
+  if (!model_pbd_solver(m)) return verr_set(err, "cutting needs a pbd or xpbd model");
+  model_pbd_t *mp = (model_pbd_t *)m;
+  if (mp->cut_broken) return verr_set(err, "cutting disabled after a failed rebuild");
+  if (!tip && !mp->cut) return 0; /* nothing was cut: nothing to end */
+  if (!mp->cut && model_pbd_enable_cutting(m, err)) return -1;
+  tet_cut_t *c = mp->cut;
+  /* The cutter holds the same nodes as the solver (rebuilt together). */
+  memcpy(c->x, mp->s.x, 3 * c->n * sizeof(double));
+  memcpy(c->v, mp->s.v, 3 * c->n * sizeof(double));
+  uint32_t version = c->version;
+  int n = tip ? tet_cut_advance(c, tip, handle, err) : tet_cut_end(c, err);
+  if (n < 0) return -1;
+  if (c->version != version && rebuild(mp, err)) return -1;
+  return n;
+}
+
+int model_pbd_cut(model_t *m, const double tip[3], const double handle[3], verr_t *err) {
+  if (!tip || !handle) return verr_set(err, "no blade");
+  return cut_call(m, tip, handle, err);
+}
+
+int model_pbd_cut_end(model_t *m, verr_t *err) { return cut_call(m, NULL, NULL, err); }
+
+const struct tet_cut *model_pbd_cutter(const model_t *m) {
+  if (!m || (m->ops != &PBD_OPS && m->ops != &XPBD_OPS)) return NULL;
+  return ((const model_pbd_t *)m)->cut;
+}
+
+const double *model_pbd_surface_attr(const model_t *m) {
+  if (!m || (m->ops != &PBD_OPS && m->ops != &XPBD_OPS)) return NULL;
+  return ((const model_pbd_t *)m)->surf_attr;
 }
