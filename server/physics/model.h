@@ -60,8 +60,11 @@ struct model {
   /* Topology of the surface: 0 at creation. A model that changes its surface
    * (adaptive refinement, cutting) increments it after it has updated nsurf,
    * nsurf_tris, surf_x, surf_rest and surf_tris (the pointers may change then,
-   * and only then). The runtime compares it after every step and rebuilds
-   * what depends on the surface (collision tree, proxies, publisher). */
+   * and only then). A cut may also replace the nodes (nnodes, x, v, x_rest,
+   * ntets): whoever keeps node or surface pointers or indices re-reads them
+   * when the version moves. The runtime compares it after every step and
+   * rebuilds what depends on the surface (collision tree, proxies, grasps,
+   * publisher). */
   uint32_t topology_version;
   void (*hook)(model_t *m, void *ctx);
   void *hook_ctx;
