@@ -416,7 +416,8 @@ void scene_ball(nb_t *nb) {
   plot_series(&p, &xs, 1, 1);
   plot_series(&p, &pb, 1, 1);
   plot_note(&p,
-            "Each model against its own converged run; ground = penalty %.0f N/m per surface vertex through the "
+            "Each model against its own converged run (the front compares solver error only); ground = penalty %.0f "
+            "N/m per surface vertex through the "
             "contact hook. Mass-spring: dt 1/30 ... 1/%.0f s, 1 sub-step. Missing points diverged.",
             K_GROUND, 1 / nb_dt(NDT - 1));
   plot_note(&p,

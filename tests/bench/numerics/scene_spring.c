@@ -321,7 +321,12 @@ static void scene_s2(nb_t *nb) {
       continue;
     }
     double e_end, e = ex_error(&o.traj, &ref.traj, sn.mass, diag, &e_end);
-    double E0 = o.traj.extra[0], drift = fabs(o.traj.extra[o.traj.ns - 1] - E0) / E0;
+    /* pbd_energy measures heights from z = 0, where the chain starts: E0 is
+     * 0. Scale the drift by the energy above the lowest reachable point, as
+     * the springnet's energy does (z_ref). */
+    double off = 0;
+    for (size_t k = 1; k < CHAIN_N; k++) off += sn.mass[k] * 9.81 * -sn.z_ref;
+    double E0 = o.traj.extra[0], drift = fabs(o.traj.extra[o.traj.ns - 1] - E0) / (E0 + off);
     if (!o.stable) e = e_end = drift = NAN;
     xs_err[i] = e;
     xs_cost[i] = o.stable ? o.wall_per_sim_s : NAN;
