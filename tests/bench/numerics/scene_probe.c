@@ -208,6 +208,8 @@ static void probe_model(nb_t *nb, const probe_model_spec_t *ms, FILE *csv, plot_
   const int ndt = nb->quick ? 5 : NDT;
   for (int ki = 0; ki < ms->nkinds; ki++) {
     const char *integ = ms->only ? ms->only : integrator_name(KINDS[ki]);
+    /* PBD/XPBD ignore the integrator: their rows say what they run. */
+    const char *row_integ = strstr(model, "pbd") ? "gauss_seidel" : integ;
     if (nb->quick && !ms->only && KINDS[ki] != INT_SYMPLECTIC_EULER && KINDS[ki] != INT_IMPLICIT_EULER) continue;
     double dts[NDT], errs[NDT], cost[NDT];
     int have = 0;
@@ -231,10 +233,11 @@ static void probe_model(nb_t *nb, const probe_model_spec_t *ms, FILE *csv, plot_
       have = 1;
       if (csv)
         fprintf(csv, "%s,%s,%.9g,%d,%d,%.6e,%.6e,%.6e,%d,%.3f,%.3f,%.6e,%s dt=1/%.0f x%d (x%d differs by %.2e)\n",
-                model, integ, dt, r.substeps, r.stable, fe, worst, ex, lost, r.step_us_median, r.step_us_p95,
+                model, row_integ, dt, r.substeps, r.stable, fe, worst, ex, lost, r.step_us_median, r.step_us_p95,
                 r.wall_per_sim_s, ms->ref_integ, 1 / dt_ref, ms->ref_sub, 2 * ms->ref_sub, ref_self);
       run_out_t o = {.stable = r.stable, .step_us_median = r.step_us_median, .wall_per_sim_s = r.wall_per_sim_s};
-      nb_result(nb, "S8", model, integ, dt, r.substeps, 1, "F_rms/F_peak", fe, worst, &o);
+      nb_result(nb, "S8", model, row_integ, dt, r.substeps, strstr(model, "pbd") ? 10 : 1, "F_rms/F_peak", fe, worst,
+                &o);
       probe_run_free(&r);
     }
     if (!have) continue;
@@ -247,9 +250,13 @@ static void probe_model(nb_t *nb, const probe_model_spec_t *ms, FILE *csv, plot_
       snprintf(lab, sizeof lab, "%s, %s", model, integ_label(KINDS[ki]));
     /* One line style per model, one marker per integrator, one colour each. */
     int style = !strcmp(model, "molecular") ? PLOT_LINE_DASHED : (ms->only ? PLOT_LINE_DOTTED : PLOT_LINE_SOLID);
-    plot_series_t *s = plot_add(wp, lab, (size_t)ndt, cost, errs, *color, ki, style);
+    /* PBD/XPBD: their own colours and markers (x, +), apart from the
+     * palette's browns the molecular curves already use. */
+    int pb = strstr(model, "pbd") != NULL, xp = pb && model[0] == 'x';
+    int col = pb ? (xp ? 13 : 15) : *color, mk = pb ? (xp ? 5 : 6) : ki;
+    plot_series_t *s = plot_add(wp, lab, (size_t)ndt, cost, errs, col, mk, style);
     if (s) s->pareto = 1;
-    plot_add(ed, lab, (size_t)ndt, dts, errs, *color, ki, style);
+    plot_add(ed, lab, (size_t)ndt, dts, errs, col, mk, style);
     (*color)++;
   }
   probe_run_free(&ref);
