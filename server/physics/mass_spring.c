@@ -157,6 +157,7 @@ void mass_spring_destroy(mass_spring_t *ms) {
   free(ms->inv_mass);
   free(ms->mass);
   free(ms->springs);
+  free(ms->k_scale);
   memset(ms, 0, sizeof *ms);
 }
 
@@ -188,7 +189,8 @@ void mass_spring_forces(const mass_spring_t *ms, const double *x, const double *
      * keeps forces finite when two nodes are moved onto each other. */
     if (len <= MS_TINY) continue;
     v3_sub(dv, v + 3 * sp->j, v + 3 * sp->i);
-    double mag = p->stiffness * (len - sp->rest) + p->damping * v3_dot(dv, d);
+    double k = ms->k_scale ? p->stiffness * ms->k_scale[s] : p->stiffness;
+    double mag = k * (len - sp->rest) + p->damping * v3_dot(dv, d);
     v3_axpy(f + 3 * sp->i, d, mag);
     v3_axpy(f + 3 * sp->j, d, -mag);
   }
@@ -199,16 +201,17 @@ void mass_spring_stiffness_mul(const mass_spring_t *ms, const double *x, double 
   const ms_params_t *p = &ms->p;
   double diag = a * p->home_stiffness + b * p->home_damping;
   for (size_t c = 0; c < 3 * ms->n; c++) out[c] = diag * y[c];
-  double axial = a * p->stiffness + b * p->damping;
   for (size_t s = 0; s < ms->nsprings; s++) {
     const ms_spring_t *sp = &ms->springs[s];
+    double ks = ms->k_scale ? p->stiffness * ms->k_scale[s] : p->stiffness;
+    double axial = a * ks + b * p->damping;
     double u[3], w[3], t[3];
     v3_sub(u, x + 3 * sp->j, x + 3 * sp->i);
     double len = v3_normalize(u);
     if (len <= MS_TINY) continue; /* the force is 0 there (see forces) */
     double geo = 1 - sp->rest / len;
     if (ms->definite_jacobian && geo < 0) geo = 0;
-    geo *= a * p->stiffness;
+    geo *= a * ks;
     v3_sub(w, y + 3 * sp->i, y + 3 * sp->j);
     double wu = v3_dot(w, u);
     /* t = axial (u u^T) w + geo (I - u u^T) w */
@@ -242,8 +245,9 @@ static double lambda_max(const mass_spring_t *ms, int damping, double extra, dou
   for (size_t i = 0; i < ms->n; i++) y[i] = home;
   for (size_t s = 0; s < ms->nsprings; s++) {
     if (!(ms->springs[s].rest > 0)) continue;
-    y[ms->springs[s].i] += 2 * per_spring;
-    y[ms->springs[s].j] += 2 * per_spring;
+    double ks = !damping && ms->k_scale ? per_spring * ms->k_scale[s] : per_spring;
+    y[ms->springs[s].i] += 2 * ks;
+    y[ms->springs[s].j] += 2 * ks;
   }
   double gersh = 0;
   for (size_t i = 0; i < ms->n; i++) gersh = fmax(gersh, y[i] * ms->inv_mass[i]);
@@ -299,7 +303,7 @@ double mass_spring_potential(const mass_spring_t *ms, const double *x) {
   }
   for (size_t s = 0; s < ms->nsprings; s++) {
     double l = v3_dist(x + 3 * ms->springs[s].i, x + 3 * ms->springs[s].j) - ms->springs[s].rest;
-    e += 0.5 * ms->p.stiffness * l * l;
+    e += 0.5 * (ms->k_scale ? ms->p.stiffness * ms->k_scale[s] : ms->p.stiffness) * l * l;
   }
   return e;
 }
@@ -319,4 +323,20 @@ double mass_spring_max_strain(const mass_spring_t *ms) {
     if (e > m) m = e;
   }
   return m;
+}
+
+int mass_spring_set_stiffness_scale(mass_spring_t *ms, const double *scale, verr_t *err) {
+  if (!scale) {
+    free(ms->k_scale);
+    ms->k_scale = NULL;
+    return 0;
+  }
+  for (size_t s = 0; s < ms->nsprings; s++)
+    if (!(scale[s] >= 0) || !isfinite(scale[s]))
+      return verr_set(err, "mass-spring: stiffness factor of spring %zu must be finite and >= 0 (got %g)", s, scale[s]);
+  double *k = realloc(ms->k_scale, (ms->nsprings + 1) * sizeof(double));
+  if (!k) return verr_set(err, "mass-spring: out of memory for %zu stiffness factors", ms->nsprings);
+  memcpy(k, scale, ms->nsprings * sizeof(double));
+  ms->k_scale = k;
+  return 0;
 }

@@ -63,6 +63,12 @@ typedef struct mass_spring {
   double *inv_mass; /* n, 0 for fixed nodes */
   ms_spring_t *springs;
   int definite_jacobian; /* see above; 0 after create */
+  /* Optional per-spring stiffness factor (nsprings, indexed like springs):
+   * spring s has stiffness p.stiffness * k_scale[s]; damping stays uniform.
+   * NULL (the default) means 1 for every spring and costs nothing. Set only
+   * through mass_spring_set_stiffness_scale; owned by this object. Code that
+   * adds or removes springs must keep it in step (or clear it). */
+  double *k_scale;
 } mass_spring_t;
 
 /* Springs from the unique edges of the triangles of `surface` (nodes = its
@@ -71,6 +77,11 @@ int mass_spring_create_surface(mass_spring_t *ms, const mesh_t *surface, const m
 /* Springs from the unique edges of the tetrahedra of `t` (nodes = its nodes). */
 int mass_spring_create_tets(mass_spring_t *ms, const tet_mesh_t *t, const ms_params_t *p, verr_t *err);
 void mass_spring_destroy(mass_spring_t *ms);
+
+/* Copies `scale` (nsprings factors, finite, >= 0, indexed like springs) into
+ * k_scale; NULL clears it (uniform stiffness again). Returns 0, or -1 with
+ * err (bad factor, OOM). Construction time: it allocates. */
+int mass_spring_set_stiffness_scale(mass_spring_t *ms, const double *scale, verr_t *err);
 
 /* Fixes every node whose rest z is below z (zero inverse mass). Returns how many. */
 size_t mass_spring_fix_below(mass_spring_t *ms, double z);

@@ -33,10 +33,18 @@ typedef struct model_pbd {
  * haptic rate. */
 #define PBD_AUTO_SUBSTEP 1e-3
 
+/* Before every sub-step: the surface is brought to the sub-step's positions
+ * so the contact hook sees where the tissue is (model.h), as the
+ * mass-spring models do; without it every sub-step of a scene step saw the
+ * surface of the step's start, and a contact force held that long is an
+ * explicit spring at the scene rate (a penalty ground then diverged at
+ * 60 Hz with any number of sub-steps). */
 static void pbd_pre_hook(pbd_t *s, void *ctx) {
-  (void)s;
   model_t *m = ctx;
-  if (m->hook) m->hook(m, m->hook_ctx);
+  if (!m->hook) return;
+  model_pbd_t *mp = (model_pbd_t *)m;
+  tet_embedding_apply(&mp->emb, &mp->tm, s->x, mp->surf_x);
+  m->hook(m, m->hook_ctx);
 }
 
 static int pbd_model_step(model_t *m, double h) {

@@ -114,14 +114,20 @@ out:
   return rc;
 }
 
-int pbd_create(pbd_t *s, size_t n, const double *x, size_t ntets, const uint32_t *tets, const pbd_params_t *p,
-               verr_t *err) {
+/* pbd_create and pbd_create_edges: distance constraints from the tetrahedra's
+ * edges and from `nextra` extra (i, j) pairs (either list may be empty, not
+ * both). */
+static int create(pbd_t *s, size_t n, const double *x, size_t ntets, const uint32_t *tets, size_t nextra,
+                  const uint32_t *extra, const pbd_params_t *p, verr_t *err) {
   memset(s, 0, sizeof *s);
   if (check_params(p, err)) return -1;
-  if (n == 0 || ntets == 0) return verr_set(err, "pbd: empty mesh (%zu nodes, %zu tetrahedra)", n, ntets);
+  if (n == 0 || (ntets == 0 && nextra == 0))
+    return verr_set(err, "pbd: empty mesh (%zu nodes, %zu tetrahedra, %zu edges)", n, ntets, nextra);
   if (n > UINT32_MAX) return verr_set(err, "pbd: too many nodes (%zu)", n);
   for (size_t t = 0; t < 4 * ntets; t++)
     if (tets[t] >= n) return verr_set(err, "pbd: tetrahedron %zu refers to node %u of %zu", t / 4, tets[t], n);
+  for (size_t e = 0; e < 2 * nextra; e++)
+    if (extra[e] >= n) return verr_set(err, "pbd: edge %zu refers to node %u of %zu", e / 2, extra[e], n);
   for (size_t c = 0; c < 3 * n; c++)
     if (!isfinite(x[c])) return verr_set(err, "pbd: node %zu has a non-finite coordinate", c / 3);
   s->p = *p;
@@ -139,12 +145,12 @@ int pbd_create(pbd_t *s, size_t n, const double *x, size_t ntets, const uint32_t
   s->inv_mass = calloc(n, sizeof(double));
   s->mass = calloc(n, sizeof(double));
   s->mark = calloc(n, 1);
-  s->tet = malloc(4 * ntets * sizeof(uint32_t));
-  s->tet_rest = calloc(ntets, sizeof(double));
-  s->tet_step2 = calloc(ntets, sizeof(double));
-  s->tet_lambda = calloc(ntets, sizeof(double));
-  s->tet_w = calloc(4 * ntets, sizeof(double));
-  uint32_t *edges = malloc(12 * ntets * sizeof(uint32_t));
+  s->tet = malloc((4 * ntets + 1) * sizeof(uint32_t)); /* + 1: an edge-only mesh allocates too */
+  s->tet_rest = calloc(ntets + 1, sizeof(double));
+  s->tet_step2 = calloc(ntets + 1, sizeof(double));
+  s->tet_lambda = calloc(ntets + 1, sizeof(double));
+  s->tet_w = calloc(4 * ntets + 1, sizeof(double));
+  uint32_t *edges = malloc((12 * ntets + 2 * nextra) * sizeof(uint32_t));
   if (!s->x || !s->v || !s->x_rest || !s->x_old || !s->x_save || !s->v_save || !s->f_ext || !s->home_lambda ||
       !s->inv_mass || !s->mass || !s->mark || !s->tet || !s->tet_rest || !s->tet_step2 || !s->tet_lambda || !s->tet_w ||
       !edges) {
@@ -154,7 +160,7 @@ int pbd_create(pbd_t *s, size_t n, const double *x, size_t ntets, const uint32_t
   }
   memcpy(s->x, x, n3 * sizeof(double));
   memcpy(s->x_rest, x, n3 * sizeof(double));
-  memcpy(s->tet, tets, 4 * ntets * sizeof(uint32_t));
+  if (ntets) memcpy(s->tet, tets, 4 * ntets * sizeof(uint32_t));
   /* Equal lumped masses, as in mass_spring.c: volume-weighted masses would
    * give the slivers of automatic meshes tiny masses and slow convergence. */
   for (size_t i = 0; i < n; i++) {
@@ -182,7 +188,12 @@ int pbd_create(pbd_t *s, size_t n, const double *x, size_t ntets, const uint32_t
     double lm = lsum / 6;
     s->tet_step2[t] = lm * lm;
   }
-  size_t ne = 6 * ntets;
+  for (size_t e = 0; e < nextra; e++) {
+    uint32_t i = extra[2 * e], j = extra[2 * e + 1];
+    edges[12 * ntets + 2 * e] = i < j ? i : j;
+    edges[12 * ntets + 2 * e + 1] = i < j ? j : i;
+  }
+  size_t ne = 6 * ntets + nextra;
   qsort(edges, ne, 2 * sizeof(uint32_t), cmp_edge);
   size_t unique = 0;
   for (size_t e = 0; e < ne; e++)
@@ -219,6 +230,24 @@ int pbd_create(pbd_t *s, size_t n, const double *x, size_t ntets, const uint32_t
   return 0;
 }
 
+int pbd_create(pbd_t *s, size_t n, const double *x, size_t ntets, const uint32_t *tets, const pbd_params_t *p,
+               verr_t *err) {
+  if (ntets == 0) {
+    memset(s, 0, sizeof *s);
+    return verr_set(err, "pbd: empty mesh (%zu nodes, 0 tetrahedra)", n);
+  }
+  return create(s, n, x, ntets, tets, 0, NULL, p, err);
+}
+
+int pbd_create_edges(pbd_t *s, size_t n, const double *x, size_t nedges, const uint32_t *edges, const pbd_params_t *p,
+                     verr_t *err) {
+  if (nedges == 0) {
+    memset(s, 0, sizeof *s);
+    return verr_set(err, "pbd: no edges (%zu nodes)", n);
+  }
+  return create(s, n, x, 0, NULL, nedges, edges, p, err);
+}
+
 void pbd_destroy(pbd_t *s) {
   free(s->x);
   free(s->v);
@@ -241,6 +270,7 @@ void pbd_destroy(pbd_t *s) {
   free(s->edge_w);
   free(s->edge_inv);
   free(s->tet_w);
+  free(s->edge_alpha_scale);
   memset(s, 0, sizeof *s);
 }
 
@@ -504,8 +534,32 @@ static void project_volumes(pbd_t *s, double k, double at) {
   project_volume_range(s, k, at, 0, s->ntets);
 }
 
+/* Distance constraints with per-edge compliance (edge_alpha_scale set):
+ * alpha~_e = at * scale[e], so the cached 1 / (w_i + w_j + alpha~) does not
+ * apply; one at a time, scalar (the uniform case keeps its fast sweeps). */
+static void project_distance_scaled(pbd_t *s, double k, double at) {
+  double *restrict x = s->x, *restrict lam = s->edge_lambda;
+  const double *restrict ew = s->edge_w, *restrict rest = s->edge_rest, *restrict xr = s->x_rest,
+                         *restrict sc = s->edge_alpha_scale;
+  for (size_t e = 0; e < s->nedges; e++) {
+    uint32_t i = s->edge[2 * e], j = s->edge[2 * e + 1];
+    double *xi = x + 3 * i, *xj = x + 3 * j, nrm[3];
+    double ate = at * sc[e], ws = ew[2 * e] + ew[2 * e + 1] + ate;
+    if (!(ws > 0)) continue; /* both nodes fixed and the edge rigid */
+    double C = pbd_distance_constraint(xi, xj, rest[e], xr + 3 * i, xr + 3 * j, nrm);
+    double dl = (-k * C - ate * lam[e]) / ws;
+    lam[e] += dl;
+    v3_axpy(xi, nrm, ew[2 * e] * dl);
+    v3_axpy(xj, nrm, -ew[2 * e + 1] * dl);
+  }
+}
+
 /* One sweep over all distance constraints, the same way. */
 static void project_distances(pbd_t *s, double k, double at) {
+  if (s->edge_alpha_scale) {
+    project_distance_scaled(s, k, at);
+    return;
+  }
 #if PBD_HAVE_AVX2
   if (s->simd) {
     for (int c = 0; c < PBD_COLOURS - 1; c++) {
@@ -696,7 +750,8 @@ double pbd_energy(const pbd_t *s) {
       double nrm[3];
       double C = pbd_distance_constraint(s->x + 3 * s->edge[2 * k], s->x + 3 * s->edge[2 * k + 1], s->edge_rest[k],
                                          s->x_rest + 3 * s->edge[2 * k], s->x_rest + 3 * s->edge[2 * k + 1], nrm);
-      e += C * C / (2 * s->p.distance_compliance);
+      double a = s->p.distance_compliance * (s->edge_alpha_scale ? s->edge_alpha_scale[k] : 1);
+      if (a > 0) e += C * C / (2 * a); /* a rigid edge (scale 0) stores nothing */
     }
   if (s->p.volume_compliance > 0)
     for (size_t t = 0; t < s->ntets; t++) {
@@ -741,4 +796,20 @@ double pbd_constraint_force(pbd_t *s, const uint32_t *nodes, size_t count, doubl
   }
   if (f) v3_copy(f, acc);
   return v3_norm(acc);
+}
+
+int pbd_set_edge_compliance_scale(pbd_t *s, const double *scale, verr_t *err) {
+  if (!scale) {
+    free(s->edge_alpha_scale);
+    s->edge_alpha_scale = NULL;
+    return 0;
+  }
+  for (size_t e = 0; e < s->nedges; e++)
+    if (!(scale[e] >= 0) || !isfinite(scale[e]))
+      return verr_set(err, "pbd: compliance factor of edge %zu must be finite and >= 0 (got %g)", e, scale[e]);
+  double *a = realloc(s->edge_alpha_scale, (s->nedges + 1) * sizeof(double));
+  if (!a) return verr_set(err, "pbd: out of memory for %zu compliance factors", s->nedges);
+  memcpy(a, scale, s->nedges * sizeof(double));
+  s->edge_alpha_scale = a;
+  return 0;
 }

@@ -94,6 +94,13 @@ typedef struct pbd {
   double rest_volume; /* sum of V0 */
   double last_h;      /* sub-step of the last step, for forces from lambda */
   uint64_t rollbacks;
+  /* Optional per-edge factor on the distance compliance (nedges, indexed like
+   * edge, i.e. in colour order): edge e has compliance
+   * p.distance_compliance * edge_alpha_scale[e] (0: rigid). XPBD only (PBD
+   * mode has no compliance). NULL (the default) means 1 for every edge and
+   * keeps the four-wide sweeps; set, the distance sweep runs scalar. Set
+   * through pbd_set_edge_compliance_scale; owned by this object. */
+  double *edge_alpha_scale;
 } pbd_t;
 
 /* Called before each sub-step (contact coupling); may add to f_ext, which is
@@ -105,7 +112,16 @@ typedef void (*pbd_substep_fn)(pbd_t *s, void *ctx);
  * 0, or -1 with err (bad parameters, out-of-range index, OOM). */
 int pbd_create(pbd_t *s, size_t nnodes, const double *x, size_t ntets, const uint32_t *tets, const pbd_params_t *p,
                verr_t *err);
+/* Distance constraints only, one per unique (i, j) pair of `edges` (2
+ * nedges node indices), no volume constraints: chains, strings and other
+ * networks that are not tetrahedral meshes. */
+int pbd_create_edges(pbd_t *s, size_t nnodes, const double *x, size_t nedges, const uint32_t *edges,
+                     const pbd_params_t *p, verr_t *err);
 void pbd_destroy(pbd_t *s);
+
+/* Copies `scale` (nedges factors, finite, >= 0, in the order of s->edge) into
+ * edge_alpha_scale; NULL clears it. Returns 0, or -1 with err. Allocates. */
+int pbd_set_edge_compliance_scale(pbd_t *s, const double *scale, verr_t *err);
 
 /* Fixes node i (inverse mass 0) or sets its mass (kg, > 0). Change masses
  * only through these: the solver caches them per constraint. */

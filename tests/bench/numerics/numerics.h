@@ -144,6 +144,7 @@ void scene_cloth(nb_t *nb);     /* S3 */
 void scene_stability(nb_t *nb); /* plot 3 */
 void scene_bar(nb_t *nb);       /* S4, S5, S6 + plots 1, 2, 4, 5 */
 void scene_probe(nb_t *nb);     /* S8 */
+void scene_ball(nb_t *nb);      /* S7 */
 void scene_scaling(nb_t *nb);   /* plot 7 */
 
 const char *integ_label(integrator_kind_t k); /* "symplectic Euler" */
