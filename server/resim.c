@@ -156,10 +156,18 @@ int main(int argc, char **argv) {
 
   for (size_t t = 0; t < rt.ntools; t++) {
     const resim_schedule_stats_t *s = &res.sched[t];
+    /* The recorded command stream itself (sorted by seq by now): a client
+     * numbers its commands 1, 2, ..., so seqs missing between the first and
+     * the last recorded are samples the recorder lost mid-session, and
+     * first - 1 those sent before it (or the server) matched the writer. */
+    const resim_tool_input_t *in = &rec.tools[t];
+    uint64_t distinct = 0, first = in->ncmd ? in->cmd[0].seq : 0, last = in->ncmd ? in->cmd[in->ncmd - 1].seq : 0;
+    for (size_t i = 0; i < in->ncmd; i++) distinct += i == 0 || in->cmd[i].seq != in->cmd[i - 1].seq;
     printf("SCHEDULE tool=%s feedback_steps=%" PRIu64 " gaps=%" PRIu64 " bridged_steps=%" PRIu64
-           " ambiguous_steps=%" PRIu64 " missing_commands=%" PRIu64 " conflicts=%" PRIu64 " releases=%" PRIu64 "\n",
+           " ambiguous_steps=%" PRIu64 " missing_commands=%" PRIu64 " conflicts=%" PRIu64 " releases=%" PRIu64
+           " cmd_first_seq=%" PRIu64 " cmd_last_seq=%" PRIu64 " cmd_seq_gaps=%" PRIu64 "\n",
            rt.tools[t].cfg->name, s->feedback_steps, s->gaps, s->bridged_steps, s->ambiguous_steps, s->missing_commands,
-           s->conflicts, s->releases);
+           s->conflicts, s->releases, first, last, in->ncmd ? last - first + 1 - distinct : 0);
   }
   int beyond = 0, compared = 0;
   for (size_t i = 0; i < rt.norgans; i++) {
@@ -168,6 +176,18 @@ int main(int argc, char **argv) {
     printf("ORGAN %s frames=%" PRIu64 " keyframes=%" PRIu64 " exact=%" PRIu64 " unmatched=%" PRIu64
            " max_err_m=%.3g rms_err_m=%.3g worst_step=%" PRIu64 "\n",
            rt.organs[i].cfg->name, r->frames, r->keyframes, r->exact, r->unmatched, r->max_err, rms, r->worst_step);
+    /* MeshDelta frame_seq counts every published frame of the organ. */
+    uint64_t dfirst = 0, dlast = 0, ddistinct = 0, dprev = 0;
+    for (size_t j = 0; j < rec.ndeltas; j++) {
+      const resim_delta_t *d = &rec.deltas[j];
+      if (d->organ != i) continue;
+      if (!ddistinct || d->frame_seq < dfirst) dfirst = d->frame_seq;
+      if (!ddistinct || d->frame_seq > dlast) dlast = d->frame_seq;
+      if (!ddistinct || d->frame_seq != dprev) ddistinct++;
+      dprev = d->frame_seq;
+    }
+    printf("STREAM organ=%s delta_first_seq=%" PRIu64 " delta_last_seq=%" PRIu64 " delta_seq_gaps=%" PRIu64 "\n",
+           rt.organs[i].cfg->name, dfirst, dlast, ddistinct ? dlast - dfirst + 1 - ddistinct : 0);
     if (r->frames) compared = 1;
     if (r->max_err > tolerance) {
       beyond = 1;

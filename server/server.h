@@ -28,6 +28,7 @@ typedef struct server_stats {
   double step_us_median, step_us_p99, step_us_max;
   size_t ntools;
   thr_tracker_t thr[SCENE_MAX_TOOLS]; /* palpation measures per tool at the end */
+  uint64_t published[VT_COUNT];       /* samples written per topic (vdds ids), for drop accounting */
 } server_stats_t;
 
 /* Runs a whole session: set-up, loop until *stop or the duration, shutdown.
