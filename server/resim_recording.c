@@ -288,7 +288,8 @@ int resim_recording_load(resim_recording_t *rec, const char *path, verr_t *err) 
       snprintf(rec->warnings, sizeof rec->warnings, "%s: damaged while reading %s: %s", path, passes[p].name,
                rep.first_error);
     if (p == 0 && !rc && !rec->have_scene)
-      rc = verr_set(err, "%s: no SceneInfo sample decodes%s%s", path, rec->skipped ? ": " : "", rec->first_skip);
+      rc = verr_set(err, "%s: no SceneInfo sample decodes%s%s%s%s", path, rec->skipped ? ": " : "", rec->first_skip,
+                    rep.damaged ? "; the file is damaged: " : "", rep.damaged ? rep.first_error : "");
   }
   recfile_close(rf);
   if (rc) {
