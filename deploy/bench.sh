@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Benchmarks (figures, not pass/fail): server step time per generated organ
 # and MeshDelta size (bench_server), then the haptic tick and command->feedback
-# latency on loopback over 60 s of palpation.
-# Output: out/bench/server_steps.csv, out/bench/latency/*.
+# latency on loopback over 60 s of palpation, then the recorder's throughput
+# under two 1 kHz haptic clients and a 60 Hz gallbladder (45 s).
+# Output: out/bench/server_steps.csv, out/bench/latency/*, out/bench/recorder_load/*.
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bash "$ROOT/deploy/install_deps.sh"
@@ -20,3 +21,6 @@ D="${VISCERA_DOMAIN:-9}"
   --domain "$D" --partition bench/latency --duration 60 --rt-priority 80 >"$OUT/latency/haptic.out" 2>"$OUT/latency/haptic.log"
 kill -INT $S; wait $S || true
 cat "$OUT/latency/haptic.log" "$OUT/latency/server.log" | grep -E "haptic:|step time"
+echo
+echo "== recorder throughput and drops: gallbladder at 60 Hz, two haptic clients at 1 kHz, 45 s"
+VISCERA_DOMAIN="$D" bash "$ROOT/tests/bench/recorder_load.sh" "$ROOT/build-bench" "$ROOT" "$OUT/recorder_load" 45

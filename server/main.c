@@ -165,6 +165,11 @@ int main(int argc, char **argv) {
             st.liveliness_blips);
   printf("SUMMARY steps=%" PRIu64 " peak_force=%.3f rejected=%" PRIu64 " rollbacks=%" PRIu64 " step_us_median=%.1f\n",
          st.steps, st.peak_force, st.rejected_total, st.rollbacks, st.step_us_median);
+  /* What went on the wire, per topic, so a recording can be checked for drops. */
+  printf("PUBLISHED");
+  for (int t = 0; t < VT_COUNT; t++)
+    if (t != VT_TOOL_COMMAND) printf(" %s=%" PRIu64, vdds_topic_name((vdds_topic_id_t)t), st.published[t]);
+  printf("\n");
   /* Trainee measures per tool (seed 002 ch. 6); levels of 0 are unset. */
   for (size_t t = 0; t < st.ntools; t++) {
     const thr_tracker_t *tr = &st.thr[t];

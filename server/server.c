@@ -54,7 +54,7 @@ static void publish_event(server_t *s, viscera_EventKind kind, int organ, int to
   e.tool_id = tool;
   e.value = value;
   snprintf(e.text, sizeof e.text, "%s", text);
-  dds_write(s->w_event, &e);
+  if (dds_write(s->w_event, &e) >= 0) s->stats->published[VT_SESSION_EVENT]++;
 }
 
 static void publish_scene_info(server_t *s) {
@@ -97,7 +97,7 @@ static void publish_scene_info(server_t *s) {
   si.organs._length = si.organs._maximum = (uint32_t)s->rt.norgans;
   si.tools._buffer = tools;
   si.tools._length = si.tools._maximum = (uint32_t)s->rt.ntools;
-  dds_write(s->w_scene, &si);
+  if (dds_write(s->w_scene, &si) >= 0) s->stats->published[VT_SCENE_INFO]++;
 }
 
 static int setup(server_t *s, const scene_t *scene, verr_t *err) {
@@ -272,7 +272,7 @@ static void publish_feedback(server_t *s) {
       fb.normal[k] = (float)tool->fb_normal[k];
       fb.force[k] = (float)tool->force[k];
     }
-    dds_write(s->w_feedback, &fb);
+    if (dds_write(s->w_feedback, &fb) >= 0) s->stats->published[VT_CONTACT_FEEDBACK]++;
     int c = tool->fb_contact != 0;
     if (c != s->was_contact[t]) {
       publish_event(s, c ? viscera_EVENT_CONTACT_BEGIN : viscera_EVENT_CONTACT_END, fb.organ_id, (int)t, 0,
@@ -340,7 +340,7 @@ static void publish_metrics(server_t *s, uint64_t window_steps) {
     m.contact_time = contact;
     m.mean_contact_force = contact > 0 ? fint / contact : 0.0;
     m.path_length = path;
-    dds_write(s->w_metrics, &m);
+    if (dds_write(s->w_metrics, &m) >= 0) s->stats->published[VT_METRICS]++;
   }
 }
 
@@ -562,6 +562,10 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
   publish_event(&s, viscera_EVENT_SESSION_STOPPED, -1, -1, 0, scene->name);
 
   stats->steps = s.rt.steps;
+  for (size_t i = 0; i < s.rt.norgans; i++) {
+    stats->published[VT_MESH_STATE] += s.pubs[i].keyframes;
+    stats->published[VT_MESH_DELTA] += s.pubs[i].frames;
+  }
   stats->ntools = s.rt.ntools;
   memcpy(stats->thr, s.thr, sizeof stats->thr);
   for (size_t t = 0; t < s.rt.ntools; t++)

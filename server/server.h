@@ -38,6 +38,7 @@ typedef struct server_stats {
   task_rt_t tasks[SCENE_MAX_TASKS]; /* cfg points into the server's scene copy: use the index, not cfg */
   int stone_removed[SCENE_MAX_OBJECTS];
   double sim_time; /* s simulated */
+  uint64_t published[VT_COUNT];       /* samples written per topic (vdds ids), for drop accounting */
 } server_stats_t;
 
 /* Runs a whole session: set-up, loop until *stop or the duration, shutdown.
