@@ -25,6 +25,7 @@ static int ms_alloc(mass_spring_t *ms, size_t n, const double *pos, const ms_par
     return verr_set(err, "mass-spring: mass must be > 0 and stiffness/damping >= 0, all finite");
   if (n == 0) return verr_set(err, "mass-spring: no nodes");
   ms->n = n;
+  ms->cap = n;
   ms->p = *p;
   ms->x = calloc(3 * n, sizeof(double));
   ms->v = calloc(3 * n, sizeof(double));
@@ -60,8 +61,9 @@ static int cmp_edge(const void *a, const void *b) {
   return (x[1] > y[1]) - (x[1] < y[1]);
 }
 
-/* Takes ownership of `edges` (ne raw (i, j) pairs, normalised i < j here). */
-static int ms_build_springs(mass_spring_t *ms, uint32_t *edges, size_t ne, verr_t *err) {
+/* Takes ownership of `edges` (ne raw (i, j) pairs, normalised i < j here).
+ * On OOM the old springs are kept and -1 returned. */
+static int ms_make_springs(mass_spring_t *ms, uint32_t *edges, size_t ne, verr_t *err) {
   for (size_t e = 0; e < ne; e++) {
     uint32_t i = edges[2 * e], j = edges[2 * e + 1];
     if (i > j) {
@@ -73,12 +75,14 @@ static int ms_build_springs(mass_spring_t *ms, uint32_t *edges, size_t ne, verr_
   size_t unique = 0;
   for (size_t e = 0; e < ne; e++)
     if (e == 0 || cmp_edge(edges + 2 * e, edges + 2 * (e - 1)) != 0) unique++;
-  ms->springs = malloc((unique + 1) * sizeof(ms_spring_t));
-  if (!ms->springs) {
+  ms_spring_t *springs = malloc((unique + 1) * sizeof(ms_spring_t));
+  if (!springs) {
     free(edges);
-    mass_spring_destroy(ms);
     return verr_set(err, "mass-spring: out of memory for %zu springs", unique);
   }
+  free(ms->springs);
+  ms->springs = springs;
+  ms->nsprings = 0;
   for (size_t e = 0; e < ne; e++) {
     if (e > 0 && cmp_edge(edges + 2 * e, edges + 2 * (e - 1)) == 0) continue;
     uint32_t i = edges[2 * e], j = edges[2 * e + 1];
@@ -89,6 +93,64 @@ static int ms_build_springs(mass_spring_t *ms, uint32_t *edges, size_t ne, verr_
     sp->rest = v3_dist(ms->x_rest + 3 * i, ms->x_rest + 3 * j);
   }
   free(edges);
+  return 0;
+}
+
+static int ms_build_springs(mass_spring_t *ms, uint32_t *edges, size_t ne, verr_t *err) {
+  if (ms_make_springs(ms, edges, ne, err)) {
+    mass_spring_destroy(ms);
+    return -1;
+  }
+  return 0;
+}
+
+/* realloc that keeps *p on failure. */
+static int grow(double **p, size_t count) {
+  double *q = realloc(*p, count * sizeof(double) + 1);
+  if (!q) return -1;
+  *p = q;
+  return 0;
+}
+
+int mass_spring_reserve(mass_spring_t *ms, size_t cap, int with_f_res, verr_t *err) {
+  if (cap > ((size_t)-1) / (3 * sizeof(double)) - 1) return verr_set(err, "mass-spring: %zu nodes is too many", cap);
+  if (cap > ms->cap) {
+    if (grow(&ms->x, 3 * cap) || grow(&ms->v, 3 * cap) || grow(&ms->x_rest, 3 * cap) || grow(&ms->f_ext, 3 * cap) ||
+        grow(&ms->mass, cap) || grow(&ms->inv_mass, cap) || (ms->f_res && grow(&ms->f_res, 3 * cap)))
+      return verr_set(err, "mass-spring: out of memory for %zu nodes", cap);
+    /* f_ext is all zero between steps (the model clears it); keep that. */
+    memset(ms->f_ext + 3 * ms->n, 0, 3 * (cap - ms->n) * sizeof(double));
+    if (ms->f_res) memset(ms->f_res + 3 * ms->n, 0, 3 * (cap - ms->n) * sizeof(double));
+    ms->cap = cap;
+  }
+  if (with_f_res && !ms->f_res) {
+    ms->f_res = calloc(3 * ms->cap + 1, sizeof(double));
+    if (!ms->f_res) return verr_set(err, "mass-spring: out of memory for residual forces");
+  }
+  ms->fs.x = ms->x;
+  ms->fs.v = ms->v;
+  ms->fs.mass = ms->mass;
+  ms->fs.inv_mass = ms->inv_mass;
+  return 0;
+}
+
+int mass_spring_set_surface_topology(mass_spring_t *ms, size_t n, const uint32_t *tris, size_t ntris, verr_t *err) {
+  if (n == 0 || n > ms->cap) return verr_set(err, "mass-spring: %zu nodes (capacity %zu)", n, ms->cap);
+  for (size_t c = 0; c < 3 * ntris; c++)
+    if (tris[c] >= n) return verr_set(err, "mass-spring: triangle %zu has a vertex index out of range", c / 3);
+  uint32_t *edges = malloc(ntris * 6 * sizeof(uint32_t) + 1);
+  if (!edges) return verr_set(err, "mass-spring: out of memory for edges");
+  for (size_t t = 0; t < ntris; t++)
+    for (int k = 0; k < 3; k++) {
+      edges[6 * t + 2 * k] = tris[3 * t + k];
+      edges[6 * t + 2 * k + 1] = tris[3 * t + (k + 1) % 3];
+    }
+  if (ms_make_springs(ms, edges, 3 * ntris, err)) return -1;
+  ms->n = n;
+  ms->fs.n = n;
+  double total = 0;
+  for (size_t i = 0; i < n; i++) total += ms->mass[i];
+  ms->p.mass = total;
   return 0;
 }
 
@@ -157,6 +219,7 @@ void mass_spring_destroy(mass_spring_t *ms) {
   free(ms->inv_mass);
   free(ms->mass);
   free(ms->springs);
+  free(ms->f_res);
   memset(ms, 0, sizeof *ms);
 }
 
@@ -179,6 +242,8 @@ void mass_spring_forces(const mass_spring_t *ms, const double *x, const double *
       fi[k] = ms->f_ext[3 * i + k] + ms->mass[i] * p->gravity[k] - p->home_stiffness * (xi[k] - xr[k]) -
               p->home_damping * vi[k];
   }
+  if (ms->f_res)
+    for (size_t c = 0; c < 3 * ms->n; c++) f[c] += ms->f_res[c];
   for (size_t s = 0; s < ms->nsprings; s++) {
     const ms_spring_t *sp = &ms->springs[s];
     double d[3], dv[3];
@@ -296,6 +361,7 @@ double mass_spring_potential(const mass_spring_t *ms, const double *x) {
     v3_sub(d, x + 3 * i, ms->x_rest + 3 * i);
     e += 0.5 * ms->p.home_stiffness * v3_dot(d, d);
     e -= ms->mass[i] * v3_dot(ms->p.gravity, x + 3 * i);
+    if (ms->f_res) e -= v3_dot(ms->f_res + 3 * i, x + 3 * i);
   }
   for (size_t s = 0; s < ms->nsprings; s++) {
     double l = v3_dist(x + 3 * ms->springs[s].i, x + 3 * ms->springs[s].j) - ms->springs[s].rest;

@@ -63,6 +63,9 @@ typedef struct mass_spring {
   double *inv_mass; /* n, 0 for fixed nodes */
   ms_spring_t *springs;
   int definite_jacobian; /* see above; 0 after create */
+  /* Cutting (server/cutting/ms_cut.h) only; NULL / 0 until a cut happens. */
+  double *f_res; /* 3n or NULL: constant nodal forces (residual stress, seed 004 eq. 4), in forces() and potential() */
+  size_t cap;    /* node capacity of the node arrays (>= n) */
 } mass_spring_t;
 
 /* Springs from the unique edges of the triangles of `surface` (nodes = its
@@ -72,11 +75,22 @@ int mass_spring_create_surface(mass_spring_t *ms, const mesh_t *surface, const m
 int mass_spring_create_tets(mass_spring_t *ms, const tet_mesh_t *t, const ms_params_t *p, verr_t *err);
 void mass_spring_destroy(mass_spring_t *ms);
 
+/* Topology changes (cutting). reserve grows every node array to cap nodes
+ * (contents kept, fs pointers updated; with_f_res also allocates f_res,
+ * zeroed); it allocates only when cap exceeds the capacity. After the caller
+ * has written n <= cap nodes (x, v, x_rest, mass, inv_mass, f_res),
+ * set_surface_topology rebuilds the springs from the unique edges of tris
+ * (rest lengths from x_rest), sets n and p.mass (the sum of the masses).
+ * Both return 0, or -1 with err (OOM, index out of range); on error the
+ * springs are left as they were. */
+int mass_spring_reserve(mass_spring_t *ms, size_t cap, int with_f_res, verr_t *err);
+int mass_spring_set_surface_topology(mass_spring_t *ms, size_t n, const uint32_t *tris, size_t ntris, verr_t *err);
+
 /* Fixes every node whose rest z is below z (zero inverse mass). Returns how many. */
 size_t mass_spring_fix_below(mass_spring_t *ms, double z);
 
-/* f = F(x, v): edge springs and dampers, home springs and dampers, gravity
- * and f_ext. Forces stay finite for coincident nodes (a zero-length spring
+/* f = F(x, v): edge springs and dampers, home springs and dampers, gravity,
+ * f_res and f_ext. Forces stay finite for coincident nodes (a zero-length spring
  * has no direction and pushes nothing). */
 void mass_spring_forces(const mass_spring_t *ms, const double *x, const double *v, double *f);
 /* out = (a K(x) + b C(x)) y, as described above. */
@@ -102,8 +116,8 @@ static inline void mass_spring_add_force(mass_spring_t *ms, uint32_t i, const do
 /* Kinetic + elastic (edge and home springs) + gravitational potential
  * energy, J; f_ext does no bookkeeping here. */
 double mass_spring_energy(const mass_spring_t *ms);
-/* Potential energy at positions x: edge and home springs plus gravity, so
- * that F(x, 0) = -grad U(x) + f_ext. */
+/* Potential energy at positions x: edge and home springs, gravity and the
+ * constant forces f_res, so that F(x, 0) = -grad U(x) + f_ext. */
 double mass_spring_potential(const mass_spring_t *ms, const double *x);
 /* Largest |L/L0 - 1| over springs with L0 > 0: the live strain figure. */
 double mass_spring_max_strain(const mass_spring_t *ms);

@@ -46,8 +46,8 @@
 #include "integrator.h"
 #include "mass_spring.h"
 #include "model.h"
+#include "model_mass_spring.h"
 #include "tet_mesh.h"
-
 
 typedef struct ms_model {
   model_t m; /* first: the model_t the caller holds */
@@ -61,6 +61,10 @@ typedef struct ms_model {
   double *surf_buf, *surf_rest_buf; /* tet variant: 3 nsurf */
   uint32_t *tris;                   /* 3 nsurf_tris, the model's own copy */
   double *try_x, *try_v;            /* implicit Euler: 3 nnodes, the state before an attempt */
+  /* What choose_substeps needs again after a topology change (cutting). */
+  double dt, tool_stiffness;
+  int requested_substeps;
+  size_t tri_cap; /* capacity of tris */
 } ms_model_t;
 
 static double state_sum(const ms_model_t *mm) {
@@ -213,14 +217,13 @@ static const model_ops_t TET_OPS = {.name = "mass_spring_tet",
                                     .add_surface_force = tet_add_force};
 
 /* Stable dt of the scheme for this system (see the file comment). */
-static int choose_substeps(ms_model_t *mm, const model_params_t *p, integrator_kind_t kind, verr_t *err) {
-  const scene_organ_t *cfg = p->cfg;
+static int choose_substeps(ms_model_t *mm, integrator_kind_t kind, verr_t *err) {
   const mass_spring_t *ms = &mm->ms;
   double lk, lc;
-  if (mass_spring_eigen_bounds(ms, p->tool_stiffness, &lk, &lc)) return verr_set(err, "out of memory");
+  if (mass_spring_eigen_bounds(ms, mm->tool_stiffness, &lk, &lc)) return verr_set(err, "out of memory");
   double m_node = ms->p.mass / (double)ms->n;
-  double lk0 = (ms->p.home_stiffness + p->tool_stiffness) / m_node, lc0 = ms->p.home_damping / m_node;
-  return integrator_choose_substeps(kind, p->dt, cfg->solver.substeps, lk, lc, lk0, lc0,
+  double lk0 = (ms->p.home_stiffness + mm->tool_stiffness) / m_node, lc0 = ms->p.home_damping / m_node;
+  return integrator_choose_substeps(kind, mm->dt, mm->requested_substeps, lk, lc, lk0, lc0,
                                     "lower material stiffness, damping or tool stiffness, raise the mass, or use "
                                     "implicit_euler (explicit_euler needs damping)",
                                     &mm->m.substeps, &mm->m.stable_dt, err);
@@ -243,6 +246,9 @@ static model_t *ms_create(const model_params_t *p, int tet, verr_t *err) {
     return NULL;
   }
   mm->tet = tet;
+  mm->dt = p->dt;
+  mm->tool_stiffness = p->tool_stiffness;
+  mm->requested_substeps = cfg->solver.substeps;
   const mesh_t *s = p->surface;
   ms_params_t mp = {.mass = cfg->material.mass,
                     .stiffness = cfg->material.stiffness,
@@ -275,6 +281,7 @@ static model_t *ms_create(const model_params_t *p, int tet, verr_t *err) {
   mm->good_x = malloc(3 * n * sizeof(double));
   mm->good_v = malloc(3 * n * sizeof(double));
   mm->tris = malloc(3 * s->ntris * sizeof(uint32_t) + 1);
+  mm->tri_cap = s->ntris;
   if (tet) {
     mm->surf_buf = malloc(3 * s->nverts * sizeof(double) + 1);
     mm->surf_rest_buf = malloc(3 * s->nverts * sizeof(double) + 1);
@@ -316,7 +323,7 @@ static model_t *ms_create(const model_params_t *p, int tet, verr_t *err) {
     m->surf_x = mm->ms.x;
     m->surf_rest = mm->ms.x_rest;
   }
-  if (choose_substeps(mm, p, (integrator_kind_t)kind, err) ||
+  if (choose_substeps(mm, (integrator_kind_t)kind, err) ||
       integrator_init(&mm->it, (integrator_kind_t)kind, n, cfg->solver.cg_tolerance, cfg->solver.cg_max_iterations,
                       err)) {
     ms_destroy(m);
@@ -330,3 +337,67 @@ model_t *model_mass_spring_tet_create(const model_params_t *p, verr_t *err);
 
 model_t *model_mass_spring_surface_create(const model_params_t *p, verr_t *err) { return ms_create(p, 0, err); }
 model_t *model_mass_spring_tet_create(const model_params_t *p, verr_t *err) { return ms_create(p, 1, err); }
+
+mass_spring_t *model_mass_spring_surface_system(model_t *m) {
+  return m && m->ops == &SURFACE_OPS ? &((ms_model_t *)m)->ms : NULL;
+}
+
+/* realloc that keeps *p on failure; NULL stays NULL. */
+static int grow_buf(double **p, size_t count) {
+  if (!*p) return 0;
+  double *q = realloc(*p, count * sizeof(double) + 1);
+  if (!q) return -1;
+  *p = q;
+  return 0;
+}
+
+int model_mass_spring_reserve(model_t *m, size_t cap, int with_f_res, verr_t *err) {
+  ms_model_t *mm = (ms_model_t *)m;
+  if (m->ops != &SURFACE_OPS) return verr_set(err, "topology changes need a mass_spring_surface model");
+  size_t old = mm->ms.cap;
+  if (cap > old) cap = cap < old + old / 2 ? old + old / 2 : cap;
+  if (mass_spring_reserve(&mm->ms, cap, with_f_res, err)) return -1;
+  if (mm->ms.cap > old || mm->it.n < mm->ms.cap) {
+    size_t c3 = 3 * mm->ms.cap;
+    if (grow_buf(&mm->good_x, c3) || grow_buf(&mm->good_v, c3) || grow_buf(&mm->try_x, c3) ||
+        grow_buf(&mm->try_v, c3))
+      return verr_set(err, "out of memory for %zu nodes", mm->ms.cap);
+    integrator_t it;
+    if (integrator_init(&it, mm->it.kind, mm->ms.cap, mm->it.cg_tolerance, mm->it.cg_max_iterations, err)) return -1;
+    integrator_destroy(&mm->it);
+    mm->it = it;
+  }
+  /* The arrays may have moved: the model's view follows (the caller bumps
+   * topology_version through commit before anyone steps again). */
+  m->x = m->surf_x = mm->ms.x;
+  m->v = mm->ms.v;
+  m->x_rest = m->surf_rest = mm->ms.x_rest;
+  return 0;
+}
+
+int model_mass_spring_commit(model_t *m, size_t n, const uint32_t *tris, size_t ntris, verr_t *err) {
+  ms_model_t *mm = (ms_model_t *)m;
+  if (m->ops != &SURFACE_OPS) return verr_set(err, "topology changes need a mass_spring_surface model");
+  if (ntris > mm->tri_cap) {
+    size_t cap = ntris < mm->tri_cap + mm->tri_cap / 2 ? mm->tri_cap + mm->tri_cap / 2 : ntris;
+    uint32_t *t = realloc(mm->tris, 3 * cap * sizeof(uint32_t) + 1);
+    if (!t) return verr_set(err, "out of memory for %zu triangles", cap);
+    mm->tris = t;
+    mm->tri_cap = cap;
+  }
+  if (mass_spring_set_surface_topology(&mm->ms, n, tris, ntris, err)) return -1;
+  memcpy(mm->tris, tris, 3 * ntris * sizeof(uint32_t));
+  memcpy(mm->good_x, mm->ms.x, 3 * n * sizeof(double));
+  memcpy(mm->good_v, mm->ms.v, 3 * n * sizeof(double));
+  m->nnodes = m->nsurf = n;
+  m->nsurf_tris = ntris;
+  m->surf_tris = mm->tris;
+  m->x = m->surf_x = mm->ms.x;
+  m->v = mm->ms.v;
+  m->x_rest = m->surf_rest = mm->ms.x_rest;
+  /* Removing springs and nodes cannot raise the largest eigenvalue of
+   * M^-1 K, but the new springs around the incision can: choose again. */
+  int rc = choose_substeps(mm, mm->it.kind, err);
+  m->topology_version++;
+  return rc;
+}
