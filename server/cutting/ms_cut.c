@@ -69,6 +69,9 @@ ms_cut_t *ms_cut_create(model_t *m, const ms_cut_params_t *p, verr_t *err) {
     verr_set(err, "cutting: the model has no springs or triangles");
     return NULL;
   }
+  /* The stability bound's dominant vectors, for quick re-estimates after
+   * each cut (model_mass_spring.h): computed now, at scene load. */
+  if (model_mass_spring_prepare(m, err)) return NULL;
   ms_cut_t *c = calloc(1, sizeof *c);
   if (!c) {
     verr_set(err, "cutting: out of memory");
@@ -83,7 +86,7 @@ ms_cut_t *ms_cut_create(model_t *m, const ms_cut_params_t *p, verr_t *err) {
   }
   c->h_mean /= (double)ms->nsprings;
   c->m0 = ms->p.mass / (double)ms->n;
-  if (c->p.segment_length == 0) c->p.segment_length = 2 * c->h_mean;
+  if (c->p.segment_length == 0) c->p.segment_length = 4 * c->h_mean;
   return c;
 }
 
@@ -108,6 +111,7 @@ size_t ms_cut_bytes(const ms_cut_t *c) {
              c->lip_cap * sizeof(lip_t);
   for (size_t i = 0; i < c->nlips; i++) b += c->lips[i].len * sizeof(uint32_t);
   if (c->ms->f_res) b += 3 * c->ms->cap * sizeof(double);
+  b += 6 * c->ms->cap * sizeof(double); /* the model's dominant vectors (model_mass_spring_prepare) */
   return b;
 }
 
@@ -303,7 +307,7 @@ static int process_segment(ms_cut_t *c, verr_t *err) {
     ms->inv_mass[j] = 1 / c->m0;
   }
   memset(ms->f_ext, 0, 3 * nn * sizeof(double));
-  if (model_mass_spring_commit(m, nn, nt_buf, ntris_new, err)) {
+  if (model_mass_spring_commit(m, nn, map, n, nt_buf, ntris_new, err)) {
     rc = -1; /* the topology did change: report, the caller passes it on */
     goto lips;
   }
@@ -393,8 +397,14 @@ size_t ms_cut_incision_width(const ms_cut_t *c, double *mean, double *max) {
   for (size_t l = 0; l < c->nlips; l++) {
     const lip_t *A = &c->lips[l];
     if (A->side != 1) continue;
-    for (size_t i = 1; i + 1 < A->len; i++) { /* the curve's end nodes excluded */
+    for (size_t i = 0; i < A->len; i++) {
       const double *p = X + 3 * (size_t)A->nodes[i];
+      /* A curve end shared by both sides is where the incision closes: no gap to measure. */
+      int shared = 0;
+      for (size_t k = 0; k < c->nlips && !shared; k++)
+        for (size_t j = 0; j < c->lips[k].len && c->lips[k].side == 2 && !shared; j++)
+          shared = c->lips[k].nodes[j] == A->nodes[i];
+      if (shared) continue;
       double best = INFINITY;
       for (size_t k = 0; k < c->nlips; k++) {
         const lip_t *B = &c->lips[k];

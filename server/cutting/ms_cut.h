@@ -64,7 +64,7 @@
 
 typedef struct ms_cut_params {
   double eps_r;          /* residual strain (seed 004: 0.1); 0 disables residual stress */
-  double segment_length; /* m of path per processed segment; 0: 2 x the mean rest edge length */
+  double segment_length; /* m of path per processed segment; 0: 4 x the mean rest edge length */
   double min_radius_rel; /* floor of the swept radius, x mean rest edge length (default 0.3) */
   double max_radius;     /* m, larger blade radii are refused (default 0.02) */
 } ms_cut_params_t;
@@ -102,7 +102,7 @@ const ms_cut_stats_t *ms_cut_stats(const ms_cut_t *c);
 size_t ms_cut_bytes(const ms_cut_t *c);
 
 /* Incision width (seed 004 §4.1: distance between points on both sides):
- * for every lip node of side 1 (curve end points excluded) its distance to
+ * for every lip node of side 1 (curve ends shared with side 2 excluded) its distance to
  * the nearest lip polyline of side 2 at the current positions; mean and max
  * over them, m. Returns the number of nodes measured (0: no incision yet). */
 size_t ms_cut_incision_width(const ms_cut_t *c, double *mean, double *max);

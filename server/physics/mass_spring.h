@@ -106,6 +106,15 @@ void mass_spring_stiffness_mul(const mass_spring_t *ms, const double *x, double 
  * Returns 0, or -1 on OOM. */
 int mass_spring_eigen_bounds(const mass_spring_t *ms, double extra_home_k, double *lambda_k, double *lambda_c);
 
+/* The same with caller-kept vectors vk, vc (3n each): the start vectors
+ * when warm (a topology change keeps most of the dominant modes, so the
+ * iteration converges in a fraction of the steps; it stops when the
+ * estimate changes by less than 1e-5 between iterations instead of 1e-7),
+ * the dominant vectors on return. warm = 0 starts from the same vector as mass_spring_eigen_bounds
+ * and gives the same figures. Returns 0, or -1 on OOM. */
+int mass_spring_eigen_bounds_warm(const mass_spring_t *ms, double extra_home_k, double *vk, double *vc, int warm,
+                                  double *lambda_k, double *lambda_c);
+
 /* Adds an external force (N) at node i; forces() includes it until cleared. */
 static inline void mass_spring_add_force(mass_spring_t *ms, uint32_t i, const double f[3]) {
   ms->f_ext[3 * i] += f[0];

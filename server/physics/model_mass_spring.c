@@ -48,6 +48,7 @@
 #include "model.h"
 #include "model_mass_spring.h"
 #include "tet_mesh.h"
+#include "vmath.h"
 
 typedef struct ms_model {
   model_t m; /* first: the model_t the caller holds */
@@ -65,6 +66,7 @@ typedef struct ms_model {
   double dt, tool_stiffness;
   int requested_substeps;
   size_t tri_cap; /* capacity of tris */
+  double *eig_k, *eig_c; /* 3 cap each or NULL: dominant vectors of M^-1 K, M^-1 C (cutting only) */
 } ms_model_t;
 
 static double state_sum(const ms_model_t *mm) {
@@ -172,6 +174,8 @@ static void ms_destroy(model_t *m) {
   free(mm->tris);
   free(mm->try_x);
   free(mm->try_v);
+  free(mm->eig_k);
+  free(mm->eig_c);
   free(mm);
 }
 
@@ -217,16 +221,20 @@ static const model_ops_t TET_OPS = {.name = "mass_spring_tet",
                                     .add_surface_force = tet_add_force};
 
 /* Stable dt of the scheme for this system (see the file comment). */
-static int choose_substeps(ms_model_t *mm, integrator_kind_t kind, verr_t *err) {
+static int substeps_from(ms_model_t *mm, integrator_kind_t kind, double lk, double lc, verr_t *err) {
   const mass_spring_t *ms = &mm->ms;
-  double lk, lc;
-  if (mass_spring_eigen_bounds(ms, mm->tool_stiffness, &lk, &lc)) return verr_set(err, "out of memory");
   double m_node = ms->p.mass / (double)ms->n;
   double lk0 = (ms->p.home_stiffness + mm->tool_stiffness) / m_node, lc0 = ms->p.home_damping / m_node;
   return integrator_choose_substeps(kind, mm->dt, mm->requested_substeps, lk, lc, lk0, lc0,
                                     "lower material stiffness, damping or tool stiffness, raise the mass, or use "
                                     "implicit_euler (explicit_euler needs damping)",
                                     &mm->m.substeps, &mm->m.stable_dt, err);
+}
+
+static int choose_substeps(ms_model_t *mm, integrator_kind_t kind, verr_t *err) {
+  double lk, lc;
+  if (mass_spring_eigen_bounds(&mm->ms, mm->tool_stiffness, &lk, &lc)) return verr_set(err, "out of memory");
+  return substeps_from(mm, kind, lk, lc, err);
 }
 
 static model_t *ms_create(const model_params_t *p, int tet, verr_t *err) {
@@ -360,7 +368,7 @@ int model_mass_spring_reserve(model_t *m, size_t cap, int with_f_res, verr_t *er
   if (mm->ms.cap > old || mm->it.n < mm->ms.cap) {
     size_t c3 = 3 * mm->ms.cap;
     if (grow_buf(&mm->good_x, c3) || grow_buf(&mm->good_v, c3) || grow_buf(&mm->try_x, c3) ||
-        grow_buf(&mm->try_v, c3))
+        grow_buf(&mm->try_v, c3) || grow_buf(&mm->eig_k, c3) || grow_buf(&mm->eig_c, c3))
       return verr_set(err, "out of memory for %zu nodes", mm->ms.cap);
     integrator_t it;
     if (integrator_init(&it, mm->it.kind, mm->ms.cap, mm->it.cg_tolerance, mm->it.cg_max_iterations, err)) return -1;
@@ -375,7 +383,49 @@ int model_mass_spring_reserve(model_t *m, size_t cap, int with_f_res, verr_t *er
   return 0;
 }
 
-int model_mass_spring_commit(model_t *m, size_t n, const uint32_t *tris, size_t ntris, verr_t *err) {
+int model_mass_spring_prepare(model_t *m, verr_t *err) {
+  ms_model_t *mm = (ms_model_t *)m;
+  if (m->ops != &SURFACE_OPS) return verr_set(err, "topology changes need a mass_spring_surface model");
+  if (mm->eig_k) return 0;
+  mm->eig_k = calloc(3 * mm->ms.cap + 1, sizeof(double));
+  mm->eig_c = calloc(3 * mm->ms.cap + 1, sizeof(double));
+  double lk, lc;
+  if (!mm->eig_k || !mm->eig_c ||
+      mass_spring_eigen_bounds_warm(&mm->ms, mm->tool_stiffness, mm->eig_k, mm->eig_c, 0, &lk, &lc)) {
+    free(mm->eig_k);
+    free(mm->eig_c);
+    mm->eig_k = mm->eig_c = NULL;
+    return verr_set(err, "out of memory for %zu nodes", mm->ms.cap);
+  }
+  return 0;
+}
+
+/* Moves the dominant vectors to the new numbering (survivors keep their
+ * components; new nodes get small pseudo-random ones, so a mode that lives
+ * in the new springs can grow). */
+static void remap_vectors(ms_model_t *mm, const uint32_t *old_to_new, size_t old_n, size_t n) {
+  double *v[2] = {mm->eig_k, mm->eig_c};
+  unsigned seed = 777;
+  for (int k = 0; k < 2; k++) {
+    double rms = 0;
+    for (size_t i = 0; i < old_n; i++) {
+      uint32_t j = old_to_new[i];
+      rms += v3_dot(v[k] + 3 * i, v[k] + 3 * i);
+      if (j != UINT32_MAX && j != i) memcpy(v[k] + 3 * (size_t)j, v[k] + 3 * i, 3 * sizeof(double));
+    }
+    rms = sqrt(rms / (double)(old_n ? old_n : 1));
+    size_t first_new = 0;
+    for (size_t i = 0; i < old_n; i++)
+      if (old_to_new[i] != UINT32_MAX) first_new++;
+    for (size_t c = 3 * first_new; c < 3 * n; c++) {
+      seed = seed * 1664525u + 1013904223u;
+      v[k][c] = rms * ((double)(seed >> 8) / 16777216.0 - 0.5);
+    }
+  }
+}
+
+int model_mass_spring_commit(model_t *m, size_t n, const uint32_t *old_to_new, size_t old_n, const uint32_t *tris,
+                             size_t ntris, verr_t *err) {
   ms_model_t *mm = (ms_model_t *)m;
   if (m->ops != &SURFACE_OPS) return verr_set(err, "topology changes need a mass_spring_surface model");
   if (ntris > mm->tri_cap) {
@@ -395,9 +445,16 @@ int model_mass_spring_commit(model_t *m, size_t n, const uint32_t *tris, size_t 
   m->x = m->surf_x = mm->ms.x;
   m->v = mm->ms.v;
   m->x_rest = m->surf_rest = mm->ms.x_rest;
-  /* Removing springs and nodes cannot raise the largest eigenvalue of
-   * M^-1 K, but the new springs around the incision can: choose again. */
-  int rc = choose_substeps(mm, mm->it.kind, err);
   m->topology_version++;
-  return rc;
+  /* New springs and nodes change the stability bound: the power iteration
+   * again, started from the previous dominant vectors (prepare) or cold. */
+  double lk, lc;
+  int rc;
+  if (mm->eig_k) {
+    remap_vectors(mm, old_to_new, old_n, n);
+    rc = mass_spring_eigen_bounds_warm(&mm->ms, mm->tool_stiffness, mm->eig_k, mm->eig_c, 1, &lk, &lc);
+  } else
+    rc = mass_spring_eigen_bounds(&mm->ms, mm->tool_stiffness, &lk, &lc);
+  if (rc) return verr_set(err, "out of memory");
+  return substeps_from(mm, mm->it.kind, lk, lc, err);
 }
