@@ -117,8 +117,8 @@ double bezier_nearest(const double ctrl[4][3], const double q[3], int nsamp, dou
   for (int side = -1; side <= 1; side += 2) {
     int o = best + side;
     if (o < 0 || o > nsamp) continue;
-    double dd, aa = chord_project(ctrl, (double)(side < 0 ? o : best) / nsamp, (double)(side < 0 ? best : o) / nsamp,
-                                  q, &dd);
+    double dd,
+        aa = chord_project(ctrl, (double)(side < 0 ? o : best) / nsamp, (double)(side < 0 ? best : o) / nsamp, q, &dd);
     if (dd < d) {
       d = dd;
       a = aa;

@@ -36,8 +36,7 @@ void bezier_tangent(const double ctrl[4][3], double a, double out[3]);
  * (they are computed and written to weights_out[2][2]: segment index and
  * fraction for 1/3 and 2/3), and the first call's weights_out as weights_in
  * the second time. Returns the polyline length. */
-double bezier_fit_path(const double *pts, size_t n, const double *weights_in, double weights_out[4],
-                       double ctrl[4][3]);
+double bezier_fit_path(const double *pts, size_t n, const double *weights_in, double weights_out[4], double ctrl[4][3]);
 
 /* Nearest point of the curve to q: samples it at nsamp + 1 parameters,
  * then projects q on the two chords beside the nearest sample. Returns the

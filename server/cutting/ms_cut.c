@@ -60,8 +60,9 @@ ms_cut_t *ms_cut_create(model_t *m, const ms_cut_params_t *p, verr_t *err) {
   ms_cut_params_t q = p ? *p : ms_cut_default_params();
   if (!(q.eps_r >= 0 && q.eps_r < 1) || !(q.segment_length >= 0) || !isfinite(q.segment_length) ||
       !(q.min_radius_rel >= 0 && q.min_radius_rel <= 2) || !(q.max_radius > 0) || !isfinite(q.max_radius)) {
-    verr_set(err, "cutting: eps_r must be in [0, 1), segment_length >= 0, min_radius_rel in [0, 2], max_radius > 0 "
-                  "(got %g, %g, %g, %g)",
+    verr_set(err,
+             "cutting: eps_r must be in [0, 1), segment_length >= 0, min_radius_rel in [0, 2], max_radius > 0 "
+             "(got %g, %g, %g, %g)",
              q.eps_r, q.segment_length, q.min_radius_rel, q.max_radius);
     return NULL;
   }
@@ -323,7 +324,8 @@ lips:
   }
   for (size_t l = 0; l < nm.nlips; l++) {
     nm_lip_t *L = &nm.lips[l];
-    for (size_t i = 0; i < L->len; i++) L->nodes[i] = L->nodes[i] < n ? map[L->nodes[i]] : (uint32_t)(keep + (L->nodes[i] - n));
+    for (size_t i = 0; i < L->len; i++)
+      L->nodes[i] = L->nodes[i] < n ? map[L->nodes[i]] : (uint32_t)(keep + (L->nodes[i] - n));
     if (lips_push(c, L->side, L->len, L->nodes) == 0) L->nodes = NULL; /* ownership moved */
   }
   c->st.segments++;

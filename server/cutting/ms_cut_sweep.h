@@ -37,17 +37,16 @@ void ms_sweep_mark(size_t n, const double *x, size_t ntris, const uint32_t *tris
                    double r, const uint32_t *hit_tris, size_t nhit, uint8_t *node_in, uint8_t *tri_dead);
 
 typedef struct ms_sweep_out {
-  uint8_t *node_dead;  /* n: referenced by no surviving triangle */
-  size_t nhole;        /* directed hole edges */
-  uint32_t *hole;      /* 2 nhole */
-  size_t ncut;         /* springs cut */
-  uint32_t *cut;       /* 2 ncut */
+  uint8_t *node_dead; /* n: referenced by no surviving triangle */
+  size_t nhole;       /* directed hole edges */
+  uint32_t *hole;     /* 2 nhole */
+  size_t ncut;        /* springs cut */
+  uint32_t *cut;      /* 2 ncut */
   size_t tris_dead, nodes_dead;
 } ms_sweep_out_t;
 
 /* tri_dead is updated in place. Returns 0, or -1 with err (OOM, bad index). */
-int ms_sweep_cleanup(size_t n, size_t ntris, const uint32_t *tris, uint8_t *tri_dead, ms_sweep_out_t *out,
-                     verr_t *err);
+int ms_sweep_cleanup(size_t n, size_t ntris, const uint32_t *tris, uint8_t *tri_dead, ms_sweep_out_t *out, verr_t *err);
 void ms_sweep_out_free(ms_sweep_out_t *o);
 
 #endif

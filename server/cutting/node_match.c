@@ -161,7 +161,7 @@ static int do_side(ctx_t *c, const uint32_t *b, size_t nb, int forward, uint32_t
         adv_chain = 1;
       else if (want > cj + 1)
         adv_chain = 0; /* lip nodes no chain node chose: fan them from b_i */
-      else /* the quadrilateral b_i, b_i+1, c_j+1, c_j: split by the shorter diagonal */
+      else             /* the quadrilateral b_i, b_i+1, c_j+1, c_j: split by the shorter diagonal */
         adv_chain = dist_nodes(c, b[bi + 1], lip.p[cj]) <= dist_nodes(c, b[bi], lip.p[cj + 1]);
     }
     if (adv_chain) {

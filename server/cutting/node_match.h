@@ -38,7 +38,7 @@
 #include "verr.h"
 
 typedef struct nm_lip {
-  int side;        /* 1: right of the curve's direction (P0 -> P3), seen from the surface's outside; 2: left */
+  int side; /* 1: right of the curve's direction (P0 -> P3), seen from the surface's outside; 2: left */
   size_t len;
   uint32_t *nodes; /* indices >= n: new nodes (n + k); ordered along the curve from a = 0 to 1 */
 } nm_lip_t;
@@ -51,7 +51,7 @@ typedef struct nm_result {
   size_t nmatch;
   uint32_t *match_node, *match_to; /* the connection made for every chain node (red/yellow springs) */
   size_t nlips;
-  nm_lip_t *lips; /* one per side chain, with its curve end nodes */
+  nm_lip_t *lips;   /* one per side chain, with its curve end nodes */
   size_t open_left; /* boundary components left open */
 } nm_result_t;
 

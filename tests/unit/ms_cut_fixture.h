@@ -88,7 +88,7 @@ static inline model_t *fx_model(const mesh_t *mesh, fx_material_t mat, const cha
  * the steps taken, or -1 on error (printed). cut_ms accumulates the wall
  * time of the steps that changed the topology. */
 static inline long fx_stroke(model_t *m, ms_cut_t *c, const double a[2], const double b[2], double z0, double radius,
-                      double speed, double dt, double *cut_ms, int *topo_changes) {
+                             double speed, double dt, double *cut_ms, int *topo_changes) {
   double len = hypot(b[0] - a[0], b[1] - a[1]);
   long steps = (long)ceil(len / (speed * dt));
   verr_t err;

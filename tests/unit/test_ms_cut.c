@@ -197,7 +197,6 @@ static void test_sweep_brute_force(void) {
   mesh_free(&m);
 }
 
-
 /* Stage 3 on a straight interior cut of a sheet, checked on its outputs:
  * every hole-boundary node is connected to the curve node at its nearest
  * point (within the merge tolerance), the connection is an edge of the new
@@ -337,17 +336,18 @@ static int cut_model(const char *what, const mesh_t *mesh, double ax, double ay,
   CHECK(m->rollbacks == 0);
   /* Sub-steps follow the stability bound of the cut mesh. */
   CHECK(m->substeps >= 1 && 1e-3 / m->substeps <= 0.9 * m->stable_dt * (1 + 1e-12));
-  {
-    double lk, lc;
-    mass_spring_eigen_bounds(model_mass_spring_surface_system(m), 0, &lk, &lc);
-    printf("  stable dt: model %.3g ms, fresh power iteration %.3g ms\n", m->stable_dt * 1e3, integrator_stable_dt(INT_SYMPLECTIC_EULER, lk, lc) * 1e3);
-  }
+  /* The warm-started re-estimate agrees with a cold power iteration on the cut mesh. */
+  double lk, lc;
+  CHECK(mass_spring_eigen_bounds(model_mass_spring_surface_system(m), 0, &lk, &lc) == 0);
+  double cold = integrator_stable_dt(INT_SYMPLECTIC_EULER, lk, lc);
+  CHECK(fabs(m->stable_dt / cold - 1) < 0.01);
   const ms_cut_stats_t *st = ms_cut_stats(c);
   CHECK(st->cuts == 1 && st->holes_left_open == 0);
-  printf("  %ld steps, %llu segments, nodes -%llu +%llu, triangles -%llu +%llu, springs cut %llu, sub-steps %d, last segment %.2f ms\n",
+  printf("  %ld steps, %llu segments, nodes -%llu +%llu, triangles -%llu +%llu, springs cut %llu, sub-steps %d (stable "
+         "dt %.3g ms, cold estimate %.3g ms), last segment %.2f ms\n",
          steps, (unsigned long long)st->segments, (unsigned long long)st->nodes_deleted,
          (unsigned long long)st->nodes_added, (unsigned long long)st->tris_deleted, (unsigned long long)st->tris_added,
-         (unsigned long long)st->springs_cut, m->substeps, st->last_segment_ms);
+         (unsigned long long)st->springs_cut, m->substeps, m->stable_dt * 1e3, cold * 1e3, st->last_segment_ms);
   *out_model = m;
   *out_cut = c;
   return 0;
@@ -357,8 +357,7 @@ static void test_cuts(void) {
   mesh_t block, sheet, spleen;
   model_t *m;
   ms_cut_t *c;
-  if (fx_load("tissue_block.obj", &block) || fx_sheet(&sheet, 61, 37, 0.1, 0.06) ||
-      fx_load("spleen.obj", &spleen)) {
+  if (fx_load("tissue_block.obj", &block) || fx_sheet(&sheet, 61, 37, 0.1, 0.06) || fx_load("spleen.obj", &spleen)) {
     CHECK(0);
     return;
   }
@@ -375,7 +374,8 @@ static void test_cuts(void) {
   if (cut_model("sheet, cut inside", &sheet, -0.03, 0.0011, 0.03, 0.0011, 0, 0.001, 1, &m, &c) == 0) {
     double mean, max;
     size_t nw = ms_cut_incision_width(c, &mean, &max);
-    printf("  width: %zu lip nodes, mean %.3g mm, max %.3g mm, %zu lips\n", nw, mean * 1e3, max * 1e3, ms_cut_lip_count(c));
+    printf("  width: %zu lip nodes, mean %.3g mm, max %.3g mm, %zu lips\n", nw, mean * 1e3, max * 1e3,
+           ms_cut_lip_count(c));
     CHECK(nw > 5);
     CHECK(ms_cut_lip_count(c) >= 2);
     ms_cut_destroy(c);
@@ -397,10 +397,141 @@ static void test_cuts(void) {
   mesh_free(&spleen);
 }
 
+/* Width of an interior cut over time after the stroke: n samples, one per
+ * `every` steps, into w[]. The whole cut is one segment, applied when the
+ * stroke ends (segment_length 1 m), so t = 0 is the moment the springs are
+ * cut: the seed's Fig. 6 set-up. Returns 0 or -1. */
+static int width_curve(const mesh_t *mesh, fx_material_t mat, double eps_r, int n, int every, double *w) {
+  verr_t err;
+  model_t *m = fx_model(mesh, mat, "symplectic_euler", 1e-3, &err);
+  if (!m) {
+    printf("%s\n", err.msg);
+    return -1;
+  }
+  ms_cut_params_t p = ms_cut_default_params();
+  p.eps_r = eps_r;
+  p.segment_length = 1.0;
+  ms_cut_t *c = ms_cut_create(m, &p, &err);
+  int rc = -1;
+  if (c && fx_stroke(m, c, (double[]){-0.03, 0.0011}, (double[]){0.03, 0.0011}, 0, 0.001, 0.5, 1e-3, NULL, NULL) > 0) {
+    rc = 0;
+    for (int i = 0; i < n; i++) {
+      for (int s = 0; s < every; s++) m->ops->step(m, 1e-3);
+      if (ms_cut_incision_width(c, &w[i], NULL) == 0) rc = -1;
+    }
+  }
+  ms_cut_destroy(c);
+  model_destroy(m);
+  return rc;
+}
+
+/* The seed's Fig. 6 shape: opens fast (peak early), shrinks (the end is at
+ * least 5 % below the peak) and is stable (the last 100 ms vary by less
+ * than 1 % of the final width). */
+static int fig6_shape(const double *w, int n, int dt_ms, double *peak, int *peak_ms, double *final, double *spread) {
+  int ip = 0;
+  for (int i = 0; i < n; i++)
+    if (w[i] > w[ip]) ip = i;
+  int tail = 100 / dt_ms;
+  double lo = INFINITY, hi = -INFINITY, sum = 0;
+  for (int i = n - tail; i < n; i++) {
+    lo = fmin(lo, w[i]);
+    hi = fmax(hi, w[i]);
+    sum += w[i];
+  }
+  *peak = w[ip];
+  *peak_ms = (ip + 1) * dt_ms;
+  *final = sum / tail;
+  *spread = hi - lo;
+  return *peak > 1e-5 && *peak_ms <= 100 && *final <= 0.95 * *peak && *final > 0 && *spread <= 0.01 * *final;
+}
+
+static void test_residual_stress(void) {
+  mesh_t sheet;
+  if (fx_sheet(&sheet, 41, 25, 0.1, 0.06)) {
+    CHECK(0);
+    return;
+  }
+  enum { N = 300, DT = 2 }; /* 600 ms */
+  double w[N], w0[N];
+  /* Scene-default stiffness, heavier and lightly damped so the opening
+   * takes tens of milliseconds and overshoots visibly. */
+  const fx_material_t mat = {1.0, 30, 0.01, 30, 0.02};
+  CHECK(width_curve(&sheet, mat, 0.1, N, DT, w) == 0);
+  CHECK(width_curve(&sheet, mat, 0.0, N, DT, w0) == 0);
+  double peak, final, spread, peak0, final0, spread0;
+  int tp, tp0;
+  int shape = fig6_shape(w, N, DT, &peak, &tp, &final, &spread);
+  int shape0 = fig6_shape(w0, N, DT, &peak0, &tp0, &final0, &spread0);
+  CHECK(shape);
+  CHECK(w[0] > 0); /* it opens at once */
+  CHECK(!shape0);
+  CHECK(peak0 < 1e-3 * peak); /* without residual stress the wound does not open */
+  printf("residual stress eps_r 0.1: width peak %.4f mm at %d ms, final %.4f mm (%.1f %% below the peak), last "
+         "100 ms within %.2g %%; eps_r 0: peak %.2g mm, Fig. 6 shape %s\n",
+         peak * 1e3, tp, final * 1e3, 100 * (1 - final / peak), 100 * spread / final, peak0 * 1e3,
+         shape0 ? "yes" : "no");
+  mesh_free(&sheet);
+}
+
+/* Allocation only when cutting; bad input refused; other models refused. */
+static void test_allocation_and_input(void) {
+  mesh_t sheet;
+  if (fx_sheet(&sheet, 21, 13, 0.1, 0.06)) {
+    CHECK(0);
+    return;
+  }
+  verr_t err;
+  model_t *m = fx_model(&sheet, FX_DEFAULT_MATERIAL, "symplectic_euler", 1e-3, &err);
+  mass_spring_t *ms = model_mass_spring_surface_system(m);
+  CHECK(ms && ms->f_res == NULL); /* a model nobody cuts has no cutting arrays */
+  ms_cut_t *c = ms_cut_create(m, NULL, &err);
+  CHECK(c != NULL);
+  size_t b0 = ms_cut_bytes(c);
+  /* Far from the tissue: nothing more is allocated, nothing changes. */
+  double far0[3] = {0.5, 0.5, 0.5}, far1[3] = {0.5, 0.5, 0.4};
+  CHECK(ms_cut_step(c, far0, far1, 0.001, &err) == 0);
+  CHECK(ms_cut_bytes(c) == b0 && ms->f_res == NULL && !ms_cut_active(c));
+  /* Bad input: refused, counted nowhere, the model unchanged. */
+  uint32_t v = m->topology_version;
+  double nan3[3] = {NAN, 0, 0}, ok[3] = {0, 0, 0.01};
+  CHECK(ms_cut_step(c, nan3, ok, 0.001, &err) == -1 && strstr(err.msg, "finite"));
+  CHECK(ms_cut_step(c, ok, ok, 0, &err) == -1 && strstr(err.msg, "radius"));
+  CHECK(ms_cut_step(c, ok, ok, 1.0, &err) == -1 && strstr(err.msg, "radius"));
+  CHECK(ms_cut_step(c, ok, ok, INFINITY, &err) == -1);
+  CHECK(m->topology_version == v);
+  /* A cut allocates the residual forces and the path. */
+  CHECK(fx_stroke(m, c, (double[]){-0.03, 0.0011}, (double[]){0.03, 0.0011}, 0, 0.001, 0.5, 1e-3, NULL, NULL) > 0);
+  CHECK(ms->f_res != NULL && ms_cut_bytes(c) > b0 && m->topology_version > v);
+  ms_cut_destroy(c);
+  model_destroy(m);
+  /* Other models cannot be cut by this method. */
+  static scene_organ_t cfg;
+  memset(&cfg, 0, sizeof cfg);
+  snprintf(cfg.model, sizeof cfg.model, "mass_spring_tet");
+  snprintf(cfg.integrator, sizeof cfg.integrator, "symplectic_euler");
+  cfg.material =
+      (scene_material_t){.mass = 0.1, .stiffness = 30, .damping = 0.02, .home_stiffness = 30, .home_damping = 0.005};
+  mesh_t spleen;
+  if (fx_load("spleen.obj", &spleen) == 0) {
+    model_params_t p = {.cfg = &cfg, .surface = &spleen, .dt = 1e-3};
+    model_t *t = model_create(&p, &err);
+    CHECK(t != NULL);
+    if (t) {
+      CHECK(ms_cut_create(t, NULL, &err) == NULL && strstr(err.msg, "mass_spring_surface"));
+      model_destroy(t);
+    }
+    mesh_free(&spleen);
+  }
+  mesh_free(&sheet);
+}
+
 int main(void) {
   test_bezier();
   test_sweep_brute_force();
   test_node_matching();
   test_cuts();
+  test_residual_stress();
+  test_allocation_and_input();
   return check_report("test_ms_cut");
 }
