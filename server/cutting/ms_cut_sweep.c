@@ -128,11 +128,11 @@ int ms_sweep_cleanup(size_t n, size_t ntris, const uint32_t *tris, uint8_t *tri_
   for (size_t c = 0; c < 3 * ntris; c++)
     if (tris[c] >= n) return verr_set(err, "cutting: triangle %zu names node %u of %zu", c / 3, tris[c], n);
   adj_t a = {0};
-  uint8_t *hole_out = calloc(n + 1, 1);
+  uint8_t *hole_out = calloc(n + 1, 1), *hole_in = calloc(n + 1, 1);
   uint32_t *alive = calloc(n + 1, sizeof(uint32_t));
   out->node_dead = calloc(n + 1, 1);
   int rc = -1;
-  if (!hole_out || !alive || !out->node_dead || adj_build(&a, n, ntris, tris)) goto out;
+  if (!hole_out || !hole_in || !alive || !out->node_dead || adj_build(&a, n, ntris, tris)) goto out;
   for (int changed = 1; changed;) {
     changed = 0;
     /* Surviving triangles that would stick into the hole. */
@@ -154,18 +154,24 @@ int ms_sweep_cleanup(size_t n, size_t ntris, const uint32_t *tris, uint8_t *tri_
         changed = 1;
       }
     }
-    /* Pinches: a node the hole boundary passes twice. */
+    /* Pinches: a node the hole boundary reaches twice (leaving it twice, or
+     * arriving twice: the hole touches an existing boundary node from two
+     * sides). */
     memset(hole_out, 0, n);
+    memset(hole_in, 0, n);
     for (size_t t = 0; t < ntris; t++) {
       if (!tri_dead[t]) continue;
       const uint32_t *f = tris + 3 * t;
       for (int e = 0; e < 3; e++) {
         long tw = tri_with_edge(&a, tris, f[(e + 1) % 3], f[e]);
-        if (tw >= 0 && !tri_dead[tw] && hole_out[f[e]] < 255) hole_out[f[e]]++;
+        if (tw >= 0 && !tri_dead[tw]) {
+          if (hole_out[f[e]] < 255) hole_out[f[e]]++;
+          if (hole_in[f[(e + 1) % 3]] < 255) hole_in[f[(e + 1) % 3]]++;
+        }
       }
     }
     for (size_t i = 0; i < n; i++) {
-      if (hole_out[i] < 2) continue;
+      if (hole_out[i] < 2 && hole_in[i] < 2) continue;
       for (uint32_t k = a.start[i]; k < a.start[i + 1]; k++)
         if (!tri_dead[a.tri[k]]) {
           tri_dead[a.tri[k]] = 1;
@@ -219,6 +225,7 @@ out:
   free(a.start);
   free(a.tri);
   free(hole_out);
+  free(hole_in);
   free(alive);
   if (rc) {
     ms_sweep_out_free(out);

@@ -13,7 +13,8 @@
  * nodes or edges is inside, or when the path runs through it: `hit_tris`).
  * ms_sweep_cleanup() then grows the deletion until the hole's boundary is
  * simple: a surviving triangle with two or more edges on the hole goes, and
- * so do all triangles of a node the hole touches twice (a pinch), repeated
+ * so do all triangles of a node the hole boundary leaves or enters twice (a
+ * pinch), repeated
  * until nothing changes. It reports the hole's boundary as directed edges
  * with the hole on their left (the deleted triangles' own edges whose twins
  * survive) and the springs that were cut (edges of deleted triangles no
