@@ -9,6 +9,7 @@
 
 #define NM_TABLE 256 /* arc-length table samples */
 #define NM_NEAREST_SAMPLES 128
+#define NM_SLIVER_DEG 15.0 /* smallest angle below which the zipper looks at the other move */
 
 /* Growable arrays (the result's and the work lists). */
 typedef struct u32vec {
@@ -90,14 +91,34 @@ static const double *pos(const ctx_t *c, uint32_t i, double buf[3]) {
   return buf;
 }
 
+/* Smallest corner angle of triangle (p, q, r), degrees. */
+static double min_angle(const ctx_t *c, uint32_t p, uint32_t q, uint32_t r) {
+  double bp[3], bq[3], br[3];
+  const double *P[3] = {pos(c, p, bp), pos(c, q, bq), pos(c, r, br)};
+  double mn = 180;
+  for (int k = 0; k < 3; k++) {
+    double u[3], w[3];
+    v3_sub(u, P[(k + 1) % 3], P[k]);
+    v3_sub(w, P[(k + 2) % 3], P[k]);
+    double nu = v3_norm(u), nw = v3_norm(w);
+    if (!(nu > 0) || !(nw > 0)) return 0;
+    double cs = v3_dot(u, w) / (nu * nw);
+    mn = fmin(mn, acos(cs < -1 ? -1 : cs > 1 ? 1 : cs) * (180 / M_PI));
+  }
+  return mn;
+}
+
 static double dist_nodes(const ctx_t *c, uint32_t i, uint32_t j) {
   double bi[3], bj[3];
   return v3_dist(pos(c, i, bi), pos(c, j, bj));
 }
 
-/* One side: chain b[0..nb-1] (hole on its left), lip from curve end node
- * e_start to e_end (already created); forward: the lip runs from a = 0 to 1. */
-static int do_side(ctx_t *c, const uint32_t *b, size_t nb, int forward, uint32_t e_start, uint32_t e_end) {
+/* One side: chain b[0..nb-1] (hole on its left), its lip from end node
+ * e_start (curve parameter a0) to e_end (a1), both already created (the same
+ * node when the lip is a single point). */
+static int do_side(ctx_t *c, const uint32_t *b, size_t nb, double a0, double a1, uint32_t e_start, uint32_t e_end) {
+  const int forward = a0 <= a1;
+  const double s0 = arc_of(c, a0), span = fabs(arc_of(c, a1) - s0);
   int rc = -1;
   double *s = malloc(nb * sizeof *s); /* arc position of the nearest point, along the lip */
   size_t *order = malloc(nb * sizeof *order);
@@ -108,12 +129,12 @@ static int do_side(ctx_t *c, const uint32_t *b, size_t nb, int forward, uint32_t
   size_t ncand = 0;
   for (size_t i = 0; i < nb; i++) {
     double arc = arc_of(c, bezier_nearest(c->ctrl, c->x + 3 * (size_t)b[i], NM_NEAREST_SAMPLES, NULL));
-    s[i] = forward ? arc : c->total - arc;
+    s[i] = forward ? arc - s0 : s0 - arc;
     /* The chain's ends and the nodes nearest the curve's ends (yellow)
      * connect to the end nodes; the others are candidates for lip nodes. */
     if (i == 0 || (i + 1 < nb && s[i] <= tol))
       match[i] = 0;
-    else if (i + 1 == nb || s[i] >= c->total - tol)
+    else if (i + 1 == nb || s[i] >= span - tol)
       match[i] = UINT32_MAX; /* the last lip node, known below */
     else
       order[ncand++] = i;
@@ -135,11 +156,18 @@ static int do_side(ctx_t *c, const uint32_t *b, size_t nb, int forward, uint32_t
     while (j < ncand && s[order[j]] - s[order[i]] < tol) sum += s[order[j++]];
     double sm = sum / (double)(j - i);
     uint32_t node;
-    if (new_node(c, param_of(c, forward ? sm : c->total - sm), &node) || u32_push(&lip, node)) goto out;
+    if (new_node(c, param_of(c, forward ? s0 + sm : s0 - sm), &node) || u32_push(&lip, node)) goto out;
     for (size_t q = i; q < j; q++) match[order[q]] = (uint32_t)(lip.n - 1);
     i = j;
   }
-  if (u32_push(&lip, e_end)) goto out;
+  if (lip.n == 1 && e_end != e_start) {
+    /* No chain node chose the inside of the curve: one lip node at its
+     * middle all the same, so the two sides of a loop never share a lip
+     * edge (they would cover it with the same triangle). */
+    uint32_t node;
+    if (new_node(c, param_of(c, forward ? s0 + 0.5 * span : s0 - 0.5 * span), &node) || u32_push(&lip, node)) goto out;
+  }
+  if (e_end != e_start && u32_push(&lip, e_end)) goto out;
   const size_t last = lip.n - 1;
   for (size_t q = 0; q < nb; q++) {
     if (match[q] == UINT32_MAX) match[q] = (uint32_t)last;
@@ -163,6 +191,14 @@ static int do_side(ctx_t *c, const uint32_t *b, size_t nb, int forward, uint32_t
         adv_chain = 0; /* lip nodes no chain node chose: fan them from b_i */
       else             /* the quadrilateral b_i, b_i+1, c_j+1, c_j: split by the shorter diagonal */
         adv_chain = dist_nodes(c, b[bi + 1], lip.p[cj]) <= dist_nodes(c, b[bi], lip.p[cj + 1]);
+      /* Quality guard: where the matching's move would make a sliver (a
+       * chain node in line with a lip segment, a chain running along the
+       * curve) and the other move makes a better triangle, take the other;
+       * any order of moves gives a valid strip. */
+      double q_chain = min_angle(c, b[bi], b[bi + 1], lip.p[cj]), q_lip = min_angle(c, b[bi], lip.p[cj + 1], lip.p[cj]);
+      if ((adv_chain ? q_chain : q_lip) < NM_SLIVER_DEG &&
+          (adv_chain ? q_lip : q_chain) > (adv_chain ? q_chain : q_lip))
+        adv_chain = !adv_chain;
     }
     if (adv_chain) {
       if (tri(c, b[bi], b[bi + 1], lip.p[cj])) goto out;
@@ -194,6 +230,72 @@ out:
   free(order);
   free(match);
   return rc;
+}
+
+/* Unit normal of triangle (p, q, r) (zero if degenerate). */
+static void tri_normal(const ctx_t *c, uint32_t p, uint32_t q, uint32_t r, double nrm[3]) {
+  double bp[3], bq[3], br[3], u[3], w[3];
+  const double *P = pos(c, p, bp), *Q = pos(c, q, bq), *R = pos(c, r, br);
+  v3_sub(u, Q, P);
+  v3_sub(w, R, P);
+  v3_cross(nrm, u, w);
+  v3_normalize(nrm);
+}
+
+/* Step 5: slivers left by the strip (a chain running along the curve, fans
+ * at its ends) are flipped away: an edge shared by two new triangles, one of
+ * them with an angle below NM_SLIVER_DEG, is replaced by the other diagonal
+ * of their quadrilateral when that raises the smaller angle of the pair and
+ * neither new triangle turns over. The new edge has a curve node at one end
+ * at least, so it cannot exist elsewhere in the mesh; it is checked against
+ * the new triangles. */
+static void flip_slivers(ctx_t *c) {
+  uint32_t *T = c->tris.p;
+  size_t nt = c->tris.n / 3;
+  for (int pass = 0; pass < 8; pass++) {
+    int flips = 0;
+    for (size_t t1 = 0; t1 < nt; t1++) {
+      uint32_t *f = T + 3 * t1;
+      double q1 = min_angle(c, f[0], f[1], f[2]);
+      if (q1 >= NM_SLIVER_DEG) continue;
+      for (int e = 0; e < 3; e++) {
+        uint32_t p = f[e], q = f[(e + 1) % 3], r = f[(e + 2) % 3];
+        size_t t2 = nt;
+        int k2 = 0;
+        for (size_t t = 0; t < nt && t2 == nt; t++)
+          for (int k = 0; k < 3; k++)
+            if (t != t1 && T[3 * t + k] == q && T[3 * t + (k + 1) % 3] == p) {
+              t2 = t;
+              k2 = k;
+            }
+        if (t2 == nt) continue;
+        uint32_t s = T[3 * t2 + (k2 + 2) % 3];
+        if (s == r || (r < c->n && s < c->n)) continue;
+        int exists = 0;
+        for (size_t t = 0; t < nt && !exists; t++) {
+          const uint32_t *g = T + 3 * t;
+          int hr = g[0] == r || g[1] == r || g[2] == r, hs = g[0] == s || g[1] == s || g[2] == s;
+          exists = hr && hs;
+        }
+        if (exists) continue;
+        double before = fmin(q1, min_angle(c, q, p, s));
+        double after = fmin(min_angle(c, p, s, r), min_angle(c, s, q, r));
+        double n1[3], n2[3], m1[3], m2[3];
+        tri_normal(c, p, q, r, n1);
+        tri_normal(c, q, p, s, n2);
+        tri_normal(c, p, s, r, m1);
+        tri_normal(c, s, q, r, m2);
+        double ref[3] = {n1[0] + n2[0], n1[1] + n2[1], n1[2] + n2[2]};
+        if (!(after > before + 1e-9) || v3_dot(m1, ref) <= 0 || v3_dot(m2, ref) <= 0) continue;
+        uint32_t a[3] = {p, s, r}, b[3] = {s, q, r};
+        memcpy(T + 3 * t1, a, sizeof a);
+        memcpy(T + 3 * t2, b, sizeof b);
+        flips++;
+        break;
+      }
+    }
+    if (!flips) break;
+  }
 }
 
 /* Edges sorted by source, for walking. */
@@ -275,8 +377,8 @@ static int do_component(ctx_t *c, uint32_t *seq, size_t len, int loop) {
     size_t s3 = nearest_to(c, rot, 1, len - 1, P3);
     uint32_t e0, e3;
     int rc = -1;
-    if (new_node(c, 0, &e0) == 0 && new_node(c, 1, &e3) == 0 && do_side(c, rot, s3 + 1, 1, e0, e3) == 0 &&
-        do_side(c, rot + s3, len + 1 - s3, 0, e3, e0) == 0)
+    if (new_node(c, 0, &e0) == 0 && new_node(c, 1, &e3) == 0 && do_side(c, rot, s3 + 1, 0, 1, e0, e3) == 0 &&
+        do_side(c, rot + s3, len + 1 - s3, 1, 0, e3, e0) == 0)
       rc = 0;
     free(rot);
     return rc;
@@ -284,22 +386,27 @@ static int do_component(ctx_t *c, uint32_t *seq, size_t len, int loop) {
   double a_s = bezier_nearest(c->ctrl, c->x + 3 * (size_t)seq[0], NM_NEAREST_SAMPLES, NULL);
   double a_e = bezier_nearest(c->ctrl, c->x + 3 * (size_t)seq[len - 1], NM_NEAREST_SAMPLES, NULL);
   if (fabs(a_e - a_s) >= 0.5 || len < 3) {
-    /* One side from one boundary to the other: both curve ends are copies. */
-    int forward = a_s <= a_e;
+    /* One side from one boundary to the other. Its lip ends where the chain
+     * ends project on the curve (not at the curve's ends: the chain may
+     * border only part of the incision, e.g. where it crosses an earlier
+     * wound); a lip shorter than merge_tol is one node. */
     uint32_t e_start, e_end;
-    if (new_node(c, forward ? 0 : 1, &e_start) || new_node(c, forward ? 1 : 0, &e_end)) return -1;
-    return do_side(c, seq, len, forward, e_start, e_end);
+    if (fabs(arc_of(c, a_e) - arc_of(c, a_s)) < c->merge_tol) {
+      if (new_node(c, 0.5 * (a_s + a_e), &e_start)) return -1;
+      return do_side(c, seq, len, a_s, a_e, e_start, e_start);
+    }
+    if (new_node(c, a_s, &e_start) || new_node(c, a_e, &e_end)) return -1;
+    return do_side(c, seq, len, a_s, a_e, e_start, e_end);
   }
   /* Both ends near the same curve end (the incision starts at a boundary and
    * ends inside): split at the node nearest the far end, which is shared. */
   int near0 = a_s < 0.5;
+  double a_far = near0 ? 1 : 0;
   size_t m = nearest_to(c, seq, 1, len - 2, near0 ? P3 : P0);
   uint32_t e_near_1, e_far, e_near_2;
-  if (new_node(c, near0 ? 0 : 1, &e_near_1) || new_node(c, near0 ? 1 : 0, &e_far) ||
-      new_node(c, near0 ? 0 : 1, &e_near_2))
-    return -1;
-  if (do_side(c, seq, m + 1, near0, e_near_1, e_far)) return -1;
-  return do_side(c, seq + m, len - m, !near0, e_far, e_near_2);
+  if (new_node(c, a_s, &e_near_1) || new_node(c, a_far, &e_far) || new_node(c, a_e, &e_near_2)) return -1;
+  if (do_side(c, seq, m + 1, a_s, a_far, e_near_1, e_far)) return -1;
+  return do_side(c, seq + m, len - m, a_far, a_e, e_far, e_near_2);
 }
 
 int node_match(size_t n, const double *x, size_t nedges, const uint32_t *edges, const double ctrl[4][3],
@@ -349,6 +456,7 @@ int node_match(size_t n, const double *x, size_t nedges, const uint32_t *edges, 
       if (do_component(&c, seq.p, seq.n, pass == 1)) goto out;
     }
   }
+  flip_slivers(&c);
   rc = 0;
 out:
   free(e);

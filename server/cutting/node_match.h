@@ -14,9 +14,11 @@
  *    A loop is split into the two sides of the incision at the nodes nearest
  *    the two curve ends; an open chain that starts and ends near the same
  *    end of the curve is split at its node nearest the other end. An end
- *    where two sides meet is one shared curve node (the incision closes
- *    there); a chain end on an existing boundary gets its own copy (the
- *    incision is open there).
+ *    where two sides meet is one shared curve node at the curve's end (the
+ *    incision closes there); a chain end on an existing boundary gets its
+ *    own node where that chain end projects on the curve (the incision is
+ *    open there, and a chain bordering only part of the curve, e.g. beyond
+ *    an earlier wound it crosses, gets a lip over that part only).
  * 3. Every side gets its own curve nodes (its lip): one per group of chain
  *    nodes whose nearest points lie within merge_tol (arc length) of each
  *    other, at the group's mean parameter, so the two lips can separate.
@@ -27,6 +29,11 @@
  *    give one triangle; lip nodes no chain node chose are fanned in between.
  *    Triangles follow the chain's orientation, so they are consistently
  *    oriented with the mesh.
+ * 5. Slivers the strip still makes (a chain running along the curve, fans
+ *    at the curve's ends) are flipped away: an edge between two new
+ *    triangles, one with an angle below 15 degrees, becomes the other
+ *    diagonal of their quadrilateral when that raises the smaller angle
+ *    (regular quadrilaterals keep the seed's shorter diagonal).
  * Loops whose ends coincide (a path shorter than merge_tol) are left open
  * and counted. Allocates the result; no global state. */
 #ifndef VISCERA_NODE_MATCH_H
