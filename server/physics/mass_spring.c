@@ -301,8 +301,8 @@ static double rest_apply(const mass_spring_t *ms, int damping, double extra, con
 /* Largest eigenvalue of M^-1 A (A symmetric positive semi-definite at rest,
  * M diagonal: real, non-negative eigenvalues). x is the start vector when
  * warm (else a fixed pseudo-random one) and holds the dominant vector after. */
-static double lambda_max(const mass_spring_t *ms, int damping, double extra, double *x, double *y, int warm,
-                         int max_it, double tol) {
+static double lambda_max(const mass_spring_t *ms, int damping, double extra, double *x, double *y, int warm, int max_it,
+                         double tol) {
   /* Block Gershgorin: no eigenvalue exceeds it, so it caps the estimate. */
   double per_spring = damping ? ms->p.damping : ms->p.stiffness;
   double home = (damping ? ms->p.home_damping : ms->p.home_stiffness) + extra;
@@ -369,7 +369,22 @@ int mass_spring_eigen_bounds_warm(const mass_spring_t *ms, double extra_home_k, 
   /* Warm: the Rayleigh quotient starts inside the top cluster, so a looser
    * stop (1e-5 between iterations) is well inside the 2 % margin. */
   *lambda_k = lambda_max(ms, 0, extra_home_k, vk, y, warm, 500, warm ? 1e-5 : 1e-7);
-  *lambda_c = lambda_max(ms, 1, 0, vc, y, warm, 500, warm ? 1e-5 : 1e-7);
+  /* At rest K = k A + (h + extra) I and C = c A + h_c I share A (the sum of
+   * u u^T over springs: the geometric term vanishes at rest), so with equal
+   * masses they share the dominant vector and lambda_c follows from
+   * lambda_k without a second iteration. */
+  double m0 = 0;
+  int equal = ms->p.stiffness > 0;
+  for (size_t i = 0; i < ms->n && equal; i++) {
+    if (ms->inv_mass[i] == 0) continue;
+    if (m0 == 0) m0 = ms->mass[i];
+    equal = ms->mass[i] == m0;
+  }
+  if (equal && m0 > 0 && *lambda_k > 0) {
+    double a = (*lambda_k - (ms->p.home_stiffness + extra_home_k) / m0) / ms->p.stiffness; /* lambda of M^-1 A */
+    *lambda_c = ms->p.damping * fmax(a, 0) + ms->p.home_damping / m0;
+  } else
+    *lambda_c = lambda_max(ms, 1, 0, vc, y, warm, 500, warm ? 1e-5 : 1e-7);
   free(y);
   return 0;
 }

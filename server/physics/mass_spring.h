@@ -110,8 +110,10 @@ int mass_spring_eigen_bounds(const mass_spring_t *ms, double extra_home_k, doubl
  * when warm (a topology change keeps most of the dominant modes, so the
  * iteration converges in a fraction of the steps; it stops when the
  * estimate changes by less than 1e-5 between iterations instead of 1e-7),
- * the dominant vectors on return. warm = 0 starts from the same vector as mass_spring_eigen_bounds
- * and gives the same figures. Returns 0, or -1 on OOM. */
+ * the dominant vectors on return. With equal masses lambda_c is derived
+ * from lambda_k (same dominant vector at rest; vc is then untouched),
+ * halving the cost. warm = 0 starts from the same vector as mass_spring_eigen_bounds
+ * and gives the same lambda_k. Returns 0, or -1 on OOM. */
 int mass_spring_eigen_bounds_warm(const mass_spring_t *ms, double extra_home_k, double *vk, double *vc, int warm,
                                   double *lambda_k, double *lambda_c);
 

@@ -65,7 +65,7 @@ typedef struct ms_model {
   /* What choose_substeps needs again after a topology change (cutting). */
   double dt, tool_stiffness;
   int requested_substeps;
-  size_t tri_cap; /* capacity of tris */
+  size_t tri_cap;        /* capacity of tris */
   double *eig_k, *eig_c; /* 3 cap each or NULL: dominant vectors of M^-1 K, M^-1 C (cutting only) */
 } ms_model_t;
 
