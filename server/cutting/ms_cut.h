@@ -46,10 +46,14 @@
  * and shrinks back to the width where the springs and home springs balance
  * the released tension: the seed's Fig. 6.
  *
- * Allocation: ms_cut_create() allocates only this object; the node-triangle
- * adjacency and path arrays are allocated when the blade first comes near
- * the tissue, the residual force array at the first cut; a topology change
- * grows capacities (never per step). ms_cut_bytes() reports what is held.
+ * Allocation: ms_cut_create() (called when the scene has a cutting tool)
+ * allocates this object and has the model keep the dominant vectors of its
+ * stability bound (2 x 3 doubles per node, one power iteration at load) for
+ * quick re-estimates after each segment; the node-triangle adjacency and
+ * path arrays are allocated when the blade first comes near the tissue, the
+ * residual force array at the first cut; a topology change grows
+ * capacities (never per step). A model nobody cuts allocates none of this.
+ * ms_cut_bytes() reports what is held.
  * Works on mass_spring_surface only (mass_spring_tet is refused: its render
  * surface is embedded in tetrahedra, which this method does not cut).
  * Not thread-safe: called from the physics thread between steps. */
@@ -97,8 +101,8 @@ int ms_cut_end(ms_cut_t *c, verr_t *err);
 
 int ms_cut_active(const ms_cut_t *c);
 const ms_cut_stats_t *ms_cut_stats(const ms_cut_t *c);
-/* Bytes of cutting structures held (this object excluded): 0 until the blade
- * first comes near the tissue. */
+/* Bytes of cutting structures held (this object excluded): the model's
+ * dominant vectors from create on, more once the blade comes near. */
 size_t ms_cut_bytes(const ms_cut_t *c);
 
 /* Incision width (seed 004 §4.1: distance between points on both sides):
