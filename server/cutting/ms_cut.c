@@ -33,8 +33,9 @@ struct ms_cut {
   int active;
   double radius; /* largest blade radius of the current cut */
   size_t npath, path_cap;
-  double *px, *pr; /* 3 per sample: current and rest position */
-  uint32_t *ptri;  /* triangle crossed (UINT32_MAX: from before a topology change) */
+  double *px, *pr;       /* 3 per sample: current and rest position */
+  uint32_t *ptri;        /* triangle crossed (UINT32_MAX: from before a topology change) */
+  uint32_t path_version; /* topology_version the ptri indices refer to */
   double seg_len_acc;
   lip_t *lips;
   size_t nlips, lip_cap;
@@ -346,7 +347,15 @@ out:
   return rc;
 }
 
+/* The triangles changed (here or elsewhere): crossed-triangle indices are stale. */
+static void path_refresh(ms_cut_t *c) {
+  if (c->m->topology_version == c->path_version) return;
+  for (size_t i = 0; i < c->npath; i++) c->ptri[i] = UINT32_MAX;
+  c->path_version = c->m->topology_version;
+}
+
 static int finish(ms_cut_t *c, verr_t *err) {
+  path_refresh(c);
   int rc = c->active ? process_segment(c, err) : 0;
   c->active = 0;
   c->npath = 0;
@@ -359,6 +368,7 @@ int ms_cut_step(ms_cut_t *c, const double p0[3], const double p1[3], double radi
     return verr_set(err, "cutting: blade pose or radius is not finite");
   if (!(radius > 0) || radius > c->p.max_radius)
     return verr_set(err, "cutting: blade radius %g m outside (0, %g]", radius, c->p.max_radius);
+  path_refresh(c);
   double x[3], xr[3];
   uint32_t tri = UINT32_MAX;
   int hit = find_crossing(c, p0, p1, radius, x, xr, &tri, err);
