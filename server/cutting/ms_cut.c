@@ -11,6 +11,8 @@
 #include "node_match.h"
 #include "vmath.h"
 
+#define MS_CUT_REFINE_ITERATIONS 4 /* power iterations per step after a topology change */
+
 typedef struct lip {
   int side;
   size_t len;
@@ -369,6 +371,9 @@ int ms_cut_step(ms_cut_t *c, const double p0[3], const double p1[3], double radi
   if (!(radius > 0) || radius > c->p.max_radius)
     return verr_set(err, "cutting: blade radius %g m outside (0, %g]", radius, c->p.max_radius);
   path_refresh(c);
+  /* A stability re-estimate left by the last topology change goes on, a few
+   * power iterations per step (model_mass_spring.h). */
+  if (model_mass_spring_refine(c->m, MS_CUT_REFINE_ITERATIONS, err) < 0) return -1;
   double x[3], xr[3];
   uint32_t tri = UINT32_MAX;
   int hit = find_crossing(c, p0, p1, radius, x, xr, &tri, err);

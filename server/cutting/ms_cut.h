@@ -30,8 +30,10 @@
  *      previous segment's wound), so a cut all the way across separates.
  * Then the model's nodes (survivors compacted, curve nodes appended with the
  * per-node mass of the uncut model), triangles and springs are replaced, the
- * sub-steps re-chosen and topology_version incremented
- * (model_mass_spring.h).
+ * sub-steps re-chosen from a bound valid at once and topology_version
+ * incremented; the following ms_cut_step calls refine that bound by a few
+ * power iterations each (model_mass_spring.h), so call it every step, with
+ * the blade away from the tissue too.
  *
  * Residual stress (eq. 3-4). sigma_r = E eps_r acts where springs were cut.
  * A spring of stiffness K and rest length L0 stands for a bundle of tissue

@@ -373,20 +373,59 @@ int mass_spring_eigen_bounds_warm(const mass_spring_t *ms, double extra_home_k, 
    * u u^T over springs: the geometric term vanishes at rest), so with equal
    * masses they share the dominant vector and lambda_c follows from
    * lambda_k without a second iteration. */
-  double m0 = 0;
-  int equal = ms->p.stiffness > 0;
-  for (size_t i = 0; i < ms->n && equal; i++) {
-    if (ms->inv_mass[i] == 0) continue;
-    if (m0 == 0) m0 = ms->mass[i];
-    equal = ms->mass[i] == m0;
-  }
-  if (equal && m0 > 0 && *lambda_k > 0) {
-    double a = (*lambda_k - (ms->p.home_stiffness + extra_home_k) / m0) / ms->p.stiffness; /* lambda of M^-1 A */
-    *lambda_c = ms->p.damping * fmax(a, 0) + ms->p.home_damping / m0;
-  } else
-    *lambda_c = lambda_max(ms, 1, 0, vc, y, warm, 500, warm ? 1e-5 : 1e-7);
+  *lambda_c = mass_spring_lambda_c_from_k(ms, extra_home_k, *lambda_k);
+  if (!isfinite(*lambda_c)) *lambda_c = lambda_max(ms, 1, 0, vc, y, warm, 500, warm ? 1e-5 : 1e-7);
   free(y);
   return 0;
+}
+
+int mass_spring_power_steps(const mass_spring_t *ms, double extra_home_k, double *x, double *y, int iterations,
+                            int *count, double *lambda) {
+  for (int k = 0; k < iterations; k++) {
+    double xmx = 0;
+    for (size_t c = 0; c < 3 * ms->n; c++) {
+      x[c] *= ms->inv_mass[c / 3] > 0;
+      xmx += ms->mass[c / 3] * x[c] * x[c];
+    }
+    if (!(xmx > 0)) return 1;
+    double next = rest_apply(ms, 0, extra_home_k, x, y) / xmx, ny = 0;
+    for (size_t c = 0; c < 3 * ms->n; c++) ny += y[c] * y[c];
+    ny = sqrt(ny);
+    if (!(ny > 0)) return 1;
+    for (size_t c = 0; c < 3 * ms->n; c++) x[c] = y[c] / ny;
+    int done = ++*count > 21 && fabs(next - *lambda) <= 1e-5 * next;
+    *lambda = next;
+    if (done || *count >= 500) return 1;
+  }
+  return 0;
+}
+
+double mass_spring_gershgorin(const mass_spring_t *ms, double extra_home_k, size_t first_new, double *scratch) {
+  /* first_new < n: only springs touching a node >= first_new, and only those
+   * nodes' home springs (the part B of a topology change). */
+  int part = first_new < ms->n;
+  for (size_t i = 0; i < ms->n; i++) scratch[i] = !part || i >= first_new ? ms->p.home_stiffness + extra_home_k : 0;
+  for (size_t s = 0; s < ms->nsprings; s++) {
+    const ms_spring_t *sp = &ms->springs[s];
+    if (!(sp->rest > 0) || (part && sp->i < first_new && sp->j < first_new)) continue;
+    scratch[sp->i] += 2 * ms->p.stiffness;
+    scratch[sp->j] += 2 * ms->p.stiffness;
+  }
+  double g = 0;
+  for (size_t i = 0; i < ms->n; i++) g = fmax(g, scratch[i] * ms->inv_mass[i]);
+  return g;
+}
+
+double mass_spring_lambda_c_from_k(const mass_spring_t *ms, double extra_home_k, double lambda_k) {
+  double m0 = 0;
+  for (size_t i = 0; i < ms->n; i++) {
+    if (ms->inv_mass[i] == 0) continue;
+    if (m0 == 0) m0 = ms->mass[i];
+    if (ms->mass[i] != m0) return NAN;
+  }
+  if (!(m0 > 0) || !(ms->p.stiffness > 0)) return NAN;
+  double a = (lambda_k - (ms->p.home_stiffness + extra_home_k) / m0) / ms->p.stiffness;
+  return ms->p.damping * fmax(a, 0) + ms->p.home_damping / m0;
 }
 
 double mass_spring_potential(const mass_spring_t *ms, const double *x) {

@@ -117,6 +117,21 @@ int mass_spring_eigen_bounds(const mass_spring_t *ms, double extra_home_k, doubl
 int mass_spring_eigen_bounds_warm(const mass_spring_t *ms, double extra_home_k, double *vk, double *vc, int warm,
                                   double *lambda_k, double *lambda_c);
 
+/* Resumable power iteration on M^-1 K at rest (+ extra_home_k I), for a
+ * re-estimate spread over several steps: up to `iterations` iterations from
+ * x (scratch y, 3n each); *count and *lambda (the last Rayleigh quotient)
+ * carry the state between calls. Returns 1 when converged (after 21
+ * iterations, change <= 1e-5) or after 500, else 0. */
+int mass_spring_power_steps(const mass_spring_t *ms, double extra_home_k, double *x, double *y, int iterations,
+                            int *count, double *lambda);
+/* Block-Gershgorin bound of M^-1 K at rest (no eigenvalue exceeds it); with
+ * first_new < n only over the springs touching nodes >= first_new and
+ * those nodes' home springs. scratch: n doubles. */
+double mass_spring_gershgorin(const mass_spring_t *ms, double extra_home_k, size_t first_new, double *scratch);
+/* lambda of M^-1 C from lambda of M^-1 K when all free nodes have the same
+ * mass (see mass_spring_eigen_bounds_warm); NAN otherwise. */
+double mass_spring_lambda_c_from_k(const mass_spring_t *ms, double extra_home_k, double lambda_k);
+
 /* Adds an external force (N) at node i; forces() includes it until cleared. */
 static inline void mass_spring_add_force(mass_spring_t *ms, uint32_t i, const double f[3]) {
   ms->f_ext[3 * i] += f[0];

@@ -65,8 +65,14 @@ typedef struct ms_model {
   /* What choose_substeps needs again after a topology change (cutting). */
   double dt, tool_stiffness;
   int requested_substeps;
-  size_t tri_cap;        /* capacity of tris */
-  double *eig_k, *eig_c; /* 3 cap each or NULL: dominant vectors of M^-1 K, M^-1 C (cutting only) */
+  size_t tri_cap; /* capacity of tris */
+  /* Cutting only (model_mass_spring_prepare): the dominant vector of M^-1 K
+   * at rest and a scratch vector (3 cap each, NULL otherwise), the bound the
+   * sub-steps follow, and the state of a re-estimate spread over steps. */
+  double *eig_k, *eig_y;
+  double lam_k;
+  int refining, refine_count;
+  double refine_lambda;
 } ms_model_t;
 
 static double state_sum(const ms_model_t *mm) {
@@ -175,7 +181,7 @@ static void ms_destroy(model_t *m) {
   free(mm->try_x);
   free(mm->try_v);
   free(mm->eig_k);
-  free(mm->eig_c);
+  free(mm->eig_y);
   free(mm);
 }
 
@@ -368,7 +374,7 @@ int model_mass_spring_reserve(model_t *m, size_t cap, int with_f_res, verr_t *er
   if (mm->ms.cap > old || mm->it.n < mm->ms.cap) {
     size_t c3 = 3 * mm->ms.cap;
     if (grow_buf(&mm->good_x, c3) || grow_buf(&mm->good_v, c3) || grow_buf(&mm->try_x, c3) ||
-        grow_buf(&mm->try_v, c3) || grow_buf(&mm->eig_k, c3) || grow_buf(&mm->eig_c, c3))
+        grow_buf(&mm->try_v, c3) || grow_buf(&mm->eig_k, c3) || grow_buf(&mm->eig_y, c3))
       return verr_set(err, "out of memory for %zu nodes", mm->ms.cap);
     integrator_t it;
     if (integrator_init(&it, mm->it.kind, mm->ms.cap, mm->it.cg_tolerance, mm->it.cg_max_iterations, err)) return -1;
@@ -388,40 +394,50 @@ int model_mass_spring_prepare(model_t *m, verr_t *err) {
   if (m->ops != &SURFACE_OPS) return verr_set(err, "topology changes need a mass_spring_surface model");
   if (mm->eig_k) return 0;
   mm->eig_k = calloc(3 * mm->ms.cap + 1, sizeof(double));
-  mm->eig_c = calloc(3 * mm->ms.cap + 1, sizeof(double));
+  mm->eig_y = calloc(3 * mm->ms.cap + 1, sizeof(double));
   double lk, lc;
-  if (!mm->eig_k || !mm->eig_c ||
-      mass_spring_eigen_bounds_warm(&mm->ms, mm->tool_stiffness, mm->eig_k, mm->eig_c, 0, &lk, &lc)) {
+  if (!mm->eig_k || !mm->eig_y ||
+      mass_spring_eigen_bounds_warm(&mm->ms, mm->tool_stiffness, mm->eig_k, mm->eig_y, 0, &lk, &lc)) {
     free(mm->eig_k);
-    free(mm->eig_c);
-    mm->eig_k = mm->eig_c = NULL;
+    free(mm->eig_y);
+    mm->eig_k = mm->eig_y = NULL;
     return verr_set(err, "out of memory for %zu nodes", mm->ms.cap);
   }
+  mm->lam_k = lk;
   return 0;
 }
 
-/* Moves the dominant vectors to the new numbering (survivors keep their
- * components; new nodes get small pseudo-random ones, so a mode that lives
- * in the new springs can grow). */
-static void remap_vectors(ms_model_t *mm, const uint32_t *old_to_new, size_t old_n, size_t n) {
-  double *v[2] = {mm->eig_k, mm->eig_c};
-  unsigned seed = 777;
-  for (int k = 0; k < 2; k++) {
-    double rms = 0;
-    for (size_t i = 0; i < old_n; i++) {
-      uint32_t j = old_to_new[i];
-      rms += v3_dot(v[k] + 3 * i, v[k] + 3 * i);
-      if (j != UINT32_MAX && j != i) memcpy(v[k] + 3 * (size_t)j, v[k] + 3 * i, 3 * sizeof(double));
-    }
-    rms = sqrt(rms / (double)(old_n ? old_n : 1));
-    size_t first_new = 0;
-    for (size_t i = 0; i < old_n; i++)
-      if (old_to_new[i] != UINT32_MAX) first_new++;
-    for (size_t c = 3 * first_new; c < 3 * n; c++) {
-      seed = seed * 1664525u + 1013904223u;
-      v[k][c] = rms * ((double)(seed >> 8) / 16777216.0 - 0.5);
-    }
+/* Moves the dominant vector to the new numbering (survivors keep their
+ * components; new nodes get pseudo-random ones of the same size, so a mode
+ * that lives in the new springs can grow). */
+static void remap_vector(ms_model_t *mm, const uint32_t *old_to_new, size_t old_n, size_t n) {
+  double *v = mm->eig_k, rms = 0;
+  size_t first_new = 0;
+  for (size_t i = 0; i < old_n; i++) {
+    uint32_t j = old_to_new[i];
+    rms += v3_dot(v + 3 * i, v + 3 * i);
+    if (j == UINT32_MAX) continue;
+    first_new++;
+    if (j != i) memcpy(v + 3 * (size_t)j, v + 3 * i, 3 * sizeof(double));
   }
+  rms = sqrt(rms / (double)(old_n ? old_n : 1));
+  unsigned seed = 777;
+  for (size_t c = 3 * first_new; c < 3 * n; c++) {
+    seed = seed * 1664525u + 1013904223u;
+    v[c] = rms * ((double)(seed >> 8) / 16777216.0 - 0.5);
+  }
+}
+
+/* Sub-steps from lambda_k, with lambda_c derived from it (equal masses) or,
+ * failing that, from the Gershgorin bound of C. */
+static int substeps_from_k(ms_model_t *mm, double lk, verr_t *err) {
+  double lc = mass_spring_lambda_c_from_k(&mm->ms, mm->tool_stiffness, lk);
+  if (!isfinite(lc)) {
+    double dummy_k;
+    if (mass_spring_eigen_bounds(&mm->ms, mm->tool_stiffness, &dummy_k, &lc)) return verr_set(err, "out of memory");
+  }
+  mm->lam_k = lk;
+  return substeps_from(mm, mm->it.kind, lk, lc, err);
 }
 
 int model_mass_spring_commit(model_t *m, size_t n, const uint32_t *old_to_new, size_t old_n, const uint32_t *tris,
@@ -446,15 +462,38 @@ int model_mass_spring_commit(model_t *m, size_t n, const uint32_t *old_to_new, s
   m->v = mm->ms.v;
   m->x_rest = m->surf_rest = mm->ms.x_rest;
   m->topology_version++;
-  /* New springs and nodes change the stability bound: the power iteration
-   * again, started from the previous dominant vectors (prepare) or cold. */
-  double lk, lc;
-  int rc;
-  if (mm->eig_k) {
-    remap_vectors(mm, old_to_new, old_n, n);
-    rc = mass_spring_eigen_bounds_warm(&mm->ms, mm->tool_stiffness, mm->eig_k, mm->eig_c, 1, &lk, &lc);
-  } else
-    rc = mass_spring_eigen_bounds(&mm->ms, mm->tool_stiffness, &lk, &lc);
-  if (rc) return verr_set(err, "out of memory");
-  return substeps_from(mm, mm->it.kind, lk, lc, err);
+  if (!mm->eig_k) { /* not prepared: a cold estimate now */
+    double lk, lc;
+    if (mass_spring_eigen_bounds(&mm->ms, mm->tool_stiffness, &lk, &lc)) return verr_set(err, "out of memory");
+    return substeps_from(mm, mm->it.kind, lk, lc, err);
+  }
+  /* A bound valid at once, as safe as the old one (see the header): K_new = A + B with A the old K
+   * less the cut springs and deleted nodes (its largest eigenvalue is at
+   * most the old bound: fewer springs, a principal submatrix) and B the
+   * springs touching new nodes plus their home springs, whose eigenvalues
+   * B's Gershgorin bound caps; Weyl: lambda(A + B) <= lambda_old +
+   * lambda(B). The whole system's Gershgorin bound caps it too. */
+  size_t first_new = 0;
+  for (size_t i = 0; i < old_n; i++) first_new += old_to_new[i] != UINT32_MAX;
+  remap_vector(mm, old_to_new, old_n, n);
+  double gb = mass_spring_gershgorin(&mm->ms, mm->tool_stiffness, first_new, mm->eig_y);
+  double gf = mass_spring_gershgorin(&mm->ms, mm->tool_stiffness, n, mm->eig_y);
+  mm->refining = 1;
+  mm->refine_count = 0;
+  mm->refine_lambda = 0;
+  return substeps_from_k(mm, fmin(mm->lam_k + gb, gf), err);
+}
+
+int model_mass_spring_refine(model_t *m, int iterations, verr_t *err) {
+  ms_model_t *mm = (ms_model_t *)m;
+  if (m->ops != &SURFACE_OPS || !mm->refining || !mm->eig_k) return 0;
+  if (!mass_spring_power_steps(&mm->ms, mm->tool_stiffness, mm->eig_k, mm->eig_y, iterations, &mm->refine_count,
+                               &mm->refine_lambda))
+    return 0;
+  mm->refining = 0;
+  /* The 2 % margin of mass_spring_eigen_bounds, never above the bound set
+   * at the change. */
+  double lk = fmin(1.02 * mm->refine_lambda, mm->lam_k);
+  if (!(lk > 0)) return 0;
+  return substeps_from_k(mm, lk, err) ? -1 : 1;
 }

@@ -13,12 +13,21 @@
  * the old_n nodes before the change to their new index (UINT32_MAX: deleted;
  * survivors keep their order); nodes after the survivors are new.
  *
- * The stability bound is re-estimated by the power iteration of
- * mass_spring_eigen_bounds, started from the dominant vectors of the last
- * estimate when model_mass_spring_prepare() has stored them (a cut changes
- * a few nodes, so the iteration converges in a fraction of the steps: about
- * 1 ms instead of hundreds at a few thousand nodes); prepare costs one power
- * iteration and 2 x 3 doubles per node, so it is for models that will be cut. */
+ * The stability bound after the change is at once a rigorous one, without a
+ * power iteration (which costs 10-20 ms at 5k nodes, too long for a step):
+ * with equal masses K_new = A + B, A the old K less the cut springs and
+ * deleted nodes (largest eigenvalue at most the old one), B the springs
+ * touching new nodes and their home springs, capped by B's Gershgorin
+ * bound; Weyl gives lambda_new <= lambda_old + lambda(B), and the whole
+ * system's Gershgorin bound caps it too. That costs up to a few extra
+ * sub-steps for a few steps: model_mass_spring_refine(), called between
+ * steps, runs the power iteration a few iterations at a time from the last
+ * dominant vector (kept by model_mass_spring_prepare(), which costs one
+ * power iteration and 2 x 3 doubles per node, so it is for models that will
+ * be cut) and, once converged (about 21 iterations), sets the sub-steps from
+ * the estimate (with mass_spring_eigen_bounds' 2 % margin, never above the
+ * bound after the change). Without prepare, commit runs a cold estimate at
+ * once. */
 #ifndef VISCERA_MODEL_MASS_SPRING_H
 #define VISCERA_MODEL_MASS_SPRING_H
 
@@ -40,5 +49,9 @@ int model_mass_spring_commit(model_t *m, size_t n, const uint32_t *old_to_new, s
                              size_t ntris, verr_t *err);
 /* See above. Returns 0 or -1 with err (OOM). */
 int model_mass_spring_prepare(model_t *m, verr_t *err);
+/* See above: up to `iterations` power iterations of a pending re-estimate.
+ * Returns 1 when it finished (sub-steps set from it), 0 when none is pending
+ * or it goes on, -1 with err when the sub-steps could not be chosen. */
+int model_mass_spring_refine(model_t *m, int iterations, verr_t *err);
 
 #endif

@@ -116,7 +116,17 @@ static inline long fx_stroke(model_t *m, ms_cut_t *c, const double a[2], const d
     return -1;
   }
   if (rc == 1 && topo_changes) (*topo_changes)++;
-  return steps + 1;
+  /* The blade lifted away for 20 steps: ms_cut_step keeps being called, as
+   * the runtime does, and finishes the stability re-estimate. */
+  for (int s = 0; s < 20; s++) {
+    double up0[3] = {b[0], b[1], z0 + 1.0}, up1[3] = {b[0], b[1], z0 + 0.9};
+    if (ms_cut_step(c, up0, up1, radius, &err) < 0) {
+      printf("ms_cut_step: %s\n", err.msg);
+      return -1;
+    }
+    m->ops->step(m, dt);
+  }
+  return steps + 21;
 }
 
 typedef struct fx_check {
