@@ -13,21 +13,21 @@
  * the old_n nodes before the change to their new index (UINT32_MAX: deleted;
  * survivors keep their order); nodes after the survivors are new.
  *
- * The stability bound after the change is at once a rigorous one, without a
- * power iteration (which costs 10-20 ms at 5k nodes, too long for a step):
+ * The stability bound after the change is available at once, as safe as the
+ * one before, without a power iteration (10-20 ms at 5k nodes: a stall):
  * with equal masses K_new = A + B, A the old K less the cut springs and
  * deleted nodes (largest eigenvalue at most the old one), B the springs
  * touching new nodes and their home springs, capped by B's Gershgorin
  * bound; Weyl gives lambda_new <= lambda_old + lambda(B), and the whole
- * system's Gershgorin bound caps it too. That costs up to a few extra
- * sub-steps for a few steps: model_mass_spring_refine(), called between
- * steps, runs the power iteration a few iterations at a time from the last
- * dominant vector (kept by model_mass_spring_prepare(), which costs one
- * power iteration and 2 x 3 doubles per node, so it is for models that will
- * be cut) and, once converged (about 21 iterations), sets the sub-steps from
- * the estimate (with mass_spring_eigen_bounds' 2 % margin, never above the
- * bound after the change). Without prepare, commit runs a cold estimate at
- * once. */
+ * system's Gershgorin bound caps it too. It is pessimistic (gallbladder: 6
+ * sub-steps become up to 15) for a few steps: model_mass_spring_refine(),
+ * called between steps, runs the power iteration a few iterations at a
+ * time from the last dominant vector (kept by model_mass_spring_prepare(),
+ * which costs one power iteration and 2 x 3 doubles per node, so it is for
+ * models that will be cut) and, once converged (about 21 iterations), sets
+ * the sub-steps from the estimate (with mass_spring_eigen_bounds' 2 %
+ * margin, never above the bound after the change). Without prepare, commit
+ * runs a cold estimate at once. */
 #ifndef VISCERA_MODEL_MASS_SPRING_H
 #define VISCERA_MODEL_MASS_SPRING_H
 
