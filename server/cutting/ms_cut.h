@@ -96,7 +96,11 @@ void ms_cut_destroy(ms_cut_t *c);
  * blade axis p0 (handle) -> p1 (tip), radius (m). Returns 1 when the surface
  * topology changed (m->topology_version was incremented), 0 when not, -1 with
  * err on invalid input (non-finite, radius <= 0 or > max_radius) or when a
- * segment could not be applied (model unchanged in both cases). */
+ * segment could not be applied (model unchanged in both cases), and also
+ * when the cut mesh was applied but would need more sub-steps than allowed
+ * or memory ran out while its springs were rebuilt: then topology_version
+ * did change (the runtime compares it after every step anyway) and err says
+ * what failed. */
 int ms_cut_step(ms_cut_t *c, const double p0[3], const double p1[3], double radius, verr_t *err);
 /* Ends the current cut (processes the rest of the path). Returns as ms_cut_step. */
 int ms_cut_end(ms_cut_t *c, verr_t *err);

@@ -481,7 +481,16 @@ int model_mass_spring_commit(model_t *m, size_t n, const uint32_t *old_to_new, s
   mm->refining = 1;
   mm->refine_count = 0;
   mm->refine_lambda = 0;
-  return substeps_from_k(mm, fmin(mm->lam_k + gb, gf), err);
+  if (substeps_from_k(mm, fmin(mm->lam_k + gb, gf), err) == 0) return 0;
+  /* The pessimistic bound asks for more sub-steps than allowed: estimate
+   * now (a stall of one step) rather than keep sub-steps chosen for the
+   * mesh before the change. */
+  mm->refining = 0;
+  double lk, lc;
+  if (mass_spring_eigen_bounds_warm(&mm->ms, mm->tool_stiffness, mm->eig_k, mm->eig_y, 1, &lk, &lc))
+    return verr_set(err, "out of memory");
+  mm->lam_k = lk;
+  return substeps_from(mm, mm->it.kind, lk, lc, err);
 }
 
 int model_mass_spring_refine(model_t *m, int iterations, verr_t *err) {
