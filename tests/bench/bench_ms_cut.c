@@ -11,7 +11,9 @@
  *     (sub-steps re-chosen).
  * Prints tables, writes ms_cut_width.csv, ms_cut_timing.csv and one PNG per
  * mesh (width over time) into --out DIR (default out/ms_cut). --quick: short
- * runs for the smoke test. Wall-clock figures are printed, never asserted. */
+ * runs for the smoke test. Meshes: $VISCERA_SOURCE_DIR/assets/meshes (default:
+ * the source tree it was built from). Wall-clock figures are printed, never
+ * asserted. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -164,6 +166,9 @@ static int timing_run(organ_t *o, int model_steps, timing_t *T) {
 int main(int argc, char **argv) {
   const char *out = "out/ms_cut";
   int quick = 0;
+#ifdef MSCUT_SOURCE_DIR
+  setenv("VISCERA_SOURCE_DIR", MSCUT_SOURCE_DIR, 0); /* the meshes of this source tree unless told otherwise */
+#endif
   for (int i = 1; i < argc; i++) {
     if (!strcmp(argv[i], "--quick"))
       quick = 1;
