@@ -317,14 +317,21 @@ static int process_segment(ms_cut_t *c, verr_t *err) {
   }
   rc = 1;
 lips:
-  /* Lips: the old ones renumbered (deleted nodes dropped), the new ones added. */
+  /* Lips: the old ones renumbered (deleted nodes dropped, emptied lips
+   * removed), the new ones added. */
+  size_t kept_lips = 0;
   for (size_t l = 0; l < c->nlips; l++) {
     lip_t *L = &c->lips[l];
     size_t o = 0;
     for (size_t i = 0; i < L->len; i++)
       if (map[L->nodes[i]] != UINT32_MAX) L->nodes[o++] = map[L->nodes[i]];
     L->len = o;
+    if (o == 0)
+      free(L->nodes);
+    else
+      c->lips[kept_lips++] = *L;
   }
+  c->nlips = kept_lips;
   for (size_t l = 0; l < nm.nlips; l++) {
     nm_lip_t *L = &nm.lips[l];
     for (size_t i = 0; i < L->len; i++)

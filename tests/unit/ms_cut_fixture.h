@@ -135,11 +135,6 @@ typedef struct fx_check {
   size_t nonfinite;
 } fx_check_t;
 
-static inline int fx_cmp_u32(const void *a, const void *b) {
-  uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
-  return (x > y) - (x < y);
-}
-
 /* The model's surface checked as a mesh. Returns 0 or -1 (OOM). */
 static inline int fx_check(const model_t *m, fx_check_t *out) {
   memset(out, 0, sizeof *out);
@@ -184,7 +179,6 @@ static inline int fx_check(const model_t *m, fx_check_t *out) {
   free(inc);
   free(start);
   free(seen);
-  (void)fx_cmp_u32;
   return 0;
 }
 
