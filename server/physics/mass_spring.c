@@ -25,6 +25,7 @@ static int ms_alloc(mass_spring_t *ms, size_t n, const double *pos, const ms_par
     return verr_set(err, "mass-spring: mass must be > 0 and stiffness/damping >= 0, all finite");
   if (n == 0) return verr_set(err, "mass-spring: no nodes");
   ms->n = n;
+  ms->cap = n;
   ms->p = *p;
   ms->x = calloc(3 * n, sizeof(double));
   ms->v = calloc(3 * n, sizeof(double));
@@ -60,8 +61,9 @@ static int cmp_edge(const void *a, const void *b) {
   return (x[1] > y[1]) - (x[1] < y[1]);
 }
 
-/* Takes ownership of `edges` (ne raw (i, j) pairs, normalised i < j here). */
-static int ms_build_springs(mass_spring_t *ms, uint32_t *edges, size_t ne, verr_t *err) {
+/* Takes ownership of `edges` (ne raw (i, j) pairs, normalised i < j here).
+ * On OOM the old springs are kept and -1 returned. */
+static int ms_make_springs(mass_spring_t *ms, uint32_t *edges, size_t ne, verr_t *err) {
   for (size_t e = 0; e < ne; e++) {
     uint32_t i = edges[2 * e], j = edges[2 * e + 1];
     if (i > j) {
@@ -73,12 +75,14 @@ static int ms_build_springs(mass_spring_t *ms, uint32_t *edges, size_t ne, verr_
   size_t unique = 0;
   for (size_t e = 0; e < ne; e++)
     if (e == 0 || cmp_edge(edges + 2 * e, edges + 2 * (e - 1)) != 0) unique++;
-  ms->springs = malloc((unique + 1) * sizeof(ms_spring_t));
-  if (!ms->springs) {
+  ms_spring_t *springs = malloc((unique + 1) * sizeof(ms_spring_t));
+  if (!springs) {
     free(edges);
-    mass_spring_destroy(ms);
     return verr_set(err, "mass-spring: out of memory for %zu springs", unique);
   }
+  free(ms->springs);
+  ms->springs = springs;
+  ms->nsprings = 0;
   for (size_t e = 0; e < ne; e++) {
     if (e > 0 && cmp_edge(edges + 2 * e, edges + 2 * (e - 1)) == 0) continue;
     uint32_t i = edges[2 * e], j = edges[2 * e + 1];
@@ -89,6 +93,68 @@ static int ms_build_springs(mass_spring_t *ms, uint32_t *edges, size_t ne, verr_
     sp->rest = v3_dist(ms->x_rest + 3 * i, ms->x_rest + 3 * j);
   }
   free(edges);
+  return 0;
+}
+
+static int ms_build_springs(mass_spring_t *ms, uint32_t *edges, size_t ne, verr_t *err) {
+  if (ms_make_springs(ms, edges, ne, err)) {
+    mass_spring_destroy(ms);
+    return -1;
+  }
+  return 0;
+}
+
+/* realloc that keeps *p on failure. */
+static int grow(double **p, size_t count) {
+  double *q = realloc(*p, count * sizeof(double) + 1);
+  if (!q) return -1;
+  *p = q;
+  return 0;
+}
+
+int mass_spring_reserve(mass_spring_t *ms, size_t cap, int with_f_res, verr_t *err) {
+  if (cap > ((size_t)-1) / (3 * sizeof(double)) - 1) return verr_set(err, "mass-spring: %zu nodes is too many", cap);
+  if (cap > ms->cap) {
+    if (grow(&ms->x, 3 * cap) || grow(&ms->v, 3 * cap) || grow(&ms->x_rest, 3 * cap) || grow(&ms->f_ext, 3 * cap) ||
+        grow(&ms->mass, cap) || grow(&ms->inv_mass, cap) || (ms->f_res && grow(&ms->f_res, 3 * cap)))
+      return verr_set(err, "mass-spring: out of memory for %zu nodes", cap);
+    /* f_ext is all zero between steps (the model clears it); keep that. */
+    memset(ms->f_ext + 3 * ms->n, 0, 3 * (cap - ms->n) * sizeof(double));
+    if (ms->f_res) memset(ms->f_res + 3 * ms->n, 0, 3 * (cap - ms->n) * sizeof(double));
+    ms->cap = cap;
+  }
+  if (with_f_res && !ms->f_res) {
+    ms->f_res = calloc(3 * ms->cap + 1, sizeof(double));
+    if (!ms->f_res) return verr_set(err, "mass-spring: out of memory for residual forces");
+  }
+  ms->fs.x = ms->x;
+  ms->fs.v = ms->v;
+  ms->fs.mass = ms->mass;
+  ms->fs.inv_mass = ms->inv_mass;
+  return 0;
+}
+
+int mass_spring_set_surface_topology(mass_spring_t *ms, size_t n, const uint32_t *tris, size_t ntris, verr_t *err) {
+  if (n == 0 || n > ms->cap) return verr_set(err, "mass-spring: %zu nodes (capacity %zu)", n, ms->cap);
+  for (size_t c = 0; c < 3 * ntris; c++)
+    if (tris[c] >= n) return verr_set(err, "mass-spring: triangle %zu has a vertex index out of range", c / 3);
+  uint32_t *edges = malloc(ntris * 6 * sizeof(uint32_t) + 1);
+  if (!edges) return verr_set(err, "mass-spring: out of memory for edges");
+  for (size_t t = 0; t < ntris; t++)
+    for (int k = 0; k < 3; k++) {
+      edges[6 * t + 2 * k] = tris[3 * t + k];
+      edges[6 * t + 2 * k + 1] = tris[3 * t + (k + 1) % 3];
+    }
+  if (ms_make_springs(ms, edges, 3 * ntris, err)) return -1;
+  /* Per-spring stiffness factors were indexed by the old springs: a cut
+   * renumbers them, so the mesh goes back to uniform stiffness. */
+  free(ms->k_scale);
+  ms->k_scale = NULL;
+  ms->n = n;
+  ms->fs.n = n;
+  double total = 0;
+  for (size_t i = 0; i < n; i++) total += ms->mass[i];
+  ms->p.mass = total;
   return 0;
 }
 
@@ -158,6 +224,7 @@ void mass_spring_destroy(mass_spring_t *ms) {
   free(ms->mass);
   free(ms->springs);
   free(ms->k_scale);
+  free(ms->f_res);
   memset(ms, 0, sizeof *ms);
 }
 
@@ -180,6 +247,8 @@ void mass_spring_forces(const mass_spring_t *ms, const double *x, const double *
       fi[k] = ms->f_ext[3 * i + k] + ms->mass[i] * p->gravity[k] - p->home_stiffness * (xi[k] - xr[k]) -
               p->home_damping * vi[k];
   }
+  if (ms->f_res)
+    for (size_t c = 0; c < 3 * ms->n; c++) f[c] += ms->f_res[c];
   for (size_t s = 0; s < ms->nsprings; s++) {
     const ms_spring_t *sp = &ms->springs[s];
     double d[3], dv[3];
@@ -237,8 +306,10 @@ static double rest_apply(const mass_spring_t *ms, int damping, double extra, con
 }
 
 /* Largest eigenvalue of M^-1 A (A symmetric positive semi-definite at rest,
- * M diagonal: real, non-negative eigenvalues). */
-static double lambda_max(const mass_spring_t *ms, int damping, double extra, double *x, double *y) {
+ * M diagonal: real, non-negative eigenvalues). x is the start vector when
+ * warm (else a fixed pseudo-random one) and holds the dominant vector after. */
+static double lambda_max(const mass_spring_t *ms, int damping, double extra, double *x, double *y, int warm, int max_it,
+                         double tol) {
   /* Block Gershgorin: no eigenvalue exceeds it, so it caps the estimate. */
   double per_spring = damping ? ms->p.damping : ms->p.stiffness;
   double home = (damping ? ms->p.home_damping : ms->p.home_stiffness) + extra;
@@ -253,13 +324,19 @@ static double lambda_max(const mass_spring_t *ms, int damping, double extra, dou
   for (size_t i = 0; i < ms->n; i++) gersh = fmax(gersh, y[i] * ms->inv_mass[i]);
   if (!(gersh > 0)) return 0;
 
-  unsigned seed = 12345;
-  for (size_t c = 0; c < 3 * ms->n; c++) {
-    seed = seed * 1664525u + 1013904223u;
-    x[c] = ((double)(seed >> 8) / 16777216.0 - 0.5) * (ms->inv_mass[c / 3] > 0);
-  }
+  double norm = 0;
+  if (warm)
+    for (size_t c = 0; c < 3 * ms->n; c++) norm += x[c] * x[c] * (ms->inv_mass[c / 3] > 0);
+  if (!(norm > 0) || !isfinite(norm)) {
+    unsigned seed = 12345;
+    for (size_t c = 0; c < 3 * ms->n; c++) {
+      seed = seed * 1664525u + 1013904223u;
+      x[c] = ((double)(seed >> 8) / 16777216.0 - 0.5) * (ms->inv_mass[c / 3] > 0);
+    }
+  } else
+    for (size_t c = 0; c < 3 * ms->n; c++) x[c] *= ms->inv_mass[c / 3] > 0;
   double lambda = 0;
-  for (int it = 0; it < 500; it++) {
+  for (int it = 0; it < max_it; it++) {
     double xmx = 0; /* x^T M x */
     for (size_t c = 0; c < 3 * ms->n; c++) xmx += ms->mass[c / 3] * x[c] * x[c] * (ms->inv_mass[c / 3] > 0);
     if (!(xmx > 0)) return 0;
@@ -269,7 +346,7 @@ static double lambda_max(const mass_spring_t *ms, int damping, double extra, dou
     ny = sqrt(ny);
     if (!(ny > 0)) return 0;
     for (size_t c = 0; c < 3 * ms->n; c++) x[c] = y[c] / ny;
-    if (it > 20 && fabs(next - lambda) <= 1e-7 * next) {
+    if (it > 20 && fabs(next - lambda) <= tol * next) {
       lambda = next;
       break;
     }
@@ -286,11 +363,77 @@ int mass_spring_eigen_bounds(const mass_spring_t *ms, double extra_home_k, doubl
     free(y);
     return -1;
   }
-  *lambda_k = lambda_max(ms, 0, extra_home_k, x, y);
-  *lambda_c = lambda_max(ms, 1, 0, x, y);
+  *lambda_k = lambda_max(ms, 0, extra_home_k, x, y, 0, 500, 1e-7);
+  *lambda_c = lambda_max(ms, 1, 0, x, y, 0, 500, 1e-7);
   free(x);
   free(y);
   return 0;
+}
+
+int mass_spring_eigen_bounds_warm(const mass_spring_t *ms, double extra_home_k, double *vk, double *vc, int warm,
+                                  double *lambda_k, double *lambda_c) {
+  double *y = malloc((3 * ms->n + 1) * sizeof(double));
+  if (!y) return -1;
+  /* Warm: the Rayleigh quotient starts inside the top cluster, so a looser
+   * stop (1e-5 between iterations) is well inside the 2 % margin. */
+  *lambda_k = lambda_max(ms, 0, extra_home_k, vk, y, warm, 500, warm ? 1e-5 : 1e-7);
+  /* At rest K = k A + (h + extra) I and C = c A + h_c I share A (the sum of
+   * u u^T over springs: the geometric term vanishes at rest), so with equal
+   * masses they share the dominant vector and lambda_c follows from
+   * lambda_k without a second iteration. */
+  *lambda_c = mass_spring_lambda_c_from_k(ms, extra_home_k, *lambda_k);
+  if (!isfinite(*lambda_c)) *lambda_c = lambda_max(ms, 1, 0, vc, y, warm, 500, warm ? 1e-5 : 1e-7);
+  free(y);
+  return 0;
+}
+
+int mass_spring_power_steps(const mass_spring_t *ms, double extra_home_k, double *x, double *y, int iterations,
+                            int *count, double *lambda) {
+  for (int k = 0; k < iterations; k++) {
+    double xmx = 0;
+    for (size_t c = 0; c < 3 * ms->n; c++) {
+      x[c] *= ms->inv_mass[c / 3] > 0;
+      xmx += ms->mass[c / 3] * x[c] * x[c];
+    }
+    if (!(xmx > 0)) return 1;
+    double next = rest_apply(ms, 0, extra_home_k, x, y) / xmx, ny = 0;
+    for (size_t c = 0; c < 3 * ms->n; c++) ny += y[c] * y[c];
+    ny = sqrt(ny);
+    if (!(ny > 0)) return 1;
+    for (size_t c = 0; c < 3 * ms->n; c++) x[c] = y[c] / ny;
+    int done = ++*count > 21 && fabs(next - *lambda) <= 1e-5 * next;
+    *lambda = next;
+    if (done || *count >= 500) return 1;
+  }
+  return 0;
+}
+
+double mass_spring_gershgorin(const mass_spring_t *ms, double extra_home_k, size_t first_new, double *scratch) {
+  /* first_new < n: only springs touching a node >= first_new, and only those
+   * nodes' home springs (the part B of a topology change). */
+  int part = first_new < ms->n;
+  for (size_t i = 0; i < ms->n; i++) scratch[i] = !part || i >= first_new ? ms->p.home_stiffness + extra_home_k : 0;
+  for (size_t s = 0; s < ms->nsprings; s++) {
+    const ms_spring_t *sp = &ms->springs[s];
+    if (!(sp->rest > 0) || (part && sp->i < first_new && sp->j < first_new)) continue;
+    scratch[sp->i] += 2 * ms->p.stiffness;
+    scratch[sp->j] += 2 * ms->p.stiffness;
+  }
+  double g = 0;
+  for (size_t i = 0; i < ms->n; i++) g = fmax(g, scratch[i] * ms->inv_mass[i]);
+  return g;
+}
+
+double mass_spring_lambda_c_from_k(const mass_spring_t *ms, double extra_home_k, double lambda_k) {
+  double m0 = 0;
+  for (size_t i = 0; i < ms->n; i++) {
+    if (ms->inv_mass[i] == 0) continue;
+    if (m0 == 0) m0 = ms->mass[i];
+    if (ms->mass[i] != m0) return NAN;
+  }
+  if (!(m0 > 0) || !(ms->p.stiffness > 0)) return NAN;
+  double a = (lambda_k - (ms->p.home_stiffness + extra_home_k) / m0) / ms->p.stiffness;
+  return ms->p.damping * fmax(a, 0) + ms->p.home_damping / m0;
 }
 
 double mass_spring_potential(const mass_spring_t *ms, const double *x) {
@@ -300,6 +443,7 @@ double mass_spring_potential(const mass_spring_t *ms, const double *x) {
     v3_sub(d, x + 3 * i, ms->x_rest + 3 * i);
     e += 0.5 * ms->p.home_stiffness * v3_dot(d, d);
     e -= ms->mass[i] * v3_dot(ms->p.gravity, x + 3 * i);
+    if (ms->f_res) e -= v3_dot(ms->f_res + 3 * i, x + 3 * i);
   }
   for (size_t s = 0; s < ms->nsprings; s++) {
     double l = v3_dist(x + 3 * ms->springs[s].i, x + 3 * ms->springs[s].j) - ms->springs[s].rest;

@@ -69,6 +69,9 @@ typedef struct mass_spring {
    * through mass_spring_set_stiffness_scale; owned by this object. Code that
    * adds or removes springs must keep it in step (or clear it). */
   double *k_scale;
+  /* Cutting (server/cutting/ms_cut.h) only; NULL / 0 until a cut happens. */
+  double *f_res; /* 3n or NULL: constant nodal forces (residual stress, seed 004 eq. 4), in forces() and potential() */
+  size_t cap;    /* node capacity of the node arrays (>= n) */
 } mass_spring_t;
 
 /* Springs from the unique edges of the triangles of `surface` (nodes = its
@@ -82,12 +85,22 @@ void mass_spring_destroy(mass_spring_t *ms);
  * k_scale; NULL clears it (uniform stiffness again). Returns 0, or -1 with
  * err (bad factor, OOM). Construction time: it allocates. */
 int mass_spring_set_stiffness_scale(mass_spring_t *ms, const double *scale, verr_t *err);
+/* Topology changes (cutting). reserve grows every node array to cap nodes
+ * (contents kept, fs pointers updated; with_f_res also allocates f_res,
+ * zeroed); it allocates only when cap exceeds the capacity. After the caller
+ * has written n <= cap nodes (x, v, x_rest, mass, inv_mass, f_res),
+ * set_surface_topology rebuilds the springs from the unique edges of tris
+ * (rest lengths from x_rest), sets n and p.mass (the sum of the masses).
+ * Both return 0, or -1 with err (OOM, index out of range); on error the
+ * springs are left as they were. */
+int mass_spring_reserve(mass_spring_t *ms, size_t cap, int with_f_res, verr_t *err);
+int mass_spring_set_surface_topology(mass_spring_t *ms, size_t n, const uint32_t *tris, size_t ntris, verr_t *err);
 
 /* Fixes every node whose rest z is below z (zero inverse mass). Returns how many. */
 size_t mass_spring_fix_below(mass_spring_t *ms, double z);
 
-/* f = F(x, v): edge springs and dampers, home springs and dampers, gravity
- * and f_ext. Forces stay finite for coincident nodes (a zero-length spring
+/* f = F(x, v): edge springs and dampers, home springs and dampers, gravity,
+ * f_res and f_ext. Forces stay finite for coincident nodes (a zero-length spring
  * has no direction and pushes nothing). */
 void mass_spring_forces(const mass_spring_t *ms, const double *x, const double *v, double *f);
 /* out = (a K(x) + b C(x)) y, as described above. */
@@ -103,6 +116,32 @@ void mass_spring_stiffness_mul(const mass_spring_t *ms, const double *x, double 
  * Returns 0, or -1 on OOM. */
 int mass_spring_eigen_bounds(const mass_spring_t *ms, double extra_home_k, double *lambda_k, double *lambda_c);
 
+/* The same with caller-kept vectors vk, vc (3n each): the start vectors
+ * when warm (a topology change keeps most of the dominant modes, so the
+ * iteration converges in a fraction of the steps; it stops when the
+ * estimate changes by less than 1e-5 between iterations instead of 1e-7),
+ * the dominant vectors on return. With equal masses lambda_c is derived
+ * from lambda_k (same dominant vector at rest; vc is then untouched),
+ * halving the cost. warm = 0 starts from the same vector as mass_spring_eigen_bounds
+ * and gives the same lambda_k. Returns 0, or -1 on OOM. */
+int mass_spring_eigen_bounds_warm(const mass_spring_t *ms, double extra_home_k, double *vk, double *vc, int warm,
+                                  double *lambda_k, double *lambda_c);
+
+/* Resumable power iteration on M^-1 K at rest (+ extra_home_k I), for a
+ * re-estimate spread over several steps: up to `iterations` iterations from
+ * x (scratch y, 3n each); *count and *lambda (the last Rayleigh quotient)
+ * carry the state between calls. Returns 1 when converged (after 21
+ * iterations, change <= 1e-5) or after 500, else 0. */
+int mass_spring_power_steps(const mass_spring_t *ms, double extra_home_k, double *x, double *y, int iterations,
+                            int *count, double *lambda);
+/* Block-Gershgorin bound of M^-1 K at rest (no eigenvalue exceeds it); with
+ * first_new < n only over the springs touching nodes >= first_new and
+ * those nodes' home springs. scratch: n doubles. */
+double mass_spring_gershgorin(const mass_spring_t *ms, double extra_home_k, size_t first_new, double *scratch);
+/* lambda of M^-1 C from lambda of M^-1 K when all free nodes have the same
+ * mass (see mass_spring_eigen_bounds_warm); NAN otherwise. */
+double mass_spring_lambda_c_from_k(const mass_spring_t *ms, double extra_home_k, double lambda_k);
+
 /* Adds an external force (N) at node i; forces() includes it until cleared. */
 static inline void mass_spring_add_force(mass_spring_t *ms, uint32_t i, const double f[3]) {
   ms->f_ext[3 * i] += f[0];
@@ -113,8 +152,8 @@ static inline void mass_spring_add_force(mass_spring_t *ms, uint32_t i, const do
 /* Kinetic + elastic (edge and home springs) + gravitational potential
  * energy, J; f_ext does no bookkeeping here. */
 double mass_spring_energy(const mass_spring_t *ms);
-/* Potential energy at positions x: edge and home springs plus gravity, so
- * that F(x, 0) = -grad U(x) + f_ext. */
+/* Potential energy at positions x: edge and home springs, gravity and the
+ * constant forces f_res, so that F(x, 0) = -grad U(x) + f_ext. */
 double mass_spring_potential(const mass_spring_t *ms, const double *x);
 /* Largest |L/L0 - 1| over springs with L0 > 0: the live strain figure. */
 double mass_spring_max_strain(const mass_spring_t *ms);

@@ -46,8 +46,9 @@
 #include "integrator.h"
 #include "mass_spring.h"
 #include "model.h"
+#include "model_mass_spring.h"
 #include "tet_mesh.h"
-
+#include "vmath.h"
 
 typedef struct ms_model {
   model_t m; /* first: the model_t the caller holds */
@@ -61,6 +62,17 @@ typedef struct ms_model {
   double *surf_buf, *surf_rest_buf; /* tet variant: 3 nsurf */
   uint32_t *tris;                   /* 3 nsurf_tris, the model's own copy */
   double *try_x, *try_v;            /* implicit Euler: 3 nnodes, the state before an attempt */
+  /* What choose_substeps needs again after a topology change (cutting). */
+  double dt, tool_stiffness;
+  int requested_substeps;
+  size_t tri_cap; /* capacity of tris */
+  /* Cutting only (model_mass_spring_prepare): the dominant vector of M^-1 K
+   * at rest and a scratch vector (3 cap each, NULL otherwise), the bound the
+   * sub-steps follow, and the state of a re-estimate spread over steps. */
+  double *eig_k, *eig_y;
+  double lam_k;
+  int refining, refine_count;
+  double refine_lambda;
 } ms_model_t;
 
 static double state_sum(const ms_model_t *mm) {
@@ -168,6 +180,8 @@ static void ms_destroy(model_t *m) {
   free(mm->tris);
   free(mm->try_x);
   free(mm->try_v);
+  free(mm->eig_k);
+  free(mm->eig_y);
   free(mm);
 }
 
@@ -213,17 +227,20 @@ static const model_ops_t TET_OPS = {.name = "mass_spring_tet",
                                     .add_surface_force = tet_add_force};
 
 /* Stable dt of the scheme for this system (see the file comment). */
-static int choose_substeps(ms_model_t *mm, const model_params_t *p, integrator_kind_t kind, verr_t *err) {
-  const scene_organ_t *cfg = p->cfg;
+static int substeps_from(ms_model_t *mm, integrator_kind_t kind, double lk, double lc, verr_t *err) {
   const mass_spring_t *ms = &mm->ms;
-  double lk, lc;
-  if (mass_spring_eigen_bounds(ms, p->tool_stiffness, &lk, &lc)) return verr_set(err, "out of memory");
   double m_node = ms->p.mass / (double)ms->n;
-  double lk0 = (ms->p.home_stiffness + p->tool_stiffness) / m_node, lc0 = ms->p.home_damping / m_node;
-  return integrator_choose_substeps(kind, p->dt, cfg->solver.substeps, lk, lc, lk0, lc0,
+  double lk0 = (ms->p.home_stiffness + mm->tool_stiffness) / m_node, lc0 = ms->p.home_damping / m_node;
+  return integrator_choose_substeps(kind, mm->dt, mm->requested_substeps, lk, lc, lk0, lc0,
                                     "lower material stiffness, damping or tool stiffness, raise the mass, or use "
                                     "implicit_euler (explicit_euler needs damping)",
                                     &mm->m.substeps, &mm->m.stable_dt, err);
+}
+
+static int choose_substeps(ms_model_t *mm, integrator_kind_t kind, verr_t *err) {
+  double lk, lc;
+  if (mass_spring_eigen_bounds(&mm->ms, mm->tool_stiffness, &lk, &lc)) return verr_set(err, "out of memory");
+  return substeps_from(mm, kind, lk, lc, err);
 }
 
 static model_t *ms_create(const model_params_t *p, int tet, verr_t *err) {
@@ -243,6 +260,9 @@ static model_t *ms_create(const model_params_t *p, int tet, verr_t *err) {
     return NULL;
   }
   mm->tet = tet;
+  mm->dt = p->dt;
+  mm->tool_stiffness = p->tool_stiffness;
+  mm->requested_substeps = cfg->solver.substeps;
   const mesh_t *s = p->surface;
   ms_params_t mp = {.mass = cfg->material.mass,
                     .stiffness = cfg->material.stiffness,
@@ -275,6 +295,7 @@ static model_t *ms_create(const model_params_t *p, int tet, verr_t *err) {
   mm->good_x = malloc(3 * n * sizeof(double));
   mm->good_v = malloc(3 * n * sizeof(double));
   mm->tris = malloc(3 * s->ntris * sizeof(uint32_t) + 1);
+  mm->tri_cap = s->ntris;
   if (tet) {
     mm->surf_buf = malloc(3 * s->nverts * sizeof(double) + 1);
     mm->surf_rest_buf = malloc(3 * s->nverts * sizeof(double) + 1);
@@ -316,7 +337,7 @@ static model_t *ms_create(const model_params_t *p, int tet, verr_t *err) {
     m->surf_x = mm->ms.x;
     m->surf_rest = mm->ms.x_rest;
   }
-  if (choose_substeps(mm, p, (integrator_kind_t)kind, err) ||
+  if (choose_substeps(mm, (integrator_kind_t)kind, err) ||
       integrator_init(&mm->it, (integrator_kind_t)kind, n, cfg->solver.cg_tolerance, cfg->solver.cg_max_iterations,
                       err)) {
     ms_destroy(m);
@@ -330,3 +351,158 @@ model_t *model_mass_spring_tet_create(const model_params_t *p, verr_t *err);
 
 model_t *model_mass_spring_surface_create(const model_params_t *p, verr_t *err) { return ms_create(p, 0, err); }
 model_t *model_mass_spring_tet_create(const model_params_t *p, verr_t *err) { return ms_create(p, 1, err); }
+
+mass_spring_t *model_mass_spring_surface_system(model_t *m) {
+  return m && m->ops == &SURFACE_OPS ? &((ms_model_t *)m)->ms : NULL;
+}
+
+/* realloc that keeps *p on failure; NULL stays NULL. */
+static int grow_buf(double **p, size_t count) {
+  if (!*p) return 0;
+  double *q = realloc(*p, count * sizeof(double) + 1);
+  if (!q) return -1;
+  *p = q;
+  return 0;
+}
+
+int model_mass_spring_reserve(model_t *m, size_t cap, int with_f_res, verr_t *err) {
+  ms_model_t *mm = (ms_model_t *)m;
+  if (m->ops != &SURFACE_OPS) return verr_set(err, "topology changes need a mass_spring_surface model");
+  size_t old = mm->ms.cap;
+  if (cap > old) cap = cap < old + old / 2 ? old + old / 2 : cap;
+  if (mass_spring_reserve(&mm->ms, cap, with_f_res, err)) return -1;
+  if (mm->ms.cap > old || mm->it.n < mm->ms.cap) {
+    size_t c3 = 3 * mm->ms.cap;
+    if (grow_buf(&mm->good_x, c3) || grow_buf(&mm->good_v, c3) || grow_buf(&mm->try_x, c3) ||
+        grow_buf(&mm->try_v, c3) || grow_buf(&mm->eig_k, c3) || grow_buf(&mm->eig_y, c3))
+      return verr_set(err, "out of memory for %zu nodes", mm->ms.cap);
+    integrator_t it;
+    if (integrator_init(&it, mm->it.kind, mm->ms.cap, mm->it.cg_tolerance, mm->it.cg_max_iterations, err)) return -1;
+    integrator_destroy(&mm->it);
+    mm->it = it;
+  }
+  /* The arrays may have moved: the model's view follows (the caller bumps
+   * topology_version through commit before anyone steps again). */
+  m->x = m->surf_x = mm->ms.x;
+  m->v = mm->ms.v;
+  m->x_rest = m->surf_rest = mm->ms.x_rest;
+  return 0;
+}
+
+int model_mass_spring_prepare(model_t *m, verr_t *err) {
+  ms_model_t *mm = (ms_model_t *)m;
+  if (m->ops != &SURFACE_OPS) return verr_set(err, "topology changes need a mass_spring_surface model");
+  if (mm->eig_k) return 0;
+  mm->eig_k = calloc(3 * mm->ms.cap + 1, sizeof(double));
+  mm->eig_y = calloc(3 * mm->ms.cap + 1, sizeof(double));
+  double lk, lc;
+  if (!mm->eig_k || !mm->eig_y ||
+      mass_spring_eigen_bounds_warm(&mm->ms, mm->tool_stiffness, mm->eig_k, mm->eig_y, 0, &lk, &lc)) {
+    free(mm->eig_k);
+    free(mm->eig_y);
+    mm->eig_k = mm->eig_y = NULL;
+    return verr_set(err, "out of memory for %zu nodes", mm->ms.cap);
+  }
+  mm->lam_k = lk;
+  return 0;
+}
+
+/* Moves the dominant vector to the new numbering (survivors keep their
+ * components; new nodes get pseudo-random ones of the same size, so a mode
+ * that lives in the new springs can grow). */
+static void remap_vector(ms_model_t *mm, const uint32_t *old_to_new, size_t old_n, size_t n) {
+  double *v = mm->eig_k, rms = 0;
+  size_t first_new = 0;
+  for (size_t i = 0; i < old_n; i++) {
+    uint32_t j = old_to_new[i];
+    rms += v3_dot(v + 3 * i, v + 3 * i);
+    if (j == UINT32_MAX) continue;
+    first_new++;
+    if (j != i) memcpy(v + 3 * (size_t)j, v + 3 * i, 3 * sizeof(double));
+  }
+  rms = sqrt(rms / (double)(old_n ? old_n : 1));
+  unsigned seed = 777;
+  for (size_t c = 3 * first_new; c < 3 * n; c++) {
+    seed = seed * 1664525u + 1013904223u;
+    v[c] = rms * ((double)(seed >> 8) / 16777216.0 - 0.5);
+  }
+}
+
+/* Sub-steps from lambda_k, with lambda_c derived from it (equal masses) or,
+ * failing that, from the Gershgorin bound of C. */
+static int substeps_from_k(ms_model_t *mm, double lk, verr_t *err) {
+  double lc = mass_spring_lambda_c_from_k(&mm->ms, mm->tool_stiffness, lk);
+  if (!isfinite(lc)) {
+    double dummy_k;
+    if (mass_spring_eigen_bounds(&mm->ms, mm->tool_stiffness, &dummy_k, &lc)) return verr_set(err, "out of memory");
+  }
+  mm->lam_k = lk;
+  return substeps_from(mm, mm->it.kind, lk, lc, err);
+}
+
+int model_mass_spring_commit(model_t *m, size_t n, const uint32_t *old_to_new, size_t old_n, const uint32_t *tris,
+                             size_t ntris, verr_t *err) {
+  ms_model_t *mm = (ms_model_t *)m;
+  if (m->ops != &SURFACE_OPS) return verr_set(err, "topology changes need a mass_spring_surface model");
+  if (ntris > mm->tri_cap) {
+    size_t cap = ntris < mm->tri_cap + mm->tri_cap / 2 ? mm->tri_cap + mm->tri_cap / 2 : ntris;
+    uint32_t *t = realloc(mm->tris, 3 * cap * sizeof(uint32_t) + 1);
+    if (!t) return verr_set(err, "out of memory for %zu triangles", cap);
+    mm->tris = t;
+    mm->tri_cap = cap;
+  }
+  if (mass_spring_set_surface_topology(&mm->ms, n, tris, ntris, err)) return -1;
+  memcpy(mm->tris, tris, 3 * ntris * sizeof(uint32_t));
+  memcpy(mm->good_x, mm->ms.x, 3 * n * sizeof(double));
+  memcpy(mm->good_v, mm->ms.v, 3 * n * sizeof(double));
+  m->nnodes = m->nsurf = n;
+  m->nsurf_tris = ntris;
+  m->surf_tris = mm->tris;
+  m->x = m->surf_x = mm->ms.x;
+  m->v = mm->ms.v;
+  m->x_rest = m->surf_rest = mm->ms.x_rest;
+  m->topology_version++;
+  if (!mm->eig_k) { /* not prepared: a cold estimate now */
+    double lk, lc;
+    if (mass_spring_eigen_bounds(&mm->ms, mm->tool_stiffness, &lk, &lc)) return verr_set(err, "out of memory");
+    return substeps_from(mm, mm->it.kind, lk, lc, err);
+  }
+  /* A bound valid at once, as safe as the old one (see the header): K_new = A + B with A the old K
+   * less the cut springs and deleted nodes (its largest eigenvalue is at
+   * most the old bound: fewer springs, a principal submatrix) and B the
+   * springs touching new nodes plus their home springs, whose eigenvalues
+   * B's Gershgorin bound caps; Weyl: lambda(A + B) <= lambda_old +
+   * lambda(B). The whole system's Gershgorin bound caps it too. */
+  size_t first_new = 0;
+  for (size_t i = 0; i < old_n; i++) first_new += old_to_new[i] != UINT32_MAX;
+  remap_vector(mm, old_to_new, old_n, n);
+  double gb = mass_spring_gershgorin(&mm->ms, mm->tool_stiffness, first_new, mm->eig_y);
+  double gf = mass_spring_gershgorin(&mm->ms, mm->tool_stiffness, n, mm->eig_y);
+  mm->refining = 1;
+  mm->refine_count = 0;
+  mm->refine_lambda = 0;
+  if (substeps_from_k(mm, fmin(mm->lam_k + gb, gf), err) == 0) return 0;
+  /* The pessimistic bound asks for more sub-steps than allowed: estimate
+   * now (a stall of one step) rather than keep sub-steps chosen for the
+   * mesh before the change. */
+  mm->refining = 0;
+  double lk, lc;
+  if (mass_spring_eigen_bounds_warm(&mm->ms, mm->tool_stiffness, mm->eig_k, mm->eig_y, 1, &lk, &lc))
+    return verr_set(err, "out of memory");
+  mm->lam_k = lk;
+  return substeps_from(mm, mm->it.kind, lk, lc, err);
+}
+
+int model_mass_spring_refine(model_t *m, int iterations, verr_t *err) {
+  ms_model_t *mm = (ms_model_t *)m;
+  if (m->ops != &SURFACE_OPS || !mm->refining || !mm->eig_k) return 0;
+  if (!mass_spring_power_steps(&mm->ms, mm->tool_stiffness, mm->eig_k, mm->eig_y, iterations, &mm->refine_count,
+                               &mm->refine_lambda))
+    return 0;
+  mm->refining = 0;
+  /* The 2 % margin of mass_spring_eigen_bounds, never above the bound set
+   * at the change. */
+  double lk = fmin(1.02 * mm->refine_lambda, mm->lam_k);
+  if (!(lk > 0)) return 0;
+  return substeps_from_k(mm, lk, err) ? -1 : 1;
+}
