@@ -234,7 +234,45 @@ static void read_commands(server_t *s, uint64_t now) {
 
 /* Applies pending instructor commands (session_control.h); each outcome is
  * logged and published, so the recording shows who changed what and when. */
-static void read_controls(server_t *s) {
+/* Restarts the scene from `sc` (a reset, or a reset with new material):
+ * the runtime is rebuilt (models, trees, proxies, tools released, tasks and
+ * stones back), measures restart, and every organ's publisher adopts the
+ * new surface with a keyframe of a new topology version, so viewers and
+ * late joiners follow as after a cut. When `sc` cannot be built (a material
+ * the models refuse) the running scene `old` is rebuilt instead and -1
+ * returned with err; if even that fails the server cannot go on (-2). */
+static int rebuild_runtime(server_t *s, const scene_t *sc, const scene_t *old, verr_t *err) {
+  runtime_destroy(&s->rt);
+  int rc = 0;
+  if (runtime_init(&s->rt, sc, err)) {
+    verr_t e2;
+    runtime_destroy(&s->rt);
+    if (runtime_init(&s->rt, old, &e2)) {
+      fprintf(stderr, "server: cannot rebuild the scene after a refused change: %s\n", e2.msg);
+      return -2;
+    }
+    rc = -1;
+  }
+  for (size_t t = 0; t < s->rt.ntools; t++) {
+    const scene_tool_t *c = s->rt.tools[t].cfg;
+    thr_init(&s->thr[t], c->st, c->mpf, c->sft);
+    memset(&s->tally[t], 0, sizeof s->tally[t]);
+    s->was_contact[t] = 0;
+  }
+  for (size_t i = 0; i < s->rt.norgans; i++) {
+    const organ_rt_t *o = &s->rt.organs[i];
+    const model_t *m = o->model;
+    verr_t e;
+    if (mesh_publisher_retopo(&s->pubs[i], o->topology_version, m->nsurf, m->surf_tris, m->nsurf_tris, m->surf_x,
+                              sim_ns(s), &e))
+      fprintf(stderr, "server: %s\n", e.msg);
+  }
+  return rc;
+}
+
+/* Applies pending instructor commands (session_control.h); each outcome is
+ * logged and published, so the recording shows who changed what and when. */
+static int read_controls(server_t *s) {
   void *samples[1] = {0};
   dds_sample_info_t info;
   while (dds_take(s->r_control, samples, &info, 1, 1) == 1) {
@@ -242,14 +280,54 @@ static void read_controls(server_t *s) {
       const viscera_SessionControl *c = samples[0];
       double maxf[SCENE_MAX_TOOLS];
       for (size_t t = 0; t < s->rt.ntools; t++) maxf[t] = s->rt.tools[t].cfg->max_force;
-      char text[200];
-      int r = session_control_apply(&s->control, c, s->thr, s->rt.ntools, maxf, text, sizeof text);
+      char text[300];
+      /* The scene lives in the runtime, which a rebuild destroys: work on
+       * copies (heap: a scene is tens of kB). */
+      scene_t *edit = malloc(sizeof *edit), *old = malloc(sizeof *old);
+      int r = -1;
+      if (edit && old) {
+        *edit = s->rt.scene;
+        *old = s->rt.scene;
+        r = session_control_apply(&s->control, c, s->thr, s->rt.ntools, maxf, edit, text, sizeof text);
+      } else {
+        snprintf(text, sizeof text, "SessionControl refused: out of memory");
+      }
+      if (r == SESSION_CONTROL_REBUILD) {
+        verr_t e;
+        int b = rebuild_runtime(s, edit, old, &e);
+        if (b == -2) {
+          free(edit);
+          free(old);
+          dds_return_loan(s->r_control, samples, 1);
+          return -1;
+        }
+        if (b == 0) {
+          s->control.applied++;
+          r = 0;
+          /* A stiff material is accepted as in a scene file, but the
+           * instructor should know when the step may no longer keep time. */
+          for (size_t i = 0; i < s->rt.norgans; i++) {
+            const model_t *m = s->rt.organs[i].model;
+            size_t len = strlen(text);
+            if (m->substeps > 16 && len < sizeof text)
+              snprintf(text + len, sizeof text - len, "; organ '%.40s' now needs %d sub-steps per step (may not keep real time)",
+                       s->rt.organs[i].cfg->name, m->substeps);
+          }
+        } else {
+          s->control.refused++;
+          size_t len = strlen(text);
+          snprintf(text + len, sizeof text - len, "; refused by the models: %.200s (scene unchanged, restarted)", e.msg);
+        }
+      }
+      free(edit);
+      free(old);
       if (!s->opts->quiet) fprintf(stderr, "server: %s\n", text);
-      publish_event(s, r == 0 ? viscera_EVENT_CONTROL_APPLIED : viscera_EVENT_INPUT_REJECTED, -1, c->tool_id,
+      publish_event(s, r == 0 ? viscera_EVENT_CONTROL_APPLIED : viscera_EVENT_INPUT_REJECTED, c->organ_id, c->tool_id,
                     (double)c->kind, text);
     }
     dds_return_loan(s->r_control, samples, 1);
   }
+  return 0;
 }
 
 static void publish_feedback(server_t *s) {
@@ -519,7 +597,10 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
   while (!*stop && (opts->duration <= 0 || (double)(vtime_mono_ns() - start) * 1e-9 < opts->duration)) {
     uint64_t t0 = vtime_mono_ns();
     read_commands(&s, t0);
-    read_controls(&s);
+    if (read_controls(&s)) {
+      stats->overruns++;
+      break; /* the scene could not be rebuilt: nothing left to simulate */
+    }
     /* Paused: the organs and the measures freeze; commands are still read
      * (so nothing queues up) and the last contact model keeps going out. */
     int rolled = s.control.paused ? 0 : runtime_step(&s.rt);

@@ -55,8 +55,22 @@ int session_control_duplicate(session_control_t *sc, const viscera_SessionContro
   return 0;
 }
 
+/* New material values as the scene file accepts them (common/scene.c);
+ * negative = keep. Returns NULL or what is wrong. */
+static const char *edit_material(scene_material_t *m, const double v[4]) {
+  for (int k = 0; k < 4; k++)
+    if (!isfinite(v[k])) return "material value not finite";
+  if (v[3] == 0 || (v[3] > 0 && v[3] > 1000)) return "mass must be > 0 and at most 1000 kg";
+  if (v[0] > 1e7 || v[1] > 1e4 || v[2] > 1e7) return "material value out of range";
+  if (v[0] >= 0) m->stiffness = v[0];
+  if (v[1] >= 0) m->damping = v[1];
+  if (v[2] >= 0) m->home_stiffness = v[2];
+  if (v[3] > 0) m->mass = v[3];
+  return NULL;
+}
+
 int session_control_apply(session_control_t *sc, const viscera_SessionControl *c, thr_tracker_t *thr, size_t ntools,
-                          const double *tool_max_force, char *text, size_t n) {
+                          const double *tool_max_force, scene_t *scene, char *text, size_t n) {
   switch (c->kind) {
   case viscera_CONTROL_PAUSE:
     sc->paused = 1;
@@ -88,6 +102,22 @@ int session_control_apply(session_control_t *sc, const viscera_SessionControl *c
     snprintf(text, n, "tool %" PRId32 " thresholds ST %.3g MPF %.3g SFT %.3g N", c->tool_id, v[0], v[1], v[2]);
     tag(c, text, n);
     return 0;
+  }
+  case viscera_CONTROL_RESET:
+    snprintf(text, n, "reset: the scene restarts from rest");
+    tag(c, text, n);
+    return SESSION_CONTROL_REBUILD;
+  case viscera_CONTROL_SET_MATERIAL: {
+    if (c->organ_id < 0 || (size_t)c->organ_id >= scene->norgans)
+      return refuse(sc, c, text, n, "organ id out of range");
+    scene_organ_t *o = &scene->organs[c->organ_id];
+    const char *bad = edit_material(&o->material, c->values);
+    if (bad) return refuse(sc, c, text, n, bad);
+    snprintf(text, n,
+             "organ '%s' material: stiffness %.4g N/m, damping %.4g N s/m, home stiffness %.4g N/m, mass %.4g kg",
+             o->name, o->material.stiffness, o->material.damping, o->material.home_stiffness, o->material.mass);
+    tag(c, text, n);
+    return SESSION_CONTROL_REBUILD;
   }
   }
   return refuse(sc, c, text, n, "unknown command kind");

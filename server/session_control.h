@@ -15,6 +15,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "scene.h"
 #include "thresholds.h"
 #include "viscera.h"
 
@@ -42,9 +43,17 @@ int session_control_duplicate(session_control_t *sc, const viscera_SessionContro
  * (thr[tool] re-initialised with the new levels; its accumulated measures
  * are kept). Tool thresholds are checked like the scene file's:
  * 0 <= st < mpf <= sft <= max_force for those that are non-zero.
- * Returns 0 when applied, -1 when refused; `text` (size n) says what was
- * done or why not, for the log and a SessionEvent. */
+ * RESET and SET_MATERIAL need the scene rebuilt, which only the server can
+ * do: for them `scene` (the running scene, copied by the caller) is edited
+ * (SET_MATERIAL: the organ's material, each value checked like the scene
+ * file's) and SESSION_CONTROL_REBUILD is returned; the caller rebuilds from
+ * it and reports the outcome (a material the models refuse, e.g. one that
+ * needs too many sub-steps, is refused then).
+ * Returns 0 when applied, SESSION_CONTROL_REBUILD, or -1 when refused;
+ * `text` (size n) says what was done or why not, for the log and a
+ * SessionEvent. */
+#define SESSION_CONTROL_REBUILD 1
 int session_control_apply(session_control_t *sc, const viscera_SessionControl *c, thr_tracker_t *thr, size_t ntools,
-                          const double *tool_max_force, char *text, size_t n);
+                          const double *tool_max_force, scene_t *scene, char *text, size_t n);
 
 #endif

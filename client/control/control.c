@@ -17,10 +17,13 @@
 #include "vtime.h"
 
 static void usage(FILE *f) {
-  fprintf(f, "usage: viscera-control [options] pause | resume | thresholds TOOL ST MPF SFT\n"
+  fprintf(f, "usage: viscera-control [options] COMMAND\n"
              "  pause                 freeze the seat's physics and measures\n"
              "  resume                continue\n"
              "  thresholds T ST MPF SFT   new palpation thresholds (N) for tool T (0 = not set)\n"
+             "  reset                 restart the scene from rest (organs, tools, measures, tasks)\n"
+             "  material O K C H M    organ O's stiffness K (N/m), damping C (N s/m), home stiffness H\n"
+             "                        (N/m), mass M (kg); -1 keeps a value; the organ restarts from rest\n"
              "  --domain N            DDS domain id (default: $VISCERA_DOMAIN or 0)\n"
              "  --partition P         the seat's partition (default: " VDDS_DEFAULT_PARTITION ")\n"
              "  --station ID          this instructor station's id (default 1)\n"
@@ -54,7 +57,8 @@ int main(int argc, char **argv) {
   unsigned long station = 1;
   double wait_s = 5;
   int c;
-  while ((c = getopt_long(argc, argv, "", opts, NULL)) != -1) {
+  while ((c = getopt_long(argc, argv, "+", opts, NULL)) !=
+         -1) { /* "+": stop at the command, so "-1" values are not options */
     switch (c) {
     case 'd':
       if ((domain = vdds_parse_domain(optarg)) < 0) {
@@ -96,12 +100,29 @@ int main(int argc, char **argv) {
   cmd.source_id = (uint32_t)station;
   cmd.seq = vtime_mono_ns(); /* increasing across invocations of one station */
   cmd.tool_id = -1;
+  cmd.organ_id = -1;
   snprintf(cmd.text, sizeof cmd.text, "%s", text);
   const char *verb = optind < argc ? argv[optind] : NULL;
   if (verb && strcmp(verb, "pause") == 0 && argc - optind == 1) {
     cmd.kind = viscera_CONTROL_PAUSE;
   } else if (verb && strcmp(verb, "resume") == 0 && argc - optind == 1) {
     cmd.kind = viscera_CONTROL_RESUME;
+  } else if (verb && strcmp(verb, "reset") == 0 && argc - optind == 1) {
+    cmd.kind = viscera_CONTROL_RESET;
+  } else if (verb && strcmp(verb, "material") == 0 && argc - optind == 6) {
+    cmd.kind = viscera_CONTROL_SET_MATERIAL;
+    char *end;
+    long organ = strtol(argv[optind + 1], &end, 10);
+    if (*end || organ < 0 || organ > 1000) {
+      fprintf(stderr, "viscera-control: material: not an organ index: '%s'\n", argv[optind + 1]);
+      return 2;
+    }
+    cmd.organ_id = (int32_t)organ;
+    for (int k = 0; k < 4; k++)
+      if (parse_double(argv[optind + 2 + k], &cmd.values[k])) {
+        fprintf(stderr, "viscera-control: material: not a number: '%s'\n", argv[optind + 2 + k]);
+        return 2;
+      }
   } else if (verb && strcmp(verb, "thresholds") == 0 && argc - optind == 5) {
     cmd.kind = viscera_CONTROL_SET_THRESHOLDS;
     char *end;

@@ -6,6 +6,8 @@
 #include "check.h"
 #include "session_control.h"
 
+static scene_t scene; /* one organ, defaults; what RESET and SET_MATERIAL edit */
+
 static viscera_SessionControl cmd(uint32_t station, uint64_t seq, viscera_ControlKind kind, int32_t tool, double st,
                                   double mpf, double sft) {
   viscera_SessionControl c;
@@ -28,15 +30,15 @@ static void test_pause_resume(void) {
   double maxf[1] = {4};
   char text[200];
   viscera_SessionControl c = cmd(3, 10, viscera_CONTROL_PAUSE, -1, 0, 0, 0);
-  CHECK(session_control_apply(&sc, &c, thr, 1, maxf, text, sizeof text) == 0);
+  CHECK(session_control_apply(&sc, &c, thr, 1, maxf, &scene, text, sizeof text) == 0);
   CHECK(sc.paused == 1);
   CHECK(strstr(text, "paused") && strstr(text, "[station 3 seq 10]"));
   c = cmd(3, 11, viscera_CONTROL_RESUME, -1, 0, 0, 0);
-  CHECK(session_control_apply(&sc, &c, thr, 1, maxf, text, sizeof text) == 0);
+  CHECK(session_control_apply(&sc, &c, thr, 1, maxf, &scene, text, sizeof text) == 0);
   CHECK(sc.paused == 0);
   CHECK(sc.applied == 2 && sc.refused == 0);
   c = cmd(3, 12, (viscera_ControlKind)77, -1, 0, 0, 0);
-  CHECK(session_control_apply(&sc, &c, thr, 1, maxf, text, sizeof text) == -1);
+  CHECK(session_control_apply(&sc, &c, thr, 1, maxf, &scene, text, sizeof text) == -1);
   CHECK(strstr(text, "unknown command kind") != NULL);
   CHECK(sc.paused == 0);
 }
@@ -58,7 +60,7 @@ static void test_thresholds(void) {
   CHECK(above_st > 0 && path > 0.009);
 
   viscera_SessionControl c = cmd(1, 1, viscera_CONTROL_SET_THRESHOLDS, 0, 0.4, 0.7, 1.2);
-  CHECK(session_control_apply(&sc, &c, thr, 2, maxf, text, sizeof text) == 0);
+  CHECK(session_control_apply(&sc, &c, thr, 2, maxf, &scene, text, sizeof text) == 0);
   CHECK_NEAR(thr[0].level[THR_ST], 0.4, 0);
   CHECK_NEAR(thr[0].level[THR_MPF], 0.7, 0);
   CHECK_NEAR(thr[0].level[THR_SFT], 1.2, 0);
@@ -72,21 +74,60 @@ static void test_thresholds(void) {
   const double bad[][3] = {{0.8, 0.5, 1.5}, {0.5, 1.6, 1.5}, {NAN, 0.8, 1.5}, {-1, 0.8, 1.5}, {0.5, 0.8, 9}};
   for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
     c = cmd(1, 2 + i, viscera_CONTROL_SET_THRESHOLDS, 0, bad[i][0], bad[i][1], bad[i][2]);
-    CHECK(session_control_apply(&sc, &c, thr, 2, maxf, text, sizeof text) == -1);
+    CHECK(session_control_apply(&sc, &c, thr, 2, maxf, &scene, text, sizeof text) == -1);
     CHECK(strstr(text, "refused") != NULL);
     CHECK_NEAR(thr[0].level[THR_ST], 0.4, 0);
     CHECK_NEAR(thr[0].level[THR_SFT], 1.2, 0);
   }
   c = cmd(1, 20, viscera_CONTROL_SET_THRESHOLDS, 2, 0.4, 0.7, 1.2); /* no tool 2 */
-  CHECK(session_control_apply(&sc, &c, thr, 2, maxf, text, sizeof text) == -1);
+  CHECK(session_control_apply(&sc, &c, thr, 2, maxf, &scene, text, sizeof text) == -1);
   c = cmd(1, 21, viscera_CONTROL_SET_THRESHOLDS, -1, 0.4, 0.7, 1.2);
-  CHECK(session_control_apply(&sc, &c, thr, 2, maxf, text, sizeof text) == -1);
+  CHECK(session_control_apply(&sc, &c, thr, 2, maxf, &scene, text, sizeof text) == -1);
   c = cmd(1, 22, viscera_CONTROL_SET_THRESHOLDS, 1, 0.5, 1.0, 2.5); /* tool 1 clamps at 2 N */
-  CHECK(session_control_apply(&sc, &c, thr, 2, maxf, text, sizeof text) == -1);
+  CHECK(session_control_apply(&sc, &c, thr, 2, maxf, &scene, text, sizeof text) == -1);
   c = cmd(1, 23, viscera_CONTROL_SET_THRESHOLDS, 1, 0, 1.0, 0); /* only MPF set: valid */
-  CHECK(session_control_apply(&sc, &c, thr, 2, maxf, text, sizeof text) == 0);
+  CHECK(session_control_apply(&sc, &c, thr, 2, maxf, &scene, text, sizeof text) == 0);
   CHECK_NEAR(thr[1].level[THR_MPF], 1.0, 0);
   CHECK(sc.refused == 8 && sc.applied == 2);
+}
+
+static void test_rebuild_commands(void) {
+  session_control_t sc;
+  memset(&sc, 0, sizeof sc);
+  thr_tracker_t thr[1];
+  thr_init(&thr[0], 0.5, 0.8, 1.5);
+  double maxf[1] = {4};
+  char text[300];
+  memset(&scene, 0, sizeof scene);
+  scene.norgans = 1;
+  snprintf(scene.organs[0].name, sizeof scene.organs[0].name, "kidney");
+  scene.organs[0].material = (scene_material_t){.mass = 0.15, .stiffness = 30, .damping = 0.02, .home_stiffness = 30};
+  viscera_SessionControl c = cmd(1, 1, viscera_CONTROL_RESET, -1, 0, 0, 0);
+  CHECK(session_control_apply(&sc, &c, thr, 1, maxf, &scene, text, sizeof text) == SESSION_CONTROL_REBUILD);
+  CHECK(strstr(text, "reset") != NULL);
+  /* New stiffness and mass, damping and home stiffness kept (-1). */
+  c = cmd(1, 2, viscera_CONTROL_SET_MATERIAL, -1, 90, -1, -1);
+  c.organ_id = 0;
+  c.values[3] = 0.3;
+  CHECK(session_control_apply(&sc, &c, thr, 1, maxf, &scene, text, sizeof text) == SESSION_CONTROL_REBUILD);
+  CHECK_NEAR(scene.organs[0].material.stiffness, 90, 0);
+  CHECK_NEAR(scene.organs[0].material.damping, 0.02, 0);
+  CHECK_NEAR(scene.organs[0].material.home_stiffness, 30, 0);
+  CHECK_NEAR(scene.organs[0].material.mass, 0.3, 0);
+  /* Refused, material unchanged: bad organ, NaN, zero mass, absurd stiffness. */
+  const double bad[][4] = {{NAN, -1, -1, -1}, {-1, -1, -1, 0}, {1e9, -1, -1, -1}, {-1, INFINITY, -1, -1}};
+  for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+    c = cmd(1, 3 + i, viscera_CONTROL_SET_MATERIAL, -1, 0, 0, 0);
+    c.organ_id = 0;
+    memcpy(c.values, bad[i], sizeof c.values);
+    CHECK(session_control_apply(&sc, &c, thr, 1, maxf, &scene, text, sizeof text) == -1);
+    CHECK_NEAR(scene.organs[0].material.stiffness, 90, 0);
+    CHECK_NEAR(scene.organs[0].material.mass, 0.3, 0);
+  }
+  c = cmd(1, 9, viscera_CONTROL_SET_MATERIAL, -1, 50, -1, -1);
+  c.organ_id = 1; /* no such organ */
+  CHECK(session_control_apply(&sc, &c, thr, 1, maxf, &scene, text, sizeof text) == -1);
+  CHECK(strstr(text, "organ id out of range") != NULL);
 }
 
 static void test_duplicates(void) {
@@ -113,6 +154,7 @@ static void test_duplicates(void) {
 int main(void) {
   test_pause_resume();
   test_thresholds();
+  test_rebuild_commands();
   test_duplicates();
   return check_report("test_session_control");
 }
