@@ -8,7 +8,7 @@
 
 #include "recfile.h"
 #include "recording.h"
-#include "resim_decode.h"
+#include "rec_decode.h"
 #include "viscera.h"
 
 typedef struct caps {
@@ -54,7 +54,7 @@ static int on_scene(void *arg, const recfile_row_t *row) {
   if (row->kind != REC_KIND_DATA) return 0; /* dispose / unregister rows carry no state */
   resim_recording_t *rec = ((load_ctx_t *)arg)->rec;
   viscera_SceneInfo si;
-  if (!resim_decode(row->cdr, row->cdr_len, &viscera_SceneInfo_desc, &si)) {
+  if (!rec_decode_cdr(row->cdr, row->cdr_len, &viscera_SceneInfo_desc, &si)) {
     skip(rec, "SceneInfo sample %lld does not decode", (long long)row->id);
     return 0;
   }
@@ -76,7 +76,7 @@ static int on_scene(void *arg, const recfile_row_t *row) {
       rec->organs[i].ntris = si.organs._buffer[i].triangle_count;
     }
   }
-  resim_decode_free(&si, &viscera_SceneInfo_desc);
+  rec_decode_free(&si, &viscera_SceneInfo_desc);
   return 0;
 }
 
@@ -86,7 +86,7 @@ static int on_command(void *arg, const recfile_row_t *row) {
   resim_recording_t *rec = ctx->rec;
   rec->n_commands++;
   viscera_ToolCommand c;
-  if (!resim_decode(row->cdr, row->cdr_len, &viscera_ToolCommand_desc, &c)) {
+  if (!rec_decode_cdr(row->cdr, row->cdr_len, &viscera_ToolCommand_desc, &c)) {
     skip(rec, "ToolCommand sample %lld does not decode", (long long)row->id);
     return 0;
   }
@@ -110,7 +110,7 @@ static int on_feedback(void *arg, const recfile_row_t *row) {
   resim_recording_t *rec = ctx->rec;
   rec->n_feedback++;
   viscera_ContactFeedback f;
-  if (!resim_decode(row->cdr, row->cdr_len, &viscera_ContactFeedback_desc, &f)) {
+  if (!rec_decode_cdr(row->cdr, row->cdr_len, &viscera_ContactFeedback_desc, &f)) {
     skip(rec, "ContactFeedback sample %lld does not decode", (long long)row->id);
     return 0;
   }
@@ -136,7 +136,7 @@ static int on_event(void *arg, const recfile_row_t *row) {
   resim_recording_t *rec = ctx->rec;
   rec->n_events++;
   viscera_SessionEvent e;
-  if (!resim_decode(row->cdr, row->cdr_len, &viscera_SessionEvent_desc, &e)) {
+  if (!rec_decode_cdr(row->cdr, row->cdr_len, &viscera_SessionEvent_desc, &e)) {
     skip(rec, "SessionEvent sample %lld does not decode", (long long)row->id);
     return 0;
   }
@@ -163,7 +163,7 @@ static int on_state(void *arg, const recfile_row_t *row) {
   resim_recording_t *rec = ctx->rec;
   rec->n_states++;
   viscera_MeshState s;
-  if (!resim_decode(row->cdr, row->cdr_len, &viscera_MeshState_desc, &s)) {
+  if (!rec_decode_cdr(row->cdr, row->cdr_len, &viscera_MeshState_desc, &s)) {
     skip(rec, "MeshState sample %lld does not decode", (long long)row->id);
     return 0;
   }
@@ -191,7 +191,7 @@ static int on_state(void *arg, const recfile_row_t *row) {
                                                    .pos = pos};
     }
   }
-  resim_decode_free(&s, &viscera_MeshState_desc);
+  rec_decode_free(&s, &viscera_MeshState_desc);
   return rc;
 }
 
@@ -201,7 +201,7 @@ static int on_delta(void *arg, const recfile_row_t *row) {
   resim_recording_t *rec = ctx->rec;
   rec->n_deltas++;
   viscera_MeshDelta d;
-  if (!resim_decode(row->cdr, row->cdr_len, &viscera_MeshDelta_desc, &d)) {
+  if (!rec_decode_cdr(row->cdr, row->cdr_len, &viscera_MeshDelta_desc, &d)) {
     skip(rec, "MeshDelta sample %lld does not decode", (long long)row->id);
     return 0;
   }
@@ -237,7 +237,7 @@ static int on_delta(void *arg, const recfile_row_t *row) {
                                                     .dq_len = d.dq._length};
     }
   }
-  resim_decode_free(&d, &viscera_MeshDelta_desc);
+  rec_decode_free(&d, &viscera_MeshDelta_desc);
   return rc;
 }
 

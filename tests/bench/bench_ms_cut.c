@@ -22,6 +22,7 @@
 
 #include "ms_cut_fixture.h"
 #include "plot.h"
+#include "plot_cleanup.h"
 #include "vstats.h"
 #include "vtime.h"
 
@@ -179,6 +180,9 @@ int main(int argc, char **argv) {
       return 2;
     }
   }
+  /* cairo and fontconfig keep their font caches until exit; released then
+   * on every return path so the sanitizer build's leak check stays clean. */
+  atexit(plot_cleanup);
   char cmd[4200];
   snprintf(cmd, sizeof cmd, "mkdir -p '%s'", out);
   if (system(cmd) != 0) {
