@@ -86,7 +86,7 @@ static int on_row(void *arg, const recfile_row_t *row) {
   decode_ctx_t *c = arg;
   if (row->kind != REC_KIND_DATA) return 0;
   if (!rec_decode_cdr(row->cdr, row->cdr_len, c->desc, c->sample)) {
-    c->rep->undecodable++;
+    if (c->rep->undecodable++ == 0) c->rep->first_undecodable = row->id;
     return 0;
   }
   c->rep->decoded++;

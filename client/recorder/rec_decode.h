@@ -42,6 +42,7 @@ typedef struct rec_decode_report {
   recfile_scan_report_t scan; /* what reading the rows met */
   uint64_t decoded;           /* data samples delivered */
   uint64_t undecodable;       /* data samples that did not decode */
+  int64_t first_undecodable;  /* row id of the first of them, 0 when none */
   bool topic_missing;         /* the recording has no such topic */
 } rec_decode_report_t;
 

@@ -12,7 +12,10 @@
 #      the kidney's stiffness doubled must FAIL (exit 1) naming the organ and
 #      the tolerance, so the comparison can fail;
 #   3. a scene that is not the recorded one (other name, other organ) is
-#      refused (exit 2) with "scene mismatch".
+#      refused (exit 2) with "scene mismatch";
+#   4. a copy of the recording with its first two SessionEvent samples
+#      garbled still re-simulates (they carry no schedule) and warns that
+#      they were skipped, naming the first by its row id.
 # usage: resim_test.sh BUILD SRC OUT
 set -euo pipefail
 BUILD="$1"; SRC="$2"; OUT="$3"
