@@ -44,7 +44,7 @@ typedef struct organ {
 } organ_t;
 
 static int setup(organ_t *o) {
-  if (fx_load(o->file, &o->mesh)) return -1;
+  if (test_mesh_load(o->file, &o->mesh)) return -1;
   double lo[3], hi[3];
   mesh_bounds(&o->mesh, lo, hi);
   double cx = 0.5 * (lo[0] + hi[0]), cy = 0.5 * (lo[1] + hi[1]), L = 0.3 * (hi[0] - lo[0]);
