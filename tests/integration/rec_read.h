@@ -1,9 +1,10 @@
 /* rec_read: the strict reading the integration-test tools (rec_tools,
- * rec_topology) do on a recording: every data sample of a topic decoded
- * with the compiled-in descriptor (rec_decode_topic), and anything short of
- * a complete read (a sample that does not decode, a damaged region or an
- * impossible row) reported on stderr and counted, because the tests read
- * recordings they just made and a salvage there is a failure. */
+ * rec_topology, rec_palpation) do on a recording: every data sample of a
+ * topic decoded with the compiled-in descriptor (rec_decode_topic), and
+ * anything short of a complete read (a sample that does not decode, a
+ * damaged region or an impossible row) reported on stderr and counted,
+ * because the tests read recordings they just made and a salvage there is
+ * a failure. */
 #ifndef VISCERA_TEST_REC_READ_H
 #define VISCERA_TEST_REC_READ_H
 
