@@ -3,11 +3,9 @@
 # and the run directly; it reads recordings with the recorder's recfile, so
 # it exists only when the recorder is built.
 if(VISCERA_BUILD_RECORDER)
-  add_library(viscera_resim STATIC resim_schedule.c resim_run.c resim_recording.c resim_decode.c)
+  add_library(viscera_resim STATIC resim_schedule.c resim_run.c resim_recording.c)
   target_include_directories(viscera_resim PUBLIC ${CMAKE_CURRENT_SOURCE_DIR})
-  target_link_libraries(viscera_resim PUBLIC viscera_server_core viscera_recording ${MATH_LIB})
+  target_link_libraries(viscera_resim PUBLIC viscera_server_core viscera_rec_decode ${MATH_LIB})
   add_executable(viscera-resim resim.c)
   target_link_libraries(viscera-resim PRIVATE viscera_resim)
-  # ddsi_cdrstream.h pulls in GNU `asm` (see client/recorder/CMakeLists.txt)
-  set_target_properties(viscera_resim PROPERTIES C_EXTENSIONS ON)
 endif()

@@ -11,6 +11,7 @@
 #include "recording.h"
 
 bool rec_decode_cdr(const void *cdr, size_t len, const dds_topic_descriptor_t *desc, void *out) {
+  memset(out, 0, desc->m_size); /* dds_stream_read would free or reuse garbage pointers */
   const unsigned char *b = cdr;
   if (!b || len < 4 || len - 4 > UINT32_MAX || b[0] != 0) return false;
   unsigned id = b[1];
@@ -85,7 +86,7 @@ static int on_row(void *arg, const recfile_row_t *row) {
   decode_ctx_t *c = arg;
   if (row->kind != REC_KIND_DATA) return 0;
   if (!rec_decode_cdr(row->cdr, row->cdr_len, c->desc, c->sample)) {
-    c->rep->undecodable++;
+    if (c->rep->undecodable++ == 0) c->rep->first_undecodable = row->id;
     return 0;
   }
   c->rep->decoded++;

@@ -1,7 +1,7 @@
 /* rec_decode: turns the raw CDR stored in a recording back into the
  * compiled-in IDL types (viscera.h), for programs that know the product
- * types: the report tool and the integration-test readers. The recorder
- * itself stays generic and never links this.
+ * types: the report tool, viscera-resim and the integration-test readers.
+ * The recorder itself stays generic and never links this.
  *
  * Nothing stored is trusted: every sample is normalized (all lengths, enum
  * values and string bounds checked against the type) before it is read, so
@@ -22,8 +22,10 @@
 #include "recfile.h"
 
 /* Decodes one stored sample (4-byte encoding header + payload) into `out`
- * (desc->m_size bytes, zeroed by the caller or by rec_decode_free). Returns
- * false when it does not decode; `out` then holds nothing to free. */
+ * (desc->m_size bytes). `out` is zeroed first, so it may be an uninitialized
+ * local; whatever it held before is overwritten, not freed (free a decoded
+ * sample with rec_decode_free before reusing it). Returns false when it does
+ * not decode; `out` is then zeroed and holds nothing to free. */
 bool rec_decode_cdr(const void *cdr, size_t len, const dds_topic_descriptor_t *desc, void *out);
 
 /* Frees what a decoded sample owns (sequences, unbounded strings) and zeroes
@@ -40,6 +42,7 @@ typedef struct rec_decode_report {
   recfile_scan_report_t scan; /* what reading the rows met */
   uint64_t decoded;           /* data samples delivered */
   uint64_t undecodable;       /* data samples that did not decode */
+  int64_t first_undecodable;  /* row id of the first of them, 0 when none */
   bool topic_missing;         /* the recording has no such topic */
 } rec_decode_report_t;
 

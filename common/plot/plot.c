@@ -167,6 +167,16 @@ static void set_line(cairo_t *cr, int style, double width) {
   }
 }
 
+/* A grid line at a tick: major ticks a darker grey than minor ones. */
+static void grid_line(cairo_t *cr, int major, double x0, double y0, double x1, double y1) {
+  double g = major ? 0.85 : 0.93;
+  cairo_set_source_rgb(cr, g, g, g);
+  set_line(cr, PLOT_LINE_SOLID, 1);
+  cairo_move_to(cr, x0, y0);
+  cairo_line_to(cr, x1, y1);
+  cairo_stroke(cr);
+}
+
 static void marker(cairo_t *cr, int shape, double x, double y, double r) {
   cairo_set_dash(cr, NULL, 0, 0);
   cairo_new_path(cr);
@@ -449,19 +459,11 @@ int plot_write_png(const plot_t *p, const char *path, verr_t *err) {
   /* Grid, then ticks and labels. */
   for (int i = 0; i < ntx; i++) {
     double px = to_px(&ax, tx[i].v);
-    cairo_set_source_rgb(cr, tx[i].major ? 0.85 : 0.93, tx[i].major ? 0.85 : 0.93, tx[i].major ? 0.85 : 0.93);
-    set_line(cr, PLOT_LINE_SOLID, 1);
-    cairo_move_to(cr, px, Y0);
-    cairo_line_to(cr, px, Y1);
-    cairo_stroke(cr);
+    grid_line(cr, tx[i].major, px, Y0, px, Y1);
   }
   for (int i = 0; i < nty; i++) {
     double py = to_px(&ay, ty[i].v);
-    cairo_set_source_rgb(cr, ty[i].major ? 0.85 : 0.93, ty[i].major ? 0.85 : 0.93, ty[i].major ? 0.85 : 0.93);
-    set_line(cr, PLOT_LINE_SOLID, 1);
-    cairo_move_to(cr, X0, py);
-    cairo_line_to(cr, X1, py);
-    cairo_stroke(cr);
+    grid_line(cr, ty[i].major, X0, py, X1, py);
   }
   cairo_set_source_rgb(cr, 0, 0, 0);
   set_line(cr, PLOT_LINE_SOLID, 1.2);

@@ -3,9 +3,7 @@
 # time above the crossed thresholds, in the recording and the server summary.
 # Domain 70.
 if(TARGET viscera-recorder)
-  add_executable(rec_palpation ${CMAKE_CURRENT_LIST_DIR}/rec_palpation.c)
-  target_link_libraries(rec_palpation PRIVATE viscera_rec_decode PkgConfig::SQLITE3)
-  # ddsi_cdrstream.h pulls in GNU `asm` (see client/recorder/CMakeLists.txt)
-  set_target_properties(rec_palpation PROPERTIES C_EXTENSIONS ON)
+  add_executable(rec_palpation ${CMAKE_CURRENT_LIST_DIR}/rec_palpation.c ${CMAKE_CURRENT_LIST_DIR}/rec_read.c)
+  target_link_libraries(rec_palpation PRIVATE viscera_rec_decode)
   viscera_integration_test(palpation_thresholds 70 palpation_test.sh)
 endif()

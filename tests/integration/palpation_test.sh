@@ -6,7 +6,8 @@
 # crossing of ST and MPF and none of SFT, decoded from the stored CDR; the
 # last recorded Metrics has time above ST and MPF > 0 (ST >= MPF), none above
 # SFT, contact time, mean contact force and path length in range; the
-# server's PALPATION summary agrees. usage: palpation_test.sh BUILD SRC OUT
+# server's PALPATION summary agrees; a reader meeting a sample that does not
+# decode fails naming it. usage: palpation_test.sh BUILD SRC OUT
 set -euo pipefail
 BUILD="$1"; SRC="$2"; OUT="$3"
 fail() { echo "FAIL: $*" >&2; for f in "$OUT"/*.log "$OUT"/*.out; do echo "--- $f"; tail -5 "$f"; done >&2; exit 1; }
@@ -41,4 +42,14 @@ awk -v st="$st" -v mpf="$mpf" -v sft="$sft" -v ct="$ct" -v mf="$mf" -v pl="$pl" 
 s=$(grep '^PALPATION tool=probe ' "$OUT/server.out")
 sst=$(echo "$s" | tr ' ' '\n' | sed -n 's/^time_above_ST=//p')
 awk -v a="$sst" -v b="$st" 'BEGIN { exit !(a >= b && a > 0) }' || fail "server summary time_above_ST $sst vs Metrics $st"
+
+# Negative control: one Metrics sample truncated in a copy; the reader
+# (rec_read.c) must fail and say which topic held it, not print a salvage.
+cp "$OUT/session.db" "$OUT/garbled.db"
+sqlite3 "$OUT/garbled.db" "UPDATE samples SET cdr = X'0001000001' WHERE id = (SELECT s.id FROM samples s
+  JOIN topics t ON t.id = s.topic_id WHERE t.name = 'viscera_Metrics' AND s.kind = 0 ORDER BY s.id LIMIT 1)"
+if "$BUILD/tests/integration/rec_palpation" "$OUT/garbled.db" > /dev/null 2> "$OUT/garbled.log"; then
+  fail "rec_palpation accepted a recording with an undecodable sample"
+fi
+grep -q "viscera_Metrics: 1 sample(s) do not decode" "$OUT/garbled.log" || fail "undecodable sample not reported"
 echo "PASS"

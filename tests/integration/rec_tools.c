@@ -1,6 +1,5 @@
-/* rec_tools: reads a session recording straight from the SQLite file and
- * prints, decoded with the compiled-in descriptors, what the tool tests
- * check (issue 4):
+/* rec_tools: reads a session recording (rec_read.h) and prints, decoded
+ * with the compiled-in descriptors, what the tool tests check (issue 4):
  *   EVENT KIND tool=N organ=N value=V TEXT       grasp and task SessionEvents
  *   TOOLMETRICS tool=N name=.. peak_force=.. ... last ToolMetrics per tool
  *   OBJECT id=N x= y= z= held_by= removed=       last ObjectState per object
@@ -9,71 +8,23 @@
  *   VERTEX index=I max_dz=.. final_dz=..         with --vertex X Y Z: the
  *       organ-0 keyframe vertex nearest (X,Y,Z), its largest and its last
  *       z displacement over the recorded MeshDeltas (m)
- * Exit 1 when the file cannot be read or a sample does not decode.
+ * Exit 1 when the file cannot be read, is damaged or a sample does not
+ * decode.
  * usage: rec_tools FILE.db [--vertex X Y Z] */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include <dds/dds.h>
-#include <dds/ddsi/ddsi_cdrstream.h>
-#include <sqlite3.h>
-
+#include "rec_read.h"
 #include "viscera.h"
 
-/* Decodes a stored sample (4-byte encoding header + payload) into `out`
- * with the compiled-in descriptor's ops (as rec_palpation does). */
-static bool decode(const unsigned char *cdr, int len, const dds_topic_descriptor_t *desc, void *out) {
-  if (!cdr || len < 4 || cdr[0] != 0) return false;
-  unsigned id = cdr[1];
-  bool le = (id & 1u) != 0;
-  uint32_t xcdrv = id <= 3 ? 1 : 2;
-  uint32_t size = (uint32_t)len - 4;
-  void *buf = malloc(size ? size : 1);
-  if (!buf) return false;
-  memcpy(buf, cdr + 4, size);
-  uint32_t off = 0;
-  bool bswap = le != (DDSRT_ENDIAN == DDSRT_LITTLE_ENDIAN);
-  bool ok = dds_stream_normalize_data(buf, &off, size, bswap, xcdrv, desc->m_ops) != NULL;
-  if (ok) {
-    dds_istream_t is;
-    dds_istream_init(&is, size, buf, xcdrv);
-    dds_stream_read(&is, out, desc->m_ops);
-    dds_istream_fini(&is);
-  }
-  free(buf);
-  return ok;
-}
-
-static sqlite3 *db;
+static recfile_t *rf;
 static int bad;
 
-/* Runs `fn` on every decoded sample of `topic`, in recording order. */
-static void each(const char *topic, const dds_topic_descriptor_t *desc, void (*fn)(void *sample, void *ctx),
-                 void *ctx) {
-  sqlite3_stmt *st = NULL;
-  if (sqlite3_prepare_v2(db,
-                         "SELECT s.cdr FROM samples s JOIN topics t ON t.id=s.topic_id"
-                         " WHERE t.name=?1 AND s.kind=0 ORDER BY s.id",
-                         -1, &st, NULL) != SQLITE_OK) {
-    fprintf(stderr, "rec_tools: %s\n", sqlite3_errmsg(db));
-    bad++;
-    return;
-  }
-  sqlite3_bind_text(st, 1, topic, -1, SQLITE_STATIC);
-  void *sample = dds_alloc(desc->m_size);
-  while (sqlite3_step(st) == SQLITE_ROW) {
-    memset(sample, 0, desc->m_size);
-    if (!decode(sqlite3_column_blob(st, 0), sqlite3_column_bytes(st, 0), desc, sample)) {
-      bad++;
-      continue;
-    }
-    fn(sample, ctx);
-    dds_sample_free(sample, desc, DDS_FREE_CONTENTS);
-  }
-  dds_free(sample);
-  sqlite3_finalize(st);
+/* Runs `fn` on every decoded sample of `topic` (see rec_read.h). */
+static void each(const char *topic, const dds_topic_descriptor_t *desc, rec_decode_cb fn, void *ctx) {
+  bad += rec_read_topic("rec_tools", rf, topic, desc, fn, ctx);
 }
 
 static const char *kind_name(viscera_EventKind k) {
@@ -91,34 +42,40 @@ static const char *kind_name(viscera_EventKind k) {
   }
 }
 
-static void on_event(void *p, void *ctx) {
+static int on_event(void *ctx, const void *p, const recfile_row_t *row) {
+  (void)row;
   (void)ctx;
   const viscera_SessionEvent *e = p;
   const char *k = kind_name(e->kind);
   if (k) printf("EVENT %s tool=%d organ=%d value=%.4f %s\n", k, (int)e->tool_id, (int)e->organ_id, e->value, e->text);
+  return 0;
 }
 
 enum { MAXN = 8 };
 static viscera_ToolMetrics tm[MAXN];
 static int have_tm[MAXN];
-static void on_tool_metrics(void *p, void *ctx) {
+static int on_tool_metrics(void *ctx, const void *p, const recfile_row_t *row) {
+  (void)row;
   (void)ctx;
   const viscera_ToolMetrics *m = p;
   if (m->tool_id < MAXN) {
     tm[m->tool_id] = *m;
     have_tm[m->tool_id] = 1;
   }
+  return 0;
 }
 
 static viscera_ObjectState ob[MAXN];
 static int have_ob[MAXN];
-static void on_object(void *p, void *ctx) {
+static int on_object(void *ctx, const void *p, const recfile_row_t *row) {
+  (void)row;
   (void)ctx;
   const viscera_ObjectState *o = p;
   if (o->object_id < MAXN) {
     ob[o->object_id] = *o;
     have_ob[o->object_id] = 1;
   }
+  return 0;
 }
 
 /* ContactFeedback of tools 0 and 1: the tip each is told, matched by sim
@@ -130,10 +87,11 @@ typedef struct fb_pairs {
   long n;
   double min_d;
 } fb_pairs_t;
-static void on_feedback(void *p, void *ctx) {
+static int on_feedback(void *ctx, const void *p, const recfile_row_t *row) {
+  (void)row;
   fb_pairs_t *fp = ctx;
   const viscera_ContactFeedback *f = p;
-  if (f->tool_id > 1) return;
+  if (f->tool_id > 1) return 0;
   int i = (int)f->tool_id;
   fp->t[i] = f->sim_time_ns;
   memcpy(fp->pos[i], f->proxy_position, sizeof fp->pos[i]);
@@ -145,6 +103,7 @@ static void on_feedback(void *p, void *ctx) {
     if (d < fp->min_d) fp->min_d = d;
     fp->n++;
   }
+  return 0;
 }
 
 typedef struct vtrack {
@@ -154,10 +113,11 @@ typedef struct vtrack {
   double max_dz, final_dz;
   long deltas;
 } vtrack_t;
-static void on_state(void *p, void *ctx) {
+static int on_state(void *ctx, const void *p, const recfile_row_t *row) {
+  (void)row;
   vtrack_t *v = ctx;
   const viscera_MeshState *s = p;
-  if (s->organ_id != 0 || v->index >= 0) return;
+  if (s->organ_id != 0 || v->index >= 0) return 0;
   double best = INFINITY;
   for (uint32_t i = 0; i + 2 < s->positions._length; i += 3) {
     double d = 0;
@@ -169,17 +129,20 @@ static void on_state(void *p, void *ctx) {
       v->key_z = s->positions._buffer[i + 2];
     }
   }
+  return 0;
 }
-static void on_delta(void *p, void *ctx) {
+static int on_delta(void *ctx, const void *p, const recfile_row_t *row) {
+  (void)row;
   vtrack_t *v = ctx;
   const viscera_MeshDelta *d = p;
-  if (d->organ_id != 0 || v->index < 0) return;
+  if (d->organ_id != 0 || v->index < 0) return 0;
   double dz = 0;
   for (uint32_t j = 0; j < d->indices._length && 3 * j + 2 < d->dq._length; j++)
     if (d->indices._buffer[j] == (uint32_t)v->index) dz = d->dq._buffer[3 * j + 2] * (double)d->quant_step;
   if (dz > v->max_dz) v->max_dz = dz;
   v->final_dz = dz;
   v->deltas++;
+  return 0;
 }
 
 int main(int argc, char **argv) {
@@ -187,9 +150,9 @@ int main(int argc, char **argv) {
     fprintf(stderr, "usage: rec_tools FILE.db [--vertex X Y Z]\n");
     return 2;
   }
-  if (sqlite3_open_v2(argv[1], &db, SQLITE_OPEN_READONLY, NULL) != SQLITE_OK) {
-    fprintf(stderr, "rec_tools: %s: %s\n", argv[1], sqlite3_errmsg(db));
-    sqlite3_close(db);
+  verr_t err;
+  if (recfile_open(&rf, argv[1], &err) < 0) {
+    fprintf(stderr, "rec_tools: %s\n", err.msg);
     return 1;
   }
   each("viscera_SessionEvent", &viscera_SessionEvent_desc, on_event, NULL);
@@ -216,7 +179,7 @@ int main(int argc, char **argv) {
     printf("VERTEX index=%ld key_z=%.5f max_dz=%.5f final_dz=%.5f deltas=%ld\n", v.index, v.key_z, v.max_dz, v.final_dz,
            v.deltas);
   }
-  sqlite3_close(db);
-  if (bad) fprintf(stderr, "rec_tools: %d samples did not decode\n", bad);
+  recfile_close(rf);
+  if (bad) fprintf(stderr, "rec_tools: %d samples or rows unreadable\n", bad);
   return bad ? 1 : 0;
 }

@@ -12,7 +12,10 @@
 #      the kidney's stiffness doubled must FAIL (exit 1) naming the organ and
 #      the tolerance, so the comparison can fail;
 #   3. a scene that is not the recorded one (other name, other organ) is
-#      refused (exit 2) with "scene mismatch".
+#      refused (exit 2) with "scene mismatch";
+#   4. a copy of the recording with its first two SessionEvent samples
+#      garbled still re-simulates (they carry no schedule) and warns that
+#      they were skipped, naming the first by its row id.
 # usage: resim_test.sh BUILD SRC OUT
 set -euo pipefail
 BUILD="$1"; SRC="$2"; OUT="$3"
@@ -99,4 +102,20 @@ set -e
 cat "$OUT/resim_spleen.log"
 [ $rc -eq 2 ] || fail "a scene with another organ mesh exited $rc, expected 2"
 grep -q "scene mismatch: organ 'kidney' has 600 vertices" "$OUT/resim_spleen.log" || fail "mismatch not named"
+
+echo "== 4. undecodable samples are skipped and named"
+cp "$OUT/session.db" "$OUT/garbled.db"
+ev="SELECT s.id FROM samples s JOIN topics t ON t.id=s.topic_id WHERE t.name='viscera_SessionEvent' AND s.kind=0"
+first=$(sqlite3 "$OUT/garbled.db" "$ev ORDER BY s.id LIMIT 1")
+[ -n "$first" ] || fail "no SessionEvent sample recorded"
+# A CDR header and one byte: truncated for any type, so it cannot decode.
+sqlite3 "$OUT/garbled.db" "UPDATE samples SET cdr = X'0001000001' WHERE id IN ($ev ORDER BY s.id LIMIT 2)"
+set +e
+"$RESIM" --scene "$SCENE" "$OUT/garbled.db" --quiet >"$OUT/resim_garbled.out" 2>"$OUT/resim_garbled.log"
+rc=$?
+set -e
+cat "$OUT/resim_garbled.log"
+[ $rc -eq 0 ] || fail "re-simulating with two garbled SessionEvents exited $rc, expected 0"
+grep -qF "2 sample(s) skipped; first: SessionEvent sample $first does not decode (2 in all)" "$OUT/resim_garbled.log" ||
+  fail "the garbled samples were not reported"
 echo "PASS"

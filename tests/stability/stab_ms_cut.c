@@ -11,15 +11,10 @@
 
 #include "check.h"
 #include "ms_cut_fixture.h"
+#include "test_rng.h"
 
 static uint64_t rng_state = 0x9e3779b97f4a7c15ull;
-static double urand(void) {
-  uint64_t z = (rng_state += 0x9e3779b97f4a7c15ull);
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-  z ^= z >> 31;
-  return (double)(z >> 11) * (1.0 / 9007199254740992.0);
-}
+static double urand(void) { return test_rng_uniform(&rng_state); }
 
 /* Triangles with a corner angle below deg. */
 static size_t count_slivers(const model_t *m, const double *x, double deg) {
@@ -119,7 +114,7 @@ int main(void) {
     mesh_free(&sheet);
   } else
     CHECK(0);
-  if (fx_load("spleen.obj", &spleen) == 0) {
+  if (test_mesh_load("spleen.obj", &spleen) == 0) {
     random_cuts("spleen", &spleen, 100);
     mesh_free(&spleen);
   } else

@@ -2,7 +2,7 @@
  * generated sheet, a mass_spring_surface model from a mesh, a straight
  * blade stroke driven step by step, and mesh validity checks (manifold
  * edges and vertices, orientation, degenerate faces, components).
- * Header-only, static functions. */
+ * Header-only, static functions; asset meshes load with test_assets.h. */
 #ifndef VISCERA_MS_CUT_FIXTURE_H
 #define VISCERA_MS_CUT_FIXTURE_H
 
@@ -17,6 +17,7 @@
 #include "mesh_check.h"
 #include "mesh_import.h"
 #include "model.h"
+#include "test_assets.h"
 #include "vmath.h"
 
 /* A flat sheet w x h metres at z = 0, nx x ny nodes, centred on the origin,
@@ -44,18 +45,6 @@ static inline int fx_sheet(mesh_t *m, int nx, int ny, double w, double h) {
         memcpy(f, q, sizeof q);
       }
     }
-  return 0;
-}
-
-static inline int fx_load(const char *name, mesh_t *m) {
-  const char *src = getenv("VISCERA_SOURCE_DIR");
-  char path[4096];
-  snprintf(path, sizeof path, "%s/assets/meshes/%s", src ? src : "../..", name);
-  verr_t err;
-  if (mesh_import(path, m, &err)) {
-    printf("cannot load %s: %s\n", name, err.msg);
-    return -1;
-  }
   return 0;
 }
 

@@ -16,20 +16,9 @@
 #include "mesh.h"
 #include "mesh_import.h"
 #include "model.h"
+#include "test_assets.h"
 #include "vmath.h"
 #include "vtime.h"
-
-static int load(const char *name, mesh_t *m) {
-  const char *src = getenv("VISCERA_SOURCE_DIR");
-  char path[4096];
-  snprintf(path, sizeof path, "%s/assets/meshes/%s", src ? src : "../..", name);
-  verr_t err;
-  if (mesh_import(path, m, &err)) {
-    printf("cannot load %s: %s\n", name, err.msg);
-    return -1;
-  }
-  return 0;
-}
 
 static adaptive_params_t params(double refine_area, int levels) {
   adaptive_params_t p = {.mass = 0.1,
@@ -179,7 +168,7 @@ static int in_star_face(const adaptive_t *ad, uint32_t c, uint32_t face) {
  * eq. 5.18 sub-steps; simplify back exactly; time both. */
 static void test_refine_simplify(void) {
   mesh_t m;
-  if (load("spleen.obj", &m)) {
+  if (test_mesh_load("spleen.obj", &m)) {
     CHECK(0);
     return;
   }
@@ -267,7 +256,7 @@ static void test_refine_simplify(void) {
  * simplification exact each time. */
 static void test_random_centres(const char *name, int levels_max, int trials) {
   mesh_t m;
-  if (load(name, &m)) {
+  if (test_mesh_load(name, &m)) {
     CHECK(0);
     return;
   }
@@ -420,7 +409,7 @@ static double probe_stiffness(adaptive_t *ad, uint32_t c, double F, int refine) 
 
 static void test_indentation(void) {
   mesh_t m;
-  if (load("spleen.obj", &m)) {
+  if (test_mesh_load("spleen.obj", &m)) {
     CHECK(0);
     return;
   }
@@ -504,7 +493,7 @@ static void model_hook(model_t *m, void *ctx) {
 
 static void test_model(void) {
   mesh_t m;
-  if (load("spleen.obj", &m)) {
+  if (test_mesh_load("spleen.obj", &m)) {
     CHECK(0);
     return;
   }
@@ -599,7 +588,7 @@ static void test_model(void) {
  * interior ones stay conforming. */
 static void test_open_mesh(void) {
   mesh_t m;
-  if (load("tissue_block.obj", &m)) {
+  if (test_mesh_load("tissue_block.obj", &m)) {
     CHECK(0);
     return;
   }
@@ -658,7 +647,7 @@ static void push_pre(void *ctx) {
 
 static void test_stability(const char *name, int L) {
   mesh_t m;
-  if (load(name, &m)) {
+  if (test_mesh_load(name, &m)) {
     CHECK(0);
     return;
   }
@@ -695,7 +684,7 @@ static void test_stability(const char *name, int L) {
  * and refined around a touched node. */
 static void bench_steps(const char *name) {
   mesh_t m;
-  if (load(name, &m)) {
+  if (test_mesh_load(name, &m)) {
     CHECK(0);
     return;
   }

@@ -8,20 +8,12 @@
 #include "check.h"
 #include "contact_model.h"
 #include "trajectory.h"
-
-static const char *write_tmp(const char *name, const char *text) {
-  static char path[256];
-  snprintf(path, sizeof path, "/tmp/viscera_test_%d_%s", (int)getpid(), name);
-  FILE *f = fopen(path, "w");
-  fputs(text, f);
-  fclose(f);
-  return path;
-}
+#include "test_tmpfile.h"
 
 int main(void) {
   trajectory_t tr;
   verr_t err;
-  const char *p = write_tmp("ok.traj", "# t x y z buttons\n0 0 0 1\n\n1.0 0 0 0  # down\n2 1 0 0 1\n");
+  const char *p = test_write_tmp("ok.traj", "# t x y z buttons\n0 0 0 1\n\n1.0 0 0 0  # down\n2 1 0 0 1\n");
   CHECK(trajectory_load(p, &tr, &err) == 0);
   CHECK(tr.n == 3);
   double pos[3];
@@ -46,7 +38,7 @@ int main(void) {
              {"0 0 0 0 x\n", ":1: field 'buttons'"},
              {"# nothing\n", "no samples"}};
   for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
-    p = write_tmp("bad.traj", bad[i].text);
+    p = test_write_tmp("bad.traj", bad[i].text);
     CHECK(trajectory_load(p, &tr, &err) == -1);
     CHECK(strstr(err.msg, bad[i].needle) != NULL);
     CHECK(strstr(err.msg, "bad.traj") != NULL);

@@ -10,15 +10,7 @@
 #include "check.h"
 #include "input_map.h"
 #include "input_script.h"
-
-static const char *write_tmp(const char *name, const char *text) {
-  static char path[256];
-  snprintf(path, sizeof path, "/tmp/viscera_test_%d_%s", (int)getpid(), name);
-  FILE *f = fopen(path, "w");
-  fputs(text, f);
-  fclose(f);
-  return path;
-}
+#include "test_tmpfile.h"
 
 static double dist_to_eye(const input_state_t *s) {
   double d = 0;
@@ -143,8 +135,8 @@ static void test_mapping(void) {
 static void test_script(void) {
   input_script_t sc;
   verr_t err;
-  const char *p = write_tmp("ok.input", "# demo\n0.5 motion 10 -4\n\n1 wheel -2   # out\n1 key_down space\n"
-                                        "2 key_up space\n2.5 button_down\n3 button_up\n3 key_down r\n");
+  const char *p = test_write_tmp("ok.input", "# demo\n0.5 motion 10 -4\n\n1 wheel -2   # out\n1 key_down space\n"
+                                             "2 key_up space\n2.5 button_down\n3 button_up\n3 key_down r\n");
   CHECK(input_script_load(p, &sc, &err) == 0);
   CHECK(sc.n == 7);
   CHECK(sc.ev[0].ev.kind == INPUT_MOTION && sc.ev[0].ev.dx == 10 && sc.ev[0].ev.dy == -4);
@@ -177,7 +169,7 @@ static void test_script(void) {
       {"0 motion 1 2 3 4\n", ":1: too many fields"},
   };
   for (size_t i = 0; i < sizeof BAD / sizeof BAD[0]; i++) {
-    p = write_tmp("bad.input", BAD[i].text);
+    p = test_write_tmp("bad.input", BAD[i].text);
     int rc = input_script_load(p, &sc, &err);
     CHECK(rc == -1);
     if (rc == -1 && !strstr(err.msg, BAD[i].expect)) {
@@ -187,7 +179,7 @@ static void test_script(void) {
   }
   CHECK(input_script_load("/nonexistent/x.input", &sc, &err) == -1 && strstr(err.msg, "cannot open"));
   unlink(p);
-  unlink(write_tmp("ok.input", ""));
+  unlink(test_write_tmp("ok.input", ""));
 }
 
 int main(void) {

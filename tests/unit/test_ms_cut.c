@@ -19,15 +19,10 @@
 #include "mass_spring.h"
 #include "model_mass_spring.h"
 #include "ms_cut_fixture.h"
+#include "test_rng.h"
 
 static uint64_t rng_state = 0x2545f4914f6cdd1dull;
-static double urand(void) {
-  uint64_t z = (rng_state += 0x9e3779b97f4a7c15ull);
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-  z ^= z >> 31;
-  return (double)(z >> 11) * (1.0 / 9007199254740992.0);
-}
+static double urand(void) { return test_rng_uniform(&rng_state); }
 
 static void test_bezier(void) {
   const double P[4][3] = {{0, 0, 0}, {1, 2, 0}, {3, 2, 1}, {4, 0, 0}};
@@ -357,7 +352,8 @@ static void test_cuts(void) {
   mesh_t block, sheet, spleen;
   model_t *m;
   ms_cut_t *c;
-  if (fx_load("tissue_block.obj", &block) || fx_sheet(&sheet, 61, 37, 0.1, 0.06) || fx_load("spleen.obj", &spleen)) {
+  if (test_mesh_load("tissue_block.obj", &block) || fx_sheet(&sheet, 61, 37, 0.1, 0.06) ||
+      test_mesh_load("spleen.obj", &spleen)) {
     CHECK(0);
     return;
   }
@@ -513,7 +509,7 @@ static void test_allocation_and_input(void) {
   cfg.material =
       (scene_material_t){.mass = 0.1, .stiffness = 30, .damping = 0.02, .home_stiffness = 30, .home_damping = 0.005};
   mesh_t spleen;
-  if (fx_load("spleen.obj", &spleen) == 0) {
+  if (test_mesh_load("spleen.obj", &spleen) == 0) {
     model_params_t p = {.cfg = &cfg, .surface = &spleen, .dt = 1e-3};
     model_t *t = model_create(&p, &err);
     CHECK(t != NULL);

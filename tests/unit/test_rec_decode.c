@@ -106,6 +106,16 @@ static void test_scene_info(void) {
     rec_decode_free(&got, &viscera_SceneInfo_desc);
     CHECK(got.tools._buffer == NULL);
   }
+  /* Into a buffer full of garbage (an uninitialized local, as viscera-resim
+   * passes): the decoder zeroes it first instead of reusing or freeing the
+   * garbage sequence pointers. A failed decode leaves it zeroed. */
+  memset(&got, 0xA5, sizeof got);
+  CHECK(rec_decode_cdr(b, len, &viscera_SceneInfo_desc, &got));
+  CHECK(got.tools._length == 2 && got.tools._buffer && got.organs._length == 0 && got.organs._buffer == NULL);
+  rec_decode_free(&got, &viscera_SceneInfo_desc);
+  memset(&got, 0xA5, sizeof got);
+  CHECK(!rec_decode_cdr(b, 3, &viscera_SceneInfo_desc, &got));
+  CHECK(got.tools._buffer == NULL && got.tools._length == 0 && got.scene[0] == 0);
   free(b);
 }
 

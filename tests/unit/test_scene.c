@@ -9,31 +9,14 @@
 
 #include "check.h"
 #include "scene.h"
+#include "scene_expect.h"
 
 static scene_t s; /* large: keep it off the stack */
 static verr_t e;
 
-/* Loads `yaml` (named t.yaml, based in /base) and reports whether it failed
- * with a message holding `a` and, if given, `b`; prints the message if not. */
-static int fails_with(const char *yaml, const char *a, const char *b) {
-  memset(&e, 0, sizeof e);
-  if (scene_load_string(yaml, "t.yaml", "/base", &s, &e) == 0) {
-    fprintf(stderr, "  loaded fine, wanted an error with '%s'\n", a);
-    return 0;
-  }
-  if (!strstr(e.msg, a) || (b && !strstr(e.msg, b))) {
-    fprintf(stderr, "  got:  %s\n  want: '%s' and '%s'\n", e.msg, a, b ? b : "");
-    return 0;
-  }
-  return 1;
-}
-
-static int loads(const char *yaml, const char *base_dir) {
-  memset(&e, 0, sizeof e);
-  if (scene_load_string(yaml, "t.yaml", base_dir, &s, &e) == 0) return 1;
-  fprintf(stderr, "  unexpected error: %s\n", e.msg);
-  return 0;
-}
+/* See scene_expect.h. */
+static int fails_with(const char *yaml, const char *a, const char *b) { return scene_fails_with(&s, &e, yaml, a, b); }
+static int loads(const char *yaml, const char *base_dir) { return scene_loads(&s, &e, yaml, base_dir); }
 
 /* Lines 1-4 of most cases: one valid organ, so line 5 is the first free one. */
 #define HEAD "scene: demo\norgans:\n  - name: kidney\n    mesh: k.obj\n"

@@ -6,29 +6,14 @@
 
 #include "check.h"
 #include "scene.h"
+#include "scene_expect.h"
 
 static scene_t s; /* large: keep it off the stack */
 static verr_t e;
 
-static int fails_with(const char *yaml, const char *a, const char *b) {
-  memset(&e, 0, sizeof e);
-  if (scene_load_string(yaml, "t.yaml", "/base", &s, &e) == 0) {
-    fprintf(stderr, "  loaded fine, wanted an error with '%s'\n", a);
-    return 0;
-  }
-  if (!strstr(e.msg, a) || (b && !strstr(e.msg, b))) {
-    fprintf(stderr, "  got:  %s\n  want: '%s' and '%s'\n", e.msg, a, b ? b : "");
-    return 0;
-  }
-  return 1;
-}
-
-static int loads(const char *yaml) {
-  memset(&e, 0, sizeof e);
-  if (scene_load_string(yaml, "t.yaml", "/base", &s, &e) == 0) return 1;
-  fprintf(stderr, "  unexpected error: %s\n", e.msg);
-  return 0;
-}
+/* See scene_expect.h. */
+static int fails_with(const char *yaml, const char *a, const char *b) { return scene_fails_with(&s, &e, yaml, a, b); }
+static int loads(const char *yaml) { return scene_loads(&s, &e, yaml, "/base"); }
 
 /* Lines 1-6: two organs. */
 #define HEAD                                                                                                           \
