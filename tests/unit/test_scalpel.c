@@ -30,7 +30,7 @@ static const char *SPLEEN_XPBD = "scene: t\n"
                                  "    mesh: ../meshes/spleen.obj\n"
                                  "    model: xpbd\n"
                                  "    material: {mass: 0.15, distance_compliance: 2.0e-3, volume_compliance: 1.0e-4}\n"
-                                 "    solver: {substeps: 1, iterations: 8, tet_size: 0.007}\n";
+                                 "    solver: {substeps: 1, iterations: 8, tet_size: 0.005}\n";
 static const char *BLOCK_MS = "  - name: block\n"
                               "    mesh: ../meshes/tissue_block.obj\n"
                               "    model: mass_spring_surface\n"
