@@ -463,6 +463,7 @@ enum {
   T_FRICTION,
   T_GRASP_RADIUS,
   T_JAW_OPENING,
+  T_BLADE_LENGTH,
   T_NKEYS
 };
 static const char *const tool_keys[T_NKEYS] = {[T_NAME] = "name",
@@ -474,7 +475,8 @@ static const char *const tool_keys[T_NKEYS] = {[T_NAME] = "name",
                                                [T_THRESHOLDS] = "thresholds",
                                                [T_FRICTION] = "friction",
                                                [T_GRASP_RADIUS] = "grasp_radius",
-                                               [T_JAW_OPENING] = "jaw_opening"};
+                                               [T_JAW_OPENING] = "jaw_opening",
+                                               [T_BLADE_LENGTH] = "blade_length"};
 
 enum { J_NAME, J_KIND, J_RADIUS, J_POSITION, J_ORGAN, J_COLOR, J_NKEYS };
 static const char *const object_keys[J_NKEYS] = {[J_NAME] = "name",         [J_KIND] = "kind",   [J_RADIUS] = "radius",
@@ -752,6 +754,7 @@ static int parse_thresholds(const ctx_t *c, const node_t *n, const char *path, s
 static int parse_capability(const ctx_t *c, const node_t *const *v, const char *path, scene_tool_t *t) {
   static const range_t mu_range = {B_INCL, 0, B_INCL, 2};
   static const range_t grasp_range = {B_EXCL, 0, B_INCL, 0.05};
+  static const range_t blade_range = {B_EXCL, 0, B_INCL, 0.2};
   char fp[128];
   if (opt_number(c, v[T_FRICTION], path, "friction", &mu_range, &t->friction)) return -1;
   int jaws = !strcmp(t->kind, "grasper") || !strcmp(t->kind, "extractor");
@@ -763,6 +766,12 @@ static int parse_capability(const ctx_t *c, const node_t *const *v, const char *
     join(fp, sizeof fp, path, "jaw_opening");
     return field_err(c, v[T_JAW_OPENING], fp, "only a grasper has jaws to open (this tool is a %s)", t->kind);
   }
+  if (v[T_BLADE_LENGTH] && strcmp(t->kind, "scalpel")) {
+    join(fp, sizeof fp, path, "blade_length");
+    return field_err(c, v[T_BLADE_LENGTH], fp, "only a scalpel has a blade (this tool is a %s)", t->kind);
+  }
+  if (!strcmp(t->kind, "scalpel")) t->blade_length = 0.02;
+  if (opt_number(c, v[T_BLADE_LENGTH], path, "blade_length", &blade_range, &t->blade_length)) return -1;
   if (jaws) t->grasp_radius = 2 * t->radius;
   if (!strcmp(t->kind, "grasper")) t->jaw_opening = 4 * t->radius;
   if (opt_number(c, v[T_GRASP_RADIUS], path, "grasp_radius", &grasp_range, &t->grasp_radius)) return -1;

@@ -79,13 +79,17 @@ typedef struct scene_organ {
  *   grasper    touches like a probe; closing the jaws (ToolCommand.buttons
  *              bit 0) within grasp_radius of the surface grabs a small
  *              patch of tissue and holds it to the tip until they open.
- *   scalpel    touches like a probe; the cutting issue (5) reads it.
+ *   scalpel    touches like a probe; with the button (bit 0) pressed its
+ *              blade, blade_length along the tool axis from the tip, cuts
+ *              pbd, xpbd and mass_spring_surface organs
+ *              (server/interaction/scalpel.h).
  *   extractor  laparoscopic stone extractor: enters through an assumed port,
  *              so it does not collide with organs; closing the jaws within
  *              grasp_radius of a stone's surface grabs the stone and carries it.
  *   syringe    touches like a probe; injection is not simulated yet.
  * grasp_radius is accepted (and required to be meaningful) only for
- * grasper and extractor; jaw_opening only for grasper. */
+ * grasper and extractor; jaw_opening only for grasper; blade_length only
+ * for scalpel. */
 typedef struct scene_tool {
   char name[SCENE_NAME_LEN];
   char kind[32];    /* probe | grasper | scalpel | extractor | syringe (default probe) */
@@ -108,6 +112,9 @@ typedef struct scene_tool {
   double grasp_radius;
   /* grasper: m, jaw opening when open, for drawing (default 4 x radius). */
   double jaw_opening;
+  /* scalpel: m, cutting edge from the tip along the tool axis (default
+   * 0.02). 0 for the other kinds. */
+  double blade_length;
   int line;
 } scene_tool_t;
 

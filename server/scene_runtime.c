@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "interaction/scalpel.h"
 #include "interaction/shaft.h"
 #include "interaction/tool_actions.h"
 #include "mesh_import.h"
@@ -107,7 +108,7 @@ int runtime_init(runtime_t *rt, const scene_t *scene, verr_t *err) {
     rt->tools[t].cfg = &rt->scene.tools[t];
     proxy_reset(&rt->tools[t].proxy);
   }
-  if (interact_init(rt, err)) {
+  if (interact_init(rt, err) || scalpel_init(rt, err)) {
     runtime_destroy(rt);
     return -1;
   }
@@ -115,6 +116,7 @@ int runtime_init(runtime_t *rt, const scene_t *scene, verr_t *err) {
 }
 
 void runtime_destroy(runtime_t *rt) {
+  scalpel_destroy(rt); /* before the models it cuts */
   for (size_t i = 0; i < rt->norgans; i++) {
     model_destroy(rt->organs[i].model);
     rt->organs[i].model = NULL;
@@ -225,6 +227,9 @@ int runtime_step(runtime_t *rt) {
       o->rollbacks++;
       rolled++;
     }
+    /* Between model steps: a cut changes the topology here, and the
+     * follow-up below runs before anything reads the surface again. */
+    scalpel_after_organ_step(rt, i);
     if (o->model->topology_version != o->topology_version) {
       /* New surface: fresh tree (its boxes are current), proxies re-attached
        * where they were, patches from the new vertices. */

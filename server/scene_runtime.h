@@ -89,6 +89,7 @@ typedef struct runtime {
   size_t ntasks;
   task_rt_t tasks[SCENE_MAX_TASKS];
   iev_queue_t events; /* interaction events; the caller drains (clears n) */
+  struct scalpel *scalpel; /* cutting (interaction/scalpel.h); NULL in a scene without a scalpel */
   uint64_t steps;
   double sim_time; /* s */
 } runtime_t;

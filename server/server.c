@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "checkpoint.h"
+#include "interaction/scalpel.h"
 #include "liveliness_watch.h"
 #include "mesh.h"
 #include "session_control.h"
@@ -450,11 +451,33 @@ static void publish_interactions(server_t *s) {
       kind = viscera_EVENT_TASK_COMPLETED;
       snprintf(text, sizeof text, "task '%s' completed in %.3f s (tool '%s')", sc->tasks[e->task].name, e->value, tool);
       break;
+    case IEV_CUT_BEGIN:
+      kind = viscera_EVENT_CUT_BEGIN;
+      snprintf(text, sizeof text, "tool '%s' cuts organ '%s' (%.0f surface vertices)", tool, sc->organs[e->organ].name,
+               e->value);
+      break;
+    case IEV_CUT_END: {
+      kind = viscera_EVENT_CUT_END;
+      const model_t *m = s->rt.organs[e->organ].model;
+      double wmean = 0, wmax = 0;
+      size_t nw = scalpel_incision_width(&s->rt, (size_t)e->organ, &wmean, &wmax);
+      int k = snprintf(text, sizeof text, "tool '%s' ends its cut of organ '%s': %.0f topology change(s), %zu vertices",
+                       tool, sc->organs[e->organ].name, e->value, m->nsurf);
+      if (nw && k > 0 && (size_t)k < sizeof text)
+        snprintf(text + k, sizeof text - (size_t)k, ", incision width %.2f mm mean, %.2f mm max", wmean * 1e3,
+                 wmax * 1e3);
+      break;
+    }
     }
     if (!s->opts->quiet) fprintf(stderr, "server: %s\n", text);
     publish_event(s, kind, e->organ, e->tool, e->value, text);
   }
   s->rt.events.n = 0;
+  /* A refused cut is logged (the first few, then every 100th), never fatal. */
+  char msg[240];
+  uint64_t r = scalpel_take_error(&s->rt, msg, sizeof msg);
+  if (r && (r <= 5 || r % 100 == 0) && !s->opts->quiet)
+    fprintf(stderr, "server: %s (%" PRIu64 " refused so far)\n", msg, r);
 }
 
 static void publish_objects(server_t *s) {
@@ -661,6 +684,7 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
   stats->step_us_median = st.median;
   stats->step_us_p99 = st.p99;
   stats->step_us_max = st.max;
+  scalpel_print_summary(&s.rt, stdout);
   /* Give reliable late samples (last frame, stop event) a moment to leave. */
   dds_sleepfor(DDS_MSECS(100));
   teardown(&s);

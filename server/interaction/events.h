@@ -8,7 +8,14 @@
 #include <stddef.h>
 #include <stdint.h>
 
-typedef enum iev_kind { IEV_GRASP_BEGIN, IEV_GRASP_END, IEV_TASK_STARTED, IEV_TASK_COMPLETED } iev_kind_t;
+typedef enum iev_kind {
+  IEV_GRASP_BEGIN,
+  IEV_GRASP_END,
+  IEV_TASK_STARTED,
+  IEV_TASK_COMPLETED,
+  IEV_CUT_BEGIN, /* scalpel.h: value = surface vertices when the blade first touched */
+  IEV_CUT_END    /* value = topology changes the cut made */
+} iev_kind_t;
 
 typedef struct iev {
   iev_kind_t kind;

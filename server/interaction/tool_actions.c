@@ -3,6 +3,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "scalpel.h"
 #include "shaft.h"
 #include "vmath.h"
 
@@ -48,7 +49,8 @@ int interact_init(runtime_t *rt, verr_t *err) {
 
 int interact_uses_proxy(const runtime_t *rt, size_t t) {
   const tool_rt_t *tool = &rt->tools[t];
-  return !is_kind(tool, "extractor") && !tool->grasp.active;
+  /* A cutting scalpel's blade goes into the tissue (scalpel.h). */
+  return !is_kind(tool, "extractor") && !tool->grasp.active && !scalpel_cutting(rt, t);
 }
 
 /* Grasper closing: the organ with a surface vertex nearest the tip. */
@@ -138,8 +140,10 @@ void interact_before_step(runtime_t *rt) {
 
 /* The shaft of a driven tool that meets tissue (not the extractor: it
  * enters through its port); its tip is where the hand's tip is held. */
-static int shaft_of(const tool_rt_t *tool, double p0[3], double p1[3]) {
-  if (!tool->active || is_kind(tool, "extractor")) return 0;
+static int shaft_of(const runtime_t *rt, size_t t, double p0[3], double p1[3]) {
+  const tool_rt_t *tool = &rt->tools[t];
+  /* A cutting scalpel parts the tissue instead of pushing it (scalpel.h). */
+  if (!tool->active || is_kind(tool, "extractor") || scalpel_cutting(rt, t)) return 0;
   const double *tip = tool->proxy.in_contact ? tool->proxy.pos : tool->device;
   shaft_segment(tip, tool->axis, tool->cfg->radius, tool->cfg->length, p0, p1);
   return 1;
@@ -170,7 +174,7 @@ void interact_apply(runtime_t *rt, organ_rt_t *o, model_t *m) {
   for (size_t t = 0; t < rt->ntools; t++) {
     tool_rt_t *tool = &rt->tools[t];
     double p0[3], p1[3], ft[3] = {0, 0, 0};
-    if (!shaft_of(tool, p0, p1)) continue;
+    if (!shaft_of(rt, t, p0, p1)) continue;
     shaft_push(p0, p1, SHAFT_RADIUS_FRACTION * tool->cfg->radius, tool->cfg->stiffness, m->surf_x, m->nsurf, add_force,
                m, ft);
   }
@@ -206,9 +210,10 @@ static void add_nothing(void *ctx, uint32_t i, const double f[3]) {
 
 /* The shaft's reaction at the end of the step: added to what the tip
  * feels; a shaft touching while the tip is free is a contact of its own. */
-static void shaft_feedback(runtime_t *rt, tool_rt_t *tool) {
+static void shaft_feedback(runtime_t *rt, size_t t) {
+  tool_rt_t *tool = &rt->tools[t];
   double p0[3], p1[3], ft[3] = {0, 0, 0};
-  if (!shaft_of(tool, p0, p1)) return;
+  if (!shaft_of(rt, t, p0, p1)) return;
   size_t hits = 0;
   int organ = -1;
   for (size_t i = 0; i < rt->norgans; i++) {
@@ -323,7 +328,7 @@ void interact_after_step(runtime_t *rt) {
       v3_copy(tool->fb_pos, tool->proxy.pos);
       v3_copy(tool->fb_normal, tool->proxy.normal);
     }
-    shaft_feedback(rt, tool);
+    shaft_feedback(rt, t);
   }
   tool_tool_contact(rt);
   for (size_t t = 0; t < rt->ntools; t++) {

@@ -39,11 +39,21 @@ typedef struct model_pbd {
  * surface of the step's start, and a contact force held that long is an
  * explicit spring at the scene rate (a penalty ground then diverged at
  * 60 Hz with any number of sub-steps). */
+static void surface_from_nodes(model_pbd_t *mp, const double *x) {
+  model_t *m = &mp->base;
+  /* After a cut the surface is the tetrahedral boundary (surf_node); the
+   * embedding describes the uncut mesh and must not be applied then. */
+  if (mp->surf_node)
+    for (size_t i = 0; i < m->nsurf; i++)
+      memcpy(mp->surf_x + 3 * i, x + 3 * (size_t)mp->surf_node[i], 3 * sizeof(double));
+  else
+    tet_embedding_apply(&mp->emb, &mp->tm, x, mp->surf_x);
+}
+
 static void pbd_pre_hook(pbd_t *s, void *ctx) {
   model_t *m = ctx;
   if (!m->hook) return;
-  model_pbd_t *mp = (model_pbd_t *)m;
-  tet_embedding_apply(&mp->emb, &mp->tm, s->x, mp->surf_x);
+  surface_from_nodes((model_pbd_t *)m, s->x);
   m->hook(m, m->hook_ctx);
 }
 
@@ -53,11 +63,7 @@ static int pbd_model_step(model_t *m, double h) {
   if (rc) m->rollbacks++;
   /* After a rollback the restored nodes are embedded again too, so the
    * surface always shows the state the model holds. */
-  if (mp->surf_node)
-    for (size_t i = 0; i < m->nsurf; i++)
-      memcpy(mp->surf_x + 3 * i, mp->s.x + 3 * (size_t)mp->surf_node[i], 3 * sizeof(double));
-  else
-    tet_embedding_apply(&mp->emb, &mp->tm, mp->s.x, mp->surf_x);
+  surface_from_nodes(mp, mp->s.x);
   return rc;
 }
 
