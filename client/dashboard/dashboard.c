@@ -19,6 +19,7 @@
 
 #include <cairo.h>
 
+#include "plot_cleanup.h"
 #include "render.h"
 #include "scene_draw.h"
 #include "seat.h"
@@ -301,5 +302,6 @@ int main(int argc, char **argv) {
 done:
   for (int i = 0; i < opened; i++) seat_close(&seats[i]);
   fclose(csv);
+  plot_cleanup(); /* cairo's and fontconfig's process caches (LeakSanitizer) */
   return rc;
 }
