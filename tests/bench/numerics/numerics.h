@@ -28,23 +28,23 @@ struct plot;
 
 typedef struct nb_row {
   char scene[8], model[24], integ[20], setting[40], metric[16];
-  double dt; /* scene step, s */
+  double dt;                /* scene step, s */
   int substeps, iterations;
-  double err, err_end;    /* metric max over time, and at the end (NAN: unstable) */
-  double step_us, sim_ms; /* median wall per scene step; wall ms per simulated second */
+  double err, err_end;      /* metric max over time, and at the end (NAN: unstable) */
+  double step_us, sim_ms;   /* median wall per scene step; wall ms per simulated second */
 } nb_row_t;
 
 typedef struct nb {
   int quick;
-  char out[1024];    /* output directory */
-  char assets[1024]; /* assets/ of the source tree */
+  char out[1024];     /* output directory */
+  char assets[1024];  /* assets/ of the source tree */
   nb_row_t *rows;
   size_t nrows, caprows;
-  int nplots;            /* PNG files written */
+  int nplots;         /* PNG files written */
   char skipped[32][200]; /* what was left out and why, printed at the end */
   int nskipped;
-  int probe_lost;        /* S8 runs that lost the probe contact */
-  char targets[24][240]; /* NUMERICS §7 figures measured on the way */
+  int probe_lost;         /* S8 runs that lost the probe contact */
+  char targets[24][240];  /* NUMERICS §7 figures measured on the way */
   int ntargets;
 } nb_t;
 
@@ -69,10 +69,10 @@ double nb_dt(int k);
 typedef struct sim sim_t;
 struct sim {
   size_t n;
-  double *x, *v;      /* live state, 3n */
-  const double *mass; /* n, for mass-weighted errors (NULL: equal) */
+  double *x, *v;       /* live state, 3n */
+  const double *mass;  /* n, for mass-weighted errors (NULL: equal) */
   int substeps, iterations;
-  uint64_t evals;                  /* force evaluations or constraint projections so far */
+  uint64_t evals;      /* force evaluations or constraint projections so far */
   int (*step)(sim_t *s, double h); /* 0, or -1 on a non-finite state */
   double (*energy)(sim_t *s);      /* NAN when the model defines none */
   void (*destroy)(sim_t *s);
@@ -99,16 +99,16 @@ void sim_destroy(sim_t *s);
 /* ---- runs ------------------------------------------------------------------------- */
 
 typedef struct traj {
-  size_t n, ns; /* nodes, samples */
-  double *x;    /* ns x 3n */
+  size_t n, ns;   /* nodes, samples */
+  double *x;      /* ns x 3n */
   size_t nextra;
-  double *extra; /* ns x nextra, from the observer */
+  double *extra;  /* ns x nextra, from the observer */
 } traj_t;
 
 typedef struct run_spec {
   double dt, T, sample_dt;
-  int reps;      /* timing repetitions (their steps are pooled); the first run is sampled */
-  double blowup; /* m: a node this far from its start is a divergence */
+  int reps;              /* timing repetitions (their steps are pooled); the first run is sampled */
+  double blowup;         /* m: a node this far from its start is a divergence */
   size_t nextra;
   /* Fills extra[nextra] at every sample (t in s); may be NULL. */
   void (*observe)(sim_t *s, double t, double *extra, void *ctx);
@@ -118,11 +118,11 @@ typedef struct run_spec {
 } run_spec_t;
 
 typedef struct run_out {
-  int stable; /* 0: non-finite or diverged at t_fail */
+  int stable;              /* 0: non-finite or diverged at t_fail */
   double t_fail;
   traj_t traj;
   size_t steps;
-  double wall_per_sim_s; /* s of wall time per simulated s: median step x steps per s */
+  double wall_per_sim_s;   /* s of wall time per simulated s: median step x steps per s */
   double step_us_median, step_us_p95;
   double evals_per_step;
 } run_out_t;
