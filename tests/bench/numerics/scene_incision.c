@@ -438,6 +438,10 @@ void scene_incision(nb_t *nb) {
               mismatches);
   plot_note(&ed, "Missing points: diverged, or a different cut topology than the reference.");
   plot_note(&wd, "Mean wound width (ms_cut_incision_width) after the settling, per scene step.");
+  plot_note(&wd, "Widths away from the common value belong to runs that cut another mesh than the reference "
+                 "(topology_match = 0 in s9_incision.csv): the deformed surface met the blade elsewhere.");
+  plot_note(&wp, "pbd and xpbd nearly coincide here: the home springs carry the organ, the distance and volume "
+                 "constraints hardly stretch, so compliance barely matters.");
   if (ed.nseries) {
     nb_plot(nb, &wp, "plot1_work_precision_S9.png");
     nb_plot(nb, &ed, "plot2_error_vs_dt_S9.png");
