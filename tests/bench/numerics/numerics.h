@@ -146,6 +146,7 @@ void scene_bar(nb_t *nb);       /* S4, S5, S6 + plots 1, 2, 4, 5 */
 void scene_probe(nb_t *nb);     /* S8 */
 void scene_ball(nb_t *nb);      /* S7 */
 void scene_scaling(nb_t *nb);   /* plot 7 */
+void scene_incision(nb_t *nb);  /* S9 */
 
 const char *integ_label(integrator_kind_t k); /* "symplectic Euler" */
 
