@@ -112,8 +112,9 @@ static void test_table(void) {
   uint8_t g1[16] = {1}, g2[16] = {2};
   CHECK(store_note_participant(s, g1, "viscera role=server host=a pid=1", "server", false, 100, &err) == 0);
   CHECK(store_note_participant(s, g2, "viscera role=haptic tool=0 host=a pid=2", "haptic", false, 200, &err) == 0);
-  CHECK(store_note_participant(s, g2, NULL, NULL, true, 300, &err) == 0);         /* left */
-  CHECK(store_note_participant(s, g1, "viscera role=server host=a pid=1", "server", false, 250, &err) == 0); /* update */
+  CHECK(store_note_participant(s, g2, NULL, NULL, true, 300, &err) == 0); /* left */
+  CHECK(store_note_participant(s, g1, "viscera role=server host=a pid=1", "server", false, 250, &err) ==
+        0); /* update */
   CHECK(store_close(s, 1000, &err) == 0);
 
   recfile_t *rf = NULL;
