@@ -3,6 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "vdds_ident.h"
 #include "viscera.h"
 
 typedef enum qos_kind { QOS_STATE, QOS_STREAM, QOS_EVENTS, QOS_METRICS, QOS_CONTROL } qos_kind_t;
@@ -72,7 +73,11 @@ static dds_qos_t *make_qos(qos_kind_t k, int lease_ms) {
 
 int vdds_open(vdds_t *v, dds_domainid_t domain, const char *partition, verr_t *err) {
   memset(v, 0, sizeof *v);
-  v->participant = dds_create_participant(domain, NULL, NULL);
+  /* USER_DATA announces role, host and pid (vdds_ident.h), so recorders
+   * and operators can tell the participants of a session apart. */
+  dds_qos_t *pq = vdds_participant_qos();
+  v->participant = dds_create_participant(domain, pq, NULL);
+  if (pq) dds_delete_qos(pq);
   if (v->participant < 0)
     return verr_set(err, "DDS: cannot create participant on domain %d: %s (check CYCLONEDDS_URI)", (int)domain,
                     dds_strretcode(v->participant));

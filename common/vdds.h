@@ -10,6 +10,7 @@
 
 #include <dds/dds.h>
 
+#include "vdds_ident.h"
 #include "verr.h"
 
 typedef enum vdds_topic_id {

@@ -36,6 +36,7 @@ static void usage(FILE *f) {
 }
 
 int main(int argc, char **argv) {
+  vdds_set_role("server"); /* announced in the participant USER_DATA */
   const char *scene_path = NULL;
   server_opts_t opts = {.domain = 0, .partition = NULL, .duration = 0, .tool_timeout = 0.5, .checkpoint_every = 1.0};
   verr_t err;

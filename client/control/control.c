@@ -40,6 +40,7 @@ static int parse_double(const char *s, double *out) {
 }
 
 int main(int argc, char **argv) {
+  vdds_set_role("control"); /* announced in the participant USER_DATA */
   static const struct option opts[] = {{"domain", required_argument, 0, 'd'},
                                        {"partition", required_argument, 0, 'p'},
                                        {"station", required_argument, 0, 's'},

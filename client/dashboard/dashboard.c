@@ -25,6 +25,7 @@
 #include "seat.h"
 #include "vsignal.h"
 #include "vtime.h"
+#include "vdds_ident.h"
 
 #define MAX_SEATS 32
 #define HEADER_H 22
@@ -124,6 +125,7 @@ static int parse_size(const char *s, int *w, int *h) {
 }
 
 int main(int argc, char **argv) {
+  vdds_set_role("dashboard"); /* announced in the participant USER_DATA */
   static const struct option opts[] = {{"prefix", required_argument, 0, 'p'},
                                        {"seats", required_argument, 0, 'n'},
                                        {"first", required_argument, 0, 'f'},

@@ -63,6 +63,7 @@ typedef struct stats {
 } stats_t;
 
 int main(int argc, char **argv) {
+  vdds_set_role("haptic"); /* announced in the participant USER_DATA */
   const char *traj = NULL, *partition = NULL, *force_csv = NULL, *device = "scripted";
   device_config_t dcfg;
   device_config_default(&dcfg);
@@ -207,6 +208,7 @@ int main(int argc, char **argv) {
     return 1;
   }
   vdds_t dds;
+  vdds_set_tool((int)tool);
   if (vdds_open(&dds, domain, partition, &err)) {
     fprintf(stderr, "viscera-haptic: %s\n", err.msg);
     dev.ops->close(&dev);

@@ -54,6 +54,7 @@ static void usage(FILE *f) {
 }
 
 int main(int argc, char **argv) {
+  vdds_set_role("recorder"); /* announced in the participant USER_DATA */
   rec_session_opts_t o = {0};
   o.partition = "viscera/local";
   o.log = stderr;

@@ -1,4 +1,5 @@
 #include "recfile.h"
+#include "vdds_ident.h"
 
 #include <errno.h>
 #include <stdio.h>
@@ -334,4 +335,40 @@ void recfile_scan(recfile_t *rf, int64_t topic_id, bool with_cdr, recfile_row_cb
     after += jump;
   }
   rep->gave_up = true;
+}
+
+static void copy_clean(char *dst, size_t size, sqlite3_stmt *st, int col) {
+  const void *t = sqlite3_column_blob(st, col);
+  vdds_ident_sanitize(dst, size, t, t ? (size_t)sqlite3_column_bytes(st, col) : 0);
+}
+
+int recfile_participants(recfile_t *rf, recfile_participant_cb cb, void *arg) {
+  sqlite3_stmt *st = NULL;
+  int rc = sqlite3_prepare_v2(rf->db, "SELECT count(*) FROM sqlite_master WHERE type='table' AND name='participants'",
+                              -1, &st, NULL);
+  bool have = rc == SQLITE_OK && sqlite3_step(st) == SQLITE_ROW && sqlite3_column_int(st, 0) > 0;
+  sqlite3_finalize(st);
+  if (!have) return -1;
+  if (sqlite3_prepare_v2(rf->db,
+                         "SELECT guid, user_data, role, first_seen_wall_ns, last_seen_wall_ns, left_wall_ns"
+                         " FROM participants ORDER BY first_seen_wall_ns, guid",
+                         -1, &st, NULL) != SQLITE_OK) {
+    sqlite3_finalize(st);
+    return -2;
+  }
+  int n = 0;
+  while ((rc = sqlite3_step(st)) == SQLITE_ROW) {
+    recfile_participant_t p;
+    memset(&p, 0, sizeof p);
+    copy_clean(p.guid, sizeof p.guid, st, 0);
+    copy_clean(p.user_data, sizeof p.user_data, st, 1);
+    copy_clean(p.role, sizeof p.role, st, 2);
+    p.first_seen_wall_ns = sqlite3_column_int64(st, 3);
+    p.last_seen_wall_ns = sqlite3_column_int64(st, 4);
+    p.left_wall_ns = sqlite3_column_type(st, 5) == SQLITE_NULL ? -1 : sqlite3_column_int64(st, 5);
+    cb(arg, &p);
+    n++;
+  }
+  sqlite3_finalize(st);
+  return rc == SQLITE_DONE ? n : -2;
 }

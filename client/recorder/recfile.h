@@ -91,4 +91,19 @@ typedef int (*recfile_row_cb)(void *arg, const recfile_row_t *row);
 void recfile_scan(recfile_t *rf, int64_t topic_id, bool with_cdr, recfile_row_cb cb, void *arg,
                   recfile_scan_report_t *rep);
 
+/* One row of the optional participants table (recording.h). Text is
+ * re-sanitized on read (the file is untrusted too) and bounded. */
+typedef struct recfile_participant {
+  char guid[33];
+  char user_data[256];
+  char role[32]; /* "" when none was announced */
+  int64_t first_seen_wall_ns, last_seen_wall_ns;
+  int64_t left_wall_ns; /* < 0: still present at the end */
+} recfile_participant_t;
+typedef void (*recfile_participant_cb)(void *arg, const recfile_participant_t *p);
+/* Calls cb for each participant, in first-seen order. Returns the count,
+ * or -1 when the file has no participants table (recorded before it
+ * existed), or -2 when the table cannot be read (damaged). */
+int recfile_participants(recfile_t *rf, recfile_participant_cb cb, void *arg);
+
 #endif

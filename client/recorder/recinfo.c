@@ -203,6 +203,35 @@ static void print_session(const recfile_t *rf) {
   }
 }
 
+static void print_participant(void *arg, const recfile_participant_t *p) {
+  (void)arg;
+  char first[64], left[64];
+  fmt_time(first, sizeof first, p->first_seen_wall_ns);
+  if (p->left_wall_ns >= 0)
+    fmt_time(left, sizeof left, p->left_wall_ns);
+  else
+    snprintf(left, sizeof left, "(present at end)");
+  printf("%-10s %-32s %-24s %-24s %s\n", p->role[0] ? p->role : "-", p->guid, first, left,
+         p->user_data[0] ? p->user_data : "(no user data)");
+}
+
+/* Who took part: an optional table (recordings made before it existed
+ * have none, and that is not an error). */
+static int print_participants(recfile_t *rf, const char *path) {
+  printf("\nparticipants (roles are each process's own claim, see vdds_ident.h):\n");
+  printf("%-10s %-32s %-24s %-24s %s\n", "role", "guid", "first seen", "left", "user data");
+  int n = recfile_participants(rf, print_participant, NULL);
+  if (n == -1) {
+    printf("(not recorded: this recording predates participant metadata)\n");
+  } else if (n == -2) {
+    fprintf(stderr, "recinfo: %s: damaged: the participants table cannot be read\n", path);
+    return -1;
+  } else {
+    printf("participants: %d\n", n);
+  }
+  return 0;
+}
+
 int main(int argc, char **argv) {
   static const struct option longopts[] = {
       {"topic", required_argument, 0, 't'},
@@ -257,6 +286,7 @@ int main(int argc, char **argv) {
   }
 
   print_session(rf);
+  if (print_participants(rf, path) < 0) status = EXIT_BAD_FILE;
   scan_ctx_t ctx = {0};
   recfile_scan_report_t rep;
   recfile_scan(rf, only, false, on_row, &ctx, &rep);

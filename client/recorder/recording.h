@@ -25,6 +25,16 @@
  *   topic_keys  the key descriptors (m_keys) of each topic, in order.
  *   writers     one row per DDS writer heard: GUID (32 hex digits), topic,
  *               its partitions (comma separated), first-seen wall time.
+ *   participants  one row per DDS participant seen in the domain (from the
+ *               DCPSParticipant built-in topic): GUID (32 hex digits), its
+ *               USER_DATA as sanitized printable text (viscera processes
+ *               announce "viscera role=R [tool=N ]host=H pid=P", see
+ *               vdds_ident.h; the role is a claim, not an authenticated
+ *               identity), the role parsed from it (NULL if none), first and
+ *               last seen wall time and the time it left (disposed or its
+ *               lease expired; NULL if still there at the end). Added after
+ *               format 1 shipped: files without this table stay valid and
+ *               readers treat it as optional.
  *   sample_kinds  lookup table naming the values of samples.kind.
  *   samples     one row per sample in the order the recorder stored it:
  *               topic, writer, source timestamp (writer's clock, ns), wall
@@ -109,6 +119,13 @@ typedef enum rec_kind { REC_KIND_DATA = 0, REC_KIND_DISPOSE = 1, REC_KIND_UNREGI
   " partitions TEXT,"                                                                                                  \
   " first_seen_wall_ns INTEGER NOT NULL,"                                                                              \
   " UNIQUE (topic_id, guid));"                                                                                         \
+  "CREATE TABLE participants ("                                                                                        \
+  " guid TEXT PRIMARY KEY,"                                                                                            \
+  " user_data TEXT,"                                                                                                   \
+  " role TEXT,"                                                                                                        \
+  " first_seen_wall_ns INTEGER NOT NULL,"                                                                              \
+  " last_seen_wall_ns INTEGER NOT NULL,"                                                                               \
+  " left_wall_ns INTEGER);"                                                                                            \
   "CREATE TABLE sample_kinds (id INTEGER PRIMARY KEY, name TEXT NOT NULL);"                                            \
   "INSERT INTO sample_kinds VALUES (0, 'data'), (1, 'dispose'), (2, 'unregister');"                                    \
   "CREATE TABLE samples ("                                                                                             \

@@ -19,8 +19,13 @@
  * decoded (dds_stream_read_sample) and sent with dds_dispose_ts /
  * dds_unregister_instance_ts, again with the original timestamp.
  *
+ * Pause: SIGUSR1 toggles pause/resume, --pause-at S pauses once when the
+ * replay reaches recording time S. While paused nothing is written; at
+ * resume the rest of the schedule is shifted by the paused time
+ * (replay_pause.h), so the samples keep their original spacing.
+ *
  * usage: viscera-replay FILE.db [--domain N] [--partition P] [--speed X]
- *                       [--seek S] [--loop] [--quiet] */
+ *                       [--seek S] [--pause-at S] [--loop] [--quiet] */
 #include <errno.h>
 #include <getopt.h>
 #include <signal.h>
@@ -36,9 +41,12 @@
 
 #include "recfile.h"
 #include "recording.h"
+#include "replay_pause.h"
 #include "replay_serdata.h"
+#include "vdds_ident.h"
 #include "verr.h"
 #include "vsignal.h"
+#include "vdds_ident.h"
 
 typedef struct rp_topic {
   int64_t id;
@@ -61,6 +69,9 @@ typedef struct replay {
   int domain;
   char partition[256];
   double speed, seek;
+  double pause_at; /* recording time to pause at once, s; < 0: none */
+  bool pause_at_done;
+  rpause_t pause;
   bool loop, quiet;
   recfile_t *rf;
   sqlite3 *db;
@@ -82,6 +93,13 @@ static void on_signal(int sig) {
   stop_flag = 1;
 }
 
+/* SIGUSR1 requests (a counter, so two quick signals toggle twice). */
+static volatile sig_atomic_t toggle_requests = 0;
+static void on_usr1(int sig) {
+  (void)sig;
+  toggle_requests++;
+}
+
 static int64_t mono_ns(void) {
   struct timespec ts;
   clock_gettime(CLOCK_MONOTONIC, &ts);
@@ -89,23 +107,32 @@ static int64_t mono_ns(void) {
 }
 
 static void usage(FILE *f) {
-  fprintf(f, "usage: viscera-replay FILE.db [--domain N] [--partition P] [--speed X] [--seek S] [--loop] [--quiet]\n"
+  fprintf(f, "usage: viscera-replay FILE.db [--domain N] [--partition P] [--speed X] [--seek S] [--pause-at S]\n"
+             "                      [--loop] [--quiet]\n"
              "  --domain N      DDS domain to publish in (default: the recorded one)\n"
              "  --partition P   partition to publish in (default: the recorded one, if not a pattern)\n"
              "  --speed X       playback speed factor, > 0 (default 1)\n"
              "  --seek S        skip the first S seconds (transient-local state is still sent)\n"
+             "  --pause-at S    pause when the replay reaches recording time S seconds (once)\n"
              "  --loop          start over at the end until interrupted\n"
-             "  --quiet         no progress lines\n");
+             "  --quiet         no progress lines\n"
+             "SIGUSR1 toggles pause/resume; after a resume the original timing goes on\n"
+             "(the schedule is shifted by the paused time, no burst of missed samples).\n");
 }
 
 static int parse_args(replay_t *r, int argc, char **argv) {
-  static const struct option opts[] = {
-      {"domain", required_argument, NULL, 'd'}, {"partition", required_argument, NULL, 'p'},
-      {"speed", required_argument, NULL, 's'},  {"seek", required_argument, NULL, 'k'},
-      {"loop", no_argument, NULL, 'l'},         {"quiet", no_argument, NULL, 'q'},
-      {"help", no_argument, NULL, 'h'},         {NULL, 0, NULL, 0}};
+  static const struct option opts[] = {{"domain", required_argument, NULL, 'd'},
+                                       {"partition", required_argument, NULL, 'p'},
+                                       {"speed", required_argument, NULL, 's'},
+                                       {"seek", required_argument, NULL, 'k'},
+                                       {"loop", no_argument, NULL, 'l'},
+                                       {"quiet", no_argument, NULL, 'q'},
+                                       {"pause-at", required_argument, NULL, 'P'},
+                                       {"help", no_argument, NULL, 'h'},
+                                       {NULL, 0, NULL, 0}};
   r->domain = -1;
   r->speed = 1.0;
+  r->pause_at = -1.0;
   int c;
   char *end;
   while ((c = getopt_long(argc, argv, "", opts, NULL)) != -1) {
@@ -131,6 +158,13 @@ static int parse_args(replay_t *r, int argc, char **argv) {
       r->speed = strtod(optarg, &end);
       if (*end || end == optarg || !(r->speed > 0.0) || r->speed > 1e6) {
         fprintf(stderr, "replay: --speed '%s': expected a number > 0\n", optarg);
+        return -1;
+      }
+      break;
+    case 'P':
+      r->pause_at = strtod(optarg, &end);
+      if (*end || end == optarg || !(r->pause_at >= 0.0) || r->pause_at > 1e8) {
+        fprintf(stderr, "replay: --pause-at '%s': expected seconds >= 0\n", optarg);
         return -1;
       }
       break;
@@ -468,16 +502,41 @@ static void progress(replay_t *r, bool force) {
   r->last_progress = now;
   double sim = (double)(r->sched_ts - r->t0) / 1e9;
   double total = r->t_end > r->t0 ? (double)(r->t_end - r->t0) / 1e9 : 0.0;
-  fprintf(stderr, "replay: %llu samples written, sim time %.1f / %.1f s\n", (unsigned long long)r->total_written,
-          sim < 0 ? 0.0 : sim, total);
+  fprintf(stderr, "replay: %llu samples written, sim time %.1f / %.1f s%s\n", (unsigned long long)r->total_written,
+          sim < 0 ? 0.0 : sim, total, r->pause.paused ? " (paused)" : "");
 }
 
-/* Sleeps until mono deadline in short steps so SIGINT stays responsive.
- * Returns false when interrupted. */
-static bool sleep_until(replay_t *r, int64_t deadline) {
+static void set_paused(replay_t *r, bool paused, const char *why) {
+  if (paused == r->pause.paused) return;
+  int64_t now = mono_ns();
+  int64_t was = r->pause.since;
+  rpause_set(&r->pause, paused, now);
+  if (r->quiet) return;
+  double sim = (double)(r->sched_ts - r->t0) / 1e9;
+  if (paused)
+    fprintf(stderr, "replay: paused at sim time %.1f s (%s)\n", sim < 0 ? 0.0 : sim, why);
+  else
+    fprintf(stderr, "replay: resumed after %.1f s paused (%s)\n", (double)(now - was) / 1e9, why);
+}
+
+/* Applies the SIGUSR1 toggles received since the last call. */
+static void handle_toggles(replay_t *r) {
+  static sig_atomic_t seen = 0;
+  while (seen != toggle_requests) {
+    seen++;
+    set_paused(r, !r->pause.paused, "SIGUSR1");
+  }
+}
+
+/* Sleeps until the schedule time `base_due` (monotonic, before pause
+ * shifts) in short steps so SIGINT and SIGUSR1 stay responsive; while
+ * paused it waits for the resume. Returns false when interrupted. */
+static bool sleep_until(replay_t *r, int64_t base_due) {
   for (;;) {
     if (stop_flag) return false;
+    handle_toggles(r);
     int64_t now = mono_ns();
+    int64_t deadline = rpause_due(&r->pause, base_due);
     if (now >= deadline) return true;
     int64_t d = deadline - now;
     if (d > DDS_MSECS(100)) d = DDS_MSECS(100);
@@ -510,6 +569,15 @@ static int on_row(void *arg, const recfile_row_t *row) {
       return 0;
     }
   } else {
+    int64_t pause_ns = (int64_t)(r->pause_at * 1e9);
+    if (r->pause_at >= 0 && !r->pause_at_done && rel >= pause_ns) {
+      /* Pause exactly at recording time S, not at the next sample's. */
+      r->pause_at_done = true;
+      int64_t at = pause_ns > seek_ns ? pause_ns : seek_ns;
+      if (!sleep_until(r, r->start_mono + (int64_t)((double)(at - seek_ns) / r->speed))) return 1;
+      set_paused(r, true, "--pause-at");
+      progress(r, true);
+    }
     int64_t due = r->start_mono + (int64_t)((double)(rel - seek_ns) / r->speed);
     if (!sleep_until(r, due)) return 1;
   }
@@ -543,6 +611,7 @@ static void find_time_range(replay_t *r) {
 }
 
 int main(int argc, char **argv) {
+  vdds_set_role("replay"); /* announced in the participant USER_DATA */
   replay_t r;
   memset(&r, 0, sizeof r);
   if (parse_args(&r, argc, argv) < 0) return 1;
@@ -577,7 +646,9 @@ int main(int argc, char **argv) {
     snprintf(r.partition, sizeof r.partition, "%s", s->partition);
   }
   int status = 0;
-  r.pp = dds_create_participant((dds_domainid_t)r.domain, NULL, NULL);
+  dds_qos_t *ppq = vdds_participant_qos();
+  r.pp = dds_create_participant((dds_domainid_t)r.domain, ppq, NULL);
+  if (ppq) dds_delete_qos(ppq);
   if (r.pp < 0) {
     fprintf(stderr, "replay: cannot create a participant on domain %d: %s\n", r.domain, dds_strretcode(r.pp));
     status = 1;
@@ -599,17 +670,27 @@ int main(int argc, char **argv) {
   }
   find_time_range(&r);
   vsignal_on_stop(on_signal, 0);
+  {
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_usr1;
+    sa.sa_flags = SA_RESTART;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGUSR1, &sa, NULL);
+  }
   if (!r.quiet)
     fprintf(stderr, "replay: %s: %zu topics into domain %d partition '%s' at speed %g\n", r.path, r.ntopics, r.domain,
             r.partition, r.speed);
   /* Let already running receivers match the new writers before the first
    * sample (volatile topics would otherwise lose it). */
+  /* (a SIGUSR1 during this wait pauses before the first sample) */
   sleep_until(&r, mono_ns() + DDS_MSECS(500));
   unsigned passes = 0;
   recfile_scan_report_t rep;
   memset(&rep, 0, sizeof rep);
   do {
     r.start_mono = mono_ns();
+    rpause_new_pass(&r.pause, r.start_mono);
     r.sched_ts = r.t0;
     r.pass_rows = 0;
     recfile_scan(r.rf, 0, true, on_row, &r, &rep);

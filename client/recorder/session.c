@@ -6,6 +6,8 @@
 
 #include "capture.h"
 #include "discovery.h"
+#include "participants.h"
+#include "vdds_ident.h"
 #include "store.h"
 #include "topic_type.h"
 #include "vtime.h"
@@ -24,6 +26,7 @@ struct rec_session {
   dds_entity_t subscriber;
   dds_entity_t waitset;
   discovery_t *disc;
+  participants_t *parts; /* who is in the domain (participants.h) */
   capture_t **caps;
   size_t ncaps, capcaps;
   pending_t *pend;
@@ -176,7 +179,9 @@ int rec_session_open(rec_session_t **out, const rec_session_opts_t *opts, const 
     free(s);
     return -1;
   }
-  s->participant = dds_create_participant((dds_domainid_t)opts->domain, NULL, NULL);
+  dds_qos_t *pq = vdds_participant_qos();
+  s->participant = dds_create_participant((dds_domainid_t)opts->domain, pq, NULL);
+  if (pq) dds_delete_qos(pq);
   if (s->participant < 0) {
     verr_set(err, "DDS: cannot create participant on domain %d: %s (check CYCLONEDDS_URI)", opts->domain,
              dds_strretcode(s->participant));
@@ -197,6 +202,7 @@ int rec_session_open(rec_session_t **out, const rec_session_opts_t *opts, const 
     goto fail;
   }
   if (discovery_open(&s->disc, s->participant, opts->partition, err) < 0) goto fail;
+  if (participants_open(&s->parts, s->participant, err) < 0) goto fail;
   dds_entity_t rc = dds_create_readcondition(discovery_reader(s->disc), DDS_ANY_STATE);
   if (rc < 0 || dds_waitset_attach(s->waitset, rc, 0) < 0) {
     verr_set(err, "DDS: cannot watch DCPSPublication");
@@ -205,6 +211,7 @@ int rec_session_open(rec_session_t **out, const rec_session_opts_t *opts, const 
   *out = s;
   return 0;
 fail:
+  participants_close(s->parts);
   discovery_close(s->disc);
   if (s->participant > 0) dds_delete(s->participant);
   store_close(s->store, -1, NULL);
@@ -233,6 +240,7 @@ int rec_session_step(rec_session_t *s, dds_duration_t timeout, verr_t *err) {
   int n = discovery_poll(s->disc, on_writer, s);
   if (n < 0) LOG(s, "DDS: reading DCPSPublication failed: %s", dds_strretcode(n));
   if (s->cb_failed) return verr_set(err, "%s", s->cb_err.msg);
+  if (participants_poll(s->parts, s->store, s->o.log, err) < 0) return -1;
   if (s->npend) resolve_pending(s);
   if (s->cb_failed) return verr_set(err, "%s", s->cb_err.msg);
   if (drain_all(s, err) < 0) return -1;
@@ -248,6 +256,11 @@ void rec_session_get_stats(const rec_session_t *s, rec_session_stats_t *st) {
 
 int rec_session_close(rec_session_t *s, rec_session_stats_t *final, verr_t *err) {
   int ret = drain_all(s, err);
+  verr_t perr;
+  /* Last discovery news (a participant that left just now) before closing;
+   * a failure here is the store's and drain_all already reported it. */
+  if (ret == 0 && participants_poll(s->parts, s->store, s->o.log, &perr) < 0) ret = verr_set(err, "%s", perr.msg);
+  participants_close(s->parts);
   if (final) rec_session_get_stats(s, final);
   for (size_t i = 0; i < s->npend; i++) {
     LOG(s, "topic %s: NOT recorded: type still unresolved at exit", s->pend[i].w->topic_name);

@@ -24,6 +24,7 @@ struct store {
   sqlite3_stmt *ins_topic;
   sqlite3_stmt *ins_key;
   sqlite3_stmt *ins_writer;
+  sqlite3_stmt *ins_part, *left_part;
   store_batch_limits_t limits;
   bool in_txn;
   uint64_t batch_start_ns;
@@ -216,7 +217,14 @@ int store_open(store_t **out, const char *path, bool force, const store_session_
       prepare(s, "INSERT INTO topic_keys (topic_id, idx, name, offset, key_index) VALUES (?,?,?,?,?)", &s->ins_key,
               err) < 0 ||
       prepare(s, "INSERT INTO writers (topic_id, guid, partitions, first_seen_wall_ns) VALUES (?,?,?,?)",
-              &s->ins_writer, err) < 0)
+              &s->ins_writer, err) < 0 ||
+      prepare(s,
+              "INSERT INTO participants (guid, user_data, role, first_seen_wall_ns, last_seen_wall_ns)"
+              " VALUES (?1,?2,?3,?4,?4) ON CONFLICT(guid) DO UPDATE SET user_data=excluded.user_data,"
+              " role=excluded.role, last_seen_wall_ns=excluded.last_seen_wall_ns, left_wall_ns=NULL",
+              &s->ins_part, err) < 0 ||
+      prepare(s, "UPDATE participants SET last_seen_wall_ns=?1, left_wall_ns=?1 WHERE guid=?2 AND left_wall_ns IS NULL",
+              &s->left_part, err) < 0)
     goto fail;
   *out = s;
   return 0;
@@ -225,6 +233,8 @@ fail:
   sqlite3_finalize(s->ins_topic);
   sqlite3_finalize(s->ins_key);
   sqlite3_finalize(s->ins_writer);
+  sqlite3_finalize(s->ins_part);
+  sqlite3_finalize(s->left_part);
   sqlite3_close(s->db);
   free(s->path);
   free(s);
@@ -458,6 +468,24 @@ void store_counts(const store_t *s, uint64_t *samples, uint64_t *bytes) {
 bool store_failed(const store_t *s) { return s->failed; }
 bool store_disk_full(const store_t *s) { return s->disk_full; }
 
+int store_note_participant(store_t *s, const uint8_t guid[16], const char *user_data, const char *role, bool left,
+                           int64_t wall_ns, verr_t *err) {
+  if (begin_if_needed(s, err) < 0) return -1;
+  char hex[33];
+  store_guid_hex(guid, hex);
+  sqlite3_stmt *st = left ? s->left_part : s->ins_part;
+  if (left) {
+    sqlite3_bind_int64(st, 1, wall_ns);
+    sqlite3_bind_text(st, 2, hex, -1, SQLITE_STATIC);
+  } else {
+    sqlite3_bind_text(st, 1, hex, -1, SQLITE_STATIC);
+    sqlite3_bind_text(st, 2, user_data, -1, SQLITE_STATIC);
+    sqlite3_bind_text(st, 3, role, -1, SQLITE_STATIC);
+    sqlite3_bind_int64(st, 4, wall_ns);
+  }
+  return step_reset(s, st, err, "cannot note participant");
+}
+
 int store_close(store_t *s, int64_t end_wall_ns, verr_t *err) {
   int ret = store_commit(s, err);
   if (s->failed) {
@@ -475,6 +503,10 @@ int store_close(store_t *s, int64_t end_wall_ns, verr_t *err) {
     char sql[128];
     snprintf(sql, sizeof sql, "UPDATE session SET end_wall_ns=%lld;", (long long)end_wall_ns);
     ret = exec_sql(s, sql, err);
+    /* Participants still present were seen until the end. */
+    snprintf(sql, sizeof sql, "UPDATE participants SET last_seen_wall_ns=%lld WHERE left_wall_ns IS NULL;",
+             (long long)end_wall_ns);
+    if (ret == 0) ret = exec_sql(s, sql, err);
     if (ret == 0) ret = exec_sql(s, REC_INDEX_SQL, err);
     /* A finished recording goes back to a rollback journal: WAL was for
      * crash safety while recording; in WAL mode every later reader, even
@@ -486,6 +518,8 @@ int store_close(store_t *s, int64_t end_wall_ns, verr_t *err) {
   sqlite3_finalize(s->ins_topic);
   sqlite3_finalize(s->ins_key);
   sqlite3_finalize(s->ins_writer);
+  sqlite3_finalize(s->ins_part);
+  sqlite3_finalize(s->left_part);
   /* After a failure the last connection's close still checkpoints the
    * WAL into the main file and removes it. */
   if (sqlite3_close(s->db) != SQLITE_OK && ret == 0) ret = verr_set(err, "%s: close failed", s->path);

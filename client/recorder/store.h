@@ -74,6 +74,14 @@ int store_add_topic(store_t *s, const char *name, const dds_topic_descriptor_t *
 int store_add_writer(store_t *s, int64_t topic_id, const uint8_t guid[16], const char *partitions, int64_t wall_ns,
                      int64_t *id, verr_t *err);
 
+/* Records a participant of the domain (recording.h, table participants):
+ * `user_data` and `role` must already be sanitized text (vdds_ident.h), role
+ * may be NULL. Alive: inserted with first/last seen = wall_ns, or its text
+ * and last seen updated (a participant that came back is no longer "left").
+ * Not alive (`left`): last seen and left time set to wall_ns. */
+int store_note_participant(store_t *s, const uint8_t guid[16], const char *user_data, const char *role, bool left,
+                           int64_t wall_ns, verr_t *err);
+
 /* Appends one sample to the current batch (starting one if needed); commits
  * at once when the batch reaches its sample or byte limit. */
 int store_add_sample(store_t *s, const store_sample_t *smp, verr_t *err);

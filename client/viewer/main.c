@@ -22,6 +22,7 @@
 #include "vtime.h"
 #ifdef VISCERA_HAVE_WINDOW
 #include "window.h"
+#include "vdds_ident.h"
 #endif
 
 #define POLL_NS 10000000ull /* 10 ms */
@@ -90,6 +91,7 @@ static void print_scene(const scene_view_t *sv, const camera_t *cam) {
 }
 
 int main(int argc, char **argv) {
+  vdds_set_role("viewer"); /* announced in the participant USER_DATA */
   install_signals();
   viewer_opts_t o;
   verr_t err = {{0}};

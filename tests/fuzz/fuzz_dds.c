@@ -210,6 +210,7 @@ static void usage(FILE *f) {
 }
 
 int main(int argc, char **argv) {
+  vdds_set_role("fuzz"); /* announced in the participant USER_DATA */
   static const struct option opts[] = {{"corpus", required_argument, 0, 'c'},
                                        {"make-corpus", required_argument, 0, 'm'},
                                        {"samples", required_argument, 0, 'n'},

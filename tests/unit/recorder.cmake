@@ -20,3 +20,10 @@ if(TARGET viscera_rec_decode)
   # ddsi_cdrstream.h pulls in GNU `asm` (see client/recorder/CMakeLists.txt)
   set_target_properties(test_rec_decode PROPERTIES C_EXTENSIONS ON)
 endif()
+
+# Issue 6 metadata: participant announcement and sanitizing (vdds_ident),
+# the replay pause schedule shift, the optional participants table.
+if(TARGET viscera_recording)
+  viscera_unit_test(NAME test_recmeta SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_recmeta.c
+    ${PROJECT_SOURCE_DIR}/client/recorder/replay_pause.c LIBS viscera_recording)
+endif()
