@@ -24,7 +24,7 @@ void shaft_segment(const double tip[3], const double axis[3], double tip_radius,
 }
 
 size_t shaft_push(const double p0[3], const double p1[3], double radius, double k, const double *x, size_t n,
-                  void (*add)(void *ctx, uint32_t i, const double f[3]), void *ctx, double f_tool[3]) {
+                  shaft_add_fn add, void *ctx, double f_tool[3]) {
   cylinder_t c;
   v3_copy(c.p0, p0);
   v3_copy(c.p1, p1);
@@ -48,4 +48,164 @@ size_t shaft_push(const double p0[3], const double p1[3], double radius, double 
     hits++;
   }
   return hits;
+}
+
+/* Box queries answer into this many slots; a piece of the segment with more
+ * candidates is halved, down to SHAFT_SPLIT_DEPTH halvings, below which the
+ * piece scans every triangle (a mesh crumpled into one spot). */
+#define SHAFT_QUERY_CAP 64
+#define SHAFT_SPLIT_DEPTH 12
+/* Each piece's box covers the segment a little past its ends, so that a
+ * triangle whose computed crossing parameter rounds into the piece is in
+ * the box even if its exact one lies just outside (rounding is far below). */
+#define SHAFT_PIECE_OVERLAP 1e-6
+
+typedef struct crossings {
+  uint32_t *tri;
+  double *t;
+  double (*bary)[3];
+  size_t n, cap;
+} crossings_t;
+
+/* Keeps the cap first crossings by (t, triangle), whatever order they come
+ * in: the tree and the scan then agree exactly. */
+static void keep(crossings_t *c, uint32_t tri, double t, const double bary[3]) {
+  size_t i = c->n;
+  while (i > 0 && (c->t[i - 1] > t || (c->t[i - 1] == t && c->tri[i - 1] > tri))) i--;
+  if (i >= c->cap) return;
+  size_t last = c->n < c->cap ? c->n : c->cap - 1;
+  for (size_t j = last; j > i; j--) {
+    c->tri[j] = c->tri[j - 1];
+    c->t[j] = c->t[j - 1];
+    v3_copy(c->bary[j], c->bary[j - 1]);
+  }
+  c->tri[i] = tri;
+  c->t[i] = t;
+  v3_copy(c->bary[i], bary);
+  if (c->n < c->cap) c->n++;
+}
+
+/* Tests triangle tri against the whole segment (as the scan does) and keeps
+ * it if it is crossed within the piece [ta, tb) ([ta, tb] for the last
+ * piece): every crossing belongs to exactly one piece. */
+static void test_tri(const double p0[3], const double p1[3], const shaft_surface_t *s, uint32_t tri, double ta,
+                     double tb, int last, crossings_t *c) {
+  const uint32_t *v = s->tris + 3 * (size_t)tri;
+  double t, bary[3];
+  if (!seg_tri_intersect(p0, p1, s->x + 3 * (size_t)v[0], s->x + 3 * (size_t)v[1], s->x + 3 * (size_t)v[2], &t, bary))
+    return;
+  if (t >= ta && (t < tb || (last && t <= tb))) keep(c, tri, t, bary);
+}
+
+static void piece(const double p0[3], const double p1[3], const shaft_surface_t *s, double ta, double tb, int last,
+                  int depth, crossings_t *c) {
+  if (!s->tree || depth > SHAFT_SPLIT_DEPTH) {
+    for (size_t i = 0; i < s->ntris; i++) test_tri(p0, p1, s, (uint32_t)i, ta, tb, last, c);
+    return;
+  }
+  double a[3], b[3], d[3], lo[3], hi[3], pad = 0;
+  v3_sub(d, p1, p0);
+  v3_copy(a, p0);
+  v3_axpy(a, d, ta - SHAFT_PIECE_OVERLAP);
+  v3_copy(b, p0);
+  v3_axpy(b, d, tb + SHAFT_PIECE_OVERLAP);
+  for (int j = 0; j < 3; j++) pad = fmax(pad, fmax(fabs(a[j]), fabs(b[j])));
+  pad *= 1e-12; /* rounding of the piece's ends */
+  for (int j = 0; j < 3; j++) {
+    lo[j] = fmin(a[j], b[j]) - pad;
+    hi[j] = fmax(a[j], b[j]) + pad;
+  }
+  uint32_t cand[SHAFT_QUERY_CAP];
+  size_t n = aabb_tree_box_query(s->tree, lo, hi, cand, SHAFT_QUERY_CAP);
+  if (n > SHAFT_QUERY_CAP) {
+    double tm = 0.5 * (ta + tb);
+    piece(p0, p1, s, ta, tm, 0, depth + 1, c);
+    piece(p0, p1, s, tm, tb, last, depth + 1, c);
+    return;
+  }
+  for (size_t i = 0; i < n; i++) test_tri(p0, p1, s, cand[i], ta, tb, last, c);
+}
+
+size_t shaft_crossings(const double p0[3], const double p1[3], const shaft_surface_t *s, uint32_t *tri, double *t,
+                       double (*bary)[3], size_t cap) {
+  crossings_t c = {tri, t, bary, 0, cap < SHAFT_MAX_CROSSINGS ? cap : SHAFT_MAX_CROSSINGS};
+  if (c.cap == 0 || s->ntris == 0) return 0;
+  /* A tree over another surface (a topology change the caller missed)
+   * would index past x: scan instead. */
+  const aabb_tree_t *tree = s->tree;
+  shaft_surface_t scan = *s;
+  if (tree && (tree->ntris != s->ntris || tree->nverts != s->n)) scan.tree = NULL;
+  piece(p0, p1, &scan, 0, 1, 1, 0, &c);
+  return c.n;
+}
+
+size_t shaft_contact(const double p0[3], const double p1[3], double radius, double k, const shaft_surface_t *s,
+                     shaft_add_fn add, void *ctx, double f_tool[3], shaft_stats_t *st) {
+  size_t nodes = shaft_push(p0, p1, radius, k, s->x, s->n, add, ctx, f_tool);
+  uint32_t tri[SHAFT_MAX_CROSSINGS];
+  double tc[SHAFT_MAX_CROSSINGS], bary[SHAFT_MAX_CROSSINGS][3];
+  size_t nc = shaft_crossings(p0, p1, s, tri, tc, bary, SHAFT_MAX_CROSSINGS);
+  /* Distinct corners and their summed shares, in order of first use. */
+  uint32_t cv[3 * SHAFT_MAX_CROSSINGS];
+  double cf[3 * SHAFT_MAX_CROSSINGS][3];
+  size_t ncv = 0;
+  cylinder_t cyl;
+  v3_copy(cyl.p0, p0);
+  v3_copy(cyl.p1, p1);
+  cyl.radius = radius;
+  double ax[3];
+  v3_sub(ax, p1, p0);
+  v3_normalize(ax); /* crossings exist only for a segment of positive length */
+  /* The crossing point is on the axis: a full radius deep. */
+  double fmag = fmin(k * radius, SHAFT_MAX_VERTEX_FORCE);
+  for (size_t c = 0; c < nc; c++) {
+    const uint32_t *v = s->tris + 3 * (size_t)tri[c];
+    const double *a = s->x + 3 * (size_t)v[0], *b = s->x + 3 * (size_t)v[1], *cc = s->x + 3 * (size_t)v[2];
+    double e1[3], e2[3], nrm[3], u[3];
+    v3_sub(e1, b, a);
+    v3_sub(e2, cc, a);
+    v3_cross(nrm, e1, e2);
+    /* Inward normal, less its part along the axis. */
+    v3_scale(u, nrm, -1);
+    v3_axpy(u, ax, -v3_dot(u, ax));
+    int head_on = !(v3_norm(u) > 1e-6 * v3_norm(nrm));
+    if (!head_on) v3_normalize(u);
+    for (int j = 0; j < 3; j++) {
+      const double *p = s->x + 3 * (size_t)v[j];
+      cylinder_hit_t h;
+      if (cylinder_test_node(&cyl, p, &h)) continue; /* the node test has it */
+      double dir[3];
+      if (head_on) {
+        /* Radially away from the axis: the corner is outside the cylinder. */
+        v3_sub(dir, p, p0);
+        v3_axpy(dir, ax, -v3_dot(dir, ax));
+        if (!(v3_normalize(dir) > 0)) continue;
+      } else {
+        v3_copy(dir, u);
+      }
+      size_t q = 0;
+      while (q < ncv && cv[q] != v[j]) q++;
+      if (q == ncv) {
+        cv[ncv] = v[j];
+        v3_set(cf[ncv], 0, 0, 0);
+        ncv++;
+      }
+      v3_axpy(cf[q], dir, bary[c][j] * fmag);
+    }
+  }
+  size_t pushed = 0;
+  for (size_t q = 0; q < ncv; q++) {
+    double mag = v3_norm(cf[q]);
+    if (!(mag > 0)) continue; /* a corner with no share (crossing on the opposite edge) */
+    if (mag > SHAFT_MAX_VERTEX_FORCE) v3_scale(cf[q], cf[q], SHAFT_MAX_VERTEX_FORCE / mag);
+    add(ctx, cv[q], cf[q]);
+    v3_axpy(f_tool, cf[q], -1);
+    pushed++;
+  }
+  if (st) {
+    st->nodes = nodes;
+    st->crossings = nc;
+    st->corners = pushed;
+  }
+  return nodes + pushed;
 }
