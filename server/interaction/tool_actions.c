@@ -171,12 +171,18 @@ void interact_apply(runtime_t *rt, organ_rt_t *o, model_t *m) {
     grasp_force(&tool->grasp, m->surf_x, tool->device, tool->cfg->stiffness, tool->max_force, fv, ft);
     for (size_t j = 0; j < tool->grasp.n; j++) m->ops->add_surface_force(m, tool->grasp.v[j], fv[j]);
   }
+  /* The shafts' crossing test reads the organ's tree as refit at the start
+   * of the step, so the surface may have moved since: the slack (shaft.h)
+   * covers a shaft radius of it. After a topology change inside the step
+   * the tree is the old surface's: scan instead. */
+  const aabb_tree_t *tree = o->tree.ntris && m->topology_version == o->topology_version ? &o->tree : NULL;
   for (size_t t = 0; t < rt->ntools; t++) {
     tool_rt_t *tool = &rt->tools[t];
     double p0[3], p1[3], ft[3] = {0, 0, 0};
     if (!shaft_of(rt, t, p0, p1)) continue;
-    shaft_push(p0, p1, SHAFT_RADIUS_FRACTION * tool->cfg->radius, tool->cfg->stiffness, m->surf_x, m->nsurf, add_force,
-               m, ft);
+    double radius = SHAFT_RADIUS_FRACTION * tool->cfg->radius;
+    shaft_surface_t surf = {m->surf_x, m->nsurf, m->surf_tris, m->nsurf_tris, tree, radius};
+    shaft_contact(p0, p1, radius, tool->cfg->stiffness, &surf, add_force, m, ft, NULL);
   }
   for (size_t i = 0; i < rt->nstones; i++) {
     stone_t *s = &rt->stones[i];
@@ -217,9 +223,17 @@ static void shaft_feedback(runtime_t *rt, size_t t) {
   size_t hits = 0;
   int organ = -1;
   for (size_t i = 0; i < rt->norgans; i++) {
-    const model_t *m = rt->organs[i].model;
-    size_t h = shaft_push(p0, p1, SHAFT_RADIUS_FRACTION * tool->cfg->radius, tool->cfg->stiffness, m->surf_x, m->nsurf,
-                          add_nothing, NULL, ft);
+    const organ_rt_t *o = &rt->organs[i];
+    const model_t *m = o->model;
+    /* After the step the runtime has refit (or rebuilt) the tree. */
+    shaft_surface_t surf = {m->surf_x,
+                            m->nsurf,
+                            m->surf_tris,
+                            m->nsurf_tris,
+                            o->tree.ntris && m->topology_version == o->topology_version ? &o->tree : NULL,
+                            0};
+    size_t h = shaft_contact(p0, p1, SHAFT_RADIUS_FRACTION * tool->cfg->radius, tool->cfg->stiffness, &surf,
+                             add_nothing, NULL, ft, NULL);
     if (h && organ < 0) organ = (int)i;
     hits += h;
   }

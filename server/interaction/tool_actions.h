@@ -7,7 +7,9 @@
  *                         or release; held stones follow their tool; tools
  *                         that hold something or have no tissue contact
  *                         (extractor) leave the god-object proxy
- *   interact_apply        in the model hook, every sub-step: grasp springs
+ *   interact_apply        in the model hook, every sub-step: grasp springs,
+ *                         shaft contact (shaft.h; node test and
+ *                         segment-triangle crossings via the organ's tree)
  *                         and stone penalty forces on the organ's surface
  *   interact_after_step   the force each tool feels and what its client is
  *                         told (tool_rt_t.fb_*), tool-tool contact (tips are

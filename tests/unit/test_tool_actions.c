@@ -9,7 +9,9 @@
  *   task completes with its operation time; a stone left inside does not;
  * - two tools driven to the same point keep their tips r1 + r2 apart and
  *   feel opposite forces;
- * - a shaft laid on the tissue presses it and is pushed back. */
+ * - a shaft laid on the tissue presses it and is pushed back;
+ * - a shaft crossing a coarse triangle between its corners (tissue_block)
+ *   pushes that triangle in and is pushed back (segment-triangle test). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -242,6 +244,46 @@ static void test_shaft(void) {
   runtime_destroy(&rt);
 }
 
+/* The coarse tissue sheet (triangles ~1.7 x 1 cm) in z = 0, a tool tilted
+ * 150 degrees from +z (handle below, 30 degrees off the downward vertical)
+ * with its tip 10 mm above the sheet: the shaft enters the sheet through the
+ * middle of the centre triangle, every vertex over 6 mm from its axis (the
+ * shaft's radius is 1.35 mm), so only the segment-triangle test sees it. */
+static void test_shaft_coarse(void) {
+  CHECK(load("scene: t\norgans:\n  - {name: block, mesh: ../meshes/tissue_block.obj, model: mass_spring_surface, "
+             "material: {mass: 0.1, stiffness: 30, damping: 0.02, home_stiffness: 30, home_damping: 0.005}}\n"
+             "tools:\n  - {name: a, radius: 0.003, length: 0.1, stiffness: 400}\n"));
+  const model_t *m = rt.organs[0].model;
+  size_t ti = 0;
+  double best = INFINITY, c[3] = {0, 0, 0};
+  for (size_t i = 0; i < m->nsurf_tris; i++) {
+    double g[3] = {0, 0, 0};
+    for (int j = 0; j < 3; j++) v3_axpy(g, m->surf_rest + 3 * m->surf_tris[3 * i + j], 1.0 / 3);
+    if (v3_norm(g) < best) best = v3_norm(g), ti = i, v3_copy(c, g);
+  }
+  const uint32_t *tv = m->surf_tris + 3 * ti;
+  const double q[4] = {cos(75 * M_PI / 180), 0, sin(75 * M_PI / 180), 0};
+  runtime_set_orientation(&rt, 0, q);
+  const double *ax = rt.tools[0].axis;
+  CHECK(ax[2] < -0.8);
+  double tip[3];
+  v3_copy(tip, c);
+  v3_axpy(tip, ax, -0.012);
+  double z0 = 0;
+  for (int j = 0; j < 3; j++) z0 += m->surf_x[3 * tv[j] + 2] / 3;
+  drive(0, tip, tip, 200);
+  double z1 = 0;
+  for (int j = 0; j < 3; j++) z1 += m->surf_x[3 * tv[j] + 2] / 3;
+  printf("shaft coarse: through triangle %zu's middle, its corners sink %.3f mm on average, the tool is pushed "
+         "(%.3f %.3f %.3f) N\n",
+         ti, (z0 - z1) * 1e3, rt.tools[0].force[0], rt.tools[0].force[1], rt.tools[0].force[2]);
+  CHECK(z1 < z0 - 0.0001);
+  CHECK(!rt.tools[0].proxy.in_contact); /* the tip itself touches nothing */
+  CHECK(rt.tools[0].fb_contact && rt.tools[0].fb_organ == 0 && rt.tools[0].force[2] > 0.01);
+  CHECK(fabs(v3_dot(rt.tools[0].force, ax)) < 1e-9 * v3_norm(rt.tools[0].force) + 1e-12); /* off the axis */
+  runtime_destroy(&rt);
+}
+
 int main(void) {
   if (!getenv("VISCERA_SOURCE_DIR")) {
     fprintf(stderr, "test_tool_actions: VISCERA_SOURCE_DIR not set (run through ctest)\n");
@@ -255,5 +297,6 @@ int main(void) {
   test_stone(0);
   test_tool_tool();
   test_shaft();
+  test_shaft_coarse();
   return check_report("test_tool_actions");
 }

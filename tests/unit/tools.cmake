@@ -4,3 +4,5 @@ viscera_unit_test(NAME test_scene_tools SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_s
 viscera_unit_test(NAME test_tool_actions SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_tool_actions.c LIBS viscera_server_core)
 # Friction cone and force shading on the god-object proxy.
 viscera_unit_test(NAME test_proxy_friction SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_proxy_friction.c LIBS viscera_server_core)
+# Tool shafts: the cylinder node test and segment-triangle crossings (tree vs scan).
+viscera_unit_test(NAME test_shaft SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_shaft.c LIBS viscera_server_core)
