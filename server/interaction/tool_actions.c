@@ -149,6 +149,11 @@ static int shaft_of(const runtime_t *rt, size_t t, double p0[3], double p1[3]) {
   return 1;
 }
 
+/* 1 when tool's god-object is in contact with organ `organ`. */
+static int tip_on(const tool_rt_t *tool, size_t organ) {
+  return tool->proxy.in_contact && tool->proxy.surface >= 0 && (size_t)tool->proxy.surface == organ;
+}
+
 static void add_force(void *ctx, uint32_t i, const double f[3]) {
   model_t *m = ctx;
   m->ops->add_surface_force(m, i, f);
@@ -181,6 +186,14 @@ void interact_apply(runtime_t *rt, organ_rt_t *o, model_t *m) {
     double p0[3], p1[3], ft[3] = {0, 0, 0};
     if (!shaft_of(rt, t, p0, p1)) continue;
     double radius = SHAFT_RADIUS_FRACTION * tool->cfg->radius;
+    if (tip_on(tool, o->id)) {
+      /* The tip presses this organ: the shaft rises out of the tip's own dent,
+       * whose walls its axis can graze when the dent is deep; pushing those
+       * triangles aside would open the dent under the god-object (stability
+       * case 9 lost its contact that way). Only the node test here. */
+      shaft_push(p0, p1, radius, tool->cfg->stiffness, m->surf_x, m->nsurf, add_force, m, ft);
+      continue;
+    }
     shaft_surface_t surf = {m->surf_x, m->nsurf, m->surf_tris, m->nsurf_tris, tree, radius};
     shaft_contact(p0, p1, radius, tool->cfg->stiffness, &surf, add_force, m, ft, NULL);
   }
@@ -232,8 +245,11 @@ static void shaft_feedback(runtime_t *rt, size_t t) {
                             m->nsurf_tris,
                             o->tree.ntris && m->topology_version == o->topology_version ? &o->tree : NULL,
                             0};
-    size_t h = shaft_contact(p0, p1, SHAFT_RADIUS_FRACTION * tool->cfg->radius, tool->cfg->stiffness, &surf,
-                             add_nothing, NULL, ft, NULL);
+    size_t h = tip_on(tool, i)
+                   ? shaft_push(p0, p1, SHAFT_RADIUS_FRACTION * tool->cfg->radius, tool->cfg->stiffness, m->surf_x,
+                                m->nsurf, add_nothing, NULL, ft)
+                   : shaft_contact(p0, p1, SHAFT_RADIUS_FRACTION * tool->cfg->radius, tool->cfg->stiffness, &surf,
+                                   add_nothing, NULL, ft, NULL);
     if (h && organ < 0) organ = (int)i;
     hits += h;
   }
