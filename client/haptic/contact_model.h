@@ -27,4 +27,11 @@ double contact_model_force(const contact_model_t *m, const double x[3], const do
  * k T (twice the k T / 2 minimum, for margin against jitter). */
 static inline double contact_model_passive_damping(double k, double period_s) { return k * period_s; }
 
+/* The stiffness to render: the server's contact stiffness k, clamped to
+ * the device's stiffness rating k_device (device capability data; 0 = no
+ * stated limit). */
+static inline double contact_model_device_stiffness(double k, double k_device) {
+  return k_device > 0 && k > k_device ? k_device : k;
+}
+
 #endif

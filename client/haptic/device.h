@@ -48,6 +48,11 @@ typedef struct device_ops {
 struct device {
   const device_ops_t *ops;
   double max_force; /* N, the device's capability */
+  /* N/m, the stiffest wall the device renders stably (its rating, or
+   * --max-stiffness); 0 = no stated limit. The client renders the server's
+   * contact stiffness clamped to it, so a stiff scene stays passive on a
+   * soft device. */
+  double max_stiffness;
   void *impl;
 };
 
@@ -55,12 +60,13 @@ struct device {
 typedef struct device_config {
   const char *trajectory; /* scripted: the trajectory file (required) */
   double max_force;       /* N: the scripted device's stated capability; for a real device an upper clamp */
+  double max_stiffness;   /* N/m: the device's stiffness rating; 0 = no stated limit */
   double scale;           /* scene metres per device metre (real devices; > 0) */
   double offset[3];       /* scene position of the device's workspace centre (real devices), m */
   int index;              /* which device of that kind, 0 = the first found */
 } device_config_t;
 
-/* Defaults: max_force 4 N, scale 1, offset 0, index 0, no trajectory. */
+/* Defaults: max_force 4 N, max_stiffness 0 (no limit), scale 1, offset 0, index 0, no trajectory. */
 void device_config_default(device_config_t *c);
 
 /* Opens the device called `name`. Returns 0, or -1 with err naming the

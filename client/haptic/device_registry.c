@@ -36,6 +36,7 @@ static const device_entry_t DEVICES[] = {
 void device_config_default(device_config_t *c) {
   memset(c, 0, sizeof *c);
   c->max_force = 4;
+  c->max_stiffness = 0;
   c->scale = 1;
 }
 
@@ -55,7 +56,7 @@ void device_to_scene(const device_config_t *c, const double p[3], double out[3])
   for (int k = 0; k < 3; k++) out[k] = c->offset[k] + c->scale * p[k];
 }
 
-int device_open(device_t *d, const char *name, const device_config_t *cfg, verr_t *err) {
+static int open_named(device_t *d, const char *name, const device_config_t *cfg, verr_t *err) {
   memset(d, 0, sizeof *d);
   const device_entry_t *e = NULL;
   for (size_t i = 0; i < NDEVICES; i++)
@@ -82,4 +83,14 @@ int device_open(device_t *d, const char *name, const device_config_t *cfg, verr_
   if (strcmp(name, "falcon") == 0) return device_falcon_open(d, cfg, err);
 #endif
   return verr_set(err, "device '%s': no open function (build error)", name);
+}
+
+int device_open(device_t *d, const char *name, const device_config_t *cfg, verr_t *err) {
+  if (!(cfg->max_stiffness >= 0) || cfg->max_stiffness > 1e6)
+    return verr_set(err, "device '%s': max_stiffness must be 0 (no stated limit) or up to 1e6 N/m", name);
+  int rc = open_named(d, name, cfg, err);
+  /* The stiffness the device renders stably: its configured rating (no
+   * driver here reads one from its SDK yet). */
+  if (rc == 0) d->max_stiffness = cfg->max_stiffness;
+  return rc;
 }

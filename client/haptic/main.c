@@ -69,7 +69,7 @@ int main(int argc, char **argv) {
   device_config_default(&dcfg);
   int domain = 0, quiet = 0, rt_priority = 0;
   unsigned tool = 0;
-  double rate = 1000, max_force = 4, wait_server = 10, duration = -1;
+  double rate = 1000, max_force = 4, max_stiffness = 0, wait_server = 10, duration = -1;
   verr_t err;
   if ((domain = vdds_env_domain(&err)) < 0) {
     fprintf(stderr, "viscera-haptic: %s\n", err.msg);
@@ -81,6 +81,7 @@ int main(int argc, char **argv) {
                                      {"partition", required_argument, 0, 'p'},
                                      {"rate", required_argument, 0, 'r'},
                                      {"max-force", required_argument, 0, 'm'},
+                                     {"max-stiffness", required_argument, 0, 'K'},
                                      {"wait-server", required_argument, 0, 'w'},
                                      {"duration", required_argument, 0, 't'},
                                      {"force-csv", required_argument, 0, 'f'},
@@ -93,15 +94,16 @@ int main(int argc, char **argv) {
                                      {"help", no_argument, 0, 'h'},
                                      {0, 0, 0, 0}};
   int c;
-  while ((c = getopt_long(argc, argv, "j:n:d:p:r:m:w:t:f:R:D:I:S:O:qh", lo, NULL)) != -1) {
+  while ((c = getopt_long(argc, argv, "j:n:d:p:r:m:K:w:t:f:R:D:I:S:O:qh", lo, NULL)) != -1) {
     char *end = NULL;
     double v = 0;
-    if (c == 'r' || c == 'm' || c == 'w' || c == 't' || c == 'n' || c == 'R' || c == 'I' || c == 'S') {
+    if (c == 'r' || c == 'm' || c == 'K' || c == 'w' || c == 't' || c == 'n' || c == 'R' || c == 'I' || c == 'S') {
       v = strtod(optarg, &end);
       if (*end || !isfinite(v) || v < 0) {
         fprintf(stderr, "viscera-haptic: option --%s: '%s' is not a non-negative number\n",
                 c == 'r'   ? "rate"
                 : c == 'm' ? "max-force"
+                : c == 'K' ? "max-stiffness"
                 : c == 'w' ? "wait-server"
                 : c == 't' ? "duration"
                 : c == 'R' ? "rt-priority"
@@ -133,6 +135,9 @@ int main(int argc, char **argv) {
       break;
     case 'm':
       max_force = v;
+      break;
+    case 'K':
+      max_stiffness = v;
       break;
     case 'w':
       wait_server = v;
@@ -203,6 +208,7 @@ int main(int argc, char **argv) {
   device_t dev;
   dcfg.trajectory = traj;
   dcfg.max_force = max_force;
+  dcfg.max_stiffness = max_stiffness;
   if (device_open(&dev, device, &dcfg, &err)) {
     fprintf(stderr, "viscera-haptic: %s\n", err.msg);
     return 1;
@@ -361,6 +367,9 @@ int main(int argc, char **argv) {
     memcpy(prev_pos, pos, sizeof prev_pos);
     prev_pos_ns = now;
     have_prev_pos = 1;
+    /* Device capability data: never render a wall stiffer than the device
+     * is rated for (its damping follows the clamped stiffness). */
+    model.stiffness = contact_model_device_stiffness(model.stiffness, dev.max_stiffness);
     model.damping = contact_model_passive_damping(model.stiffness, 1.0 / rate);
     double f[3];
     double mag = contact_model_force(&model, pos, vel, dev.max_force, f);

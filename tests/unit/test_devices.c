@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include "check.h"
+#include "contact_model.h"
 #include "device.h"
 
 static void expect_error(const char *name, const device_config_t *cfg, const char *text) {
@@ -44,7 +45,23 @@ int main(void) {
   d.ops->read(&d, 1.0, pos, q, &b);
   CHECK_NEAR(pos[2], 0.03, 1e-12);
   CHECK(b == 1 && q[0] == 1);
+  CHECK(d.max_stiffness == 0); /* no stated limit by default */
   d.ops->close(&d);
+  /* Device capability data: a stiffness rating clamps what is rendered. */
+  cfg.max_stiffness = 500;
+  CHECK(device_open(&d, "scripted", &cfg, &err) == 0);
+  CHECK(d.max_stiffness == 500);
+  contact_model_t m = {.in_contact = 1, .proxy = {0, 0, 0}, .normal = {0, 0, 1}};
+  m.stiffness = contact_model_device_stiffness(800, d.max_stiffness);
+  CHECK(m.stiffness == 500);
+  double x[3] = {0, 0, -0.002}, fv[3];
+  CHECK_NEAR(contact_model_force(&m, x, NULL, 4, fv), 1.0, 1e-12); /* 500 N/m x 2 mm, not 1.6 N */
+  CHECK(contact_model_device_stiffness(300, 500) == 300);
+  CHECK(contact_model_device_stiffness(800, 0) == 800);
+  d.ops->close(&d);
+  cfg.max_stiffness = -1;
+  expect_error("scripted", &cfg, "max_stiffness must be");
+  cfg.max_stiffness = 0;
   unlink(path);
   cfg.max_force = 0;
   expect_error("scripted", &cfg, "max_force must be > 0");
