@@ -45,6 +45,8 @@ static void usage(FILE *f) {
           "  --partition P       session partition (default: " VDDS_DEFAULT_PARTITION ")\n"
           "  --rate HZ           loop rate (default 1000)\n"
           "  --max-force N       device capability in newtons (default 4)\n"
+          "  --max-stiffness K   device stiffness rating, N/m: the server's contact stiffness is\n"
+          "                      rendered clamped to it (default 0: no stated limit)\n"
           "  --wait-server S     wait up to S s for the server's scene before starting (default 10)\n"
           "  --duration S        stop after S s (default: end of the trajectory + 0.5 s)\n"
           "  --force-csv FILE    write t,x,y,z,fx,fy,fz,in_contact per tick\n"
