@@ -301,21 +301,6 @@ static int surf_init(surf_t *s, const mesh_t *m, const double *centre, verr_t *e
   return 0;
 }
 
-/* Signed solid angle of triangle (a, b, c) seen from q (Van Oosterom and
- * Strackee): positive when q sees the triangle's back, i.e. q is on the inner
- * side of a counter-clockwise (outward) triangle. */
-static double solid_angle(const double *q, const double *a, const double *b, const double *c) {
-  double x[3], y[3], z[3], yz[3];
-  v3_sub(x, a, q);
-  v3_sub(y, b, q);
-  v3_sub(z, c, q);
-  double lx = v3_norm(x), ly = v3_norm(y), lz = v3_norm(z);
-  v3_cross(yz, y, z);
-  double num = v3_dot(x, yz);
-  double den = lx * ly * lz + v3_dot(x, y) * lz + v3_dot(y, z) * lx + v3_dot(z, x) * ly;
-  return 2 * atan2(num, den);
-}
-
 /* Generalized winding number of the surface at q: the summed solid angle over
  * 4 pi. 1 inside a closed outward surface, 0 outside, and it degrades gently
  * where the surface has holes, which is why it decides inside here rather than
@@ -336,7 +321,7 @@ static double winding_number(const surf_t *s, const double *q) {
     } else if (nd->count) {
       for (uint32_t i = 0; i < nd->count; i++) {
         uint32_t t = s->order[nd->first + i];
-        omega += solid_angle(q, tri_v(s, t, 0), tri_v(s, t, 1), tri_v(s, t, 2));
+        omega += tri_solid_angle(q, tri_v(s, t, 0), tri_v(s, t, 1), tri_v(s, t, 2));
       }
     } else {
       stack[sp++] = nd->first;

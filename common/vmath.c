@@ -94,3 +94,15 @@ int seg_tri_intersect(const double *p0, const double *p1, const double *a, const
   v3_set(bary, 1 - u - v, u, v);
   return 1;
 }
+
+double tri_solid_angle(const double q[3], const double a[3], const double b[3], const double c[3]) {
+  double x[3], y[3], z[3], yz[3];
+  v3_sub(x, a, q);
+  v3_sub(y, b, q);
+  v3_sub(z, c, q);
+  double lx = v3_norm(x), ly = v3_norm(y), lz = v3_norm(z);
+  v3_cross(yz, y, z);
+  double num = v3_dot(x, yz);
+  double den = lx * ly * lz + v3_dot(x, y) * lz + v3_dot(y, z) * lx + v3_dot(z, x) * ly;
+  return 2 * atan2(num, den);
+}

@@ -67,4 +67,10 @@ void tri_closest_point(const double *p, const double *a, const double *b, const 
 int seg_tri_intersect(const double *p0, const double *p1, const double *a, const double *b, const double *c, double *t,
                       double *bary);
 
+/* Signed solid angle of triangle (a, b, c) seen from q (Van Oosterom and
+ * Strackee): positive when q sees the triangle's back, i.e. q is on the
+ * inner side of a counter-clockwise (outward) triangle. Summed over a closed
+ * outward surface and divided by 4 pi it is the winding number of q. */
+double tri_solid_angle(const double q[3], const double a[3], const double b[3], const double c[3]);
+
 #endif

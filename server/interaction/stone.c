@@ -13,23 +13,10 @@ void stone_init(stone_t *s, double radius, int organ, const double pos[3]) {
   s->held_by = -1;
 }
 
-/* Solid angle of triangle abc seen from p (Van Oosterom and Strackee). */
-static double solid_angle(const double *a, const double *b, const double *c, const double *p) {
-  double u[3], v[3], w[3], bc[3];
-  v3_sub(u, a, p);
-  v3_sub(v, b, p);
-  v3_sub(w, c, p);
-  double lu = v3_norm(u), lv = v3_norm(v), lw = v3_norm(w);
-  v3_cross(bc, v, w);
-  double num = v3_dot(u, bc);
-  double den = lu * lv * lw + v3_dot(u, v) * lw + v3_dot(u, w) * lv + v3_dot(v, w) * lu;
-  return 2 * atan2(num, den);
-}
-
 double stone_winding_number(const double *x, const uint32_t *tris, size_t ntris, const double p[3]) {
   double sum = 0;
   for (size_t t = 0; t < ntris; t++)
-    sum += solid_angle(x + 3 * tris[3 * t], x + 3 * tris[3 * t + 1], x + 3 * tris[3 * t + 2], p);
+    sum += tri_solid_angle(p, x + 3 * tris[3 * t], x + 3 * tris[3 * t + 1], x + 3 * tris[3 * t + 2]);
   return sum / (4 * 3.14159265358979323846);
 }
 
