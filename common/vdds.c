@@ -27,6 +27,7 @@ static const struct {
     [VT_SESSION_CONTROL] = {"viscera_SessionControl", &viscera_SessionControl_desc, QOS_CONTROL},
     [VT_OBJECT_STATE] = {"viscera_ObjectState", &viscera_ObjectState_desc, QOS_STATE},
     [VT_TOOL_METRICS] = {"viscera_ToolMetrics", &viscera_ToolMetrics_desc, QOS_METRICS},
+    [VT_TOOL_ROLE] = {"viscera_ToolRole", &viscera_ToolRole_desc, QOS_STATE},
 };
 
 const char *vdds_topic_name(vdds_topic_id_t t) { return t < VT_COUNT ? TOPICS[t].name : "?"; }
@@ -124,6 +125,57 @@ dds_entity_t vdds_reader_listener(vdds_t *v, vdds_topic_id_t t, const dds_listen
   dds_delete_qos(q);
   if (r < 0) verr_set(err, "DDS: cannot create reader for %s: %s", TOPICS[t].name, dds_strretcode(r));
   return r;
+}
+
+int vdds_station_valid(const char *name) {
+  if (!name) return 0;
+  size_t n = 0;
+  for (; name[n]; n++) {
+    char c = name[n];
+    int ok =
+        (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '.' || c == '-';
+    if (!ok || n + 1 >= VDDS_STATION_MAX) return 0;
+  }
+  return n > 0;
+}
+
+#define STATION_TAG "station="
+
+dds_entity_t vdds_writer_station(vdds_t *v, vdds_topic_id_t t, const char *station, verr_t *err) {
+  if (!station || !*station) return vdds_writer(v, t, err);
+  if (!vdds_station_valid(station)) {
+    verr_set(err, "station name '%.40s' is not 1..%d characters of A-Z a-z 0-9 _ . -", station, VDDS_STATION_MAX - 1);
+    return DDS_RETCODE_BAD_PARAMETER;
+  }
+  char ud[sizeof STATION_TAG + VDDS_STATION_MAX];
+  int n = snprintf(ud, sizeof ud, STATION_TAG "%s", station);
+  dds_qos_t *q = make_qos(TOPICS[t].qos, TOPICS[t].lease_ms);
+  dds_qset_userdata(q, ud, (size_t)n);
+  dds_entity_t w = dds_create_writer(v->publisher, v->topics[t], q, NULL);
+  dds_delete_qos(q);
+  if (w < 0) verr_set(err, "DDS: cannot create writer for %s: %s", TOPICS[t].name, dds_strretcode(w));
+  return w;
+}
+
+int vdds_station_of_writer(dds_entity_t reader, dds_instance_handle_t pub, char out[VDDS_STATION_MAX]) {
+  out[0] = 0;
+  dds_builtintopic_endpoint_t *ep = dds_get_matched_publication_data(reader, pub);
+  if (!ep) return -1;
+  void *ud = NULL;
+  size_t sz = 0;
+  /* Exactly "station=NAME": a longer or malformed value is someone else's
+   * USER_DATA (or an attack) and stays anonymous. */
+  if (ep->qos && dds_qget_userdata(ep->qos, &ud, &sz) && ud && sz > strlen(STATION_TAG) &&
+      sz < strlen(STATION_TAG) + VDDS_STATION_MAX && memcmp(ud, STATION_TAG, strlen(STATION_TAG)) == 0) {
+    char name[VDDS_STATION_MAX];
+    size_t len = sz - strlen(STATION_TAG);
+    memcpy(name, (const char *)ud + strlen(STATION_TAG), len);
+    name[len] = 0;
+    if (strlen(name) == len && vdds_station_valid(name)) memcpy(out, name, len + 1);
+  }
+  dds_free(ud);
+  dds_builtintopic_free_endpoint(ep);
+  return 0;
 }
 
 int vdds_parse_domain(const char *s) {

@@ -24,6 +24,7 @@ typedef enum vdds_topic_id {
   VT_SESSION_CONTROL,
   VT_OBJECT_STATE,
   VT_TOOL_METRICS,
+  VT_TOOL_ROLE,
   VT_COUNT
 } vdds_topic_id_t;
 
@@ -67,6 +68,22 @@ dds_entity_t vdds_writer(vdds_t *v, vdds_topic_id_t t, verr_t *err);
 dds_entity_t vdds_reader(vdds_t *v, vdds_topic_id_t t, verr_t *err);
 /* Same with a listener (callbacks run on a DDS thread; may be NULL). */
 dds_entity_t vdds_reader_listener(vdds_t *v, vdds_topic_id_t t, const dds_listener_t *l, verr_t *err);
+
+/* Stations (idl ToolRole): a ToolCommand writer names the station driving
+ * it in its USER_DATA QoS as "station=NAME". NAME must be 1..VDDS_STATION_MAX-1
+ * characters of [A-Za-z0-9_.-]; vdds_station_valid() says whether it is. */
+#define VDDS_STATION_MAX 32
+int vdds_station_valid(const char *name);
+/* A writer with the table's QoS plus USER_DATA "station=NAME" (NAME NULL or
+ * "": no USER_DATA, the anonymous station). An invalid name is refused. */
+dds_entity_t vdds_writer_station(vdds_t *v, vdds_topic_id_t t, const char *station, verr_t *err);
+/* The station a remote writer matched by `reader` announced: looks up the
+ * publication `pub` (a sample's publication_handle) and parses its
+ * USER_DATA, which is untrusted: anything that is not exactly
+ * "station=NAME" with a valid NAME yields "" (anonymous). Returns 0, or -1
+ * (out = "") when the publication is not (or no longer) matched. Costs a
+ * lookup in Cyclone's matched-endpoint table: callers cache it per handle. */
+int vdds_station_of_writer(dds_entity_t reader, dds_instance_handle_t pub, char out[VDDS_STATION_MAX]);
 
 /* Parses a domain id string (0..230); -1 on bad input. */
 int vdds_parse_domain(const char *s);

@@ -119,6 +119,10 @@ int session_control_apply(session_control_t *sc, const viscera_SessionControl *c
     tag(c, text, n);
     return SESSION_CONTROL_REBUILD;
   }
+  case viscera_CONTROL_ASSIGN_TOOL:
+  case viscera_CONTROL_GUIDE:
+  case viscera_CONTROL_START_TASK:
+    break; /* being built (issue 7): refused as unknown until then */
   }
   return refuse(sc, c, text, n, "unknown command kind");
 }

@@ -41,6 +41,9 @@ static void usage(FILE *f) {
           "  --workspace-offset X,Y,Z  real devices: scene position (m) of the device's\n"
           "                      workspace centre (default 0,0,0)\n"
           "  --tool N            tool index in the scene (default 0)\n"
+          "  --station NAME      the station (person/seat) this device belongs to, announced with\n"
+          "                      every command; a tool assigned to a station obeys only it\n"
+          "                      (default: none, the anonymous station)\n"
           "  --domain N          DDS domain id (default: $VISCERA_DOMAIN or 0)\n"
           "  --partition P       session partition (default: " VDDS_DEFAULT_PARTITION ")\n"
           "  --rate HZ           loop rate (default 1000)\n"
@@ -66,7 +69,7 @@ typedef struct stats {
 
 int main(int argc, char **argv) {
   vdds_set_role("haptic"); /* announced in the participant USER_DATA */
-  const char *traj = NULL, *partition = NULL, *force_csv = NULL, *device = "scripted";
+  const char *traj = NULL, *partition = NULL, *force_csv = NULL, *device = "scripted", *station = NULL;
   device_config_t dcfg;
   device_config_default(&dcfg);
   int domain = 0, quiet = 0, rt_priority = 0;
@@ -79,6 +82,7 @@ int main(int argc, char **argv) {
   }
   static const struct option lo[] = {{"trajectory", required_argument, 0, 'j'},
                                      {"tool", required_argument, 0, 'n'},
+                                     {"station", required_argument, 0, 's'},
                                      {"domain", required_argument, 0, 'd'},
                                      {"partition", required_argument, 0, 'p'},
                                      {"rate", required_argument, 0, 'r'},
@@ -96,7 +100,7 @@ int main(int argc, char **argv) {
                                      {"help", no_argument, 0, 'h'},
                                      {0, 0, 0, 0}};
   int c;
-  while ((c = getopt_long(argc, argv, "j:n:d:p:r:m:K:w:t:f:R:D:I:S:O:qh", lo, NULL)) != -1) {
+  while ((c = getopt_long(argc, argv, "j:n:s:d:p:r:m:K:w:t:f:R:D:I:S:O:qh", lo, NULL)) != -1) {
     char *end = NULL;
     double v = 0;
     if (c == 'r' || c == 'm' || c == 'K' || c == 'w' || c == 't' || c == 'n' || c == 'R' || c == 'I' || c == 'S') {
@@ -122,6 +126,14 @@ int main(int argc, char **argv) {
       break;
     case 'n':
       tool = (unsigned)v;
+      break;
+    case 's':
+      if (!vdds_station_valid(optarg)) {
+        fprintf(stderr, "viscera-haptic: --station '%s': 1..%d characters of A-Z a-z 0-9 _ . -\n", optarg,
+                VDDS_STATION_MAX - 1);
+        return 2;
+      }
+      station = optarg;
       break;
     case 'd':
       if ((domain = vdds_parse_domain(optarg)) < 0) {
@@ -222,7 +234,7 @@ int main(int argc, char **argv) {
     dev.ops->close(&dev);
     return 1;
   }
-  dds_entity_t w_cmd = vdds_writer(&dds, VT_TOOL_COMMAND, &err);
+  dds_entity_t w_cmd = vdds_writer_station(&dds, VT_TOOL_COMMAND, station, &err);
   static feedback_slot_t slot;
   double cap_s = duration >= 0 ? duration + 1 : 600;
   if (feedback_slot_init(&slot, tool, (size_t)fmin(1e7, fmax(1000, rate * cap_s)))) {
