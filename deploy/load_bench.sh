@@ -5,16 +5,23 @@
 # (tests/bench/delta_sub: keyframe + every MeshDelta, latency measured) spread
 # over the seats, a third of them joining late (at a third of the run).
 # Samples every server's CPU time and resident memory every 10 s; at the end
-# prints per-seat step time (median, p99), delta latency (median, p99 over all
+# prints per-seat step time (median, p99; wall time and the server thread's
+# CPU time, which tells the step's own cost from time spent preempted by the
+# other processes) and real-time ratio, delta latency (median, p99 over all
 # subscribers), the time late joiners waited for their keyframe, and CPU /
 # memory at the start and the end of the run. Writes OUT/load.csv (samples)
 # and OUT/summary.txt.
 #
+# Before the lab starts, one seat runs alone (same scene, same trainee, no
+# subscribers) for BASELINE s: its step times are the reference that "step
+# time unchanged" is judged against.
+#
 # usage: deploy/load_bench.sh [--build DIR] [--out DIR] [--seats N] [--subscribers M] [--duration S]
-# defaults: build/, out/load, 5 seats, 30 subscribers, 600 s (the issue's setting)
+#                             [--baseline S]
+# defaults: build/, out/load, 5 seats, 30 subscribers, 600 s (the issue's setting), baseline 30 s
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-BUILD="$ROOT/build" OUT="$ROOT/out/load" SEATS=5 SUBS=30 DURATION=600
+BUILD="$ROOT/build" OUT="$ROOT/out/load" SEATS=5 SUBS=30 DURATION=600 BASELINE=30
 while [ $# -gt 0 ]; do
   case "$1" in
     --build) BUILD="$2"; shift 2 ;;
@@ -22,11 +29,12 @@ while [ $# -gt 0 ]; do
     --seats) SEATS="$2"; shift 2 ;;
     --subscribers) SUBS="$2"; shift 2 ;;
     --duration) DURATION="$2"; shift 2 ;;
-    -h|--help) sed -n 2,16p "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --baseline) BASELINE="$2"; shift 2 ;;
+    -h|--help) sed -n 2,22p "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "load_bench.sh: unknown option '$1'" >&2; exit 2 ;;
   esac
 done
-for v in SEATS SUBS DURATION; do [[ "${!v}" =~ ^[0-9]+$ ]] && [ "${!v}" -ge 1 ] || { echo "load_bench.sh: bad ${v,,}" >&2; exit 2; }; done
+for v in SEATS SUBS DURATION BASELINE; do [[ "${!v}" =~ ^[0-9]+$ ]] && [ "${!v}" -ge 1 ] || { echo "load_bench.sh: bad ${v,,}" >&2; exit 2; }; done
 [ -x "$BUILD/tests/bench/delta_sub" ] || { echo "load_bench.sh: $BUILD/tests/bench/delta_sub missing (build with -DVISCERA_BUILD_BENCH=ON)" >&2; exit 1; }
 export CYCLONEDDS_URI="${CYCLONEDDS_URI:-file://$ROOT/deploy/cyclonedds-loopback.xml}"
 export VISCERA_DOMAIN="${VISCERA_DOMAIN:-8}"
@@ -37,6 +45,21 @@ TRAJ="$OUT/press_release.traj"
 { t=0; echo "0 0.012 0.004 0.07"; while [ $t -lt $((DURATION + 4)) ]; do
     echo "$t.5 0.012 0.004 0.07"; echo "$((t + 1)).5 0.012 0.004 0.027"; echo "$((t + 2)).5 0.012 0.004 0.027"
     echo "$((t + 3)).9 0.012 0.004 0.07"; t=$((t + 4)); done; } > "$TRAJ"
+step_line() { # server log -> "N steps, step wall time ...; step CPU time ...; real-time ratio R"
+  local wall cpu
+  wall=$(sed -n 's/^server: \([0-9]*\) steps, step time median \([0-9.]*\) us p99 \([0-9.]*\) us.*/\1 steps, step wall time median \2 us, p99 \3 us/p' "$1")
+  cpu=$(sed -n 's/^server: step CPU time median \([0-9.]*\) us p99 \([0-9.]*\) us; \([0-9.]*\) simulated.*/step CPU time median \1 us, p99 \2 us; real-time ratio \3/p' "$1")
+  echo "$wall; $cpu"
+}
+# The reference: one seat alone.
+echo "load_bench: baseline, one seat alone for $BASELINE s" >&2
+"$BUILD/server/viscera-server" --scene "$SCENE" --partition "load/alone" --duration $((BASELINE + 2)) --quiet \
+  > "$OUT/alone-server.out" 2> "$OUT/alone-server.log" &
+alone=$!
+sleep 1
+"$BUILD/client/haptic/viscera-haptic" --partition "load/alone" --trajectory "$TRAJ" --duration "$BASELINE" --quiet \
+  > "$OUT/alone-haptic.log" 2>&1 || true
+wait "$alone" || true
 pids=()
 cleanup() { for p in "${pids[@]}"; do kill -TERM "$p" 2>/dev/null || true; done; wait 2>/dev/null || true; }
 trap cleanup EXIT
@@ -90,9 +113,10 @@ sleep 1
 pids=()
 {
   echo "load_bench: $SEATS seats x classroom_kidney (2,000 vertices, 1 kHz physics, meshes at 60 Hz), $SUBS subscribers ($late late), $DURATION s"
+  echo "  alone (baseline, $BASELINE s): $(step_line "$OUT/alone-server.log")"
   for i in $(seq 1 "$SEATS"); do
     s=$(printf 'seat%02d' "$i")
-    sed -n 's/^server: \([0-9]*\) steps, step time median \([0-9.]*\) us p99 \([0-9.]*\) us.*/  '"$s"': \1 steps, step time median \2 us, p99 \3 us/p' "$OUT/$s-server.log"
+    echo "  $s: $(step_line "$OUT/$s-server.log")"
   done
   field() { sed -n "s/^SUB.* $1=\([0-9.e+-]*\).*/\1/p" "$OUT"/sub*.out | sort -g; }
   n=$(grep -h '^SUB' "$OUT"/sub*.out | wc -l)

@@ -153,6 +153,8 @@ int main(int argc, char **argv) {
           "server: %" PRIu64 " steps, step time median %.1f us p99 %.1f us max %.1f us, %" PRIu64 " overruns, %" PRIu64
           " rollbacks\n",
           st.steps, st.step_us_median, st.step_us_p99, st.step_us_max, st.overruns, st.rollbacks);
+  fprintf(stderr, "server: step CPU time median %.1f us p99 %.1f us; %.3f simulated s per wall s\n",
+          st.step_cpu_us_median, st.step_cpu_us_p99, st.realtime_ratio);
   fprintf(stderr, "server: %" PRIu64 " tool commands applied, %" PRIu64 " rejected (", st.commands, st.rejected_total);
   for (int v = 1; v < TOOLCMD_VERDICT_COUNT; v++)
     fprintf(stderr, "%s%s: %" PRIu64, v > 1 ? ", " : "", tool_command_verdict_str((tool_cmd_verdict_t)v),
@@ -162,7 +164,8 @@ int main(int argc, char **argv) {
     fprintf(stderr, "server: %" PRIu64 " checkpoint(s) written to %s%s\n", st.checkpoints_written, opts.checkpoint,
             st.resumed ? " (this run resumed from it)" : "");
   if (st.liveliness_blips)
-    fprintf(stderr, "server: %" PRIu64 " client liveliness lapse(s) while still sending (kept, see liveliness_watch.h)\n",
+    fprintf(stderr,
+            "server: %" PRIu64 " client liveliness lapse(s) while still sending (kept, see liveliness_watch.h)\n",
             st.liveliness_blips);
   printf("SUMMARY steps=%" PRIu64 " peak_force=%.3f rejected=%" PRIu64 " rollbacks=%" PRIu64 " step_us_median=%.1f\n",
          st.steps, st.peak_force, st.rejected_total, st.rollbacks, st.step_us_median);

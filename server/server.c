@@ -37,7 +37,8 @@ typedef struct server {
   thr_tracker_t thr[SCENE_MAX_TOOLS];
   session_control_t control;
   uint64_t event_seq;
-  double *step_us; /* ring of recent step times */
+  double *step_us;     /* ring of recent step times */
+  double *step_cpu_us; /* the same steps' thread CPU times */
   size_t nstep_us;
   server_stats_t *stats;
 } server_t;
@@ -128,7 +129,8 @@ static int setup(server_t *s, const scene_t *scene, verr_t *err) {
       return -1;
   }
   s->step_us = calloc(STEP_RING, sizeof(double));
-  if (!s->step_us) return verr_set(err, "out of memory");
+  s->step_cpu_us = calloc(STEP_RING, sizeof(double));
+  if (!s->step_us || !s->step_cpu_us) return verr_set(err, "out of memory");
   return 0;
 }
 
@@ -138,6 +140,7 @@ static void teardown(server_t *s) {
   vdds_close(&s->dds); /* stops the listener before the watch goes */
   liveliness_watch_destroy(&s->lw);
   free(s->step_us);
+  free(s->step_cpu_us);
 }
 
 /* Releases every tool whose commanding writer lost its liveliness (the
@@ -152,8 +155,10 @@ static void release_lost_writers(server_t *s, uint64_t now) {
         /* Alive after all: this process was starved past the lease (see
          * liveliness_watch.h). Keep the tool; say so a few times. */
         if (++s->stats->liveliness_blips <= 3 && !s->opts->quiet)
-          fprintf(stderr, "server: tool %zu: client liveliness lapsed while it kept sending (machine overloaded?); "
-                          "kept\n", t);
+          fprintf(stderr,
+                  "server: tool %zu: client liveliness lapsed while it kept sending (machine overloaded?); "
+                  "kept\n",
+                  t);
         continue;
       }
       runtime_release_tool(&s->rt, t);
@@ -226,7 +231,8 @@ static void read_commands(server_t *s, uint64_t now) {
     if (s->rt.tools[t].active && now - s->last_cmd_mono[t] > (uint64_t)(s->opts->tool_timeout * 1e9)) {
       runtime_release_tool(&s->rt, t);
       s->tool_lost[t] = 1;
-      if (!s->opts->quiet) fprintf(stderr, "server: tool %zu: no commands for %.1f s, released\n", t, s->opts->tool_timeout);
+      if (!s->opts->quiet)
+        fprintf(stderr, "server: tool %zu: no commands for %.1f s, released\n", t, s->opts->tool_timeout);
       publish_event(s, viscera_EVENT_CLIENT_LOST, -1, (int)t, s->opts->tool_timeout,
                     "haptic client lost (no commands): tool released");
     }
@@ -311,13 +317,15 @@ static int read_controls(server_t *s) {
             const model_t *m = s->rt.organs[i].model;
             size_t len = strlen(text);
             if (m->substeps > 16 && len < sizeof text)
-              snprintf(text + len, sizeof text - len, "; organ '%.40s' now needs %d sub-steps per step (may not keep real time)",
+              snprintf(text + len, sizeof text - len,
+                       "; organ '%.40s' now needs %d sub-steps per step (may not keep real time)",
                        s->rt.organs[i].cfg->name, m->substeps);
           }
         } else {
           s->control.refused++;
           size_t len = strlen(text);
-          snprintf(text + len, sizeof text - len, "; refused by the models: %.200s (scene unchanged, restarted)", e.msg);
+          snprintf(text + len, sizeof text - len, "; refused by the models: %.200s (scene unchanged, restarted)",
+                   e.msg);
         }
       }
       free(edit);
@@ -548,8 +556,8 @@ static void write_final_mesh(server_t *s) {
     else
       snprintf(path, sizeof path, "%s.%zu", s->opts->final_mesh, i);
     const model_t *model = s->rt.organs[i].model;
-    mesh_t m = {.nverts = model->nsurf, .ntris = model->nsurf_tris, .pos = model->surf_x,
-                .tris = (uint32_t *)model->surf_tris};
+    mesh_t m = {
+        .nverts = model->nsurf, .ntris = model->nsurf_tris, .pos = model->surf_x, .tris = (uint32_t *)model->surf_tris};
     char comment[160];
     snprintf(comment, sizeof comment, "organ %zu topology %u keyframe %u frame %u", i, s->pubs[i].topology_version,
              s->pubs[i].keyframe_seq, s->pubs[i].frame_seq);
@@ -576,11 +584,12 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
       fprintf(stderr,
               "server: organ '%s': %s, %s, %zu nodes, %zu tetrahedra, surface %zu vertices / %zu triangles, "
               "%d sub-step(s) per %.3g ms (stable below %.3g ms)\n",
-              o->cfg->name, m->ops->name, o->cfg->integrator, m->nnodes, m->ntets, m->nsurf, m->nsurf_tris,
-              m->substeps, scene->dt * 1e3, m->stable_dt * 1e3);
+              o->cfg->name, m->ops->name, o->cfg->integrator, m->nnodes, m->ntets, m->nsurf, m->nsurf_tris, m->substeps,
+              scene->dt * 1e3, m->stable_dt * 1e3);
       if (m->substeps > 0 && scene->dt / m->substeps > m->stable_dt)
-        fprintf(stderr, "server: organ '%s': warning: solver.substeps %d gives %.3g ms sub-steps, above the "
-                        "stable %.3g ms: expect rollbacks\n",
+        fprintf(stderr,
+                "server: organ '%s': warning: solver.substeps %d gives %.3g ms sub-steps, above the "
+                "stable %.3g ms: expect rollbacks\n",
                 o->cfg->name, m->substeps, scene->dt / m->substeps * 1e3, m->stable_dt * 1e3);
     }
     fprintf(stderr, "server: scene '%s' running on domain %d, partition '%s'\n", scene->name, opts->domain,
@@ -617,8 +626,9 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
   uint64_t publish_every = (uint64_t)fmax(1.0, floor(1.0 / (scene->publish_hz * scene->dt) + 0.5));
   uint64_t metrics_every = (uint64_t)fmax(1.0, floor(1.0 / scene->dt + 0.5));
   uint64_t start = vtime_mono_ns(), next = start;
+  double sim0 = s.rt.sim_time; /* a resumed run starts where its checkpoint was */
   while (!*stop && (opts->duration <= 0 || (double)(vtime_mono_ns() - start) * 1e-9 < opts->duration)) {
-    uint64_t t0 = vtime_mono_ns();
+    uint64_t t0 = vtime_mono_ns(), c0 = vtime_thread_cpu_ns();
     read_commands(&s, t0);
     if (read_controls(&s)) {
       stats->overruns++;
@@ -641,6 +651,7 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
     }
     if (s.rt.steps % publish_every == 0) publish_frames(&s);
     uint64_t t1 = vtime_mono_ns();
+    s.step_cpu_us[s.nstep_us % STEP_RING] = (double)(vtime_thread_cpu_ns() - c0) * 1e-3;
     s.step_us[s.nstep_us++ % STEP_RING] = (double)(t1 - t0) * 1e-3;
     if (s.rt.steps % metrics_every == 0) {
       publish_metrics(&s, metrics_every);
@@ -684,6 +695,11 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
   stats->step_us_median = st.median;
   stats->step_us_p99 = st.p99;
   stats->step_us_max = st.max;
+  vstats_summary_t sc = vstats_summarise(s.step_cpu_us, n);
+  stats->step_cpu_us_median = sc.median;
+  stats->step_cpu_us_p99 = sc.p99;
+  double wall = (double)(vtime_mono_ns() - start) * 1e-9;
+  stats->realtime_ratio = wall > 0 ? (s.rt.sim_time - sim0) / wall : 0;
   scalpel_print_summary(&s.rt, stdout);
   /* Give reliable late samples (last frame, stop event) a moment to leave. */
   dds_sleepfor(DDS_MSECS(100));

@@ -19,8 +19,8 @@ typedef struct server_opts {
   double duration;        /* s of wall time; 0 = until stopped */
   const char *final_mesh; /* write exact positions of the last published frame here (OBJ) */
   int quiet;
-  double tool_timeout;    /* s without a command before a tool is released */
-  const char *checkpoint; /* state file: resumed from at start when it fits the scene, written periodically */
+  double tool_timeout;     /* s without a command before a tool is released */
+  const char *checkpoint;  /* state file: resumed from at start when it fits the scene, written periodically */
   double checkpoint_every; /* s of simulated time between checkpoints */
 } server_opts_t;
 
@@ -31,14 +31,19 @@ typedef struct server_stats {
   uint64_t liveliness_blips; /* client liveliness lapses that were not a lost client */
   double peak_force;
   double step_us_median, step_us_p99, step_us_max;
+  /* The same steps in this thread's CPU time: the work a step costs, apart
+   * from time the scheduler gave to other processes (on a crowded machine
+   * wall time grows while this stays put). */
+  double step_cpu_us_median, step_cpu_us_p99;
+  double realtime_ratio; /* simulated s per wall s over the run */
   size_t ntools;
-  thr_tracker_t thr[SCENE_MAX_TOOLS]; /* palpation measures per tool at the end */
+  thr_tracker_t thr[SCENE_MAX_TOOLS];         /* palpation measures per tool at the end */
   viscera_ToolMetrics tools[SCENE_MAX_TOOLS]; /* per-tool measures at the end */
   size_t ntasks;
   task_rt_t tasks[SCENE_MAX_TASKS]; /* cfg points into the server's scene copy: use the index, not cfg */
   int stone_removed[SCENE_MAX_OBJECTS];
-  double sim_time; /* s simulated */
-  uint64_t published[VT_COUNT];       /* samples written per topic (vdds ids), for drop accounting */
+  double sim_time;              /* s simulated */
+  uint64_t published[VT_COUNT]; /* samples written per topic (vdds ids), for drop accounting */
 } server_stats_t;
 
 /* Runs a whole session: set-up, loop until *stop or the duration, shutdown.
