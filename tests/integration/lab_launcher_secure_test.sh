@@ -64,4 +64,18 @@ for s in seat01 seat02; do
   expect_trainee_force "$OUT/lab/$s-haptic.log"
 done
 expect_logs "$OUT/lab" recorder seat01-server seat01-viewer1 seat01-haptic seat02-server seat02-viewer1 seat02-haptic
+
+# A seat the PKI has no identity for (--pki of this 2-seat lab, seat 3): lab.sh
+# names the identity, exits 1 and stops the recorder it had already started.
+launch_lab M "$OUT/lab3.out" --out "$OUT/lab3" --pki "$OUT/lab/pki" --first 3 --seats 1 --secure --duration 30
+PIDS+=("$M")
+for ((t = 0; t < 300; t++)); do kill -0 "$M" 2>/dev/null || break; sleep 0.1; done
+st=0
+wait "$M" || st=$?
+PIDS=()
+cat "$OUT/lab3.out"
+[ $st = 1 ] || fail "lab.sh with an identity missing from the PKI exited with $st, expected 1"
+grep -q "no identity 'server-seat03' in $OUT/lab/pki" "$OUT/lab3.out" || fail "the missing identity was not named"
+[ -f "$OUT/lab3/recorder.log" ] || fail "the recorder was not started first"
+expect_nothing_left "$M" "lab.sh stopped by an error"
 echo PASS
