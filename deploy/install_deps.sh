@@ -15,6 +15,7 @@ PKGS=(
   openssl                                   # DDS Security PKI (deploy/pki.sh)
   libsdl2-dev                               # window viewer (--window, --drive)
   xvfb xauth                                # headless X server for the window test
+  systemd                                   # systemd-analyze verify of the service units (test)
 )
 
 missing=()

@@ -3,28 +3,37 @@
 # seat (partition PREFIX/seatNN of one domain), optional scripted trainees,
 # offscreen viewers per seat, and one recorder for the whole lab (PREFIX/*).
 # With --secure, every process runs with its own DDS Security identity from
-# a PKI made by deploy/pki.sh (generated into OUT/pki when missing).
+# a PKI made by deploy/pki.sh (generated into --pki DIR when missing).
 # To spread a lab over machines, run it with --seats/--first on each machine
-# and a LAN configuration (CYCLONEDDS_URI=file://deploy/cyclonedds-lan.xml).
+# and a LAN configuration (CYCLONEDDS_URI=file://deploy/cyclonedds-lan.xml);
+# one machine records (the others --no-record) and, with --secure, all use
+# copies of one PKI (--pki).
 #
 # usage: deploy/lab.sh [options]
 #   --build DIR         build directory (default: build/, built if missing)
-#   --out DIR           logs, frames, recording (default: out/lab)
+#   --out DIR           logs (one per process), frames, recording (default: out/lab)
 #   --seats N           seats on this machine (default 3)
 #   --first K           number of the first seat (default 1)
 #   --prefix P          partition prefix (default lab)
 #   --scene FILE        scene every seat runs (default assets/scenes/default.yaml)
 #   --trainees          a scripted haptic client per seat (palpate_kidney.traj)
-#   --viewers K         offscreen viewers per seat (default 1)
-#   --duration S        seconds the lab runs (default 20)
-#   --secure            DDS Security on (PKI in OUT/pki)
+#   --viewers K         offscreen viewers per seat (default 1; 0 for none)
+#   --duration S        seconds the lab runs (default 20; 0: until SIGINT/SIGTERM)
+#   --secure            DDS Security on (PKI in --pki DIR)
+#   --pki DIR           the lab's PKI (default OUT/pki; made by pki.sh when missing)
 #   --no-record         no lab recorder
-# env: VISCERA_DOMAIN (default 9), CYCLONEDDS_URI (default the loopback config)
+# SIGINT (Ctrl-C) or SIGTERM stops the lab: every process it started gets
+# SIGTERM (SIGKILL if still running 10 s later), then the summary is printed.
+# Exit status: 0 when every process ended cleanly, 1 when one failed (named
+# with its log), 2 on bad usage.
+# env: VISCERA_DOMAIN (default 9), CYCLONEDDS_URI (default the loopback config),
+#   VISCERA_LAB_STOP_GRACE (seconds before SIGKILL, default 10)
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD="$ROOT/build" OUT="$ROOT/out/lab" SEATS=3 FIRST=1 PREFIX=lab SCENE="$ROOT/assets/scenes/default.yaml"
-TRAINEES=0 VIEWERS=1 DURATION=20 SECURE=0 RECORD=1
-usage() { sed -n 2,23p "$0" | sed 's/^# \{0,1\}//'; }
+TRAINEES=0 VIEWERS=1 DURATION=20 SECURE=0 RECORD=1 PKI=""
+STOP_GRACE_S="${VISCERA_LAB_STOP_GRACE:-10}"
+usage() { awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"; }
 while [ $# -gt 0 ]; do
   case "$1" in
     --build) BUILD="$2"; shift 2 ;;
@@ -37,6 +46,7 @@ while [ $# -gt 0 ]; do
     --viewers) VIEWERS="$2"; shift 2 ;;
     --duration) DURATION="$2"; shift 2 ;;
     --secure) SECURE=1; shift ;;
+    --pki) PKI="$2"; shift 2 ;;
     --no-record) RECORD=0; shift ;;
     -h|--help) usage; exit 0 ;;
     *) echo "lab.sh: unknown option '$1'" >&2; usage >&2; exit 2 ;;
@@ -45,54 +55,121 @@ done
 for v in SEATS FIRST VIEWERS DURATION; do
   [[ "${!v}" =~ ^[0-9]+$ ]] || { echo "lab.sh: --${v,,} must be a whole number" >&2; exit 2; }
 done
-[ "$SEATS" -ge 1 ] && [ $((FIRST + SEATS - 1)) -le 99 ] || { echo "lab.sh: seats must lie in 1..99" >&2; exit 2; }
+[[ "$STOP_GRACE_S" =~ ^[0-9]+$ ]] || { echo "lab.sh: VISCERA_LAB_STOP_GRACE must be a whole number" >&2; exit 2; }
+[ "$SEATS" -ge 1 ] && [ "$FIRST" -ge 1 ] && [ $((FIRST + SEATS - 1)) -le 99 ] || { echo "lab.sh: seats must lie in 1..99" >&2; exit 2; }
+[[ "$PREFIX" =~ ^[A-Za-z0-9_-]+$ ]] || { echo "lab.sh: --prefix: letters, digits, '-' and '_' only" >&2; exit 2; }
 [ -f "$SCENE" ] || { echo "lab.sh: scene file not found: $SCENE" >&2; exit 2; }
 [ -x "$BUILD/server/viscera-server" ] || bash "$ROOT/deploy/build.sh" "$BUILD"
 export VISCERA_DOMAIN="${VISCERA_DOMAIN:-9}"
 NET="${CYCLONEDDS_URI:-file://$ROOT/deploy/cyclonedds-loopback.xml}"
 mkdir -p "$OUT"
+OUT="$(cd "$OUT" && pwd)" # children get absolute paths
 LAST=$((FIRST + SEATS - 1))
-if [ $SECURE = 1 ] && [ ! -f "$OUT/pki/permissions.p7s" ]; then
-  bash "$ROOT/deploy/pki.sh" "$OUT/pki" --seats "$LAST" --prefix "$PREFIX"
+PKI="${PKI:-$OUT/pki}"
+if [ $SECURE = 1 ] && [ ! -f "$PKI/permissions.p7s" ]; then
+  bash "$ROOT/deploy/pki.sh" "$PKI" --seats "$LAST" --prefix "$PREFIX"
 fi
-as() { if [ $SECURE = 1 ]; then echo "$NET,file://$OUT/pki/identities/$1/security.xml"; else echo "$NET"; fi; }
+as() {
+  if [ $SECURE = 0 ]; then echo "$NET"; return; fi
+  local f="$PKI/identities/$1/security.xml"
+  # A PKI made for fewer seats (or another prefix) lacks the identity: say which.
+  [ -f "$f" ] || { echo "lab.sh: no identity '$1' in $PKI (make the PKI with pki.sh --seats $LAST --prefix $PREFIX)" >&2; return 1; }
+  echo "$NET,file://$f"
+}
+# With --duration 0 the children run until stopped.
+dur() { [ "$DURATION" -gt 0 ] && echo "--duration $(($1))"; true; }
 
-pids=()
-cleanup() { for p in "${pids[@]}"; do kill -TERM "$p" 2>/dev/null || true; done; wait 2>/dev/null || true; }
-trap cleanup EXIT INT TERM
+# Every child is started by start() and stays in pids/names until it is
+# reaped; nothing else is started, so stop_all() can account for all of them.
+pids=() names=() stop_sig=""
+running() { # a live, not yet exited process (bash reaps its children by itself)
+  local st
+  st="$(sed 's/.*) \(.\).*/\1/' "/proc/$1/stat" 2>/dev/null)" || return 1
+  [ -n "$st" ] && [ "$st" != Z ]
+}
+stop_all() {
+  local p t left
+  for p in "${pids[@]}"; do [ -n "$p" ] && { kill -TERM "$p" 2>/dev/null || true; }; done
+  for ((t = 0; t < STOP_GRACE_S * 10; t++)); do
+    left=0
+    for p in "${pids[@]}"; do [ -n "$p" ] && running "$p" && left=1 && break; done
+    [ $left = 0 ] && return 0
+    sleep 0.1
+  done
+  for p in "${pids[@]}"; do
+    if [ -n "$p" ] && running "$p"; then
+      echo "lab: pid $p still running ${STOP_GRACE_S} s after SIGTERM: SIGKILL" >&2
+      kill -KILL "$p" 2>/dev/null || true
+    fi
+  done
+}
+on_signal() {
+  [ -z "$stop_sig" ] || return 0 # already stopping
+  stop_sig="$1"
+  echo "lab: $1, stopping every process" >&2
+  stop_all
+}
+trap 'on_signal SIGINT' INT
+trap 'on_signal SIGTERM' TERM
+trap 'stop_all' EXIT # an error in this script must not leave processes behind
+start() { # start NAME IDENTITY COMMAND... : log in OUT/NAME.log
+  local name="$1" uri
+  uri="$(as "$2")" || exit 1
+  shift 2
+  [ -z "$stop_sig" ] || return 0
+  env CYCLONEDDS_URI="$uri" "$@" > "$OUT/$name.log" 2>&1 &
+  pids+=($!) names+=("$name")
+}
+pause() { # a sleep that SIGINT/SIGTERM cut short
+  sleep "$1" &
+  local s=$!
+  wait $s 2>/dev/null || kill $s 2>/dev/null || true
+}
 
 echo "lab: seats $FIRST..$LAST on domain $VISCERA_DOMAIN, partitions $PREFIX/seatNN, $VIEWERS viewer(s) per seat," \
-  "secure=$SECURE, $DURATION s; output in $OUT"
+  "secure=$SECURE, $([ "$DURATION" -gt 0 ] && echo "$DURATION s" || echo "until stopped"); output in $OUT"
 if [ $RECORD = 1 ]; then
   rm -f "$OUT/lab.db" "$OUT/lab.db-wal" "$OUT/lab.db-shm"
-  CYCLONEDDS_URI="$(as recorder)" "$BUILD/client/recorder/viscera-recorder" --partition "$PREFIX/*" \
-    --out "$OUT/lab.db" --scene "$PREFIX" --duration $((DURATION + 2)) --quiet > "$OUT/recorder.log" 2>&1 &
-  pids+=($!)
+  # shellcheck disable=SC2046 # dur prints nothing or two words
+  start recorder recorder "$BUILD/client/recorder/viscera-recorder" --partition "$PREFIX/*" \
+    --out "$OUT/lab.db" --scene "$PREFIX" $(dur DURATION+2) --quiet
 fi
 for i in $(seq "$FIRST" "$LAST"); do
   s=$(printf 'seat%02d' "$i")
-  CYCLONEDDS_URI="$(as "server-$s")" "$BUILD/server/viscera-server" --scene "$SCENE" --partition "$PREFIX/$s" \
-    --duration "$DURATION" > "$OUT/$s-server.log" 2>&1 &
-  pids+=($!)
+  # shellcheck disable=SC2046
+  start "$s-server" "server-$s" "$BUILD/server/viscera-server" --scene "$SCENE" --partition "$PREFIX/$s" $(dur DURATION)
   for k in $(seq 1 "$VIEWERS"); do
     rm -rf "$OUT/$s-frames$k"
-    CYCLONEDDS_URI="$(as observer)" "$BUILD/client/viewer/viscera-viewer" --partition "$PREFIX/$s" \
-      --out "$OUT/$s-frames$k" --interval-ms 1000 --duration "$DURATION" > "$OUT/$s-viewer$k.log" 2>&1 &
-    pids+=($!)
+    # shellcheck disable=SC2046
+    start "$s-viewer$k" observer "$BUILD/client/viewer/viscera-viewer" --partition "$PREFIX/$s" \
+      --out "$OUT/$s-frames$k" --interval-ms 1000 $(dur DURATION)
   done
 done
 if [ $TRAINEES = 1 ]; then
-  sleep 2
+  [ -n "$stop_sig" ] || pause 2
   for i in $(seq "$FIRST" "$LAST"); do
     s=$(printf 'seat%02d' "$i")
-    CYCLONEDDS_URI="$(as "trainee-$s")" "$BUILD/client/haptic/viscera-haptic" --partition "$PREFIX/$s" \
-      --trajectory "$ROOT/assets/trajectories/palpate_kidney.traj" --quiet > "$OUT/$s-haptic.log" 2>&1 &
-    pids+=($!)
+    start "$s-haptic" "trainee-$s" "$BUILD/client/haptic/viscera-haptic" --partition "$PREFIX/$s" \
+      --trajectory "$ROOT/assets/trajectories/palpate_kidney.traj" --quiet
   done
 fi
-wait || true
-pids=()
-echo "lab: done"
+
+# Reap every child with its exit status. A trapped signal cuts a wait short
+# while the child still runs: wait again until it is gone, then read the
+# status bash kept for it.
+failed=0
+for i in "${!pids[@]}"; do
+  p=${pids[$i]}
+  while running "$p"; do wait "$p" 2>/dev/null || true; done
+  st=0
+  wait "$p" 2>/dev/null || st=$?
+  pids[i]=""
+  if [ $st != 0 ]; then
+    echo "lab: ${names[$i]} (pid $p) exited with status $st; log: $OUT/${names[$i]}.log" >&2
+    failed=1
+  fi
+done
+echo "lab: ${stop_sig:+stopped by $stop_sig, }done"
 for i in $(seq "$FIRST" "$LAST"); do
   s=$(printf 'seat%02d' "$i")
   peak=$(sed -n 's/.*peak_force=\([0-9.]*\).*/\1/p' "$OUT/$s-haptic.log" 2>/dev/null || true)
@@ -100,5 +177,7 @@ for i in $(seq "$FIRST" "$LAST"); do
   step=$(grep -o 'step [^;]*median[^;,]*' "$OUT/$s-server.log" | tail -1 || true)
   echo "  $s: frames $frames${peak:+, trainee peak force $peak N}${step:+, $step}"
 done
-[ $RECORD = 1 ] && "$BUILD/client/recorder/viscera-recinfo" "$OUT/lab.db" | tail -1 | sed 's/^/  recording: /'
-exit 0
+if [ $RECORD = 1 ]; then
+  "$BUILD/client/recorder/viscera-recinfo" "$OUT/lab.db" | tail -1 | sed 's/^/  recording: /' || true
+fi
+exit $failed

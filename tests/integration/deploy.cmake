@@ -1,0 +1,7 @@
+# The deployment kit (issue 7): deploy/lab.sh, the LAN configuration and the
+# service units, run as users run them. Domains 161-165.
+viscera_integration_test(lab_launcher 161 lab_launcher_test.sh)
+viscera_integration_test(lab_launcher_secure 162 lab_launcher_secure_test.sh)
+viscera_integration_test(lan_config 163 lan_config_test.sh)
+viscera_integration_test(systemd_units 164 systemd_units_test.sh)
+set_tests_properties(systemd_units PROPERTIES SKIP_RETURN_CODE 77)
