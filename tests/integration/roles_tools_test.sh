@@ -11,6 +11,7 @@
 #   release 0        -> version 5, no guide, the tool back at A
 #   guide 0 bob 0.5, then bob's client killed -> the tool back at A with
 #   alice alone (the guide's side ends, the tool stays with its owner)
+#   reset            -> roles kept and published again, the tool at A
 #   refusals: bob guiding a tool it owns, a coupling above the tool's
 #   stiffness, an unknown tool; and the server counted bob's commands
 #   rejected while the tool was alice's alone.
@@ -62,6 +63,9 @@ step unchanged -- --version 5 --owner alice --guide - --near $A
 step guide-again guide 0 bob 0.5 -- --version 6 --near $M
 kill -9 $BOB
 step guide-lost -- --version 6 --guide bob --near $A
+# A reset releases the tools but keeps the roles (published again, same
+# version): alice's commands move the tool again, bob's role is still there.
+step reset reset -- --version 6 --owner alice --guide bob --near $A
 kill -INT $ALICE; kill -INT $SRV
 wait $SRV || fail "server exited with an error"
 wait $ALICE || true
@@ -72,6 +76,8 @@ n=$(sed -n 's/.*tool assigned to another station: \([0-9]*\).*/\1/p' "$OUT/serve
 echo "commands rejected as not assigned: ${n:-none}"
 [ "${n:-0}" -gt 0 ] || fail "the server counted no command rejected for the tool's assignment"
 roles=$(sed -n 's/.*viscera_ToolRole=\([0-9]*\).*/\1/p' "$OUT/server.out")
-[ "${roles:-0}" -ge 6 ] || fail "ToolRole published ${roles:-0} times, expected at least 6"
+# Once per tool at start, once per change (5), once after the reset; never
+# for a refused or unchanged command.
+[ "${roles:-0}" -eq 7 ] || fail "ToolRole published ${roles:-0} times, expected 7"
 grep "guide client" "$OUT/server.log" || true
 echo PASS
