@@ -206,10 +206,9 @@ static int apply_guide(tool_roles_t *r, size_t t, const viscera_SessionControl *
     return -1;
   }
   int changed = set_role(r, t, tr->owner, station, a, k);
-  int w = snprintf(text, n, "tool %zu '%s' %s by station '%s' (authority %.3g, coupling %.4g N/m; owner: %s)%s", t,
-                   tr->name, a >= 1 ? "taken over" : "guided", station, a, k,
-                   tool_roles_who(tr->owner, who, sizeof who), changed ? "" : " (unchanged)");
-  (void)w;
+  snprintf(text, n, "tool %zu '%s' %s by station '%s' (authority %.3g, coupling %.4g N/m; owner: %s)%s", t, tr->name,
+           a >= 1 ? "taken over" : "guided", station, a, k, tool_roles_who(tr->owner, who, sizeof who),
+           changed ? "" : " (unchanged)");
   return 0;
 }
 
