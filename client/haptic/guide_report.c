@@ -1,0 +1,65 @@
+#include "guide_report.h"
+
+#include <string.h>
+
+static const char *side_name(guide_side_t s) {
+  return s == GUIDE_SIDE_OWNER ? "owner (trainee)" : s == GUIDE_SIDE_GUIDE ? "guide (instructor)" : "none";
+}
+
+void guide_report_init(guide_report_t *r) {
+  memset(r, 0, sizeof *r);
+  r->w = 1; /* as plain rendering reports it: no line until something changes */
+}
+
+void guide_report_tick(guide_report_t *r, double t, const guide_role_t *role, const char *peer, const guide_output_t *o,
+                       FILE *log) {
+  if (!peer || !o->coupled) peer = "";
+  if (o->coupled) {
+    if (o->side == GUIDE_SIDE_OWNER) r->ticks_owner++;
+    if (o->side == GUIDE_SIDE_GUIDE) r->ticks_guide++;
+    r->last_side = o->side;
+    r->last_authority = role->authority;
+    r->last_k = o->k;
+    snprintf(r->last_peer, sizeof r->last_peer, "%s", peer);
+  }
+  /* A new role version is worth a line even when the coupling it gives is
+   * the same (e.g. an assignment to us while unguided). */
+  int role_changed = role->known != r->role_known || (role->known && role->version != r->role_version);
+  int changed =
+      o->coupled != r->coupled || o->side != r->side || o->w != r->w || o->k != r->k || strcmp(peer, r->peer) != 0;
+  if (!changed && !role_changed) return;
+  r->coupled = o->coupled;
+  r->side = o->side;
+  r->w = o->w;
+  r->k = o->k;
+  snprintf(r->peer, sizeof r->peer, "%s", peer);
+  r->role_known = role->known;
+  r->role_version = role->version;
+  r->changes++;
+  if (!log) return;
+  if (o->coupled)
+    fprintf(log, "haptic: t=%.3f s guide: coupled as %s, own share %.2f, k %.0f N/m, peer %s (role v%u)\n", t,
+            side_name(o->side), o->w, o->k, peer[0] ? peer : "(anonymous)", role->version);
+  else if (!role->known)
+    fprintf(log, "haptic: t=%.3f s guide: not coupled (no role for the tool)\n", t);
+  else
+    fprintf(log, "haptic: t=%.3f s guide: not coupled (role v%u: owner '%s', guide '%s'; we are %s%s)\n", t,
+            role->version, role->owner, role->guide, side_name(o->side),
+            o->side != GUIDE_SIDE_NONE ? ", peer silent or absent" : "");
+}
+
+double guide_report_coupled_s(const guide_report_t *r, double period_s) {
+  return (double)(r->ticks_owner + r->ticks_guide) * period_s;
+}
+
+void guide_report_summary(const guide_report_t *r, double period_s, FILE *f) {
+  if (!r->ticks_owner && !r->ticks_guide) {
+    fprintf(f, "haptic: GUIDE never coupled\n");
+    return;
+  }
+  fprintf(f,
+          "haptic: GUIDE coupled %.1f s as owner (trainee), %.1f s as guide (instructor); last: as %s, authority "
+          "%.2f, k %.0f N/m, peer %s\n",
+          (double)r->ticks_owner * period_s, (double)r->ticks_guide * period_s, side_name(r->last_side),
+          r->last_authority, r->last_k, r->last_peer[0] ? r->last_peer : "(anonymous)");
+}
