@@ -466,9 +466,10 @@ int main(int argc, char **argv) {
             foreign);
   guide_report_summary(&guide_rep, 1.0 / rate, stderr);
   pthread_mutex_lock(&guide.lock);
-  if (guide.roles_rejected || guide.bad_samples)
-    fprintf(stderr, "haptic: guide: %" PRIu64 " ToolRole samples refused, %" PRIu64 " peer commands not finite\n",
-            guide.roles_rejected, guide.bad_samples);
+  fprintf(stderr,
+          "haptic: guide: %" PRIu64 " ToolRole samples (%" PRIu64 " refused), %" PRIu64
+          " commands from other stations (%" PRIu64 " not finite), %" PRIu64 " of ours skipped\n",
+          guide.roles_received, guide.roles_rejected, guide.peer_samples, guide.bad_samples, guide.own_samples_skipped);
   pthread_mutex_unlock(&guide.lock);
   printf("SUMMARY ticks=%" PRIu64 " rate_hz=%.1f peak_force=%.4f contact_ticks=%" PRIu64 " latency_us_median=%.1f "
          "latency_us_p99=%.1f period_us_p99=%.1f jitter_us_p99=%.1f late_ticks=%" PRIu64 " guide_coupled_s=%.2f\n",
