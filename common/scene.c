@@ -16,6 +16,8 @@
 #include <strings.h>
 #include <yaml.h>
 
+#include "vdds.h" /* station names (vdds_station_valid) */
+
 /* A scene is a few kilobytes; the caps keep a hostile or mistaken file (a
  * mesh passed by accident, a YAML bomb) from costing more than a few MB. */
 #define SCENE_MAX_BYTES (1u << 20)
@@ -464,6 +466,7 @@ enum {
   T_GRASP_RADIUS,
   T_JAW_OPENING,
   T_BLADE_LENGTH,
+  T_STATION,
   T_NKEYS
 };
 static const char *const tool_keys[T_NKEYS] = {[T_NAME] = "name",
@@ -476,7 +479,8 @@ static const char *const tool_keys[T_NKEYS] = {[T_NAME] = "name",
                                                [T_FRICTION] = "friction",
                                                [T_GRASP_RADIUS] = "grasp_radius",
                                                [T_JAW_OPENING] = "jaw_opening",
-                                               [T_BLADE_LENGTH] = "blade_length"};
+                                               [T_BLADE_LENGTH] = "blade_length",
+                                               [T_STATION] = "station"};
 
 enum { J_NAME, J_KIND, J_RADIUS, J_POSITION, J_ORGAN, J_COLOR, J_NKEYS };
 static const char *const object_keys[J_NKEYS] = {[J_NAME] = "name",         [J_KIND] = "kind",   [J_RADIUS] = "radius",
@@ -502,6 +506,7 @@ _Static_assert(P_NKEYS <= SCENE_MAX_KEYS && M_NKEYS <= SCENE_MAX_KEYS && V_NKEYS
                    O_NKEYS <= SCENE_MAX_KEYS && T_NKEYS <= SCENE_MAX_KEYS && H_NKEYS <= SCENE_MAX_KEYS &&
                    S_NKEYS <= SCENE_MAX_KEYS && J_NKEYS <= SCENE_MAX_KEYS && K_NKEYS <= SCENE_MAX_KEYS,
                "raise SCENE_MAX_KEYS");
+_Static_assert(sizeof(((scene_tool_t *)0)->station) == VDDS_STATION_MAX, "scene_tool_t.station: one station name");
 
 static void organ_defaults(scene_organ_t *o) {
   memset(o, 0, sizeof *o);
@@ -807,6 +812,13 @@ static int parse_tool(const ctx_t *c, const node_t *n, size_t idx, scene_t *s) {
   if (v[T_THRESHOLDS]) {
     join(fp, sizeof fp, path, "thresholds");
     if (parse_thresholds(c, v[T_THRESHOLDS], fp, t)) return -1;
+  }
+  if (v[T_STATION]) { /* the initial owner (idl ToolRole); absent: any station */
+    join(fp, sizeof fp, path, "station");
+    if (get_string(c, v[T_STATION], fp, t->station, sizeof t->station)) return -1;
+    if (!vdds_station_valid(t->station))
+      return field_err(c, v[T_STATION], fp, "must be 1..%d characters of A-Z a-z 0-9 _ . - (got '%.*s%s')",
+                       VDDS_STATION_MAX - 1, SHOW(v[T_STATION]));
   }
   return parse_capability(c, v, path, t);
 }

@@ -115,6 +115,10 @@ typedef struct scene_tool {
   /* scalpel: m, cutting edge from the tip along the tool axis (default
    * 0.02). 0 for the other kinds. */
   double blade_length;
+  /* The station that drives the tool from the start (key `station:`, see
+   * idl ToolRole and vdds.h: 1..31 of [A-Za-z0-9_.-]); "" = any station.
+   * The instructor reassigns it at run time (CONTROL_ASSIGN_TOOL). */
+  char station[32];
   int line;
 } scene_tool_t;
 

@@ -12,10 +12,12 @@
 #include "mesh.h"
 #include "session_control.h"
 #include "tool_metrics.h"
+#include "tool_roles.h"
 #include "viscera.h"
 #include "vmath.h"
 #include "vstats.h"
 #include "vtime.h"
+#include "writer_stations.h"
 
 #define STEP_RING 65536
 
@@ -24,16 +26,19 @@ typedef struct server {
   runtime_t rt;
   vdds_t dds;
   dds_entity_t w_scene, w_state, w_delta, w_feedback, w_event, w_metrics, r_cmd, r_control;
-  dds_entity_t w_objects, w_tool_metrics;
+  dds_entity_t w_objects, w_tool_metrics, w_role;
   tool_tally_t tally[SCENE_MAX_TOOLS];
   mesh_publisher_t pubs[SCENE_MAX_ORGANS];
   uint64_t cmd_seq[SCENE_MAX_TOOLS], cmd_echo[SCENE_MAX_TOOLS], last_cmd_mono[SCENE_MAX_TOOLS];
   int was_contact[SCENE_MAX_TOOLS];
-  /* Loss detection: the writer driving each tool (publication handle) and
-   * whether the tool was released for a lost client (to report its return). */
+  /* Loss detection: the writers driving each tool are in roles (per side),
+   * and whether the tool was released for a lost client (to report its return). */
   liveliness_watch_t lw;
-  dds_instance_handle_t cmd_writer[SCENE_MAX_TOOLS];
   int tool_lost[SCENE_MAX_TOOLS];
+  /* Who drives each tool and each side's latest command (tool_roles.h);
+   * the station of each command writer (writer_stations.h). */
+  tool_roles_t roles;
+  writer_stations_t stations;
   thr_tracker_t thr[SCENE_MAX_TOOLS];
   session_control_t control;
   uint64_t event_seq;
@@ -101,6 +106,21 @@ static void publish_scene_info(server_t *s) {
   if (dds_write(s->w_scene, &si) >= 0) s->stats->published[VT_SCENE_INFO]++;
 }
 
+/* The ToolCommand reader. Its topic keeps the last sample per tool, but two
+ * writers share a tool when it is guided (tool_roles.h): with depth 1 one
+ * station's sample would overwrite the other's before the loop takes it.
+ * 16 per tool covers both at 1 kHz through an 8 ms stall of the loop. */
+#define CMD_READER_DEPTH 16
+static dds_entity_t command_reader(server_t *s, const dds_listener_t *l, verr_t *err) {
+  dds_qos_t *q = dds_create_qos();
+  dds_return_t rc = dds_get_qos(s->dds.topics[VT_TOOL_COMMAND], q); /* the table's QoS (liveliness, best effort) */
+  dds_qset_history(q, DDS_HISTORY_KEEP_LAST, CMD_READER_DEPTH);
+  dds_entity_t r = rc < 0 ? rc : dds_create_reader(s->dds.subscriber, s->dds.topics[VT_TOOL_COMMAND], q, l);
+  dds_delete_qos(q);
+  if (r < 0) verr_set(err, "DDS: cannot create the ToolCommand reader: %s", dds_strretcode(r));
+  return r;
+}
+
 static int setup(server_t *s, const scene_t *scene, verr_t *err) {
   liveliness_watch_init(&s->lw); /* first: teardown always destroys it */
   if (runtime_init(&s->rt, scene, err)) return -1;
@@ -113,14 +133,18 @@ static int setup(server_t *s, const scene_t *scene, verr_t *err) {
   s->w_metrics = vdds_writer(&s->dds, VT_METRICS, err);
   dds_listener_t *l = dds_create_listener(&s->lw);
   liveliness_watch_listen(&s->lw, l);
-  s->r_cmd = vdds_reader_listener(&s->dds, VT_TOOL_COMMAND, l, err);
+  s->r_cmd = command_reader(s, l, err);
   dds_delete_listener(l);
   s->r_control = vdds_reader(&s->dds, VT_SESSION_CONTROL, err);
   s->w_objects = vdds_writer(&s->dds, VT_OBJECT_STATE, err);
   s->w_tool_metrics = vdds_writer(&s->dds, VT_TOOL_METRICS, err);
+  s->w_role = vdds_writer(&s->dds, VT_TOOL_ROLE, err);
   if (s->w_scene < 0 || s->w_state < 0 || s->w_delta < 0 || s->w_feedback < 0 || s->w_event < 0 || s->w_metrics < 0 ||
-      s->r_cmd < 0 || s->r_control < 0 || s->w_objects < 0 || s->w_tool_metrics < 0)
+      s->r_cmd < 0 || s->r_control < 0 || s->w_objects < 0 || s->w_tool_metrics < 0 || s->w_role < 0)
     return -1;
+  tool_roles_init(&s->roles, &s->rt.scene);
+  writer_stations_init(&s->stations);
+  s->control.roles = &s->roles;
   for (size_t i = 0; i < s->rt.norgans; i++) {
     organ_rt_t *o = &s->rt.organs[i];
     if (mesh_publisher_init(&s->pubs[i], o->id, o->model->nsurf, o->model->surf_tris, o->model->nsurf_tris,
@@ -147,8 +171,10 @@ static void release_lost_writers(server_t *s, uint64_t now) {
   liveliness_lost_t e;
   while (liveliness_watch_pop(&s->lw, now, LIVELINESS_CONFIRM_NS, &e)) {
     for (size_t t = 0; t < s->rt.ntools; t++) {
-      if (!s->rt.tools[t].active || s->cmd_writer[t] != e.writer) continue;
-      if (e.expired && (e.regained || s->last_cmd_mono[t] > e.mono_ns)) {
+      int side = tool_roles_side_of_writer(&s->roles, t, e.writer);
+      if (!s->rt.tools[t].active || side < 0) continue;
+      uint64_t last = s->roles.tool[t].side[side].mono_ns;
+      if (e.expired && (e.regained || last > e.mono_ns)) {
         /* Alive after all: this process was starved past the lease (see
          * liveliness_watch.h). Keep the tool; say so a few times. */
         if (++s->stats->liveliness_blips <= 3 && !s->opts->quiet)
@@ -156,12 +182,26 @@ static void release_lost_writers(server_t *s, uint64_t now) {
                           "kept\n", t);
         continue;
       }
+      /* One side of a guided tool gone: its hand stops counting at once and
+       * the other side drives alone (tool_roles.h); the tool stays, so no
+       * CLIENT_LOST (which says the tool was released, e.g. to viscera-resim). */
+      char who[TOOL_ROLE_STATION_MAX + 16];
+      const char *st = s->roles.tool[t].side[side].station;
+      snprintf(who, sizeof who, st[0] ? "station '%s'" : "anonymous%s", st);
+      tool_roles_forget(&s->roles, t, (tool_side_t)side);
+      tool_effective_t eff;
+      if (tool_roles_effective(&s->roles, t, now, &eff)) {
+        if (!s->opts->quiet)
+          fprintf(stderr, "server: tool %zu: %s client (%s) lost: the %s drives on alone\n", t,
+                  side ? "guide" : "owner", who, side ? "owner" : "guide");
+        continue;
+      }
       runtime_release_tool(&s->rt, t);
       s->tool_lost[t] = 1;
       /* From the last command taken to the listener's report, and to this
        * release (which adds the confirmation delay and the step). */
-      double heard_ms = e.mono_ns > s->last_cmd_mono[t] ? (double)(e.mono_ns - s->last_cmd_mono[t]) * 1e-6 : 0;
-      double released_ms = (double)(now - s->last_cmd_mono[t]) * 1e-6;
+      double heard_ms = e.mono_ns > last ? (double)(e.mono_ns - last) * 1e-6 : 0;
+      double released_ms = (double)(now - last) * 1e-6;
       char text[200];
       if (e.expired)
         snprintf(text, sizeof text,
@@ -171,8 +211,37 @@ static void release_lost_writers(server_t *s, uint64_t now) {
       else
         snprintf(text, sizeof text, "haptic client left (its command writer was deleted): tool released");
       if (!s->opts->quiet) fprintf(stderr, "server: tool %zu: %s\n", t, text);
-      publish_event(s, viscera_EVENT_CLIENT_LOST, -1, (int)t, (double)(now - s->last_cmd_mono[t]) * 1e-9, text);
+      publish_event(s, viscera_EVENT_CLIENT_LOST, -1, (int)t, (double)(now - last) * 1e-9, text);
     }
+  }
+}
+
+/* Moves tool t to the pose its stations give it now (tool_roles.h: the
+ * owner's, the guide's, or their mix). */
+static void drive_tool(server_t *s, size_t t, uint64_t now) {
+  tool_effective_t eff;
+  if (!tool_roles_effective(&s->roles, t, now, &eff)) return;
+  if (s->tool_lost[t]) {
+    s->tool_lost[t] = 0;
+    if (!s->opts->quiet) fprintf(stderr, "server: tool %zu: haptic client back\n", t);
+  }
+  runtime_set_tool(&s->rt, t, eff.pos, eff.max_force);
+  runtime_set_buttons(&s->rt, t, eff.buttons);
+  runtime_set_orientation(&s->rt, t, eff.q);
+  s->cmd_seq[t] = eff.seq;
+  s->cmd_echo[t] = eff.echo;
+}
+
+/* Publishes the ToolRole of every tool whose role changed (or all, after
+ * start and after a reset). */
+static void publish_roles(server_t *s) {
+  uint32_t changed = s->roles.changed;
+  s->roles.changed = 0;
+  for (size_t t = 0; t < s->roles.ntools; t++) {
+    if (!(changed & (1u << t))) continue;
+    viscera_ToolRole m;
+    tool_roles_fill(&s->roles, t, sim_ns(s), &m);
+    if (dds_write(s->w_role, &m) >= 0) s->stats->published[VT_TOOL_ROLE]++;
   }
 }
 
@@ -181,6 +250,7 @@ static void read_commands(server_t *s, uint64_t now) {
   enum { MAXS = 16 };
   void *samples[MAXS] = {0};
   dds_sample_info_t infos[MAXS];
+  uint32_t fresh = 0; /* tools with a new command this step */
   for (;;) {
     int n = dds_take(s->r_cmd, samples, infos, MAXS, MAXS);
     if (n <= 0) break;
@@ -188,39 +258,46 @@ static void read_commands(server_t *s, uint64_t now) {
       if (!infos[i].valid_data) continue;
       const viscera_ToolCommand *c = samples[i];
       tool_cmd_verdict_t v = tool_command_check(c, s->rt.ntools, &s->rt.workspace);
+      const char *station = "";
+      tool_side_t side = TOOL_SIDE_REJECTED;
+      if (v == TOOLCMD_OK) { /* well-formed: does its station drive this tool? */
+        station = writer_stations_get(&s->stations, s->r_cmd, infos[i].publication_handle);
+        side = tool_roles_classify(&s->roles, c->tool_id, station);
+        if (side == TOOL_SIDE_REJECTED) v = TOOLCMD_NOT_ASSIGNED;
+      }
       if (v != TOOLCMD_OK) {
         s->stats->rejected[v]++;
         uint64_t r = ++s->stats->rejected_total;
         /* Report the first few and then every 1000th, so a flood of garbage
          * cannot flood the event topic or the log. */
         if (r <= 5 || r % 1000 == 0) {
-          char text[200];
-          snprintf(text, sizeof text, "ToolCommand from tool %u rejected: %s (%" PRIu64 " rejected so far)", c->tool_id,
-                   tool_command_verdict_str(v), r);
+          char text[200], who[64];
+          if (v == TOOLCMD_NOT_ASSIGNED)
+            snprintf(text, sizeof text,
+                     "ToolCommand for tool %u from %s rejected: tool assigned to station '%s' (%" PRIu64
+                     " rejected so far)",
+                     c->tool_id, station[0] ? tool_roles_who(station, who, sizeof who) : "an anonymous station",
+                     s->roles.tool[c->tool_id].owner, r);
+          else
+            snprintf(text, sizeof text, "ToolCommand from tool %u rejected: %s (%" PRIu64 " rejected so far)", c->tool_id,
+                     tool_command_verdict_str(v), r);
           if (!s->opts->quiet) fprintf(stderr, "server: %s\n", text);
           publish_event(s, viscera_EVENT_INPUT_REJECTED, -1, (int)(c->tool_id < 1u << 30 ? c->tool_id : 0), (double)r,
                         text);
         }
         continue;
       }
-      double pos[3] = {c->position[0], c->position[1], c->position[2]};
-      if (s->tool_lost[c->tool_id]) {
-        s->tool_lost[c->tool_id] = 0;
-        if (!s->opts->quiet) fprintf(stderr, "server: tool %u: haptic client back\n", c->tool_id);
-      }
-      s->cmd_writer[c->tool_id] = infos[i].publication_handle;
-      runtime_set_tool(&s->rt, c->tool_id, pos, c->max_force);
-      runtime_set_buttons(&s->rt, c->tool_id, c->buttons);
-      double q[4] = {c->orientation[0], c->orientation[1], c->orientation[2], c->orientation[3]};
-      runtime_set_orientation(&s->rt, c->tool_id, q);
-      s->cmd_seq[c->tool_id] = c->seq;
-      s->cmd_echo[c->tool_id] = c->client_mono_ns;
+      tool_roles_note(&s->roles, c->tool_id, side, station, infos[i].publication_handle, c, now);
+      fresh |= 1u << c->tool_id;
       s->last_cmd_mono[c->tool_id] = now;
       s->stats->commands++;
     }
     dds_return_loan(s->r_cmd, samples, n);
     if (n < MAXS) break;
   }
+  /* Once per step, after every side's latest command is in. */
+  for (size_t t = 0; t < s->rt.ntools; t++)
+    if (fresh & (1u << t)) drive_tool(s, t, now);
   release_lost_writers(s, now);
   for (size_t t = 0; t < s->rt.ntools; t++) {
     if (s->rt.tools[t].active && now - s->last_cmd_mono[t] > (uint64_t)(s->opts->tool_timeout * 1e9)) {
@@ -260,6 +337,7 @@ static int rebuild_runtime(server_t *s, const scene_t *sc, const scene_t *old, v
     memset(&s->tally[t], 0, sizeof s->tally[t]);
     s->was_contact[t] = 0;
   }
+  tool_roles_forget_all(&s->roles); /* tools released; roles kept and published again */
   for (size_t i = 0; i < s->rt.norgans; i++) {
     const organ_rt_t *o = &s->rt.organs[i];
     const model_t *m = o->model;
@@ -610,6 +688,7 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
   }
   uint64_t ckpt_every = (uint64_t)fmax(1.0, floor(opts->checkpoint_every / scene->dt + 0.5));
   publish_scene_info(&s);
+  publish_roles(&s);
   for (size_t i = 0; i < s.rt.norgans; i++) mesh_publisher_keyframe(&s.pubs[i], s.rt.organs[i].model->surf_x, 0);
   publish_event(&s, viscera_EVENT_SESSION_STARTED, -1, -1, stats->resumed, resumed[0] ? resumed : scene->name);
 
@@ -624,6 +703,7 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
       stats->overruns++;
       break; /* the scene could not be rebuilt: nothing left to simulate */
     }
+    if (s.roles.changed) publish_roles(&s);
     /* Paused: the organs and the measures freeze; commands are still read
      * (so nothing queues up) and the last contact model keeps going out. */
     int rolled = s.control.paused ? 0 : runtime_step(&s.rt);

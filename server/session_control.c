@@ -5,6 +5,8 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "tool_roles.h"
+
 /* Every answer ends with the command's origin, so the station that sent it
  * can tell its own answer from older events it receives as a late joiner. */
 static void tag(const viscera_SessionControl *c, char *text, size_t n) {
@@ -69,6 +71,18 @@ static const char *edit_material(scene_material_t *m, const double v[4]) {
   return NULL;
 }
 
+/* Tool roles (tool_roles.h) validate and apply themselves; answered like
+ * every other command. */
+static int apply_roles(session_control_t *sc, const viscera_SessionControl *c, char *text, size_t n) {
+  char what[200];
+  if (!sc->roles) return refuse(sc, c, text, n, "this seat does not assign tools");
+  if (tool_roles_apply(sc->roles, c, what, sizeof what)) return refuse(sc, c, text, n, what);
+  sc->applied++;
+  snprintf(text, n, "%s", what);
+  tag(c, text, n);
+  return 0;
+}
+
 int session_control_apply(session_control_t *sc, const viscera_SessionControl *c, thr_tracker_t *thr, size_t ntools,
                           const double *tool_max_force, scene_t *scene, char *text, size_t n) {
   switch (c->kind) {
@@ -121,6 +135,7 @@ int session_control_apply(session_control_t *sc, const viscera_SessionControl *c
   }
   case viscera_CONTROL_ASSIGN_TOOL:
   case viscera_CONTROL_GUIDE:
+    return apply_roles(sc, c, text, n);
   case viscera_CONTROL_START_TASK:
     break; /* being built (issue 7): refused as unknown until then */
   }

@@ -33,6 +33,9 @@ typedef struct session_control {
   uint32_t station[SESSION_CONTROL_STATIONS];
   uint64_t last_seq[SESSION_CONTROL_STATIONS];
   size_t nstations, next_evict;
+  /* Who drives each tool (CONTROL_ASSIGN_TOOL, CONTROL_GUIDE), owned by the
+   * server; NULL: those commands are refused. */
+  struct tool_roles *roles;
 } session_control_t;
 
 /* Returns 1 (and does nothing else) when `c` is a resent copy of a command

@@ -27,6 +27,7 @@ const char *tool_command_verdict_str(tool_cmd_verdict_t v) {
   case TOOLCMD_OUT_OF_WORKSPACE: return "position outside the workspace";
   case TOOLCMD_BAD_ORIENTATION: return "orientation is not a unit quaternion";
   case TOOLCMD_BAD_MAX_FORCE: return "max_force not in (0, 1000] N";
+  case TOOLCMD_NOT_ASSIGNED: return "tool assigned to another station";
   default: return "?";
   }
 }

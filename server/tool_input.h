@@ -16,6 +16,7 @@ typedef enum tool_cmd_verdict {
   TOOLCMD_OUT_OF_WORKSPACE,
   TOOLCMD_BAD_ORIENTATION,
   TOOLCMD_BAD_MAX_FORCE,
+  TOOLCMD_NOT_ASSIGNED, /* well-formed, but the tool is assigned to another station (tool_roles.h) */
   TOOLCMD_VERDICT_COUNT
 } tool_cmd_verdict_t;
 
