@@ -68,8 +68,15 @@ void guide_force(const guide_input_t *in, guide_output_t *out) {
   out->w = 1.0;
   v3_copy(out->x_tool, in->x);
   int coupled = out->side != GUIDE_SIDE_NONE && in->have_peer && v3_isfinite(in->peer) && isfinite(in->peer_age_s) &&
-                in->peer_age_s >= 0 && in->peer_age_s <= GUIDE_PEER_TIMEOUT_S;
+                in->peer_age_s >= 0 && in->peer_age_s <= GUIDE_PEER_TIMEOUT_S && in->server_silent_s >= 0 &&
+                in->server_silent_s <= GUIDE_SERVER_TIMEOUT_S;
   if (!coupled) {
+    out->why = !in->role->known                                                   ? "no role"
+               : !in->role->guide[0]                                              ? "no guide"
+               : out->side == GUIDE_SIDE_NONE                                     ? "not in the role"
+               : !in->have_peer || !v3_isfinite(in->peer)                         ? "no peer"
+               : !(in->peer_age_s >= 0 && in->peer_age_s <= GUIDE_PEER_TIMEOUT_S) ? "peer silent"
+                                                                                  : "server silent";
     /* Plain rendering, exactly as without roles. */
     contact_model_force(in->contact, in->x, in->v, in->max_force, out->f);
     out->magnitude = clamp_force(out->f, in->max_force);

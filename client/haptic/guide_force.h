@@ -29,7 +29,13 @@
  * outside 0..1, k not finite or <= 0), no peer position, or a peer position
  * older than GUIDE_PEER_TIMEOUT_S: plain contact rendering at own position,
  * as without roles (the server then uses our position alone too). A peer
- * still in the role but silent is therefore never a spring to a stale point. */
+ * still in the role but silent is therefore never a spring to a stale point.
+ * Likewise no coupling once the server has been silent (no ContactFeedback)
+ * for GUIDE_SERVER_TIMEOUT_S: the server is what makes the two hands one
+ * tool, so a lost server ends the coupling as it ends the contact force. A
+ * shorter gap (a feedback blip on a loaded machine: the contact force drops
+ * for its 50 ms timeout) keeps the spring, so a guided hand is not jolted
+ * by every blip. */
 #ifndef VISCERA_GUIDE_FORCE_H
 #define VISCERA_GUIDE_FORCE_H
 
@@ -39,6 +45,7 @@
 
 #define GUIDE_STATION_MAX 32 /* = VDDS_STATION_MAX, with the terminating NUL */
 #define GUIDE_PEER_TIMEOUT_S 0.1
+#define GUIDE_SERVER_TIMEOUT_S 0.25
 /* Largest coupling stiffness accepted from the wire, N/m (the scene's
  * largest tool stiffness); above it the role is refused as corrupt. */
 #define GUIDE_MAX_COUPLING_STIFFNESS 1e5
@@ -76,8 +83,9 @@ typedef struct guide_input {
   const char *own_station; /* "" = anonymous */
   double x[3], v[3];       /* own device position (m) and velocity (m/s) */
   int have_peer;
-  double peer[3];    /* peer's latest commanded position, m */
-  double peer_age_s; /* since it arrived */
+  double peer[3];         /* peer's latest commanded position, m */
+  double peer_age_s;      /* since it arrived */
+  double server_silent_s; /* since the last ContactFeedback arrived; < 0: none yet */
   const contact_model_t *contact;
   double max_force;     /* N, > 0 */
   double max_stiffness; /* N/m device rating, 0 = none stated */
@@ -92,6 +100,8 @@ typedef struct guide_output {
   double w;          /* own share used (1 when not coupled) */
   double k;          /* coupling stiffness used, N/m (0 when not coupled) */
   double x_tool[3];  /* where the contact force was evaluated */
+  const char *why;   /* when not coupled: "no role", "no guide", "not in the role", "no peer",
+                        "peer silent", "server silent"; NULL when coupled */
 } guide_output_t;
 
 /* Computes the force to render. Never returns a non-finite force: a

@@ -25,8 +25,11 @@ void guide_report_tick(guide_report_t *r, double t, const guide_role_t *role, co
   /* A new role version is worth a line even when the coupling it gives is
    * the same (e.g. an assignment to us while unguided). */
   int role_changed = role->known != r->role_known || (role->known && role->version != r->role_version);
-  int changed =
-      o->coupled != r->coupled || o->side != r->side || o->w != r->w || o->k != r->k || strcmp(peer, r->peer) != 0;
+  /* Why we are not coupled, once a role is known (before that there is
+   * nothing to say: a server without roles, or one still starting). */
+  const char *why = o->why ? o->why : "", *was = r->why ? r->why : "";
+  int changed = o->coupled != r->coupled || o->side != r->side || o->w != r->w || o->k != r->k ||
+                strcmp(peer, r->peer) != 0 || (!o->coupled && role->known && strcmp(why, was) != 0);
   if (!changed && !role_changed) return;
   r->coupled = o->coupled;
   r->side = o->side;
@@ -35,17 +38,15 @@ void guide_report_tick(guide_report_t *r, double t, const guide_role_t *role, co
   snprintf(r->peer, sizeof r->peer, "%s", peer);
   r->role_known = role->known;
   r->role_version = role->version;
+  r->why = o->why;
   r->changes++;
   if (!log) return;
   if (o->coupled)
     fprintf(log, "haptic: t=%.3f s guide: coupled as %s, own share %.2f, k %.0f N/m, peer %s (role v%u)\n", t,
             side_name(o->side), o->w, o->k, peer[0] ? peer : "(anonymous)", role->version);
-  else if (!role->known)
-    fprintf(log, "haptic: t=%.3f s guide: not coupled (no role for the tool)\n", t);
   else
-    fprintf(log, "haptic: t=%.3f s guide: not coupled (role v%u: owner '%s', guide '%s'; we are %s%s)\n", t,
-            role->version, role->owner, role->guide, side_name(o->side),
-            o->side != GUIDE_SIDE_NONE ? ", peer silent or absent" : "");
+    fprintf(log, "haptic: t=%.3f s guide: not coupled (%s; role v%u: owner '%s', guide '%s')\n", t,
+            o->why ? o->why : "?", role->version, role->owner, role->guide);
 }
 
 double guide_report_coupled_s(const guide_report_t *r, double period_s) {

@@ -20,6 +20,7 @@ typedef struct guide_report {
   char peer[GUIDE_STATION_MAX];
   uint32_t role_version;
   int role_known;
+  const char *why;
   /* Accumulated. */
   uint64_t ticks_owner, ticks_guide; /* coupled ticks per side */
   double last_authority, last_k;     /* of the last coupling */

@@ -399,15 +399,15 @@ int main(int argc, char **argv) {
      * is rated for (its damping follows the clamped stiffness). */
     model.stiffness = contact_model_device_stiffness(model.stiffness, dev.max_stiffness);
     model.damping = contact_model_passive_damping(model.stiffness, 1.0 / rate);
-    /* Guided or not, one force law (guide_force.h); without a live server
-     * there is no role: the coupling stops with the contact force. */
+    /* Guided or not, one force law (guide_force.h); a server silent for
+     * GUIDE_SERVER_TIMEOUT_S ends the coupling too. */
     guide_view_t gv;
     guide_slot_read(&guide, own_station, now, &gv);
-    if (lost_live || (last_fb_mono && now > last_fb_mono + 50000000ull)) memset(&gv.role, 0, sizeof gv.role);
     guide_input_t gin = {.role = &gv.role,
                          .own_station = own_station,
                          .have_peer = gv.have_peer,
                          .peer_age_s = gv.peer_age_s,
+                         .server_silent_s = last_fb_mono ? (double)(now - last_fb_mono) * 1e-9 : -1.0,
                          .contact = &model,
                          .max_force = dev.max_force,
                          .max_stiffness = dev.max_stiffness,

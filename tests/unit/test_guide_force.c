@@ -40,6 +40,7 @@ static guide_input_t input(const guide_role_t *r, const char *own, const double 
     memcpy(in.peer, peer, sizeof in.peer);
     in.peer_age_s = 0.01;
   }
+  in.server_silent_s = 0.001;
   in.contact = m;
   in.max_force = 10;
   in.period_s = 1e-3;
@@ -127,9 +128,23 @@ static void test_fallbacks_and_clamps(void) {
   in.peer_age_s = 0.15;
   guide_force(&in, &o);
   CHECK(!o.coupled && o.side == GUIDE_SIDE_OWNER && o.magnitude == 0);
+  CHECK(o.why && strcmp(o.why, "peer silent") == 0);
   in.peer_age_s = 0.099;
   guide_force(&in, &o);
   CHECK(o.coupled);
+  /* The server silent for longer than 250 ms (lost), or never heard: no
+   * coupling; a shorter feedback gap keeps it. */
+  in = input(&r, "alice", A, B, &FREE);
+  in.server_silent_s = 0.2;
+  guide_force(&in, &o);
+  CHECK(o.coupled);
+  in.server_silent_s = 0.3;
+  guide_force(&in, &o);
+  CHECK(!o.coupled && o.magnitude == 0);
+  CHECK(o.why && strcmp(o.why, "server silent") == 0);
+  in.server_silent_s = -1;
+  guide_force(&in, &o);
+  CHECK(!o.coupled && o.magnitude == 0);
   /* No peer, a corrupt peer position: plain. */
   in = input(&r, "alice", A, NULL, &FREE);
   guide_force(&in, &o);
@@ -164,6 +179,7 @@ static void test_fallbacks_and_clamps(void) {
   in = input(&other, "alice", A, B, &wall);
   guide_force(&in, &o);
   CHECK(!o.coupled && o.side == GUIDE_SIDE_NONE);
+  CHECK(o.why && strcmp(o.why, "not in the role") == 0);
   CHECK_NEAR(o.f[2], 4.0, 1e-9);
   double f_plain[3];
   contact_model_force(&wall, A, NULL, 10, f_plain);
@@ -342,7 +358,7 @@ static void test_report(void) {
   guide_report_init(&rep);
   guide_role_t none = {0};
   guide_role_t r = role("", "bob", 0.5, 200);
-  guide_output_t plain = {.w = 1}, coupled = {.coupled = 1, .side = GUIDE_SIDE_OWNER, .w = 0.5, .k = 200};
+  guide_output_t plain = {.w = 1, .why = "peer silent"}, coupled = {.coupled = 1, .side = GUIDE_SIDE_OWNER, .w = 0.5, .k = 200};
   guide_report_tick(&rep, 0.001, &none, "", &plain, log);
   for (int i = 0; i < 1500; i++) guide_report_tick(&rep, 1.0 + i * 1e-3, &r, "bob", &coupled, log);
   r.version = 2;
@@ -360,7 +376,7 @@ static void test_report(void) {
   printf("%s", text);
   CHECK(strstr(text, "t=1.000 s guide: coupled as owner (trainee), own share 0.50, k 200 N/m, peer bob") != NULL);
   CHECK(strstr(text, "t=2.500 s guide: coupled as owner (trainee), own share 0.00") != NULL);
-  CHECK(strstr(text, "t=3.000 s guide: not coupled") != NULL);
+  CHECK(strstr(text, "t=3.000 s guide: not coupled (peer silent; role v2: owner '', guide 'bob')") != NULL);
   CHECK(strstr(text, "GUIDE coupled 1.5 s as owner (trainee), 0.0 s as guide (instructor); last: as owner "
                      "(trainee), authority 1.00, k 200 N/m, peer bob") != NULL);
   CHECK(strstr(text, "no role") == NULL); /* nothing to say before a role arrives */
