@@ -190,7 +190,9 @@ static void release_lost_writers(server_t *s, uint64_t now) {
       snprintf(who, sizeof who, st[0] ? "station '%s'" : "anonymous%s", st);
       tool_roles_forget(&s->roles, t, (tool_side_t)side);
       tool_effective_t eff;
-      if (tool_roles_effective(&s->roles, t, now, &eff)) {
+      /* A guide never takes the tool away with it; the owner's loss
+       * releases it unless the guide is driving right now. */
+      if (side == TOOL_SIDE_GUIDE || tool_roles_effective(&s->roles, t, now, &eff)) {
         if (!s->opts->quiet)
           fprintf(stderr, "server: tool %zu: %s client (%s) lost: the %s drives on alone\n", t,
                   side ? "guide" : "owner", who, side ? "owner" : "guide");

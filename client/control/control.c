@@ -24,9 +24,19 @@ static void usage(FILE *f) {
              "  reset                 restart the scene from rest (organs, tools, measures, tasks)\n"
              "  material O K C H M    organ O's stiffness K (N/m), damping C (N s/m), home stiffness H\n"
              "                        (N/m), mass M (kg); -1 keeps a value; the organ restarts from rest\n"
+             "  assign T STATION|*    only STATION's haptic client drives tool T from now on (* = any\n"
+             "                        station); ends any guiding of T\n"
+             "  guide T STATION [A [K]]  couple STATION's device to tool T ('guiding hand'): the tool\n"
+             "                        goes to A * guide + (1 - A) * owner, A in 0..1 (default 0.5);\n"
+             "                        coupling stiffness K N/m between the two devices (default: the\n"
+             "                        server's, 200 or the tool's stiffness if lower)\n"
+             "  takeover T STATION    guide with authority 1: STATION drives T, the owner's hand is led\n"
+             "  release T             end guiding: tool T is its owner's again\n"
+             "  (STATION: a haptic client's --station name, 1..31 of A-Z a-z 0-9 _ . -)\n"
              "  --domain N            DDS domain id (default: $VISCERA_DOMAIN or 0)\n"
              "  --partition P         the seat's partition (default: " VDDS_DEFAULT_PARTITION ")\n"
-             "  --station ID          this instructor station's id (default 1)\n"
+             "  --station ID          this instructor console's number (SessionControl source_id, default\n"
+             "                        1); not a haptic client's station name\n"
              "  --text TEXT           who/why, kept in the recording\n"
              "  --wait S              wait up to S s for the server's answer (default 5)\n"
              "  --help                this text\n"
@@ -37,6 +47,54 @@ static int parse_double(const char *s, double *out) {
   char *end;
   *out = strtod(s, &end);
   return end != s && *end == 0 && isfinite(*out) ? 0 : -1;
+}
+
+/* assign / guide / takeover / release (idl CONTROL_ASSIGN_TOOL, CONTROL_GUIDE):
+ * the station travels in the command's text, so --text cannot go with them.
+ * argv[0] is the verb. Returns 0, or -1 after saying what is wrong. */
+static int parse_role(const char *verb, int argc, char **argv, int has_text, viscera_SessionControl *cmd) {
+  int release = strcmp(verb, "release") == 0, guide = strcmp(verb, "guide") == 0;
+  int want_min = release ? 2 : 3, want_max = release ? 2 : guide ? 5 : 3;
+  if (argc < want_min || argc > want_max) {
+    fprintf(stderr, "viscera-control: %s: usage: %s\n", verb,
+            release                       ? "release TOOL"
+            : guide                       ? "guide TOOL STATION [AUTHORITY [K]]"
+            : strcmp(verb, "assign") == 0 ? "assign TOOL STATION|*"
+                                          : "takeover TOOL STATION");
+    return -1;
+  }
+  if (has_text) {
+    fprintf(stderr, "viscera-control: %s: --text cannot be used (the station goes in the command's text)\n", verb);
+    return -1;
+  }
+  char *end;
+  long tool = strtol(argv[1], &end, 10);
+  if (*argv[1] == 0 || *end || tool < 0 || tool > 1000) {
+    fprintf(stderr, "viscera-control: %s: not a tool index: '%s'\n", verb, argv[1]);
+    return -1;
+  }
+  cmd->tool_id = (int32_t)tool;
+  cmd->kind = strcmp(verb, "assign") == 0 ? viscera_CONTROL_ASSIGN_TOOL : viscera_CONTROL_GUIDE;
+  if (release) return 0; /* GUIDE with station "": guiding ends */
+  const char *station = argv[2];
+  int any = cmd->kind == viscera_CONTROL_ASSIGN_TOOL && strcmp(station, "*") == 0;
+  if (!any && !vdds_station_valid(station)) {
+    fprintf(stderr, "viscera-control: %s: station '%s' is not 1..%d characters of A-Z a-z 0-9 _ . -%s\n", verb, station,
+            VDDS_STATION_MAX - 1, cmd->kind == viscera_CONTROL_ASSIGN_TOOL ? " (or * for any station)" : "");
+    return -1;
+  }
+  snprintf(cmd->text, sizeof cmd->text, "%s", station);
+  if (cmd->kind == viscera_CONTROL_ASSIGN_TOOL) return 0;
+  cmd->values[0] = guide ? 0.5 : 1.0;
+  if (argc >= 4 && (parse_double(argv[3], &cmd->values[0]) || cmd->values[0] < 0 || cmd->values[0] > 1)) {
+    fprintf(stderr, "viscera-control: guide: authority '%s' is not a number in 0..1\n", argv[3]);
+    return -1;
+  }
+  if (argc >= 5 && parse_double(argv[4], &cmd->values[1])) {
+    fprintf(stderr, "viscera-control: guide: coupling stiffness '%s' is not a number (N/m)\n", argv[4]);
+    return -1;
+  }
+  return 0;
 }
 
 int main(int argc, char **argv) {
@@ -138,6 +196,9 @@ int main(int argc, char **argv) {
         fprintf(stderr, "viscera-control: thresholds: not a force in N: '%s'\n", argv[optind + 2 + k]);
         return 2;
       }
+  } else if (verb && (strcmp(verb, "assign") == 0 || strcmp(verb, "guide") == 0 || strcmp(verb, "takeover") == 0 ||
+                      strcmp(verb, "release") == 0)) {
+    if (parse_role(verb, argc - optind, argv + optind, *text != 0, &cmd)) return 2;
   } else {
     usage(stderr);
     return 2;
