@@ -407,7 +407,9 @@ int main(int argc, char **argv) {
                          .own_station = own_station,
                          .have_peer = gv.have_peer,
                          .peer_age_s = gv.peer_age_s,
-                         .server_silent_s = last_fb_mono ? (double)(now - last_fb_mono) * 1e-9 : -1.0,
+                         .server_silent_s = !last_fb_mono        ? -1.0
+                                            : now > last_fb_mono ? (double)(now - last_fb_mono) * 1e-9
+                                                                 : 0.0,
                          .contact = &model,
                          .max_force = dev.max_force,
                          .max_stiffness = dev.max_stiffness,
