@@ -10,7 +10,9 @@
 #   (still taken over)   the instructor presses into the kidney: he feels the
 #                        tissue push up, the trainee the pull towards his hand,
 #                        clamped to the 6 N device limit;
-#   release 0:           both ~0 in free space.
+#   release 0:           both ~0 in free space;
+#   takeover again, then kill -9 the server: the coupling ends 250 ms after
+#                        the last feedback and both forces stay zero.
 # Phases are cut from the clients' own log lines ("t=... s guide: ..."), in
 # the same clock as their force CSV, so a loaded machine that delivers a
 # command late shifts a phase instead of failing it; each phase is judged on
@@ -55,11 +57,14 @@ sleep 2.5
 # the CSVs filled, ~0.5 s before T0).
 while awk -v t0="$T0" -v now="$(date +%s.%N)" 'BEGIN { exit !(now - t0 < 12.5) }'; do sleep 0.2; done
 "${CTL[@]}" release 0 >> "$OUT/ctl.log" 2>&1 || fail "release not applied"
+sleep 1.5
+# Taken over again, then the server dies: the coupling must end with it.
+"${CTL[@]}" takeover 0 bob >> "$OUT/ctl.log" 2>&1 || fail "second takeover not applied"
+sleep 1.3
+{ kill -9 $SRV && wait $SRV; } 2>/dev/null || true
 cat "$OUT/ctl.log"
 wait $ALICE || fail "trainee client failed"
 wait $BOB || fail "instructor client failed"
-kill -INT $SRV 2>/dev/null || true
-wait $SRV || true
 PIDS=()
 grep -h 'guide:\|GUIDE\|latency\|another station' "$OUT/alice.log" "$OUT/bob.log"
 
@@ -126,9 +131,24 @@ expect "alice during the press: |F| (clamped)" "$OUT/alice.csv" "$w0" "$w1" "$ma
 # AX's z) normalised: (-0.44, 0, -0.90).
 expect "alice during the press: Fx/|F|" "$OUT/alice.csv" "$w0" "$w1" "\$5 / $mag" -0.5 -0.38
 expect "alice during the press: Fz/|F|" "$OUT/alice.csv" "$w0" "$w1" "\$7 / $mag" -0.93 -0.86
-# Released: both free, nothing felt.
-expect "alice released |F|" "$OUT/alice.csv" "$(calc "$ta_r + 0.3")" "$ea" "$mag" 0 0.05
-expect "bob released |F|" "$OUT/bob.csv" "$(calc "$tb_r + 0.3")" "$eb" "$mag" 0 0.05
+# Released: both free, nothing felt (until the second take-over).
+ta_t2=$(t_of "$OUT/alice.log" "coupled as owner (trainee), own share 0.00" "$ta_r")
+tb_t2=$(t_of "$OUT/bob.log" "coupled as guide (instructor), own share 1.00" "$tb_r")
+[ -n "$ta_t2" ] && [ -n "$tb_t2" ] || fail "the clients never logged the second take-over"
+expect "alice released |F|" "$OUT/alice.csv" "$(calc "$ta_r + 0.3")" "$(calc "$ta_t2 - 0.1")" "$mag" 0 0.05
+expect "bob released |F|" "$OUT/bob.csv" "$(calc "$tb_r + 0.3")" "$(calc "$tb_t2 - 0.1")" "$mag" 0 0.05
+# Server killed during the second take-over: the trainee is pulled until the
+# server has been silent for 250 ms, then both render nothing to the end.
+ta_l=$(t_of "$OUT/alice.log" "not coupled (server silent" "$ta_t2")
+tb_l=$(t_of "$OUT/bob.log" "not coupled (server silent" "$tb_t2")
+[ -n "$ta_l" ] && [ -n "$tb_l" ] || fail "the coupling did not end when the server was killed"
+expect "alice taken over again: Fx" "$OUT/alice.csv" "$(calc "$ta_t2 + 0.3")" "$(calc "$ta_l - 0.4")" '$5' -4.4 -3.6
+for who in alice bob; do
+  tl=$ta_l; [ $who = bob ] && tl=$tb_l
+  r=$(awk -F, -v t0="$(calc "$tl + 0.002")" "NR > 1 && \$1 >= t0 { n++; f = $mag; if (f > m) m = f } END { print n + 0, m + 0 }" "$OUT/$who.csv")
+  echo "  $who after the server was lost: ${r% *} ticks, largest |F| ${r#* } N"
+  awk -v n="${r% *}" -v m="${r#* }" 'BEGIN { exit !(n >= 500 && m == 0) }' || fail "$who: force after the server was lost: $r"
+done
 # Summaries: coupled time on the right side; latency only from own echoes.
 grep -q 'GUIDE coupled .* s as owner (trainee), 0.0 s as guide (instructor); last: as owner (trainee), authority 1.00, k 200 N/m, peer bob' "$OUT/alice.log" \
   || fail "trainee summary"
