@@ -186,6 +186,10 @@ int guide_slot_attach(guide_slot_t *s, vdds_t *v, dds_entity_t own_writer, verr_
   dds_entity_t r_cmd = r_role < 0 ? r_role : dds_get_qos(v->topics[VT_TOOL_COMMAND], q);
   if (r_cmd >= 0) {
     dds_qset_history(q, DDS_HISTORY_KEEP_LAST, GUIDE_TAKE);
+    /* Our own 1 kHz commands are not delivered at all (no listener call
+     * per tick for nothing); the handle check in on_command stays for a
+     * DDS that delivers them anyway. */
+    dds_qset_ignorelocal(q, DDS_IGNORELOCAL_PARTICIPANT);
     r_cmd = dds_create_reader(v->subscriber, v->topics[VT_TOOL_COMMAND], q, l);
     if (r_cmd < 0) verr_set(err, "DDS: cannot create the ToolCommand reader: %s", dds_strretcode(r_cmd));
   }

@@ -10,9 +10,10 @@
  * station, or numbers outside the contract (guide_role_valid), is refused
  * and counted (the previous role stays: a corrupt sample never couples us
  * to anyone); a ToolCommand with a non-finite position is counted and
- * ignored. Our own writer's samples (publication handle = our writer's
- * instance handle) are skipped: with one keyed instance per tool the reader
- * sees every writer of the tool, ours included.
+ * ignored. Our own writer's samples are not delivered (IGNORELOCAL
+ * participant) and would be skipped anyway (publication handle = our
+ * writer's instance handle): with one keyed instance per tool the reader
+ * sees every writer of the tool.
  *
  * Stations of remote writers come from their USER_DATA
  * (vdds_station_of_writer), looked up once per publication handle on the

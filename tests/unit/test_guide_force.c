@@ -358,7 +358,8 @@ static void test_report(void) {
   guide_report_init(&rep);
   guide_role_t none = {0};
   guide_role_t r = role("", "bob", 0.5, 200);
-  guide_output_t plain = {.w = 1, .why = "peer silent"}, coupled = {.coupled = 1, .side = GUIDE_SIDE_OWNER, .w = 0.5, .k = 200};
+  guide_output_t plain = {.w = 1, .why = "peer silent"},
+                 coupled = {.coupled = 1, .side = GUIDE_SIDE_OWNER, .w = 0.5, .k = 200};
   guide_report_tick(&rep, 0.001, &none, "", &plain, log);
   for (int i = 0; i < 1500; i++) guide_report_tick(&rep, 1.0 + i * 1e-3, &r, "bob", &coupled, log);
   r.version = 2;
