@@ -1,18 +1,33 @@
 #include "guide_report.h"
 
+#include <stdlib.h>
 #include <string.h>
+
+#include "vstats.h"
 
 static const char *side_name(guide_side_t s) {
   return s == GUIDE_SIDE_OWNER ? "owner (trainee)" : s == GUIDE_SIDE_GUIDE ? "guide (instructor)" : "none";
 }
 
-void guide_report_init(guide_report_t *r) {
+int guide_report_init(guide_report_t *r, size_t age_capacity) {
   memset(r, 0, sizeof *r);
   r->w = 1; /* as plain rendering reports it: no line until something changes */
+  if (age_capacity) {
+    r->peer_age_us = malloc(age_capacity * sizeof *r->peer_age_us);
+    if (!r->peer_age_us) return -1;
+    r->cap_age = age_capacity;
+  }
+  return 0;
 }
 
-void guide_report_tick(guide_report_t *r, double t, const guide_role_t *role, const char *peer, const guide_output_t *o,
-                       FILE *log) {
+void guide_report_free(guide_report_t *r) {
+  free(r->peer_age_us);
+  r->peer_age_us = NULL;
+  r->cap_age = r->n_age = 0;
+}
+
+void guide_report_tick(guide_report_t *r, double t, const guide_role_t *role, const char *peer, double peer_age_s,
+                       const guide_output_t *o, FILE *log) {
   if (!peer || !o->coupled) peer = "";
   if (o->coupled) {
     if (o->side == GUIDE_SIDE_OWNER) r->ticks_owner++;
@@ -21,6 +36,7 @@ void guide_report_tick(guide_report_t *r, double t, const guide_role_t *role, co
     r->last_authority = role->authority;
     r->last_k = o->k;
     snprintf(r->last_peer, sizeof r->last_peer, "%s", peer);
+    if (r->n_age < r->cap_age) r->peer_age_us[r->n_age++] = peer_age_s * 1e6;
   }
   /* A new role version is worth a line even when the coupling it gives is
    * the same (e.g. an assignment to us while unguided). */
@@ -63,4 +79,11 @@ void guide_report_summary(const guide_report_t *r, double period_s, FILE *f) {
           "%.2f, k %.0f N/m, peer %s\n",
           (double)r->ticks_owner * period_s, (double)r->ticks_guide * period_s, side_name(r->last_side),
           r->last_authority, r->last_k, r->last_peer[0] ? r->last_peer : "(anonymous)");
+  if (r->n_age) {
+    vstats_summary_t a = vstats_summarise(r->peer_age_us, r->n_age);
+    fprintf(f,
+            "haptic: GUIDE peer position age when rendered (since its arrival): median %.0f us, p99 %.0f us, max %.0f "
+            "us (%zu ticks)\n",
+            a.median, a.p99, a.max, a.n);
+  }
 }

@@ -323,7 +323,10 @@ int main(int argc, char **argv) {
   }
   contact_model_t model = {0};
   guide_report_t guide_rep;
-  guide_report_init(&guide_rep);
+  if (guide_report_init(&guide_rep, st.cap)) {
+    fprintf(stderr, "viscera-haptic: out of memory\n");
+    return 1;
+  }
   const char *own_station = station ? station : "";
   double prev_pos[3] = {0, 0, 0};
   uint64_t prev_pos_ns = 0;
@@ -419,7 +422,7 @@ int main(int argc, char **argv) {
     memcpy(gin.peer, gv.peer, sizeof gin.peer);
     guide_output_t gout;
     guide_force(&gin, &gout);
-    guide_report_tick(&guide_rep, t, &gv.role, gv.peer_station, &gout, quiet ? NULL : stderr);
+    guide_report_tick(&guide_rep, t, &gv.role, gv.peer_station, gv.peer_age_s, &gout, quiet ? NULL : stderr);
     double *f = gout.f, mag = gout.magnitude;
     dev.ops->write_force(&dev, f);
     st.ticks++;
@@ -478,6 +481,7 @@ int main(int argc, char **argv) {
          st.ticks, (double)st.ticks / elapsed, st.peak_force, st.contact_ticks, lat.median, lat.p99, per.p99,
          jitter_p99, st.late_ticks, guide_report_coupled_s(&guide_rep, 1.0 / rate));
   free(st.period_us);
+  guide_report_free(&guide_rep);
   vdds_close(&dds); /* stops the listener before the slot goes */
   feedback_slot_destroy(&slot);
   guide_slot_destroy(&guide);

@@ -355,18 +355,18 @@ static void test_report(void) {
   CHECK(log != NULL);
   if (!log) return;
   guide_report_t rep;
-  guide_report_init(&rep);
+  CHECK(guide_report_init(&rep, 1000) == 0);
   guide_role_t none = {0};
   guide_role_t r = role("", "bob", 0.5, 200);
   guide_output_t plain = {.w = 1, .why = "peer silent"},
                  coupled = {.coupled = 1, .side = GUIDE_SIDE_OWNER, .w = 0.5, .k = 200};
-  guide_report_tick(&rep, 0.001, &none, "", &plain, log);
-  for (int i = 0; i < 1500; i++) guide_report_tick(&rep, 1.0 + i * 1e-3, &r, "bob", &coupled, log);
+  guide_report_tick(&rep, 0.001, &none, "", 0, &plain, log);
+  for (int i = 0; i < 1500; i++) guide_report_tick(&rep, 1.0 + i * 1e-3, &r, "bob", (i % 4) * 1e-3, &coupled, log);
   r.version = 2;
   r.authority = 1;
   coupled.w = 0;
-  guide_report_tick(&rep, 2.5, &r, "bob", &coupled, log);
-  guide_report_tick(&rep, 3.0, &r, "bob", &plain, log);
+  guide_report_tick(&rep, 2.5, &r, "bob", 0, &coupled, log);
+  guide_report_tick(&rep, 3.0, &r, "bob", 0.5, &plain, log);
   CHECK_NEAR(guide_report_coupled_s(&rep, 1e-3), 1.501, 1e-9);
   guide_report_summary(&rep, 1e-3, log);
   rewind(log);
@@ -381,10 +381,15 @@ static void test_report(void) {
   CHECK(strstr(text, "GUIDE coupled 1.5 s as owner (trainee), 0.0 s as guide (instructor); last: as owner "
                      "(trainee), authority 1.00, k 200 N/m, peer bob") != NULL);
   CHECK(strstr(text, "no role") == NULL); /* nothing to say before a role arrives */
-  /* Exactly three lines of changes plus the summary. */
+  /* Ages sampled on the 1000 coupled ticks the capacity holds (0..3 ms),
+   * none from the uncoupled tick. */
+  CHECK(strstr(text, "peer position age when rendered (since its arrival): median 2000 us, p99 3000 us, max 3000 us "
+                     "(1000 ticks)") != NULL);
+  guide_report_free(&rep);
+  /* Exactly three lines of changes plus the two summary lines. */
   int lines = 0;
   for (char *p = text; *p; p++) lines += *p == '\n';
-  CHECK(lines == 4);
+  CHECK(lines == 5);
 }
 
 int main(void) {
