@@ -30,38 +30,54 @@ rm -rf "$OUT"; mkdir -p "$OUT"
 # A trainee, B instructor (above the kidney's top, z 0.0346 at x 0.012).
 AX=0.032; BX=0.012; Y=0.004; Z=0.070; PRESS_Z=0.029
 printf '0 %s %s %s\n' $AX $Y $Z > "$OUT/alice.traj"
-# The instructor holds B, presses 4-6 mm into the kidney from 8.5 s to 12 s of
-# his clock (during the take-over below), and comes back up.
-printf '0 %s %s %s\n8.0 %s %s %s\n8.5 %s %s %s\n12.0 %s %s %s\n12.5 %s %s %s\n' \
+# The instructor holds B, presses 4-6 mm into the kidney from 10.5 s to 13.5 s
+# of his clock (during the take-over below), and comes back up.
+printf '0 %s %s %s\n10.0 %s %s %s\n10.5 %s %s %s\n13.5 %s %s %s\n14.0 %s %s %s\n' \
   $BX $Y $Z $BX $Y $Z $BX $Y $PRESS_Z $BX $Y $PRESS_Z $BX $Y $Z > "$OUT/bob.traj"
 CTL=("$BUILD/client/control/viscera-control" --partition $PART --wait 8)
-HAP=("$BUILD/client/haptic/viscera-haptic" --partition $PART --max-force 6 --duration 18)
-"$BUILD/server/viscera-server" --scene "$SRC/assets/scenes/default.yaml" --partition $PART --duration 24 \
+# The clients are stopped with SIGINT at the end; --duration only bounds a run gone wrong.
+HAP=("$BUILD/client/haptic/viscera-haptic" --partition $PART --max-force 6 --duration 50)
+"$BUILD/server/viscera-server" --scene "$SRC/assets/scenes/default.yaml" --partition $PART --duration 55 \
   > "$OUT/server.out" 2> "$OUT/server.log" & SRV=$!; PIDS+=($SRV)
 "${HAP[@]}" --trajectory "$OUT/alice.traj" --station alice --force-csv "$OUT/alice.csv" \
   > "$OUT/alice.out" 2> "$OUT/alice.log" & ALICE=$!; PIDS+=($ALICE)
 "${HAP[@]}" --trajectory "$OUT/bob.traj" --station bob --force-csv "$OUT/bob.csv" \
   > "$OUT/bob.out" 2> "$OUT/bob.log" & BOB=$!; PIDS+=($BOB)
-# Both clients are driving once their force CSVs have rows.
-for _ in $(seq 100); do
-  rows() { if [ -f "$1" ]; then wc -l < "$1"; else echo 0; fi; }
-  [ "$(rows "$OUT/alice.csv")" -gt 500 ] && [ "$(rows "$OUT/bob.csv")" -gt 500 ] && break
-  sleep 0.1
-done
-T0=$(date +%s.%N)
+# wait_for SECONDS COMMAND...: polls until COMMAND succeeds; 1 on timeout.
+wait_for() {
+  local until; until=$(awk -v n="$(date +%s.%N)" -v s="$1" 'BEGIN { printf "%.3f", n + s }'); shift
+  until "$@"; do
+    awk -v n="$(date +%s.%N)" -v u="$until" 'BEGIN { exit !(n > u) }' && return 1
+    sleep 0.1
+  done
+}
+rows() { if [ -f "$1" ]; then wc -l < "$1"; else echo 0; fi; }
+both_driving() { [ "$(rows "$OUT/alice.csv")" -gt 500 ] && [ "$(rows "$OUT/bob.csv")" -gt 500 ]; }
+# The instructor's loop time, from the last row of his force CSV.
+bob_past() { awk -F, -v t="$1" 'END { exit !($1 + 0 >= t) }' "$OUT/bob.csv"; }
+# A log line matching PAT after the last line matching AFTER.
+logged_after() { awk -v a="$2" -v p="$3" 'index($0, a) { seen = 1; found = 0 } seen && index($0, p) { found = 1 }
+                                         END { exit !found }' "$1"; }
+wait_for 20 both_driving || fail "the clients did not start driving"
 sleep 1 # a second of unguided free space first
 "${CTL[@]}" guide 0 bob 0.5 200 > "$OUT/ctl.log" 2>&1 || fail "guide not applied"
 sleep 2.5
 "${CTL[@]}" takeover 0 bob >> "$OUT/ctl.log" 2>&1 || fail "takeover not applied"
-# Release once the instructor's press is over (his clock started about when
-# the CSVs filled, ~0.5 s before T0).
-while awk -v t0="$T0" -v now="$(date +%s.%N)" 'BEGIN { exit !(now - t0 < 12.5) }'; do sleep 0.2; done
+# Release once the instructor's press is over.
+wait_for 30 bob_past 14.5 || fail "the instructor's client stopped"
 "${CTL[@]}" release 0 >> "$OUT/ctl.log" 2>&1 || fail "release not applied"
 sleep 1.5
 # Taken over again, then the server dies: the coupling must end with it.
 "${CTL[@]}" takeover 0 bob >> "$OUT/ctl.log" 2>&1 || fail "second takeover not applied"
-sleep 1.3
+wait_for 10 logged_after "$OUT/alice.log" "guide ''" "coupled as owner (trainee), own share 0.00" \
+  || fail "the trainee's client did not couple again"
+sleep 1.5
 { kill -9 $SRV && wait $SRV; } 2>/dev/null || true
+for who in alice bob; do
+  wait_for 10 logged_after "$OUT/$who.log" "guide ''" "not coupled (server silent" || fail "$who stayed coupled to a dead server"
+done
+sleep 1.5
+kill -INT $ALICE $BOB
 cat "$OUT/ctl.log"
 wait $ALICE || fail "trainee client failed"
 wait $BOB || fail "instructor client failed"
@@ -91,13 +107,13 @@ median() {
 }
 mag='sqrt($5*$5 + $6*$6 + $7*$7)'
 # expect WHO CSV T0 T1 EXPR LO HI [FILTER]: the median lies in [LO, HI] over
-# at least 300 ticks (0.3 s).
+# at least 200 ticks (0.2 s at 1 kHz; a loaded machine ticks slower).
 expect() {
   local r; r=$(median "$2" "$3" "$4" "$5" "${8:-}")
   local m=${r% *} n=${r#* }
   printf '  %-44s median %9.4f over %5d ticks (want %s..%s)\n' "$1" "$m" "$n" "$6" "$7"
-  awk -v m="$m" -v n="$n" -v lo="$6" -v hi="$7" 'BEGIN { exit !(n >= 300 && m >= lo && m <= hi) }' \
-    || fail "$1: median $m over $n ticks, want $6..$7 over >= 300 ticks"
+  awk -v m="$m" -v n="$n" -v lo="$6" -v hi="$7" 'BEGIN { exit !(n >= 200 && m >= lo && m <= hi) }' \
+    || fail "$1: median $m over $n ticks, want $6..$7 over >= 200 ticks"
 }
 ea=$(awk 'END { print $1 }' "$OUT/alice.csv"); eb=$(awk 'END { print $1 }' "$OUT/bob.csv")
 # Before guiding: free space, no force.
@@ -108,11 +124,11 @@ expect "alice guided 0.5: Fx" "$OUT/alice.csv" "$(calc "$ta_g + 0.3")" "$(calc "
 expect "alice guided 0.5: |F|" "$OUT/alice.csv" "$(calc "$ta_g + 0.3")" "$(calc "$ta_t - 0.1")" "$mag" 1.8 2.2
 expect "bob guiding 0.5: Fx" "$OUT/bob.csv" "$(calc "$tb_g + 0.3")" "$(calc "$tb_t - 0.1")" '$5' 1.8 2.2
 expect "bob guiding 0.5: |F|" "$OUT/bob.csv" "$(calc "$tb_g + 0.3")" "$(calc "$tb_t - 0.1")" "$mag" 1.8 2.2
-# Take-over, before the press (bob's clock < 8 s): trainee pulled with the
+# Take-over, before the press (bob's clock < 10 s): trainee pulled with the
 # whole spring, instructor free.
-tb_p=8.0
+tb_p=10.0
 off=$(calc "$tb_t - $ta_t") # bob clock - alice clock
-awk -v a="$tb_t" 'BEGIN { exit !(a + 0.3 + 0.5 < 8.0) }' || fail "take-over came too late (bob t=$tb_t) to judge it before the press"
+awk -v a="$tb_t" -v p="$tb_p" 'BEGIN { exit !(a + 0.3 + 0.5 < p) }' || fail "take-over came too late (bob t=$tb_t) to judge it before the press"
 expect "alice taken over: Fx" "$OUT/alice.csv" "$(calc "$ta_t + 0.3")" "$(calc "$tb_p - $off - 0.1")" '$5' -4.4 -3.6
 expect "bob taking over: |F|" "$OUT/bob.csv" "$(calc "$tb_t + 0.3")" "$(calc "$tb_p - 0.1")" "$mag" 0 0.05
 # The press, still taken over (bob's ticks below z 0.031): he feels the
@@ -139,15 +155,21 @@ expect "alice released |F|" "$OUT/alice.csv" "$(calc "$ta_r + 0.3")" "$(calc "$t
 expect "bob released |F|" "$OUT/bob.csv" "$(calc "$tb_r + 0.3")" "$(calc "$tb_t2 - 0.1")" "$mag" 0 0.05
 # Server killed during the second take-over: the trainee is pulled until the
 # server has been silent for 250 ms, then both render nothing to the end.
-ta_l=$(t_of "$OUT/alice.log" "not coupled (server silent" "$ta_t2")
-tb_l=$(t_of "$OUT/bob.log" "not coupled (server silent" "$tb_t2")
+# (The first such line after the last coupling: a feedback gap of 250 ms on a
+# loaded machine may have ended the coupling for a moment before.)
+t_lost() { awk 'match($0, /t=[0-9.]+ s/) { t = substr($0, RSTART + 2, RLENGTH - 4) }
+                index($0, "guide: coupled as") { lost = "" }
+                index($0, "not coupled (server silent") && lost == "" { lost = t }
+                END { print lost }' "$1"; }
+ta_l=$(t_lost "$OUT/alice.log")
+tb_l=$(t_lost "$OUT/bob.log")
 [ -n "$ta_l" ] && [ -n "$tb_l" ] || fail "the coupling did not end when the server was killed"
 expect "alice taken over again: Fx" "$OUT/alice.csv" "$(calc "$ta_t2 + 0.3")" "$(calc "$ta_l - 0.4")" '$5' -4.4 -3.6
 for who in alice bob; do
   tl=$ta_l; [ $who = bob ] && tl=$tb_l
   r=$(awk -F, -v t0="$(calc "$tl + 0.002")" "NR > 1 && \$1 >= t0 { n++; f = $mag; if (f > m) m = f } END { print n + 0, m + 0 }" "$OUT/$who.csv")
   echo "  $who after the server was lost: ${r% *} ticks, largest |F| ${r#* } N"
-  awk -v n="${r% *}" -v m="${r#* }" 'BEGIN { exit !(n >= 500 && m == 0) }' || fail "$who: force after the server was lost: $r"
+  awk -v n="${r% *}" -v m="${r#* }" 'BEGIN { exit !(n >= 300 && m == 0) }' || fail "$who: force after the server was lost: $r"
 done
 # Summaries: coupled time on the right side; latency only from own echoes.
 grep -q 'GUIDE coupled .* s as owner (trainee), 0.0 s as guide (instructor); last: as owner (trainee), authority 1.00, k 200 N/m, peer bob' "$OUT/alice.log" \
