@@ -17,7 +17,10 @@ cat "$OUT/server.out"
 rejected=$(grep -o 'rejected=[0-9]*' "$OUT/server.out" | cut -d= -f2)
 line=$(grep "rejected (" "$OUT/server.log"); echo "$line"
 # 270 bad commands, one every 2 ms; best-effort on a loaded machine may lose some,
-# but every kind must have been seen and counted.
+# but every kind must have been seen and counted. (Not "tool assigned to
+# another station": a well-formed command from the wrong station needs an
+# assigned tool, which the tool_roles test covers.)
 [ "${rejected:-0}" -ge 135 ] || { echo "FAIL: only ${rejected:-0} rejections counted"; exit 1; }
-if grep -Eq ': 0(,|\))' <<<"${line#*rejected (}"; then echo "FAIL: a kind of bad command was never counted"; exit 1; fi
+kinds=$(sed 's/, tool assigned to another station: [0-9]*//' <<<"${line#*rejected (}")
+if grep -Eq ': 0(,|\))' <<<"$kinds"; then echo "FAIL: a kind of bad command was never counted"; exit 1; fi
 echo "PASS"
