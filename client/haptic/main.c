@@ -426,8 +426,12 @@ int main(int argc, char **argv) {
     double *f = gout.f, mag = gout.magnitude;
     dev.ops->write_force(&dev, f);
     st.ticks++;
-    if (mag > 0) st.contact_ticks++;
-    st.force_sum += mag;
+    /* In contact: the tissue pushes (a guiding spring in free space is not
+     * contact; unguided, mag > 0 only in contact anyway). */
+    if (mag > 0 && model.in_contact) {
+      st.contact_ticks++;
+      st.force_sum += mag;
+    }
     if (mag > st.peak_force) st.peak_force = mag;
     if (csv)
       fprintf(csv, "%.4f,%.6f,%.6f,%.6f,%.5f,%.5f,%.5f,%d\n", t, pos[0], pos[1], pos[2], f[0], f[1], f[2],
