@@ -14,6 +14,7 @@ int feedback_slot_init(feedback_slot_t *s, uint32_t tool_id, size_t latency_capa
   s->cap = latency_capacity;
   s->latency_us = malloc((latency_capacity + 1) * sizeof(double));
   if (!s->latency_us) return -1;
+  for (size_t i = 0; i < FEEDBACK_SENT_RING; i++) atomic_init(&s->sent_mono_ns[i], 0);
   pthread_mutex_init(&s->lock, NULL);
   return 0;
 }
@@ -24,39 +25,51 @@ void feedback_slot_destroy(feedback_slot_t *s) {
   s->latency_us = NULL;
 }
 
+void feedback_slot_sent(feedback_slot_t *s, uint64_t seq, uint64_t client_mono_ns) {
+  atomic_store_explicit(&s->sent_mono_ns[seq % FEEDBACK_SENT_RING], client_mono_ns, memory_order_relaxed);
+}
+
+int feedback_slot_accept(feedback_slot_t *s, const viscera_ContactFeedback *fb, uint64_t now) {
+  if (fb->tool_id != s->tool_id) return 0;
+  /* Untrusted: never render a plane built from NaN or a negative stiffness. */
+  int ok = isfinite(fb->stiffness) && fb->stiffness >= 0;
+  for (int k = 0; k < 3; k++) ok = ok && isfinite(fb->proxy_position[k]) && isfinite(fb->normal[k]);
+  /* Our own command's echo (seq and send time as we sent them), or another
+   * station's sharing the tool: only ours is a round trip of ours. */
+  int ours = fb->cmd_client_mono_ns > 0 && atomic_load_explicit(&s->sent_mono_ns[fb->cmd_seq % FEEDBACK_SENT_RING],
+                                                                memory_order_relaxed) == fb->cmd_client_mono_ns;
+  pthread_mutex_lock(&s->lock);
+  if (!ok) {
+    s->rejected++;
+    pthread_mutex_unlock(&s->lock);
+    return -1;
+  }
+  s->model.in_contact = fb->in_contact;
+  s->model.stiffness = fb->stiffness;
+  for (int k = 0; k < 3; k++) {
+    s->model.proxy[k] = fb->proxy_position[k];
+    s->model.normal[k] = fb->normal[k];
+  }
+  v3_normalize(s->model.normal);
+  s->arrival_mono_ns = now;
+  s->received++;
+  if (!ours && fb->cmd_client_mono_ns > 0) s->foreign_echoes++;
+  if (ours && fb->cmd_seq != s->last_cmd_seq && fb->cmd_client_mono_ns <= now) {
+    s->last_cmd_seq = fb->cmd_seq;
+    if (s->nlatency < s->cap) s->latency_us[s->nlatency++] = (double)(now - fb->cmd_client_mono_ns) * 1e-3;
+  }
+  pthread_mutex_unlock(&s->lock);
+  return 1;
+}
+
 static void on_data(dds_entity_t reader, void *arg) {
   feedback_slot_t *s = arg;
   void *samples[8] = {0};
   dds_sample_info_t infos[8];
   int n = dds_take(reader, samples, infos, 8, 8);
   uint64_t now = vtime_mono_ns();
-  for (int i = 0; i < n; i++) {
-    const viscera_ContactFeedback *fb = samples[i];
-    if (!infos[i].valid_data || fb->tool_id != s->tool_id) continue;
-    /* Untrusted: never render a plane built from NaN or a negative stiffness. */
-    int ok = isfinite(fb->stiffness) && fb->stiffness >= 0;
-    for (int k = 0; k < 3; k++) ok = ok && isfinite(fb->proxy_position[k]) && isfinite(fb->normal[k]);
-    pthread_mutex_lock(&s->lock);
-    if (!ok) {
-      s->rejected++;
-      pthread_mutex_unlock(&s->lock);
-      continue;
-    }
-    s->model.in_contact = fb->in_contact;
-    s->model.stiffness = fb->stiffness;
-    for (int k = 0; k < 3; k++) {
-      s->model.proxy[k] = fb->proxy_position[k];
-      s->model.normal[k] = fb->normal[k];
-    }
-    v3_normalize(s->model.normal);
-    s->arrival_mono_ns = now;
-    s->received++;
-    if (fb->cmd_seq != s->last_cmd_seq && fb->cmd_client_mono_ns > 0 && fb->cmd_client_mono_ns <= now) {
-      s->last_cmd_seq = fb->cmd_seq;
-      if (s->nlatency < s->cap) s->latency_us[s->nlatency++] = (double)(now - fb->cmd_client_mono_ns) * 1e-3;
-    }
-    pthread_mutex_unlock(&s->lock);
-  }
+  for (int i = 0; i < n; i++)
+    if (infos[i].valid_data) feedback_slot_accept(s, samples[i], now);
   if (n > 0) dds_return_loan(reader, samples, n);
 }
 

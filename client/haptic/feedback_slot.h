@@ -5,6 +5,13 @@
  * tick) and overwrites the slot; the loop copies the newest value. Neither
  * side ever waits for the other longer than one short critical section.
  *
+ * Latency counts only echoes of our own commands: with two stations on one
+ * tool (guiding hand) the server echoes the owner's seq and send time, which
+ * the guide's client must not take for its own round trip. The loop notes
+ * each command it sends (feedback_slot_sent: seq -> send time in a ring of
+ * FEEDBACK_SENT_RING atomics, no lock); an echo counts when its pair
+ * matches, i.e. for round trips shorter than the ring (1 s at 1 kHz).
+ *
  * Server loss: the same reader's liveliness-changed listener sees the
  * server's ContactFeedback writer lose its liveliness (lease
  * VDDS_FEEDBACK_LEASE_MS, vdds.h) when the server process dies, and clears
@@ -15,11 +22,15 @@
 
 #include <dds/dds.h>
 #include <pthread.h>
+#include <stdatomic.h>
 #include <stddef.h>
 #include <stdint.h>
 
 #include "contact_model.h"
 #include "vdds.h"
+#include "viscera.h"
+
+#define FEEDBACK_SENT_RING 1024
 
 typedef struct feedback_slot {
   pthread_mutex_t lock;
@@ -33,6 +44,8 @@ typedef struct feedback_slot {
   double *latency_us;
   size_t nlatency, cap;
   uint64_t last_cmd_seq;
+  uint64_t foreign_echoes;                           /* feedback answering another station's command */
+  _Atomic uint64_t sent_mono_ns[FEEDBACK_SENT_RING]; /* by seq % ring */
   /* Liveliness of the server's feedback writer(s). */
   uint32_t writers_alive;
   int server_lost;            /* every writer lost its liveliness */
@@ -46,6 +59,11 @@ void feedback_slot_destroy(feedback_slot_t *s);
 /* Creates the ContactFeedback reader with a data-available listener feeding
  * the slot; negative on failure (err set). */
 dds_entity_t feedback_slot_attach(feedback_slot_t *s, vdds_t *v, verr_t *err);
+/* The loop sent command `seq` at client_mono_ns (lock-free). */
+void feedback_slot_sent(feedback_slot_t *s, uint64_t seq, uint64_t client_mono_ns);
+/* Applies one ContactFeedback arriving at now (the listener calls this;
+ * tests may too): -1 refused (not finite), 0 another tool's, 1 taken. */
+int feedback_slot_accept(feedback_slot_t *s, const viscera_ContactFeedback *fb, uint64_t now);
 /* Copies the newest value; returns its arrival time (0: none yet). */
 uint64_t feedback_slot_read(feedback_slot_t *s, contact_model_t *out);
 /* 1 while the server is lost by liveliness (its feedback writer's lease

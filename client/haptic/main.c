@@ -1,7 +1,8 @@
 /* viscera-haptic: a haptic-device client. Runs a 1 kHz loop that reads the
  * device, publishes ToolCommand and renders force from the latest
- * ContactFeedback's local contact model. Prints rate, jitter, force and
- * latency statistics on exit. */
+ * ContactFeedback's local contact model, coupled to the peer station's
+ * device while the tool is guided (guide_force.h). Prints rate, jitter,
+ * force, latency and guiding statistics on exit. */
 #include <errno.h>
 #include <getopt.h>
 #include <pthread.h>
@@ -17,6 +18,9 @@
 #include "contact_model.h"
 #include "device.h"
 #include "feedback_slot.h"
+#include "guide_force.h"
+#include "guide_report.h"
+#include "guide_slot.h"
 #include "vsignal.h"
 #include "vdds.h"
 #include "viscera.h"
@@ -243,7 +247,13 @@ int main(int argc, char **argv) {
   }
   dds_entity_t r_fb = feedback_slot_attach(&slot, &dds, &err);
   dds_entity_t r_scene = vdds_reader(&dds, VT_SCENE_INFO, &err);
-  if (w_cmd < 0 || r_fb < 0 || r_scene < 0) {
+  /* Guiding hand: the tool's role and the other station's positions. */
+  static guide_slot_t guide;
+  if (guide_slot_init(&guide, tool)) {
+    fprintf(stderr, "viscera-haptic: cannot initialise the guide slot\n");
+    return 1;
+  }
+  if (w_cmd < 0 || r_fb < 0 || r_scene < 0 || guide_slot_attach(&guide, &dds, w_cmd, &err)) {
     fprintf(stderr, "viscera-haptic: %s\n", err.msg);
     return 1;
   }
@@ -312,6 +322,12 @@ int main(int argc, char **argv) {
     return 1;
   }
   contact_model_t model = {0};
+  guide_report_t guide_rep;
+  if (guide_report_init(&guide_rep, st.cap)) {
+    fprintf(stderr, "viscera-haptic: out of memory\n");
+    return 1;
+  }
+  const char *own_station = station ? station : "";
   double prev_pos[3] = {0, 0, 0};
   uint64_t prev_pos_ns = 0;
   int have_prev_pos = 0;
@@ -342,6 +358,7 @@ int main(int argc, char **argv) {
     for (int k = 0; k < 4; k++) cmd.orientation[k] = (float)quat[k];
     cmd.buttons = buttons;
     cmd.max_force = (float)dev.max_force;
+    feedback_slot_sent(&slot, cmd.seq, cmd.client_mono_ns); /* before the write: the echo may beat it back */
     dds_write(w_cmd, &cmd);
 
     uint64_t last_fb_mono = feedback_slot_read(&slot, &model);
@@ -385,12 +402,36 @@ int main(int argc, char **argv) {
      * is rated for (its damping follows the clamped stiffness). */
     model.stiffness = contact_model_device_stiffness(model.stiffness, dev.max_stiffness);
     model.damping = contact_model_passive_damping(model.stiffness, 1.0 / rate);
-    double f[3];
-    double mag = contact_model_force(&model, pos, vel, dev.max_force, f);
+    /* Guided or not, one force law (guide_force.h); a server silent for
+     * GUIDE_SERVER_TIMEOUT_S ends the coupling too. */
+    guide_view_t gv;
+    guide_slot_read(&guide, own_station, now, &gv);
+    guide_input_t gin = {.role = &gv.role,
+                         .own_station = own_station,
+                         .have_peer = gv.have_peer,
+                         .peer_age_s = gv.peer_age_s,
+                         .server_silent_s = !last_fb_mono        ? -1.0
+                                            : now > last_fb_mono ? (double)(now - last_fb_mono) * 1e-9
+                                                                 : 0.0,
+                         .contact = &model,
+                         .max_force = dev.max_force,
+                         .max_stiffness = dev.max_stiffness,
+                         .period_s = 1.0 / rate};
+    memcpy(gin.x, pos, sizeof gin.x);
+    memcpy(gin.v, vel, sizeof gin.v);
+    memcpy(gin.peer, gv.peer, sizeof gin.peer);
+    guide_output_t gout;
+    guide_force(&gin, &gout);
+    guide_report_tick(&guide_rep, t, &gv.role, gv.peer_station, gv.peer_age_s, &gout, quiet ? NULL : stderr);
+    double *f = gout.f, mag = gout.magnitude;
     dev.ops->write_force(&dev, f);
     st.ticks++;
-    if (mag > 0) st.contact_ticks++;
-    st.force_sum += mag;
+    /* In contact: the tissue pushes (a guiding spring in free space is not
+     * contact; unguided, mag > 0 only in contact anyway). */
+    if (mag > 0 && model.in_contact) {
+      st.contact_ticks++;
+      st.force_sum += mag;
+    }
     if (mag > st.peak_force) st.peak_force = mag;
     if (csv)
       fprintf(csv, "%.4f,%.6f,%.6f,%.6f,%.5f,%.5f,%.5f,%d\n", t, pos[0], pos[1], pos[2], f[0], f[1], f[2],
@@ -410,6 +451,7 @@ int main(int argc, char **argv) {
   pthread_mutex_lock(&slot.lock);
   vstats_summary_t lat = vstats_summarise(slot.latency_us, slot.nlatency);
   uint64_t feedback = slot.received, live_lost = slot.lost_events, live_back = slot.regained_events;
+  uint64_t foreign = slot.foreign_echoes;
   pthread_mutex_unlock(&slot.lock);
   /* Jitter: the p99 of |period - nominal| (early and late ticks alike). */
   for (size_t i = 0; i < st.nperiod; i++) st.period_us[i] = fabs(st.period_us[i] - 1e6 / rate);
@@ -428,13 +470,25 @@ int main(int argc, char **argv) {
             live_back);
   fprintf(stderr, "haptic: command->feedback latency median %.1f us, p99 %.1f us (%zu samples)\n", lat.median, lat.p99,
           lat.n);
+  if (foreign)
+    fprintf(stderr, "haptic: %" PRIu64 " feedback samples answered another station's commands (not in the latency)\n",
+            foreign);
+  guide_report_summary(&guide_rep, 1.0 / rate, stderr);
+  pthread_mutex_lock(&guide.lock);
+  fprintf(stderr,
+          "haptic: guide: %" PRIu64 " ToolRole samples (%" PRIu64 " refused), %" PRIu64
+          " commands from other stations (%" PRIu64 " not finite), %" PRIu64 " of ours skipped\n",
+          guide.roles_received, guide.roles_rejected, guide.peer_samples, guide.bad_samples, guide.own_samples_skipped);
+  pthread_mutex_unlock(&guide.lock);
   printf("SUMMARY ticks=%" PRIu64 " rate_hz=%.1f peak_force=%.4f contact_ticks=%" PRIu64 " latency_us_median=%.1f "
-         "latency_us_p99=%.1f period_us_p99=%.1f jitter_us_p99=%.1f late_ticks=%" PRIu64 "\n",
+         "latency_us_p99=%.1f period_us_p99=%.1f jitter_us_p99=%.1f late_ticks=%" PRIu64 " guide_coupled_s=%.2f\n",
          st.ticks, (double)st.ticks / elapsed, st.peak_force, st.contact_ticks, lat.median, lat.p99, per.p99,
-         jitter_p99, st.late_ticks);
+         jitter_p99, st.late_ticks, guide_report_coupled_s(&guide_rep, 1.0 / rate));
   free(st.period_us);
+  guide_report_free(&guide_rep);
   vdds_close(&dds); /* stops the listener before the slot goes */
   feedback_slot_destroy(&slot);
+  guide_slot_destroy(&guide);
   dev.ops->close(&dev);
   return 0;
 }
