@@ -80,6 +80,20 @@ static int write_png(cairo_surface_t *surf, const char *out, const char *kind, i
   return -1;
 }
 
+/* Each change of who drives a tool, on stdout: the instructor's log (and
+ * what the tests read). */
+static void log_roles(seat_t *s) {
+  for (int t = 0; t < SCENE_VIEW_MAX_TOOLS; t++) {
+    seat_role_t *r = &s->roles[t];
+    if (!r->changed) continue;
+    r->changed = 0;
+    char txt[160];
+    printf("dashboard: %s tool %d driven by: %s\n", s->partition, t,
+           seat_role_text(txt, sizeof txt, r->have, r->owner, r->guide, r->authority));
+    fflush(stdout);
+  }
+}
+
 int main(int argc, char **argv) {
   vdds_set_role("dashboard"); /* announced in the participant USER_DATA */
   static const struct option opts[] = {{"prefix", required_argument, 0, 'p'},
@@ -269,8 +283,10 @@ int main(int argc, char **argv) {
     uint64_t now_ns = vtime_mono_ns();
     double now = (double)(now_ns - t0) * 1e-9;
     if (duration > 0 && now >= duration) break;
-    for (int i = 0; i < nseats; i++)
+    for (int i = 0; i < nseats; i++) {
       if (seat_poll(&seats[i], now, &err)) fprintf(stderr, "viscera-dashboard: %s: %s\n", seats[i].partition, err.msg);
+      log_roles(&seats[i]);
+    }
     if (now_ns >= next_sample) {
       /* The history is at DASH_SAMPLE_HZ whatever the refresh rate. */
       for (int i = 0; i < nseats; i++) seat_sample(&seats[i], (double)(now_ns - last_sample) * 1e-9);

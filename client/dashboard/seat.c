@@ -44,10 +44,10 @@ static void on_role(seat_t *s, const void *x, double now) {
     return;
   }
   seat_role_t *d = &s->roles[r->tool_id];
-  d->have = 1;
-  snprintf(d->owner, sizeof d->owner, "%s", r->owner);
-  snprintf(d->guide, sizeof d->guide, "%s", r->guide);
-  d->authority = r->authority;
+  seat_role_t nr = {.have = 1, .changed = 1, .authority = r->authority};
+  snprintf(nr.owner, sizeof nr.owner, "%s", r->owner);
+  snprintf(nr.guide, sizeof nr.guide, "%s", r->guide);
+  if (!d->have || strcmp(d->owner, nr.owner) || strcmp(d->guide, nr.guide) || d->authority != nr.authority) *d = nr;
 }
 
 static void on_measures(seat_t *s, const void *x, double now) {

@@ -32,6 +32,7 @@ typedef struct seat_event {
 /* A tool's ToolRole (idl). */
 typedef struct seat_role {
   int have;
+  int changed; /* set when a sample changes it; the caller clears it */
   char owner[33], guide[33];
   float authority;
 } seat_role_t;
