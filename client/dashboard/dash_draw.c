@@ -261,20 +261,29 @@ static void field(cairo_t *cr, double x, double y, const char *label, const char
   text(cr, x + 110, y, 14, value);
 }
 
-/* "ST 4.2 s   MPF 3.1 s   SFT 0.0 s", each in its level's colour. */
-static void three_levels(cairo_t *cr, double x, double y, const double v[3], const char *fmt) {
+/* "ST 4.2 s   MPF 3.1 s   SFT 0.0 s", each in its level's colour, in a
+ * smaller font when 14 px would not fit in maxw. */
+static void three_levels(cairo_t *cr, double x, double y, const double v[3], const char *fmt, double maxw) {
   static const char *const names[3] = {"ST", "MPF", "SFT"};
+  char b[3][48];
+  double wsum = 0, size = 14, gap = 16;
+  cairo_set_font_size(cr, size);
   for (int k = 0; k < 3; k++) {
-    char b[48];
-    snprintf(b, sizeof b, fmt, names[k], v[k]);
+    snprintf(b[k], sizeof b[k], fmt, names[k], v[k]);
+    cairo_text_extents_t te;
+    cairo_text_extents(cr, b[k], &te);
+    wsum += te.x_advance + (k < 2 ? gap : 0);
+  }
+  if (wsum > maxw && maxw > 0) size = fmax(8, size * maxw / wsum), gap *= size / 14;
+  for (int k = 0; k < 3; k++) {
     double c[3];
     level_rgb((seat_alert_t)(k + 1), c);
     set_rgb(cr, c);
-    cairo_set_font_size(cr, 14);
+    cairo_set_font_size(cr, size);
     cairo_text_extents_t te;
-    cairo_text_extents(cr, b, &te);
-    text(cr, x, y, 14, b);
-    x += te.x_advance + 16;
+    cairo_text_extents(cr, b[k], &te);
+    text(cr, x, y, size, b[k]);
+    x += te.x_advance + gap;
   }
 }
 
@@ -302,13 +311,13 @@ static void draw_panel(const seat_t *s, cairo_t *cr, double x, double y, double 
   ly += 24;
   cairo_set_source_rgb(cr, 0.62, 0.62, 0.68);
   text(cr, x, ly, 14, "Time above");
-  three_levels(cr, x + 110, ly, m ? m->above : s->above_seen, "%s %.1f s");
+  three_levels(cr, x + 110, ly, m ? m->above : s->above_seen, "%s %.1f s", pw - 110);
   ly += 24;
   const double thr[3] = {st, mpf, sft};
   cairo_set_source_rgb(cr, 0.62, 0.62, 0.68);
   text(cr, x, ly, 14, "Thresholds");
   if (p >= 0 && (st > 0 || mpf > 0 || sft > 0))
-    three_levels(cr, x + 110, ly, thr, "%s %.2f N");
+    three_levels(cr, x + 110, ly, thr, "%s %.2f N", pw - 110);
   else {
     cairo_set_source_rgb(cr, 0.93, 0.93, 0.95);
     text(cr, x + 110, ly, 14, p >= 0 ? "none set" : "-");

@@ -114,8 +114,9 @@ int seat_poll(seat_t *s, double now, verr_t *err) {
   if (now > s->alert_until) s->alert = SEAT_OK;
   /* A trainee still pressing above a threshold stays alerted after the
    * crossing's hold runs out. */
-  float st = 0, mpf = 0, sft = 0, mf = 0;
-  seat_alert_t cur = seat_level_of(seat_force(s, &st, &mpf, &sft, &mf), st, mpf, sft);
+  float st, mpf, sft, mf;
+  double f = seat_force(s, &st, &mpf, &sft, &mf); /* before reading the thresholds it sets */
+  seat_alert_t cur = seat_level_of(f, st, mpf, sft);
   if (cur > s->alert) s->alert = cur;
   return 0;
 }

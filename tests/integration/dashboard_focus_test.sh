@@ -25,13 +25,14 @@ out=$("$DASH" --seats 2 --focus 3 2>&1) && fail "--focus 3 of 2 seats accepted"
 echo "$out" | grep -q "focus 3: not one of the seats 1..2" || fail "bad --focus message: $out"
 
 # Press 8 mm into the default kidney (about 0.97 N: above MPF 0.8, below SFT 1.5), hold, withdraw.
+# The hold is long so a server starved by a loaded machine still gets there.
 cat > "$OUT/hold.traj" <<'TRAJ'
 0.0   0.012  0.004  0.070
 0.5   0.012  0.004  0.070
 1.5   0.012  0.004  0.027
-7.0   0.012  0.004  0.027
-8.0   0.012  0.004  0.070
-9.0   0.012  0.004  0.070
+14.0  0.012  0.004  0.027
+15.0  0.012  0.004  0.070
+16.0  0.012  0.004  0.070
 TRAJ
 "$BUILD/server/viscera-server" --scene "$SRC/assets/scenes/default.yaml" --partition lab/seat01 \
   > "$OUT/server.out" 2> "$OUT/server.log" & SERVER=$!; PIDS+=($SERVER)
@@ -60,17 +61,20 @@ awk -F, 'NR>1 && $12==1 { f[$3]++ } END { printf "focused frames: seat01 %d, sea
   exit !(f["lab/seat01"] >= 5 && f["lab/seat02"] == 0) }' "$csv" || fail "focus frames not flagged for seat 1 only"
 n=$(ls "$OUT/dash"/focus_*.png | wc -l)
 [ "$n" -ge 5 ] || fail "only $n focus frames"
-red=0; curve=0
+red=0; curve=0; framed=0
 for f in "$OUT/dash"/focus_*.png; do
   if focus_badge_is "$f" $W "${BADGE_MPF[@]}"; then
     red=$((red + 1))
     focus_has_curve "$f" $W $H && curve=$((curve + 1))
+    focus_framed "$f" $H "${BADGE_MPF[@]}" && framed=$((framed + 1))
   fi
 done
 last=$(ls "$OUT/dash"/focus_*.png | tail -1)
-echo "focus frames: $n, with the red MPF badge: $red (force curve drawn in $curve of them)"
+echo "focus frames: $n, with the red MPF badge: $red (force curve drawn in $curve, red alert frame in $framed)"
+grep -q "MPF crossed up" "$OUT/server.log" || fail "the server never reported the press above MPF (starved?)"
 [ "$red" -ge 2 ] || fail "no focus frame shows the above-MPF badge"
 [ "$curve" -ge 1 ] || fail "no focus frame above MPF shows the force curve"
+[ "$framed" -ge 1 ] || fail "no focus frame above MPF is framed in red"
 focus_badge_is "$last" $W "${BADGE_NONE[@]}" || fail "after the release the badge is not grey ($last)"
 if [ $roles = 1 ]; then
   grep -q "lab/seat01 tool 0 driven by: owner alice$" "$OUT/dashboard.out" || fail "no 'owner alice' role seen"

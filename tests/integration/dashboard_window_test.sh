@@ -67,14 +67,17 @@ grep -q " 0 of [0-9]* window pixels differ" "$OUT/dashboard.out" || fail "the wi
 csv="$OUT/dash/dashboard.csv"
 awk -F, 'NR>1 { n++; if ($12==1) f++; if ($7=="MPF") a++ } END { printf "frames: %d, focused %d, with an MPF alert %d\n", n, f, a;
   exit !(n >= 10 && f >= 3 && n - f >= 3 && a >= 1) }' "$csv" || fail "grid frames, focused frames or alerts missing"
-red=0; curve=0
+red=0; curve=0; framed=0
 for f in "$OUT/dash"/focus_*.png; do
   if focus_badge_is "$f" $W "${BADGE_MPF[@]}"; then
     red=$((red + 1))
     focus_has_curve "$f" $W $H && curve=$((curve + 1))
+    focus_framed "$f" $H "${BADGE_MPF[@]}" && framed=$((framed + 1))
   fi
 done
-echo "focus frames: $(ls "$OUT/dash"/focus_*.png | wc -l), with the red MPF badge: $red (force curve in $curve)"
-[ "$red" -ge 1 ] && [ "$curve" -ge 1 ] || fail "no focused frame shows the above-MPF badge with the force curve"
+echo "focus frames: $(ls "$OUT/dash"/focus_*.png | wc -l), with the red MPF badge: $red (force curve in $curve, red alert frame in $framed)"
+grep -q "MPF crossed up" "$OUT/server.log" || fail "the server never reported the press above MPF (starved?)"
+[ "$red" -ge 1 ] && [ "$curve" -ge 1 ] && [ "$framed" -ge 1 ] \
+  || fail "no focused frame shows the above-MPF badge with the force curve and the red frame"
 grep 'window closed' "$OUT/dashboard.out"
 echo PASS
