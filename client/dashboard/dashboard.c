@@ -56,7 +56,8 @@ static void usage(FILE *f) {
           "  --out DIR           PNG frames and dashboard.csv (default ./dashboard)\n"
           "  --interval-ms MS    a frame every MS ms (default 1000)\n"
           "  --duration S        stop after S s (default: until SIGINT/SIGTERM)\n"
-          "  --focus SEAT        also write the focus view of seat number SEAT (PNG, no display needed)\n"
+          "  --focus SEAT        also write the focus view of seat number SEAT (PNG, no display needed);\n"
+          "                      with --window: start focused on it\n"
           "  --size WxH          focus view size, and the window's first size (default %dx%d)\n"
           "  --window            show the dashboard live in a window (SDL2); PNGs then only with --out\n"
           "  --refresh-hz HZ     window refresh rate (default 15, 1..60)\n"
@@ -266,6 +267,7 @@ int main(int argc, char **argv) {
       rc = 1;
       goto done;
     }
+    if (focus_seat) dw.focused = focus_seat - first; /* the window starts on that seat */
     printf("dashboard: window open (SDL video driver %s)\n", SDL_GetCurrentVideoDriver());
     fflush(stdout);
   }

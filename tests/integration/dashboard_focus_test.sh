@@ -12,28 +12,15 @@
 # usage: dashboard_focus_test.sh BUILD SRC OUT
 set -euo pipefail
 BUILD="$1"; SRC="$2"; OUT="$3"
-. "$(dirname "$0")/dashboard_pixels.sh"
-PIDS=()
-cleanup() { for p in "${PIDS[@]}"; do kill -9 "$p" 2>/dev/null || true; done; }
-trap cleanup EXIT
-fail() { echo "FAIL: $*" >&2; for f in "$OUT"/*.log "$OUT"/*.out; do echo "--- $f"; tail -8 "$f"; done >&2; exit 1; }
-rm -rf "$OUT"; mkdir -p "$OUT"
+. "$(dirname "$0")/dashboard_lib.sh"
 W=800; H=520
 DASH="$BUILD/client/dashboard/viscera-dashboard"
 
 out=$("$DASH" --seats 2 --focus 3 2>&1) && fail "--focus 3 of 2 seats accepted"
 echo "$out" | grep -q "focus 3: not one of the seats 1..2" || fail "bad --focus message: $out"
 
-# Press 8 mm into the default kidney (about 0.97 N: above MPF 0.8, below SFT 1.5), hold, withdraw.
 # The hold is long so a server starved by a loaded machine still gets there.
-cat > "$OUT/hold.traj" <<'TRAJ'
-0.0   0.012  0.004  0.070
-0.5   0.012  0.004  0.070
-1.5   0.012  0.004  0.027
-14.0  0.012  0.004  0.027
-15.0  0.012  0.004  0.070
-16.0  0.012  0.004  0.070
-TRAJ
+write_hold_traj "$OUT/hold.traj" 14
 "$BUILD/server/viscera-server" --scene "$SRC/assets/scenes/default.yaml" --partition lab/seat01 \
   > "$OUT/server.out" 2> "$OUT/server.log" & SERVER=$!; PIDS+=($SERVER)
 "$DASH" --prefix lab --seats 2 --focus 1 --size ${W}x${H} --out "$OUT/dash" --interval-ms 500 \
@@ -61,14 +48,7 @@ awk -F, 'NR>1 && $12==1 { f[$3]++ } END { printf "focused frames: seat01 %d, sea
   exit !(f["lab/seat01"] >= 5 && f["lab/seat02"] == 0) }' "$csv" || fail "focus frames not flagged for seat 1 only"
 n=$(ls "$OUT/dash"/focus_*.png | wc -l)
 [ "$n" -ge 5 ] || fail "only $n focus frames"
-red=0; curve=0; framed=0
-for f in "$OUT/dash"/focus_*.png; do
-  if focus_badge_is "$f" $W "${BADGE_MPF[@]}"; then
-    red=$((red + 1))
-    focus_has_curve "$f" $W $H && curve=$((curve + 1))
-    focus_framed "$f" $H "${BADGE_MPF[@]}" && framed=$((framed + 1))
-  fi
-done
+scan_focus_frames "$OUT/dash" $W $H
 last=$(ls "$OUT/dash"/focus_*.png | tail -1)
 echo "focus frames: $n, with the red MPF badge: $red (force curve drawn in $curve, red alert frame in $framed)"
 grep -q "MPF crossed up" "$OUT/server.log" || fail "the server never reported the press above MPF (starved?)"

@@ -12,23 +12,12 @@
 # usage: dashboard_window_test.sh BUILD SRC OUT
 set -euo pipefail
 BUILD="$1"; SRC="$2"; OUT="$3"
-. "$(dirname "$0")/dashboard_pixels.sh"
-PIDS=()
-cleanup() { for p in "${PIDS[@]}"; do kill -9 "$p" 2>/dev/null || true; done; }
-trap cleanup EXIT
-fail() { echo "FAIL: $*" >&2; for f in "$OUT"/*.log "$OUT"/*.out; do echo "--- $f"; tail -8 "$f"; done >&2; exit 1; }
-rm -rf "$OUT"; mkdir -p "$OUT"
+. "$(dirname "$0")/dashboard_lib.sh"
 # Window 1024 x (680 + 22 footer); the 1-seat grid (320 x 332) is centred in
 # the 680 px above the footer, so its tile's centre is at (512, 340).
 W=1024; H=680
 
-cat > "$OUT/hold.traj" <<'TRAJ'
-0.0   0.012  0.004  0.070
-0.5   0.012  0.004  0.070
-1.5   0.012  0.004  0.027
-40.0  0.012  0.004  0.027
-41.0  0.012  0.004  0.070
-TRAJ
+write_hold_traj "$OUT/hold.traj" 40
 # t (s) since the window opened
 cat > "$OUT/dash.input" <<'INPUT'
 4.0 key_down 1
@@ -67,14 +56,7 @@ grep -q " 0 of [0-9]* window pixels differ" "$OUT/dashboard.out" || fail "the wi
 csv="$OUT/dash/dashboard.csv"
 awk -F, 'NR>1 { n++; if ($12==1) f++; if ($7=="MPF") a++ } END { printf "frames: %d, focused %d, with an MPF alert %d\n", n, f, a;
   exit !(n >= 10 && f >= 3 && n - f >= 3 && a >= 1) }' "$csv" || fail "grid frames, focused frames or alerts missing"
-red=0; curve=0; framed=0
-for f in "$OUT/dash"/focus_*.png; do
-  if focus_badge_is "$f" $W "${BADGE_MPF[@]}"; then
-    red=$((red + 1))
-    focus_has_curve "$f" $W $H && curve=$((curve + 1))
-    focus_framed "$f" $H "${BADGE_MPF[@]}" && framed=$((framed + 1))
-  fi
-done
+scan_focus_frames "$OUT/dash" $W $H
 echo "focus frames: $(ls "$OUT/dash"/focus_*.png | wc -l), with the red MPF badge: $red (force curve in $curve, red alert frame in $framed)"
 grep -q "MPF crossed up" "$OUT/server.log" || fail "the server never reported the press above MPF (starved?)"
 [ "$red" -ge 1 ] && [ "$curve" -ge 1 ] && [ "$framed" -ge 1 ] \
