@@ -74,6 +74,12 @@ static void text_fit(cairo_t *cr, double x, double y, double size, const char *s
   snprintf(buf, sizeof buf, "%s", s);
   cairo_set_font_size(cr, size);
   cairo_text_extents_t te;
+  if (size < 0) { /* -size: shrink down to 10 px before cutting */
+    cairo_set_font_size(cr, -size);
+    cairo_text_extents(cr, buf, &te);
+    size = te.x_advance > maxw && maxw > 0 ? fmax(10, -size * maxw / te.x_advance) : -size;
+    cairo_set_font_size(cr, size);
+  }
   size_t n = strlen(buf);
   for (;;) {
     cairo_text_extents(cr, buf, &te);
@@ -290,10 +296,11 @@ static void three_levels(cairo_t *cr, double x, double y, const double v[3], con
 static void draw_panel(const seat_t *s, cairo_t *cr, double x, double y, double pw, double ph) {
   float st, mpf, sft, maxf;
   double f = seat_force(s, &st, &mpf, &sft, &maxf);
-  int p = scene_view_primary_tool(&s->sv);
+  int p = seat_tool(s);
   seat_alert_t lv = seat_level_of(f, st, mpf, sft);
-  double c[3];
-  level_rgb(lv, c);
+  /* The level's colour only in contact, as the badge: no contact is grey. */
+  double c[3] = {0.6, 0.6, 0.65};
+  if (p >= 0 && s->sv.tools[p].have_contact && s->sv.tools[p].in_contact) level_rgb(lv, c);
   char b[200];
   double ly = y + 18;
   cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_BOLD);
@@ -308,11 +315,11 @@ static void draw_panel(const seat_t *s, cairo_t *cr, double x, double y, double 
   const seat_tool_measures_t *m = p >= 0 && s->measures[p].have ? &s->measures[p] : NULL;
   snprintf(b, sizeof b, "%.2f N%s", m ? fmax(m->peak, s->peak) : s->peak, m ? "" : "  (seen here)");
   field(cr, x, ly, "Peak", b, NULL);
-  ly += 24;
+  ly += 22;
   cairo_set_source_rgb(cr, 0.62, 0.62, 0.68);
   text(cr, x, ly, 14, "Time above");
   three_levels(cr, x + 110, ly, m ? m->above : s->above_seen, "%s %.1f s", pw - 110);
-  ly += 24;
+  ly += 22;
   const double thr[3] = {st, mpf, sft};
   cairo_set_source_rgb(cr, 0.62, 0.62, 0.68);
   text(cr, x, ly, 14, "Thresholds");
@@ -322,10 +329,10 @@ static void draw_panel(const seat_t *s, cairo_t *cr, double x, double y, double 
     cairo_set_source_rgb(cr, 0.93, 0.93, 0.95);
     text(cr, x + 110, ly, 14, p >= 0 ? "none set" : "-");
   }
-  ly += 24;
+  ly += 22;
   snprintf(b, sizeof b, "ST x%u   MPF x%u   SFT x%u", s->crossings[0], s->crossings[1], s->crossings[2]);
   field(cr, x, ly, "Crossed up", b, NULL);
-  ly += 30;
+  ly += 28;
   /* Who drives and who guides the trainee's tool (ToolRole). */
   char tname[72], role[160];
   if (p >= 0) {
@@ -338,17 +345,12 @@ static void draw_panel(const seat_t *s, cairo_t *cr, double x, double y, double 
     cairo_set_source_rgb(cr, 0.62, 0.62, 0.68);
     text(cr, x, ly, 14, "Driven by");
     cairo_set_source_rgb(cr, 0.93, 0.93, 0.95);
-    text_fit(cr, x + 110, ly, 14, role, pw - 110);
+    text_fit(cr, x + 110, ly, -14, role, pw - 110); /* shrunk rather than cut: the role matters */
   } else {
-    field(cr, x, ly, "Tool", s->sv.have_scene ? "no tool in use" : "-", NULL);
+    field(cr, x, ly, "Tool", s->sv.have_scene ? "none in the scene" : "-", NULL);
     ly += 22;
   }
-  if (s->client_lost) {
-    ly += 22;
-    cairo_set_source_rgb(cr, 0.95, 0.35, 0.3);
-    text(cr, x, ly, 14, "Trainee's client lost");
-  }
-  ly += 32;
+  ly += 30;
   cairo_set_source_rgb(cr, 0.62, 0.62, 0.68);
   text(cr, x, ly, 14, "Seat events (simulated time)");
   ly += 6;
@@ -397,10 +399,21 @@ int dash_draw_focus(dash_t *d, int i, cairo_t *cr, int w, int h, verr_t *err) {
   cairo_set_source_rgb(cr, 0.93, 0.93, 0.95);
   int bx, by, bw, bh;
   dash_focus_badge_rect(w, h, &bx, &by, &bw, &bh);
-  text_fit(cr, M, 31, 20, b, bx - 2 * M);
+  if (s->client_lost) {
+    /* Next to the seat's name, where the instructor looks first. */
+    cairo_set_font_size(cr, 20);
+    cairo_text_extents_t tt;
+    cairo_text_extents(cr, b, &tt);
+    double room = bx - 2 * M - 190;
+    text_fit(cr, M, 31, 20, b, room);
+    cairo_set_source_rgb(cr, 0.95, 0.35, 0.3);
+    text(cr, M + fmin(tt.x_advance, room) + 14, 31, 15, "trainee's client lost");
+  } else {
+    text_fit(cr, M, 31, 20, b, bx - 2 * M);
+  }
   float st, mpf, sft, maxf;
   double f = seat_force(s, &st, &mpf, &sft, &maxf);
-  int p = scene_view_primary_tool(&s->sv);
+  int p = seat_tool(s);
   int contact = p >= 0 && s->sv.tools[p].have_contact && s->sv.tools[p].in_contact;
   seat_alert_t lv = seat_level_of(f, st, mpf, sft);
   double c[3] = {0.35, 0.35, 0.4};
@@ -411,7 +424,10 @@ int dash_draw_focus(dash_t *d, int i, cairo_t *cr, int w, int h, verr_t *err) {
   static const char *const badge[4] = {"BELOW ST", "ABOVE ST", "ABOVE MPF", "ABOVE SFT"};
   cairo_set_source_rgb(cr, 1, 1, 1);
   cairo_set_font_size(cr, 17);
-  const char *bt = contact ? badge[lv] : p >= 0 ? "NO CONTACT" : "NO TOOL";
+  const char *bt = contact                                                               ? badge[lv]
+                   : p >= 0 && (s->sv.tools[p].have_pose || s->sv.tools[p].have_contact) ? "NO CONTACT"
+                   : p >= 0                                                              ? "NOT DRIVEN"
+                                                                                         : "NO TOOL";
   cairo_text_extents_t te;
   cairo_text_extents(cr, bt, &te);
   text(cr, bx + (bw - te.x_advance) / 2, by + bh / 2.0 + 6, 17, bt);

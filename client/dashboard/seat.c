@@ -121,8 +121,15 @@ int seat_poll(seat_t *s, double now, verr_t *err) {
   return 0;
 }
 
-double seat_force(const seat_t *s, float *st, float *mpf, float *sft, float *max_force) {
+int seat_tool(const seat_t *s) {
   int p = scene_view_primary_tool(&s->sv);
+  for (int i = 0; p < 0 && i < SCENE_VIEW_MAX_TOOLS; i++)
+    if (s->sv.tools[i].listed) p = i;
+  return p;
+}
+
+double seat_force(const seat_t *s, float *st, float *mpf, float *sft, float *max_force) {
+  int p = seat_tool(s);
   *st = *mpf = *sft = 0;
   *max_force = SCENE_VIEW_TOOL_MAX_FORCE;
   if (p < 0) return 0;

@@ -72,7 +72,12 @@ int seat_poll(seat_t *s, double now, verr_t *err);
 /* Records the primary tool's force (N) into the history; dt (s) since the
  * previous sample counts towards the time above each threshold reached. */
 void seat_sample(seat_t *s, double dt);
-/* The primary tool's current force (N) and thresholds; 0 when none. */
+/* The tool the dashboard follows: the viewer's primary tool (the lowest
+ * id with a pose or contact), else the first tool of the scene, so its
+ * thresholds and role stay on show while no client drives it; -1 when the
+ * scene has none. */
+int seat_tool(const seat_t *s);
+/* That tool's current force (N, 0 out of contact) and thresholds; 0 when none. */
 double seat_force(const seat_t *s, float *st, float *mpf, float *sft, float *max_force);
 /* The k-th newest kept event (k = 0 newest), or NULL. */
 const seat_event_t *seat_event(const seat_t *s, unsigned k);

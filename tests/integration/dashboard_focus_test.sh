@@ -35,9 +35,12 @@ if "$BUILD/client/control/viscera-control" --help 2>&1 | grep -q "assign"; then
   roles=1
   ctl() { "$BUILD/client/control/viscera-control" --partition lab/seat01 "$@" >> "$OUT/control.log" 2>&1 \
           || fail "viscera-control $* failed"; }
+  # ToolRole is keep-last 1: wait for each change to show before the next.
+  seen() { for _ in $(seq 50); do grep -q "$1" "$OUT/dashboard.out" && return 0; sleep 0.2; done; return 1; }
   ctl assign 0 alice
+  seen "driven by: owner alice$" || true
   ctl guide 0 bob 0.5
-  for _ in $(seq 50); do grep -q "guided by bob 50 %" "$OUT/dashboard.out" && break; sleep 0.2; done
+  seen "guided by bob 50 %" || true
 fi
 kill -INT $DASHP; wait $DASHP || fail "dashboard exited with an error"
 kill -INT $SERVER; wait $SERVER || true
