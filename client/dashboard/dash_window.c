@@ -112,6 +112,7 @@ int dash_window_tick(dash_window_t *w, dash_t *d, verr_t *err) {
   if ((ww != w->w || wh != w->h) && ww >= DASH_FOCUS_MIN_W && wh >= DASH_FOCUS_MIN_H + DASH_WINDOW_FOOTER_H &&
       make_canvas(w, ww, wh, err))
     return -1;
+  uint64_t t_draw = vtime_mono_ns();
   cairo_t *cr = cairo_create(w->canvas);
   int rc = 0;
   if (w->focused >= 0) {
@@ -133,6 +134,7 @@ int dash_window_tick(dash_window_t *w, dash_t *d, verr_t *err) {
                          cairo_image_surface_get_stride(w->canvas), err))
     return -1;
   w->shown++;
+  w->draw_s += (double)(vtime_mono_ns() - t_draw) * 1e-9;
   return quit;
 }
 

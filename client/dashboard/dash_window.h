@@ -35,6 +35,7 @@ typedef struct dash_window {
   input_script_t script;
   uint64_t t_open_ns;
   long shown, changes;
+  double draw_s; /* summed time drawing and presenting, for the closing line */
 } dash_window_t;
 
 /* Opens a width x height window (resizable, not smaller than the focus

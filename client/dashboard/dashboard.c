@@ -358,8 +358,10 @@ int main(int argc, char **argv) {
       else
         printf("dashboard: window.png written; %ld of %d window pixels differ from the drawing\n", differ, dw.w * dw.h);
     }
-    printf("dashboard: window closed after %.1f s, %ld frames shown, %ld view changes\n",
-           (double)(vtime_mono_ns() - t0) * 1e-9, dw.shown, dw.changes);
+    printf("dashboard: window closed after %.1f s, %ld frames shown (%.1f ms each to draw and present), %ld view "
+           "changes\n",
+           (double)(vtime_mono_ns() - t0) * 1e-9, dw.shown, dw.shown ? dw.draw_s * 1e3 / (double)dw.shown : 0.0,
+           dw.changes);
   }
 #endif
   (void)window_open;
