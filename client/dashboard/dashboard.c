@@ -1,13 +1,19 @@
-/* viscera-dashboard: the instructor's grid of a lab's seats (issue 7).
+/* viscera-dashboard: the instructor's view of a lab's seats (issue 7).
  *
  * One tile per seat (partition PREFIX/seatNN): the organ and tool as the
  * viewer draws them, the trainee's contact force over the last 30 s against
- * the seat's palpation thresholds, and an alert frame (orange above ST, red
- * above MPF or SFT) for SEAT_ALERT_HOLD_S after the server reports a
- * crossing. Seats without a server say so. Writes the grid as PNG frames at
- * an interval and a CSV row per seat and frame, so a session's alerts can be
- * checked afterwards. The window version of this view waits for the window
- * viewer. */
+ * the seat's palpation thresholds, and an alert frame (amber above ST, red
+ * above MPF, magenta above SFT) for SEAT_ALERT_HOLD_S after the server
+ * reports a crossing. Seats without a server say so. A seat can be focused:
+ * its scene large, force graph with axes, level badge, peak, time above each
+ * threshold, who drives and guides its tool, its last events (dash_draw.h).
+ *
+ * Output: the grid as PNG frames at an interval with a CSV row per seat and
+ * frame, so a session's alerts can be checked afterwards; with --focus SEAT
+ * also the focus view of that seat (focus_NNNNN.png) without any display;
+ * with --window the same pictures live in an SDL2 window (dash_window.h),
+ * where keys and clicks choose the view, and PNGs only when --out is given
+ * (a focused window's view is written as focus_NNNNN.png). */
 #include <errno.h>
 #include <getopt.h>
 #include <math.h>
@@ -19,19 +25,19 @@
 
 #include <cairo.h>
 
+#include "dash_draw.h"
 #include "plot_cleanup.h"
-#include "render.h"
-#include "scene_draw.h"
 #include "seat.h"
+#include "vdds_ident.h"
 #include "vsignal.h"
 #include "vtime.h"
-#include "vdds_ident.h"
+#ifdef VISCERA_HAVE_WINDOW
+#include "dash_window.h"
+#endif
 
 #define MAX_SEATS 32
-#define HEADER_H 22
-#define GRAPH_H 70
-#define GRAPH_SECONDS 30.0
-#define SAMPLE_HZ 10.0
+#define FOCUS_W 1024 /* default focus view / window size */
+#define FOCUS_H 680
 
 static volatile sig_atomic_t g_stop;
 static void on_signal(int sig) {
@@ -50,78 +56,43 @@ static void usage(FILE *f) {
           "  --out DIR           PNG frames and dashboard.csv (default ./dashboard)\n"
           "  --interval-ms MS    a frame every MS ms (default 1000)\n"
           "  --duration S        stop after S s (default: until SIGINT/SIGTERM)\n"
+          "  --focus SEAT        also write the focus view of seat number SEAT (PNG, no display needed);\n"
+          "                      with --window: start focused on it\n"
+          "  --size WxH          focus view size, and the window's first size (default %dx%d)\n"
+          "  --window            show the dashboard live in a window (SDL2); PNGs then only with --out\n"
+          "  --refresh-hz HZ     window refresh rate (default 15, 1..60)\n"
+          "  --script-input F    window: timed keys and clicks from F (viewer's input script format)\n"
           "  --domain N          DDS domain id (default: $VISCERA_DOMAIN or 0)\n"
-          "  --help              this text\n",
-          MAX_SEATS);
+          "  --help              this text\n"
+          "window keys: 1-9 or a click on a tile: focus that seat; Tab / Shift+Tab: next / previous\n"
+          "  seat; Esc or a click: back to the grid; Q or closing the window: quit\n",
+          MAX_SEATS, FOCUS_W, FOCUS_H);
 }
 
-static const char *alert_name(seat_alert_t a) {
-  static const char *const n[] = {"ok", "ST", "MPF", "SFT"};
-  return n[a];
+static int parse_size(const char *s, int *w, int *h, int minw, int minh, int max) {
+  return sscanf(s, "%dx%d", w, h) == 2 && *w >= minw && *h >= minh && *w <= max && *h <= max ? 0 : -1;
 }
 
-/* Copies the renderer's RGB rows (bottom-up) into the cairo surface at (x0, y0). */
-static void blit(cairo_surface_t *dst, const uint8_t *rgb, int w, int h, int x0, int y0) {
-  cairo_surface_flush(dst);
-  unsigned char *d = cairo_image_surface_get_data(dst);
-  int stride = cairo_image_surface_get_stride(dst);
-  for (int y = 0; y < h; y++) {
-    const uint8_t *src = rgb + (size_t)(h - 1 - y) * w * 3;
-    uint32_t *row = (uint32_t *)(d + (size_t)(y0 + y) * stride) + x0;
-    for (int x = 0; x < w; x++)
-      row[x] = 0xff000000u | (uint32_t)src[3 * x] << 16 | (uint32_t)src[3 * x + 1] << 8 | src[3 * x + 2];
+static int write_png(cairo_surface_t *surf, const char *out, const char *kind, int frame) {
+  char png[1100];
+  snprintf(png, sizeof png, "%s/%s_%05d.png", out, kind, frame);
+  if (cairo_surface_write_to_png(surf, png) == CAIRO_STATUS_SUCCESS) return 0;
+  fprintf(stderr, "viscera-dashboard: cannot write %s\n", png);
+  return -1;
+}
+
+/* Each change of who drives a tool, on stdout: the instructor's log (and
+ * what the tests read). */
+static void log_roles(seat_t *s) {
+  for (int t = 0; t < SCENE_VIEW_MAX_TOOLS; t++) {
+    seat_role_t *r = &s->roles[t];
+    if (!r->changed) continue;
+    r->changed = 0;
+    char txt[160];
+    printf("dashboard: %s tool %d driven by: %s\n", s->partition, t,
+           seat_role_text(txt, sizeof txt, r->have, r->owner, r->guide, r->authority));
+    fflush(stdout);
   }
-  cairo_surface_mark_dirty(dst);
-}
-
-static void text(cairo_t *cr, double x, double y, double size, const char *s) {
-  cairo_set_font_size(cr, size);
-  cairo_move_to(cr, x, y);
-  cairo_show_text(cr, s);
-}
-
-/* Force over the last GRAPH_SECONDS with the threshold lines. */
-static void draw_graph(cairo_t *cr, const seat_t *s, double x, double y, double w, double h) {
-  float st, mpf, sft, maxf;
-  seat_force(s, &st, &mpf, &sft, &maxf);
-  double top = fmax(fmax(sft, mpf) * 1.25, fmax(s->peak * 1.1, 0.5));
-  cairo_set_source_rgb(cr, 0.12, 0.12, 0.14);
-  cairo_rectangle(cr, x, y, w, h);
-  cairo_fill(cr);
-  const float lv[3] = {st, mpf, sft};
-  const double col[3][3] = {{0.95, 0.6, 0.1}, {0.9, 0.2, 0.2}, {0.7, 0.1, 0.6}};
-  cairo_set_line_width(cr, 1);
-  for (int k = 0; k < 3; k++) {
-    if (!(lv[k] > 0)) continue;
-    double ly = y + h - lv[k] / top * h;
-    cairo_set_source_rgb(cr, col[k][0], col[k][1], col[k][2]);
-    cairo_move_to(cr, x, ly);
-    cairo_line_to(cr, x + w, ly);
-    cairo_stroke(cr);
-  }
-  uint64_t n = s->nhist < SEAT_HISTORY ? s->nhist : SEAT_HISTORY;
-  size_t span = (size_t)(GRAPH_SECONDS * SAMPLE_HZ);
-  if (n > span) n = span;
-  cairo_set_source_rgb(cr, 0.55, 0.85, 1.0);
-  cairo_set_line_width(cr, 1.5);
-  for (uint64_t i = 0; i < n; i++) {
-    float f = s->history[(s->nhist - n + i) % SEAT_HISTORY];
-    double px = x + w - (double)(n - 1 - i) / (double)span * w, py = y + h - fmin(f / top, 1.0) * h;
-    if (i == 0)
-      cairo_move_to(cr, px, py);
-    else
-      cairo_line_to(cr, px, py);
-  }
-  cairo_stroke(cr);
-  char buf[96];
-  cairo_set_source_rgb(cr, 0.8, 0.8, 0.85);
-  snprintf(buf, sizeof buf, "%.0f s   peak %.2f N   above ST x%u MPF x%u SFT x%u", GRAPH_SECONDS, s->peak,
-           s->crossings[0], s->crossings[1], s->crossings[2]);
-  text(cr, x + 4, y + 12, 10, buf);
-}
-
-static int parse_size(const char *s, int *w, int *h) {
-  return sscanf(s, "%dx%d", w, h) == 2 && *w >= 64 && *h >= 48 && *w <= 1024 && *h <= 1024 ? 0 : -1;
 }
 
 int main(int argc, char **argv) {
@@ -134,13 +105,19 @@ int main(int argc, char **argv) {
                                        {"out", required_argument, 0, 'o'},
                                        {"interval-ms", required_argument, 0, 'i'},
                                        {"duration", required_argument, 0, 'd'},
+                                       {"focus", required_argument, 0, 'F'},
+                                       {"size", required_argument, 0, 's'},
+                                       {"window", no_argument, 0, 'W'},
+                                       {"refresh-hz", required_argument, 0, 'r'},
+                                       {"script-input", required_argument, 0, 'S'},
                                        {"domain", required_argument, 0, 'D'},
                                        {"help", no_argument, 0, 'h'},
                                        {0, 0, 0, 0}};
-  const char *prefix = "lab", *out = "dashboard";
+  const char *prefix = "lab", *out = "dashboard", *script = NULL;
   int nseats = 4, first = 1, tw = 320, th = 240, cols = 0, interval_ms = 1000, c;
-  double duration = 0;
-  verr_t err;
+  int focus_seat = 0, fw = FOCUS_W, fh = FOCUS_H, window = 0, out_set = 0;
+  double duration = 0, refresh_hz = 15;
+  verr_t err = {{0}};
   int domain = vdds_env_domain(&err);
   if (domain < 0) {
     fprintf(stderr, "viscera-dashboard: %s\n", err.msg);
@@ -158,7 +135,7 @@ int main(int argc, char **argv) {
       first = atoi(optarg);
       break;
     case 't':
-      if (parse_size(optarg, &tw, &th)) {
+      if (parse_size(optarg, &tw, &th, 64, 48, 1024)) {
         fprintf(stderr, "viscera-dashboard: --tile '%s': expected WxH, 64x48 to 1024x1024\n", optarg);
         return 2;
       }
@@ -168,12 +145,36 @@ int main(int argc, char **argv) {
       break;
     case 'o':
       out = optarg;
+      out_set = 1;
       break;
     case 'i':
       interval_ms = atoi(optarg);
       break;
     case 'd':
       duration = atof(optarg);
+      break;
+    case 'F':
+      focus_seat = atoi(optarg);
+      if (focus_seat < 1 || focus_seat > 99) {
+        fprintf(stderr, "viscera-dashboard: --focus '%s': expected a seat number 1..99\n", optarg);
+        return 2;
+      }
+      break;
+    case 's':
+      if (parse_size(optarg, &fw, &fh, DASH_FOCUS_MIN_W, DASH_FOCUS_MIN_H, 4096)) {
+        fprintf(stderr, "viscera-dashboard: --size '%s': expected WxH, %dx%d to 4096x4096\n", optarg, DASH_FOCUS_MIN_W,
+                DASH_FOCUS_MIN_H);
+        return 2;
+      }
+      break;
+    case 'W':
+      window = 1;
+      break;
+    case 'r':
+      refresh_hz = atof(optarg);
+      break;
+    case 'S':
+      script = optarg;
       break;
     case 'D':
       domain = vdds_parse_domain(optarg);
@@ -187,31 +188,58 @@ int main(int argc, char **argv) {
     }
   }
   if (nseats < 1 || nseats > MAX_SEATS || first < 1 || first + nseats - 1 > 99 || interval_ms < 50 || domain < 0 ||
-      cols < 0 || !(duration >= 0) || strlen(prefix) > 100) {
-    fprintf(stderr, "viscera-dashboard: bad option value (seats 1..%d within seat numbers 1..99, interval >= 50 ms)\n",
+      cols < 0 || !(duration >= 0) || strlen(prefix) > 100 || !(refresh_hz >= 1 && refresh_hz <= 60)) {
+    fprintf(stderr,
+            "viscera-dashboard: bad option value (seats 1..%d within seat numbers 1..99, interval >= 50 ms, "
+            "refresh 1..60 Hz)\n",
             MAX_SEATS);
     usage(stderr);
     return 2;
   }
+  if (focus_seat && (focus_seat < first || focus_seat >= first + nseats)) {
+    fprintf(stderr, "viscera-dashboard: --focus %d: not one of the seats %d..%d\n", focus_seat, first,
+            first + nseats - 1);
+    return 2;
+  }
+  if ((script || refresh_hz != 15) && !window) {
+    fprintf(stderr, "viscera-dashboard: --script-input and --refresh-hz need --window\n");
+    return 2;
+  }
+#ifndef VISCERA_HAVE_WINDOW
+  if (window) {
+    fprintf(stderr, "viscera-dashboard: --window: this build has no window mode (SDL2 not found at build time or "
+                    "VISCERA_BUILD_WINDOW=OFF); the PNG output needs none\n");
+    return 2;
+  }
+#endif
   if (cols == 0) cols = (int)ceil(sqrt((double)nseats));
   if (cols > nseats) cols = nseats;
-  int rows = (nseats + cols - 1) / cols;
-  if (mkdir(out, 0755) && errno != EEXIST) {
-    fprintf(stderr, "viscera-dashboard: cannot create %s: %s\n", out, strerror(errno));
-    return 1;
+  /* A window writes PNGs only when asked; the headless dashboard always does. */
+  int pngs = !window || out_set;
+  FILE *csv = NULL;
+  if (pngs) {
+    if (mkdir(out, 0755) && errno != EEXIST) {
+      fprintf(stderr, "viscera-dashboard: cannot create %s: %s\n", out, strerror(errno));
+      return 1;
+    }
+    char csv_path[1024];
+    snprintf(csv_path, sizeof csv_path, "%s/dashboard.csv", out);
+    csv = fopen(csv_path, "w");
+    if (!csv) {
+      fprintf(stderr, "viscera-dashboard: cannot write %s: %s\n", csv_path, strerror(errno));
+      return 1;
+    }
+    fprintf(csv, "frame,wall_s,seat,have_scene,force_n,peak_n,alert,crossings_st,crossings_mpf,crossings_sft,"
+                 "client_lost,focused\n");
   }
-  char csv_path[1024];
-  snprintf(csv_path, sizeof csv_path, "%s/dashboard.csv", out);
-  FILE *csv = fopen(csv_path, "w");
-  if (!csv) {
-    fprintf(stderr, "viscera-dashboard: cannot write %s: %s\n", csv_path, strerror(errno));
-    return 1;
-  }
-  fprintf(csv,
-          "frame,wall_s,seat,have_scene,force_n,peak_n,alert,crossings_st,crossings_mpf,crossings_sft,client_lost\n");
 
   static seat_t seats[MAX_SEATS];
-  int rc = 0, opened = 0;
+  static dash_t dash;
+#ifdef VISCERA_HAVE_WINDOW
+  static dash_window_t dw;
+#endif
+  int rc = 0, opened = 0, window_open = 0;
+  cairo_surface_t *grid = NULL, *focus = NULL;
   for (int i = 0; i < nseats; i++) {
     char part[128];
     snprintf(part, sizeof part, "%s/seat%02d", prefix, first + i);
@@ -222,18 +250,36 @@ int main(int argc, char **argv) {
     }
     opened++;
   }
-  render_t *r = NULL;
-  if (render_open(&r, tw, th, 2, &err)) {
+  if (dash_open(&dash, seats, nseats, cols, tw, th, &err)) {
     fprintf(stderr, "viscera-dashboard: %s\n", err.msg);
     rc = 1;
     goto done;
   }
-  int W = cols * tw, H = rows * (HEADER_H + th + GRAPH_H);
-  cairo_surface_t *surf = cairo_image_surface_create(CAIRO_FORMAT_RGB24, W, H);
-  fprintf(stderr, "viscera-dashboard: %d seat(s) %s/seat%02d..seat%02d on domain %d, %dx%d grid, frames to %s\n",
-          nseats, prefix, first, first + nseats - 1, domain, cols, rows, out);
+  int W, H;
+  dash_grid_size(&dash, &W, &H);
+  grid = cairo_image_surface_create(CAIRO_FORMAT_RGB24, W, H);
+  if (focus_seat) focus = cairo_image_surface_create(CAIRO_FORMAT_RGB24, fw, fh);
+#ifdef VISCERA_HAVE_WINDOW
+  if (window) {
+    window_open = 1;
+    if (dash_window_open(&dw, W > fw ? W : fw, (H > fh ? H : fh) + DASH_WINDOW_FOOTER_H, script, &err)) {
+      fprintf(stderr, "viscera-dashboard: --window: %s\n", err.msg);
+      rc = 1;
+      goto done;
+    }
+    if (focus_seat) dw.focused = focus_seat - first; /* the window starts on that seat */
+    printf("dashboard: window open (SDL video driver %s)\n", SDL_GetCurrentVideoDriver());
+    fflush(stdout);
+  }
+#endif
+  fprintf(stderr, "viscera-dashboard: %d seat(s) %s/seat%02d..seat%02d on domain %d, %dx%d grid%s%s%s\n", nseats,
+          prefix, first, first + nseats - 1, domain, cols, dash.rows, window ? ", window" : "",
+          pngs ? ", frames to " : "", pngs ? out : "");
   vsignal_on_stop(on_signal, 0);
-  uint64_t t0 = vtime_mono_ns(), next_sample = t0, next_frame = t0 + (uint64_t)interval_ms * 1000000ull;
+  const uint64_t sample_ns = (uint64_t)(1e9 / DASH_SAMPLE_HZ);
+  const uint64_t tick_ns = window ? (uint64_t)(1e9 / refresh_hz) : sample_ns;
+  uint64_t t0 = vtime_mono_ns(), next_tick = t0, next_sample = t0, last_sample = t0;
+  uint64_t next_frame = t0 + (uint64_t)interval_ms * 1000000ull;
   int frame = 0;
   while (!g_stop) {
     uint64_t now_ns = vtime_mono_ns();
@@ -241,69 +287,94 @@ int main(int argc, char **argv) {
     if (duration > 0 && now >= duration) break;
     for (int i = 0; i < nseats; i++) {
       if (seat_poll(&seats[i], now, &err)) fprintf(stderr, "viscera-dashboard: %s: %s\n", seats[i].partition, err.msg);
-      seat_t *s = &seats[i];
-      double bmin[3], bmax[3];
-      if (!s->have_camera && scene_view_complete(&s->sv) && scene_view_key_bounds(&s->sv, bmin, bmax) == 0 &&
-          camera_frame(&s->cam, bmin, bmax, tw, th) == 0)
-        s->have_camera = 1;
-      seat_sample(s);
+      log_roles(&seats[i]);
     }
-    if (now_ns >= next_frame) {
+    if (now_ns >= next_sample) {
+      /* The history is at DASH_SAMPLE_HZ whatever the refresh rate. */
+      for (int i = 0; i < nseats; i++) seat_sample(&seats[i], (double)(now_ns - last_sample) * 1e-9);
+      last_sample = now_ns;
+      next_sample += sample_ns;
+      if (next_sample <= now_ns) next_sample = now_ns + sample_ns;
+    }
+    dash_update(&dash);
+    int focused = focus_seat ? focus_seat - first : -1;
+#ifdef VISCERA_HAVE_WINDOW
+    if (window) {
+      int q = dash_window_tick(&dw, &dash, &err);
+      if (q < 0) {
+        fprintf(stderr, "viscera-dashboard: --window: %s\n", err.msg);
+        rc = 1;
+        break;
+      }
+      if (q) break;
+      focused = dw.focused;
+    }
+#endif
+    if (pngs && now_ns >= next_frame) {
       next_frame += (uint64_t)interval_ms * 1000000ull;
-      cairo_t *cr = cairo_create(surf);
+      cairo_t *cr = cairo_create(grid);
       cairo_set_source_rgb(cr, 0.07, 0.07, 0.08);
       cairo_paint(cr);
-      cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_BOLD);
+      dash_draw_grid(&dash, cr, 0, 0, &err);
+      cairo_destroy(cr);
+      write_png(grid, out, "dashboard", frame);
+      if (focused >= 0) {
+        /* The window's focused view as shown; headless, the --focus view. */
+        cairo_surface_t *fs = focus;
+#ifdef VISCERA_HAVE_WINDOW
+        if (window) fs = dw.canvas;
+#endif
+        if (!window) {
+          cr = cairo_create(focus);
+          if (dash_draw_focus(&dash, focused, cr, fw, fh, &err))
+            fprintf(stderr, "viscera-dashboard: focus view: %s\n", err.msg);
+          cairo_destroy(cr);
+        }
+        write_png(fs, out, "focus", frame);
+      }
       for (int i = 0; i < nseats; i++) {
         seat_t *s = &seats[i];
-        int x = (i % cols) * tw, y = (i / cols) * (HEADER_H + th + GRAPH_H);
-        if (s->have_camera) {
-          const uint8_t *img = scene_draw(r, &s->cam, &s->sv, 1, &err);
-          if (img) blit(surf, img, tw, th, x, y + HEADER_H);
-        } else {
-          cairo_set_source_rgb(cr, 0.6, 0.6, 0.65);
-          text(cr, x + 12, y + HEADER_H + th / 2.0, 14, s->sv.have_scene ? "waiting for the organs" : "no server");
-        }
-        draw_graph(cr, s, x + 2, y + HEADER_H + th, tw - 4, GRAPH_H - 4);
         float st, mpf, sft, maxf;
         double f = seat_force(s, &st, &mpf, &sft, &maxf);
-        char head[200];
-        snprintf(head, sizeof head, "%.60s  %.64s  %.2f N%s", s->partition, s->sv.have_scene ? s->sv.scene_name : "-", f,
-                 s->client_lost ? "  trainee lost" : "");
-        cairo_set_source_rgb(cr, 0.9, 0.9, 0.92);
-        text(cr, x + 6, y + 15, 12, head);
-        if (s->alert != SEAT_OK) {
-          /* The frame an instructor notices from across the room. */
-          if (s->alert == SEAT_ABOVE_ST)
-            cairo_set_source_rgb(cr, 0.95, 0.6, 0.1);
-          else
-            cairo_set_source_rgb(cr, 0.9, 0.15, 0.15);
-          cairo_set_line_width(cr, 5);
-          cairo_rectangle(cr, x + 2.5, y + 2.5, tw - 5, HEADER_H + th + GRAPH_H - 5);
-          cairo_stroke(cr);
-          char a[32];
-          snprintf(a, sizeof a, "above %s", alert_name(s->alert));
-          text(cr, x + tw - 110, y + HEADER_H + 22, 16, a);
-        }
-        fprintf(csv, "%d,%.3f,%s,%d,%.4f,%.4f,%s,%u,%u,%u,%d\n", frame, now, s->partition, s->sv.have_scene, f, s->peak,
-                alert_name(s->alert), s->crossings[0], s->crossings[1], s->crossings[2], s->client_lost);
+        fprintf(csv, "%d,%.3f,%s,%d,%.4f,%.4f,%s,%u,%u,%u,%d,%d\n", frame, now, s->partition, s->sv.have_scene, f,
+                s->peak, seat_level_name(s->alert), s->crossings[0], s->crossings[1], s->crossings[2], s->client_lost,
+                i == focused);
       }
-      cairo_destroy(cr);
-      char png[1100];
-      snprintf(png, sizeof png, "%s/dashboard_%05d.png", out, frame++);
-      if (cairo_surface_write_to_png(surf, png) != CAIRO_STATUS_SUCCESS)
-        fprintf(stderr, "viscera-dashboard: cannot write %s\n", png);
       fflush(csv);
+      frame++;
     }
-    next_sample += (uint64_t)(1e9 / SAMPLE_HZ);
-    vtime_sleep_until(next_sample);
+    next_tick += tick_ns;
+    if (next_tick <= vtime_mono_ns()) next_tick = vtime_mono_ns() + tick_ns / 4; /* behind: do not spin */
+    vtime_sleep_until(next_tick);
   }
+#ifdef VISCERA_HAVE_WINDOW
+  if (window_open && dw.canvas) {
+    if (pngs) {
+      char path[1100];
+      snprintf(path, sizeof path, "%s/window.png", out);
+      long differ = dash_window_snapshot(&dw, path, &err);
+      if (differ < 0)
+        fprintf(stderr, "viscera-dashboard: %s\n", err.msg);
+      else
+        printf("dashboard: window.png written; %ld of %d window pixels differ from the drawing\n", differ, dw.w * dw.h);
+    }
+    printf("dashboard: window closed after %.1f s, %ld frames shown (%.1f ms each to draw and present), %ld view "
+           "changes\n",
+           (double)(vtime_mono_ns() - t0) * 1e-9, dw.shown, dw.shown ? dw.draw_s * 1e3 / (double)dw.shown : 0.0,
+           dw.changes);
+  }
+#endif
+  (void)window_open;
   fprintf(stderr, "viscera-dashboard: %d frame(s) written\n", frame);
-  cairo_surface_destroy(surf);
-  render_close(r);
 done:
+#ifdef VISCERA_HAVE_WINDOW
+  if (window_open) dash_window_close(&dw);
+#endif
+  if (grid) cairo_surface_destroy(grid);
+  if (focus) cairo_surface_destroy(focus);
+  dash_close(&dash);
   for (int i = 0; i < opened; i++) seat_close(&seats[i]);
-  fclose(csv);
+  if (csv) fclose(csv);
   plot_cleanup(); /* cairo's and fontconfig's process caches (LeakSanitizer) */
   return rc;
 }

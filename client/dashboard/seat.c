@@ -11,7 +11,9 @@ int seat_open(seat_t *s, int domain, const char *partition, verr_t *err) {
   snprintf(s->partition, sizeof s->partition, "%s", partition);
   if (scene_view_open(&s->sv, domain, partition, NULL, NULL, err)) return -1;
   s->rd_event = vdds_reader(&s->sv.dds, VT_SESSION_EVENT, err);
-  if (s->rd_event < 0) {
+  if (s->rd_event >= 0) s->rd_role = vdds_reader(&s->sv.dds, VT_TOOL_ROLE, err);
+  if (s->rd_event >= 0 && s->rd_role >= 0) s->rd_measures = vdds_reader(&s->sv.dds, VT_TOOL_METRICS, err);
+  if (s->rd_event < 0 || s->rd_role < 0 || s->rd_measures < 0) {
     scene_view_close(&s->sv);
     return -1;
   }
@@ -20,7 +22,66 @@ int seat_open(seat_t *s, int domain, const char *partition, verr_t *err) {
 
 void seat_close(seat_t *s) { scene_view_close(&s->sv); }
 
-static void on_event(seat_t *s, const viscera_SessionEvent *e, double now) {
+static void keep_event(seat_t *s, const viscera_SessionEvent *e) {
+  if (!seat_event_label((int)e->kind)) return;
+  seat_event_t *k = &s->events[s->nevents++ % SEAT_EVENTS];
+  k->sim_s = (double)e->sim_time_ns * 1e-9;
+  k->kind = (int)e->kind;
+  seat_text_clean(k->text, sizeof k->text, e->text);
+}
+
+const seat_event_t *seat_event(const seat_t *s, unsigned k) {
+  uint64_t kept = s->nevents < SEAT_EVENTS ? s->nevents : SEAT_EVENTS;
+  return k < kept ? &s->events[(s->nevents - 1 - k) % SEAT_EVENTS] : NULL;
+}
+
+/* Sample handlers: x is the reader's sample type. */
+static void on_role(seat_t *s, const void *x, double now) {
+  const viscera_ToolRole *r = x;
+  (void)now;
+  if (r->tool_id >= SCENE_VIEW_MAX_TOOLS || !isfinite(r->authority) || r->authority < 0 || r->authority > 1) {
+    s->rejected++;
+    return;
+  }
+  seat_role_t *d = &s->roles[r->tool_id];
+  seat_role_t nr = {.have = 1, .changed = 1, .authority = r->authority};
+  snprintf(nr.owner, sizeof nr.owner, "%s", r->owner);
+  snprintf(nr.guide, sizeof nr.guide, "%s", r->guide);
+  if (!d->have || strcmp(d->owner, nr.owner) || strcmp(d->guide, nr.guide) || d->authority != nr.authority) *d = nr;
+}
+
+static void on_measures(seat_t *s, const void *x, double now) {
+  const viscera_ToolMetrics *m = x;
+  (void)now;
+  const double v[4] = {m->peak_force, m->time_above_st, m->time_above_mpf, m->time_above_sft};
+  int ok = m->tool_id < SCENE_VIEW_MAX_TOOLS;
+  for (int i = 0; i < 4 && ok; i++) ok = isfinite(v[i]) && v[i] >= 0;
+  if (!ok) {
+    s->rejected++;
+    return;
+  }
+  seat_tool_measures_t *d = &s->measures[m->tool_id];
+  d->have = 1;
+  d->peak = v[0];
+  for (int i = 0; i < 3; i++) d->above[i] = v[i + 1];
+}
+
+/* Takes every sample of reader rd and hands each valid one to fn. */
+static void take_all(seat_t *s, dds_entity_t rd, void (*fn)(seat_t *, const void *, double), double now) {
+  for (;;) {
+    void *samples[16] = {0};
+    dds_sample_info_t infos[16];
+    int n = dds_take(rd, samples, infos, 16, 16);
+    if (n <= 0) break;
+    for (int i = 0; i < n; i++)
+      if (infos[i].valid_data) fn(s, samples[i], now);
+    dds_return_loan(rd, samples, n);
+  }
+}
+
+static void on_event(seat_t *s, const void *x, double now) {
+  const viscera_SessionEvent *e = x;
+  keep_event(s, e);
   switch (e->kind) {
   case viscera_EVENT_THRESHOLD_CROSSED_UP: {
     /* Which level: the event's text starts with its name (server.c). */
@@ -47,21 +108,28 @@ static void on_event(seat_t *s, const viscera_SessionEvent *e, double now) {
 
 int seat_poll(seat_t *s, double now, verr_t *err) {
   if (scene_view_poll(&s->sv, err) < 0) return -1;
-  for (;;) {
-    void *samples[16] = {0};
-    dds_sample_info_t infos[16];
-    int n = dds_take(s->rd_event, samples, infos, 16, 16);
-    if (n <= 0) break;
-    for (int i = 0; i < n; i++)
-      if (infos[i].valid_data) on_event(s, samples[i], now);
-    dds_return_loan(s->rd_event, samples, n);
-  }
+  take_all(s, s->rd_event, on_event, now);
+  take_all(s, s->rd_role, on_role, now);
+  take_all(s, s->rd_measures, on_measures, now);
   if (now > s->alert_until) s->alert = SEAT_OK;
+  /* A trainee still pressing above a threshold stays alerted after the
+   * crossing's hold runs out. */
+  float st, mpf, sft, mf;
+  double f = seat_force(s, &st, &mpf, &sft, &mf); /* before reading the thresholds it sets */
+  seat_alert_t cur = seat_level_of(f, st, mpf, sft);
+  if (cur > s->alert) s->alert = cur;
   return 0;
 }
 
-double seat_force(const seat_t *s, float *st, float *mpf, float *sft, float *max_force) {
+int seat_tool(const seat_t *s) {
   int p = scene_view_primary_tool(&s->sv);
+  for (int i = 0; p < 0 && i < SCENE_VIEW_MAX_TOOLS; i++)
+    if (s->sv.tools[i].listed) p = i;
+  return p;
+}
+
+double seat_force(const seat_t *s, float *st, float *mpf, float *sft, float *max_force) {
+  int p = seat_tool(s);
   *st = *mpf = *sft = 0;
   *max_force = SCENE_VIEW_TOOL_MAX_FORCE;
   if (p < 0) return 0;
@@ -73,9 +141,12 @@ double seat_force(const seat_t *s, float *st, float *mpf, float *sft, float *max
   return isfinite(f) ? f : 0;
 }
 
-void seat_sample(seat_t *s) {
+void seat_sample(seat_t *s, double dt) {
   float st, mpf, sft, mf;
   double f = seat_force(s, &st, &mpf, &sft, &mf);
   s->history[s->nhist++ % SEAT_HISTORY] = (float)f;
   if (f > s->peak) s->peak = (float)f;
+  seat_alert_t lv = seat_level_of(f, st, mpf, sft);
+  if (dt > 0 && dt < 1.0)
+    for (int k = 0; k < (int)lv; k++) s->above_seen[k] += dt;
 }

@@ -1,9 +1,14 @@
 /* seat: what the dashboard follows of one seat: the scene (scene_view.h:
  * organs, tools, contact force), the seat's SessionEvents (threshold
- * crossings, lost clients) and a short history of the trainee's force.
+ * crossings, lost clients, instructor commands; the last SEAT_EVENTS kept
+ * for the focus view), who drives each tool (ToolRole), the server's
+ * per-tool measures (ToolMetrics: peak, time above each threshold) and a
+ * short history of the trainee's force.
  *
  * Every sample is untrusted (scene_view validates meshes and tools; events
- * are only counted and their levels checked). Not thread-safe. */
+ * are counted, their levels checked and their text cleaned; roles and
+ * measures with an out-of-range tool or a non-finite number are dropped and
+ * counted in `rejected`). Not thread-safe. */
 #ifndef VISCERA_DASHBOARD_SEAT_H
 #define VISCERA_DASHBOARD_SEAT_H
 
@@ -11,34 +16,70 @@
 
 #include "camera.h"
 #include "scene_view.h"
+#include "seat_text.h"
 
 #define SEAT_HISTORY 600      /* force samples kept (60 s at 10 Hz) */
 #define SEAT_ALERT_HOLD_S 3.0 /* an alert stays up this long after its crossing */
+#define SEAT_EVENTS 8         /* events kept for the focus view */
 
-typedef enum seat_alert { SEAT_OK, SEAT_ABOVE_ST, SEAT_ABOVE_MPF, SEAT_ABOVE_SFT } seat_alert_t;
+/* One SessionEvent as the focus view lists it. */
+typedef struct seat_event {
+  double sim_s; /* the server's simulated time */
+  int kind;     /* viscera_EventKind */
+  char text[160];
+} seat_event_t;
+
+/* A tool's ToolRole (idl). */
+typedef struct seat_role {
+  int have;
+  int changed; /* set when a sample changes it; the caller clears it */
+  char owner[33], guide[33];
+  float authority;
+} seat_role_t;
+
+/* A tool's ToolMetrics, the measures the dashboard shows. */
+typedef struct seat_tool_measures {
+  int have;
+  double peak;     /* N */
+  double above[3]; /* s above ST, MPF, SFT */
+} seat_tool_measures_t;
 
 typedef struct seat {
   char partition[128];
   scene_view_t sv;
-  dds_entity_t rd_event;
+  dds_entity_t rd_event, rd_role, rd_measures;
   int have_camera;
   camera_t cam;
   float history[SEAT_HISTORY]; /* N, newest at (nhist - 1) % SEAT_HISTORY */
   uint64_t nhist;
-  float peak;            /* N since the dashboard started */
-  seat_alert_t alert;    /* highest level crossed up within SEAT_ALERT_HOLD_S */
-  double alert_until;    /* dashboard time (s) the alert shows until */
-  uint32_t crossings[3]; /* upward crossings seen: ST, MPF, SFT */
-  int client_lost;       /* a CLIENT_LOST event since the last contact */
+  float peak;                       /* N since the dashboard started */
+  seat_alert_t alert;               /* highest level crossed up within SEAT_ALERT_HOLD_S, or the force's level now */
+  double alert_until;               /* dashboard time (s) the alert shows until */
+  uint32_t crossings[3];            /* upward crossings seen: ST, MPF, SFT */
+  int client_lost;                  /* a CLIENT_LOST event since the last contact */
+  seat_event_t events[SEAT_EVENTS]; /* newest at (nevents - 1) % SEAT_EVENTS */
+  uint64_t nevents;
+  seat_role_t roles[SCENE_VIEW_MAX_TOOLS];
+  seat_tool_measures_t measures[SCENE_VIEW_MAX_TOOLS];
+  double above_seen[3]; /* s above ST, MPF, SFT in this dashboard's samples */
+  unsigned long rejected;
 } seat_t;
 
 int seat_open(seat_t *s, int domain, const char *partition, verr_t *err);
 void seat_close(seat_t *s);
 /* Takes what arrived; `now` is the dashboard's clock in s. */
 int seat_poll(seat_t *s, double now, verr_t *err);
-/* Records the primary tool's force (N) into the history. */
-void seat_sample(seat_t *s);
-/* The primary tool's current force (N) and thresholds; 0 when none. */
+/* Records the primary tool's force (N) into the history; dt (s) since the
+ * previous sample counts towards the time above each threshold reached. */
+void seat_sample(seat_t *s, double dt);
+/* The tool the dashboard follows: the viewer's primary tool (the lowest
+ * id with a pose or contact), else the first tool of the scene, so its
+ * thresholds and role stay on show while no client drives it; -1 when the
+ * scene has none. */
+int seat_tool(const seat_t *s);
+/* That tool's current force (N, 0 out of contact) and thresholds; 0 when none. */
 double seat_force(const seat_t *s, float *st, float *mpf, float *sft, float *max_force);
+/* The k-th newest kept event (k = 0 newest), or NULL. */
+const seat_event_t *seat_event(const seat_t *s, unsigned k);
 
 #endif

@@ -39,13 +39,28 @@ typedef enum input_kind {
   INPUT_BUTTON_UP
 } input_kind_t;
 
-typedef enum input_key { INPUT_KEY_W, INPUT_KEY_S, INPUT_KEY_SPACE, INPUT_KEY_R, INPUT_KEY_OTHER } input_key_t;
+/* Q, Tab, Escape and the digits are not mapped to the tool: they are here
+ * so scripts (input_script.h) can drive the dashboard window's keys too. */
+typedef enum input_key {
+  INPUT_KEY_W,
+  INPUT_KEY_S,
+  INPUT_KEY_SPACE,
+  INPUT_KEY_R,
+  INPUT_KEY_Q,
+  INPUT_KEY_TAB,
+  INPUT_KEY_ESCAPE,
+  INPUT_KEY_1, /* INPUT_KEY_1 + k - 1 is digit k, 1..9 */
+  INPUT_KEY_9 = INPUT_KEY_1 + 8,
+  INPUT_KEY_OTHER
+} input_key_t;
 
 typedef struct input_event {
   input_kind_t kind;
   double dx, dy; /* INPUT_MOTION */
   int n;         /* INPUT_WHEEL */
   input_key_t key;
+  int at;      /* INPUT_BUTTON_*: x, y give the pointer position */
+  double x, y; /* window pixels from the top-left corner */
 } input_event_t;
 
 typedef struct input_state {

@@ -10,7 +10,12 @@ static int parse_key(const char *w, input_key_t *k) {
   static const struct {
     const char *name;
     input_key_t key;
-  } KEYS[] = {{"w", INPUT_KEY_W}, {"s", INPUT_KEY_S}, {"r", INPUT_KEY_R}, {"space", INPUT_KEY_SPACE}};
+  } KEYS[] = {{"w", INPUT_KEY_W}, {"s", INPUT_KEY_S},     {"r", INPUT_KEY_R},          {"space", INPUT_KEY_SPACE},
+              {"q", INPUT_KEY_Q}, {"tab", INPUT_KEY_TAB}, {"escape", INPUT_KEY_ESCAPE}};
+  if (w[0] >= '1' && w[0] <= '9' && w[1] == 0) {
+    *k = (input_key_t)(INPUT_KEY_1 + (w[0] - '1'));
+    return 0;
+  }
   for (size_t i = 0; i < sizeof KEYS / sizeof KEYS[0]; i++)
     if (strcmp(w, KEYS[i].name) == 0) {
       *k = KEYS[i].key;
@@ -60,10 +65,16 @@ static int parse_line(char *line, const char *path, int lineno, input_script_eve
     e->ev.kind = kind[4] == 'd' ? INPUT_KEY_DOWN : INPUT_KEY_UP;
     want = 3;
     if (nw == 3 && parse_key(w[2], &e->ev.key))
-      return verr_set(err, "%s:%d: %s: unknown key '%s' (expected w, s, r or space)", path, lineno, kind, w[2]);
+      return verr_set(err, "%s:%d: %s: unknown key '%s' (expected w, s, r, space, q, tab, escape or 1..9)", path,
+                      lineno, kind, w[2]);
   } else if (strcmp(kind, "button_down") == 0 || strcmp(kind, "button_up") == 0) {
     e->ev.kind = kind[7] == 'd' ? INPUT_BUTTON_DOWN : INPUT_BUTTON_UP;
-    want = 2;
+    want = nw == 4 ? 4 : 2;
+    if (nw == 4) {
+      if (parse_num(w[2], 1e4, &e->ev.x) || parse_num(w[3], 1e4, &e->ev.y) || e->ev.x < 0 || e->ev.y < 0)
+        return verr_set(err, "%s:%d: %s: expected X Y in window pixels, 0..10000", path, lineno, kind);
+      e->ev.at = 1;
+    }
   } else {
     return verr_set(err, "%s:%d: unknown event '%s' (expected motion, wheel, key_down, key_up, button_down, button_up)",
                     path, lineno, kind);

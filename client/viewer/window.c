@@ -15,6 +15,7 @@
 #include "render.h"
 #include "scene_draw.h"
 #include "scene_view.h"
+#include "sdl_window.h"
 #include "vtime.h"
 
 #define SUPERSAMPLE 2
@@ -28,13 +29,11 @@
 
 typedef struct win {
   const viewer_opts_t *o;
-  SDL_Window *window;
-  SDL_Renderer *sdl;
-  SDL_Texture *tex;
+  sdl_window_t sw;
   uint8_t *flip; /* one frame top-down for the texture */
   render_t *r;
   scene_view_t sv;
-  int sv_open, sdl_inited;
+  int sv_open, window_opened;
   camera_t cam;
   int have_cam;
   input_state_t in;
@@ -64,56 +63,6 @@ static input_key_t map_key(SDL_Keycode k) {
   default:
     return INPUT_KEY_OTHER;
   }
-}
-
-static SDL_Keycode sdl_key(input_key_t k) {
-  switch (k) {
-  case INPUT_KEY_W:
-    return SDLK_w;
-  case INPUT_KEY_S:
-    return SDLK_s;
-  case INPUT_KEY_R:
-    return SDLK_r;
-  case INPUT_KEY_SPACE:
-    return SDLK_SPACE;
-  default:
-    return SDLK_UNKNOWN;
-  }
-}
-
-/* A scripted event as the SDL event a user would have produced. */
-static void push_scripted(const input_event_t *e, Uint32 window_id) {
-  SDL_Event ev;
-  memset(&ev, 0, sizeof ev);
-  switch (e->kind) {
-  case INPUT_MOTION:
-    ev.type = SDL_MOUSEMOTION;
-    ev.motion.windowID = window_id;
-    ev.motion.xrel = (Sint32)lround(e->dx);
-    ev.motion.yrel = (Sint32)lround(e->dy);
-    break;
-  case INPUT_WHEEL:
-    ev.type = SDL_MOUSEWHEEL;
-    ev.wheel.windowID = window_id;
-    ev.wheel.y = e->n;
-    ev.wheel.direction = SDL_MOUSEWHEEL_NORMAL;
-    break;
-  case INPUT_KEY_DOWN:
-  case INPUT_KEY_UP:
-    ev.type = e->kind == INPUT_KEY_DOWN ? SDL_KEYDOWN : SDL_KEYUP;
-    ev.key.windowID = window_id;
-    ev.key.state = e->kind == INPUT_KEY_DOWN ? SDL_PRESSED : SDL_RELEASED;
-    ev.key.keysym.sym = sdl_key(e->key);
-    break;
-  case INPUT_BUTTON_DOWN:
-  case INPUT_BUTTON_UP:
-    ev.type = e->kind == INPUT_BUTTON_DOWN ? SDL_MOUSEBUTTONDOWN : SDL_MOUSEBUTTONUP;
-    ev.button.windowID = window_id;
-    ev.button.button = SDL_BUTTON_LEFT;
-    ev.button.state = e->kind == INPUT_BUTTON_DOWN ? SDL_PRESSED : SDL_RELEASED;
-    break;
-  }
-  SDL_PushEvent(&ev);
 }
 
 /* Handles one SDL event; returns 1 when the user asked to quit. */
@@ -153,33 +102,14 @@ static int handle_event(win_t *w, const SDL_Event *ev, int driving) {
 }
 
 static int open_window(win_t *w) {
-  /* The frame is ready-made pixels: SDL's software renderer presents it on
-   * any X server (Xvfb included) without pulling a second GL into the
-   * process (see window.h); SDL_RENDER_DRIVER still overrides. */
-  SDL_SetHint(SDL_HINT_RENDER_DRIVER, "software");
-  /* Left to itself SDL backs the software window surface with an OpenGL
-   * renderer; with OSMesa's GL symbols in the process that crashed inside
-   * Mesa's GLX driver (seen under Xvfb). The X11 framebuffer (XShm) path
-   * needs no GL. */
-  SDL_SetHint(SDL_HINT_FRAMEBUFFER_ACCELERATION, "0");
-  if (SDL_Init(SDL_INIT_VIDEO) != 0) {
-    fprintf(stderr,
-            "viscera-viewer: --window: cannot open a display: %s (is DISPLAY set? the offscreen mode "
-            "needs none)\n",
-            SDL_GetError());
-    SDL_Quit();
+  verr_t err = {{0}};
+  w->flip = malloc((size_t)w->o->width * (size_t)w->o->height * 3);
+  if (!w->flip) {
+    fprintf(stderr, "viscera-viewer: --window: out of memory\n");
     return -1;
   }
-  w->sdl_inited = 1;
-  w->window = SDL_CreateWindow("viscera", SDL_WINDOWPOS_UNDEFINED, SDL_WINDOWPOS_UNDEFINED, w->o->width, w->o->height,
-                               SDL_WINDOW_SHOWN);
-  if (w->window) w->sdl = SDL_CreateRenderer(w->window, -1, 0);
-  if (w->sdl)
-    w->tex = SDL_CreateTexture(w->sdl, SDL_PIXELFORMAT_RGB24, SDL_TEXTUREACCESS_STREAMING, w->o->width, w->o->height);
-  w->flip = malloc((size_t)w->o->width * (size_t)w->o->height * 3);
-  if (!w->window || !w->sdl || !w->tex || !w->flip) {
-    fprintf(stderr, "viscera-viewer: --window: cannot create the window: %s\n",
-            w->flip ? SDL_GetError() : "out of memory");
+  if (sdl_window_open(&w->sw, "viscera", w->o->width, w->o->height, 0, &err)) {
+    fprintf(stderr, "viscera-viewer: --window: %s\n", err.msg);
     return -1;
   }
   return 0;
@@ -187,10 +117,7 @@ static int open_window(win_t *w) {
 
 static void close_window(win_t *w) {
   free(w->flip);
-  if (w->tex) SDL_DestroyTexture(w->tex);
-  if (w->sdl) SDL_DestroyRenderer(w->sdl);
-  if (w->window) SDL_DestroyWindow(w->window);
-  SDL_Quit();
+  sdl_window_close(&w->sw);
 }
 
 static int present(win_t *w, const uint8_t *img) {
@@ -198,12 +125,11 @@ static int present(win_t *w, const uint8_t *img) {
   size_t row = (size_t)w->o->width * 3;
   for (int y = 0; y < w->o->height; y++)
     memcpy(w->flip + (size_t)y * row, img + (size_t)(w->o->height - 1 - y) * row, row);
-  if (SDL_UpdateTexture(w->tex, NULL, w->flip, (int)row) != 0 || SDL_RenderClear(w->sdl) != 0 ||
-      SDL_RenderCopy(w->sdl, w->tex, NULL, NULL) != 0) {
-    fprintf(stderr, "viscera-viewer: --window: %s\n", SDL_GetError());
+  verr_t err = {{0}};
+  if (sdl_window_present(&w->sw, SDL_PIXELFORMAT_RGB24, w->flip, w->o->width, w->o->height, (int)row, &err)) {
+    fprintf(stderr, "viscera-viewer: --window: %s\n", err.msg);
     return -1;
   }
-  SDL_RenderPresent(w->sdl);
   return 0;
 }
 
@@ -217,8 +143,7 @@ static long window_snapshot(win_t *w, verr_t *err) {
   size_t row = (size_t)wd * 3;
   uint8_t *back = malloc(row * (size_t)ht);
   if (!back) return verr_set(err, "out of memory"), -1L;
-  if (SDL_RenderReadPixels(w->sdl, NULL, SDL_PIXELFORMAT_RGB24, back, (int)row) != 0) {
-    verr_set(err, "window read-back: %s", SDL_GetError());
+  if (sdl_window_read_back(&w->sw, SDL_PIXELFORMAT_RGB24, back, (int)row, err)) {
     free(back);
     return -1;
   }
@@ -256,7 +181,7 @@ static void update_title(win_t *w, int driving) {
              w->in.buttons & 1 ? " [button]" : "", f);
   else
     snprintf(title, sizeof title, "viscera %s - force %.2f N", w->sv.have_scene ? w->sv.scene_name : "", f);
-  SDL_SetWindowTitle(w->window, title);
+  SDL_SetWindowTitle(w->sw.window, title);
 }
 
 static int run(win_t *w, volatile sig_atomic_t *stop) {
@@ -269,7 +194,6 @@ static int run(win_t *w, volatile sig_atomic_t *stop) {
   uint64_t first_key_ns = 0, cam_ns = 0, last_ns = t0, next_png = 0, next_title = 0;
   long presented = 0;
   const uint8_t *last_img = NULL;
-  Uint32 window_id = SDL_GetWindowID(w->window);
   while (!*stop) {
     uint64_t now = vtime_mono_ns();
     if (duration_ns && now - t0 >= duration_ns) break;
@@ -302,7 +226,7 @@ static int run(win_t *w, volatile sig_atomic_t *stop) {
     /* Scripted input becomes SDL events, timed from the camera fix. */
     if (w->have_cam && w->script.n) {
       const input_script_event_t *se;
-      while ((se = input_script_due(&w->script, (double)(now - cam_ns) * 1e-9))) push_scripted(&se->ev, window_id);
+      while ((se = input_script_due(&w->script, (double)(now - cam_ns) * 1e-9))) sdl_window_push_input(&w->sw, &se->ev);
     }
     SDL_Event ev;
     while (SDL_PollEvent(&ev))
@@ -396,11 +320,12 @@ int window_main(const viewer_opts_t *o, volatile sig_atomic_t *stop) {
     fprintf(stderr, "viscera-viewer: --drive: %s\n", err.msg);
     goto out;
   }
+  w.window_opened = 1;
   if (open_window(&w)) goto out;
   status = run(&w, stop);
 out:
   input_drive_stop(&w.drive);
-  if (w.sdl_inited) close_window(&w);
+  if (w.window_opened) close_window(&w);
   if (w.sv_open) scene_view_close(&w.sv);
   if (w.r) render_close(w.r);
   if (w.fl_open && frame_log_close(&w.fl, &err)) {

@@ -153,13 +153,46 @@ static void test_script(void) {
   CHECK(input_script_due(&sc, 1.0) == NULL);
   input_script_free(&sc);
 
+  /* The dashboard window's keys and clicks at a place. */
+  p = test_write_tmp("dash.input", "0 key_down 1\n0 key_up 9\n1 key_down tab\n1 key_down escape\n1 key_down q\n"
+                                   "2 button_down 512 340\n2 button_up 512.5 0\n3 button_down\n");
+  CHECK(input_script_load(p, &sc, &err) == 0);
+  CHECK(sc.n == 8);
+  if (sc.n == 8) {
+    CHECK(sc.ev[0].ev.kind == INPUT_KEY_DOWN && sc.ev[0].ev.key == INPUT_KEY_1);
+    CHECK(sc.ev[1].ev.kind == INPUT_KEY_UP && sc.ev[1].ev.key == INPUT_KEY_9);
+    CHECK(sc.ev[2].ev.key == INPUT_KEY_TAB && sc.ev[3].ev.key == INPUT_KEY_ESCAPE && sc.ev[4].ev.key == INPUT_KEY_Q);
+    CHECK(sc.ev[5].ev.kind == INPUT_BUTTON_DOWN && sc.ev[5].ev.at && sc.ev[5].ev.x == 512 && sc.ev[5].ev.y == 340);
+    CHECK(sc.ev[6].ev.kind == INPUT_BUTTON_UP && sc.ev[6].ev.at && sc.ev[6].ev.x == 512.5 && sc.ev[6].ev.y == 0);
+    CHECK(sc.ev[7].ev.kind == INPUT_BUTTON_DOWN && !sc.ev[7].ev.at);
+  }
+  input_script_free(&sc);
+  /* The digits, Tab, Escape and Q do not move or press the tool. */
+  double bmin[3] = {-0.05, -0.03, 0.0}, bmax[3] = {0.05, 0.03, 0.04};
+  camera_t cam;
+  input_state_t ks;
+  CHECK(camera_frame(&cam, bmin, bmax, 640, 480) == 0);
+  CHECK(input_map_init(&ks, &cam, bmin, bmax) == 0);
+  double home[3] = {ks.pos[0], ks.pos[1], ks.pos[2]};
+  const input_key_t other[] = {INPUT_KEY_1, INPUT_KEY_9, INPUT_KEY_TAB, INPUT_KEY_ESCAPE, INPUT_KEY_Q};
+  for (size_t i = 0; i < sizeof other / sizeof other[0]; i++) {
+    input_event_t e = {.kind = INPUT_KEY_DOWN, .key = other[i]};
+    input_map_apply(&ks, &e);
+  }
+  input_map_advance(&ks, 0.1);
+  CHECK(ks.pos[0] == home[0] && ks.pos[1] == home[1] && ks.pos[2] == home[2] && ks.buttons == 0);
+
   static const struct {
     const char *text, *expect;
   } BAD[] = {
       {"0 motion 1\n", ":1: motion takes 2 value(s), got 1"},
       {"0 motion 1 nan\n", ":1: motion: expected DX DY"},
       {"0 wheel 1.5\n", ":1: wheel: expected an integer"},
-      {"0 key_down q\n", ":1: key_down: unknown key 'q'"},
+      {"0 key_down x\n", ":1: key_down: unknown key 'x'"},
+      {"0 key_down 0\n", ":1: key_down: unknown key '0'"},
+      {"0 key_down 12\n", ":1: key_down: unknown key '12'"},
+      {"0 button_down 10 -1\n", ":1: button_down: expected X Y in window pixels"},
+      {"0 button_up 10 20000\n", ":1: button_up: expected X Y in window pixels"},
       {"0 jump\n", ":1: unknown event 'jump'"},
       {"1 wheel 1\n0.5 wheel 1\n", ":2: time 0.5 is before the previous event's 1"},
       {"-1 wheel 1\n", ":1: time '-1'"},
