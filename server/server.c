@@ -271,6 +271,13 @@ static int rebuild_runtime(server_t *s, const scene_t *sc, const scene_t *old, v
   return rc;
 }
 
+/* An instructor's START_TASK (session_control.h): the task (re)starts now,
+ * reported as a TASK_STARTED whose text carries the station tag. */
+static void start_task(server_t *s, int k, const char *text) {
+  tasks_start(&s->rt.tasks[k], s->rt.sim_time);
+  publish_event(s, viscera_EVENT_TASK_STARTED, -1, s->rt.scene.tasks[k].tool, 1, text);
+}
+
 /* Applies pending instructor commands (session_control.h); each outcome is
  * logged and published, so the recording shows who changed what and when. */
 static int read_controls(server_t *s) {
@@ -319,6 +326,10 @@ static int read_controls(server_t *s) {
           size_t len = strlen(text);
           snprintf(text + len, sizeof text - len, "; refused by the models: %.200s (scene unchanged, restarted)", e.msg);
         }
+      }
+      if (r == SESSION_CONTROL_START_TASK) {
+        r = 0;
+        start_task(s, s->control.start_task, text);
       }
       free(edit);
       free(old);

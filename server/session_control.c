@@ -69,6 +69,23 @@ static const char *edit_material(scene_material_t *m, const double v[4]) {
   return NULL;
 }
 
+/* The task a START_TASK names: by name in `text`, or by index values[0]
+ * when text is "". Returns NULL with *idx set, or why not. */
+static const char *find_task(const viscera_SessionControl *c, const scene_t *scene, int *idx) {
+  if (c->text[0]) {
+    for (size_t i = 0; i < scene->ntasks; i++)
+      if (!strcmp(scene->tasks[i].name, c->text)) {
+        *idx = (int)i;
+        return NULL;
+      }
+    return "no task of that name in the scene";
+  }
+  double v = c->values[0];
+  if (!isfinite(v) || v != floor(v) || v < 0 || v >= (double)scene->ntasks) return "task index out of range";
+  *idx = (int)v;
+  return NULL;
+}
+
 int session_control_apply(session_control_t *sc, const viscera_SessionControl *c, thr_tracker_t *thr, size_t ntools,
                           const double *tool_max_force, scene_t *scene, char *text, size_t n) {
   switch (c->kind) {
@@ -119,9 +136,19 @@ int session_control_apply(session_control_t *sc, const viscera_SessionControl *c
     tag(c, text, n);
     return SESSION_CONTROL_REBUILD;
   }
+  case viscera_CONTROL_START_TASK: {
+    int k = -1;
+    const char *bad = find_task(c, scene, &k);
+    if (bad) return refuse(sc, c, text, n, bad);
+    sc->start_task = k;
+    sc->applied++;
+    snprintf(text, n, "task '%s' started by the instructor (tool '%s')", scene->tasks[k].name,
+             scene->tools[scene->tasks[k].tool].name);
+    tag(c, text, n);
+    return SESSION_CONTROL_START_TASK;
+  }
   case viscera_CONTROL_ASSIGN_TOOL:
   case viscera_CONTROL_GUIDE:
-  case viscera_CONTROL_START_TASK:
     break; /* being built (issue 7): refused as unknown until then */
   }
   return refuse(sc, c, text, n, "unknown command kind");

@@ -24,6 +24,8 @@ static void usage(FILE *f) {
              "  reset                 restart the scene from rest (organs, tools, measures, tasks)\n"
              "  material O K C H M    organ O's stiffness K (N/m), damping C (N s/m), home stiffness H\n"
              "                        (N/m), mass M (kg); -1 keeps a value; the organ restarts from rest\n"
+             "  start-task NAME|INDEX start (or restart) a task now, by its scene name or index;\n"
+             "                        a restart replaces the earlier run (clock from now)\n"
              "  --domain N            DDS domain id (default: $VISCERA_DOMAIN or 0)\n"
              "  --partition P         the seat's partition (default: " VDDS_DEFAULT_PARTITION ")\n"
              "  --station ID          this instructor station's id (default 1)\n"
@@ -138,6 +140,24 @@ int main(int argc, char **argv) {
         fprintf(stderr, "viscera-control: thresholds: not a force in N: '%s'\n", argv[optind + 2 + k]);
         return 2;
       }
+  } else if (verb && strcmp(verb, "start-task") == 0 && argc - optind == 2) {
+    /* A name goes in `text` (so --text is not used); all digits is an index. */
+    cmd.kind = viscera_CONTROL_START_TASK;
+    const char *arg = argv[optind + 1];
+    if (*arg && strspn(arg, "0123456789") == strlen(arg)) {
+      if (strlen(arg) > 4) {
+        fprintf(stderr, "viscera-control: start-task: task index too large: '%s'\n", arg);
+        return 2;
+      }
+      cmd.text[0] = 0;
+      cmd.values[0] = atof(arg);
+    } else {
+      if (!*arg || strlen(arg) >= sizeof cmd.text) {
+        fprintf(stderr, "viscera-control: start-task: not a task name: '%s'\n", arg);
+        return 2;
+      }
+      snprintf(cmd.text, sizeof cmd.text, "%s", arg);
+    }
   } else {
     usage(stderr);
     return 2;
