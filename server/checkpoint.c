@@ -19,13 +19,29 @@
  * file fails the length and CRC checks. */
 typedef state_blob_t buf_t;
 
-static uint32_t crc32(const unsigned char *p, size_t n) {
-  uint32_t c = 0xffffffffu;
-  for (size_t i = 0; i < n; i++) {
-    c ^= p[i];
+/* CRC-32 (IEEE), a byte at a time from a table built on first use: a
+ * cut organ's checkpoint is some 300 kB, 8 x faster than bit by bit. The
+ * table is built before any thread runs (checkpoint_load or
+ * checkpointer_start, from the server's main thread). */
+static uint32_t crc_table[256];
+static void crc_init(void) {
+  if (crc_table[1]) return;
+  for (uint32_t i = 0; i < 256; i++) {
+    uint32_t c = i;
     for (int k = 0; k < 8; k++) c = (c >> 1) ^ (0xedb88320u & (0u - (c & 1u)));
+    crc_table[i] = c;
   }
+}
+static uint32_t crc32(const unsigned char *p, size_t n) {
+  crc_init();
+  uint32_t c = 0xffffffffu;
+  for (size_t i = 0; i < n; i++) c = crc_table[(c ^ p[i]) & 0xffu] ^ (c >> 8);
   return ~c;
+}
+/* Appends the CRC of everything in b. */
+static void seal(buf_t *b) {
+  uint64_t crc = b->bad ? 0 : crc32(b->p, b->len);
+  sb_put_u64(b, crc);
 }
 
 static void put_tracker(buf_t *b, const thr_tracker_t *t) {
@@ -47,7 +63,8 @@ static void put_tracker(buf_t *b, const thr_tracker_t *t) {
  *   ntools, per tool: tracker measures, tally (grasps, grasp_time)
  *   ntasks, per task: started completed t_start t_end
  *   nstones, per stone: pos[3] held_by removed
- *   crc32 (as u64) of everything before it. */
+ *   crc32 (as u64) of everything before it (seal(): the checkpointer's
+ *   writer thread computes it, not the physics loop). */
 static int serialise(buf_t *b, const runtime_t *rt, const thr_tracker_t *thr, const tool_tally_t *tally, verr_t *err) {
   b->len = 0;
   b->bad = 0;
@@ -100,8 +117,6 @@ static int serialise(buf_t *b, const runtime_t *rt, const thr_tracker_t *thr, co
     sb_put_u64(b, (uint64_t)(int64_t)st->held_by);
     sb_put_u64(b, (uint64_t)st->removed);
   }
-  uint64_t crc = b->bad ? 0 : crc32(b->p, b->len);
-  sb_put_u64(b, crc);
   return b->bad ? verr_set(err, "checkpoint: out of memory") : 0;
 }
 
@@ -132,7 +147,12 @@ static int write_atomic(const char *path, const unsigned char *p, size_t len, ve
 int checkpoint_save(const char *path, const runtime_t *rt, const thr_tracker_t *thr, const tool_tally_t *tally,
                     verr_t *err) {
   buf_t b = {0};
-  if (serialise(&b, rt, thr, tally, err)) {
+  int bad = serialise(&b, rt, thr, tally, err);
+  if (!bad) {
+    seal(&b);
+    if (b.bad) bad = verr_set(err, "checkpoint: out of memory");
+  }
+  if (bad) {
     free(b.p);
     return -1;
   }
@@ -169,7 +189,9 @@ static void *writer_main(void *arg) {
     c->have_pending = 0;
     pthread_mutex_unlock(&c->lock);
     verr_t err;
-    int rc = write_atomic(c->path, c->writing.p, c->writing.len, &err);
+    seal(&c->writing);
+    int rc = c->writing.bad ? verr_set(&err, "checkpoint: out of memory")
+                            : write_atomic(c->path, c->writing.p, c->writing.len, &err);
     pthread_mutex_lock(&c->lock);
     if (rc) {
       c->failed++;
@@ -183,6 +205,7 @@ static void *writer_main(void *arg) {
 }
 
 checkpointer_t *checkpointer_start(const char *path, verr_t *err) {
+  crc_init(); /* before the writer thread exists (see crc32) */
   checkpointer_t *c = calloc(1, sizeof *c);
   if (!c) return verr_set(err, "checkpoint: out of memory"), NULL;
   if (strlen(path) >= sizeof c->path) {
