@@ -139,7 +139,10 @@ static void test_objects_tasks_tallies(void) {
   printf("objects: s1 removed at z %.4f, s2 held at z %.4f restored dropped; out1 %.3f s; %u grasps, %.3f s held\n",
          b.stones[0].pos[2], b.stones[1].pos[2], b.tasks[0].t_end - b.tasks[0].t_start, lb[0].grasps, lb[0].grasp_time);
 
-  /* Crafted task and object states behind a valid CRC: refused, b at rest. */
+  /* Crafted task and object states behind a valid CRC: refused, a fresh b
+   * at rest and left so. */
+  runtime_destroy(&b);
+  CHECK(load(&b, KIDNEY_STONES));
   unsigned char *bytes = NULL;
   size_t n = read_file(path, &bytes);
   CHECK(n > 200);
@@ -164,9 +167,7 @@ static void test_objects_tasks_tallies(void) {
       memcpy(bytes + bad_fields[k].at, &bad_fields[k].v, 8);
       write_bad(bytes, body, 1);
       memcpy(bytes + bad_fields[k].at, &save, 8);
-      runtime_destroy(&b);
-      CHECK(load(&b, KIDNEY_STONES));
-      CHECK(checkpoint_load(bad, &b, tb, lb, &err) == -1);
+      CHECK(checkpoint_load(bad, &b, tb, lb, &err) == -1); /* b stays at rest: no reload needed */
       if (!strstr(err.msg, bad_fields[k].why)) fprintf(stderr, "  case %zu: %s\n", k, err.msg);
       CHECK(strstr(err.msg, bad_fields[k].why) != NULL);
       CHECK(b.steps == 0 && !b.tasks[0].started && !b.stones[0].removed);
@@ -262,7 +263,11 @@ static void test_cut_xpbd(void) {
   printf("after a second cut in both: %zu surface vertices (original) vs %zu (restored), topology %u vs %u\n",
          ma->nsurf, mb->nsurf, ma->topology_version, mb->topology_version);
 
-  /* Damaged and crafted copies: each refused, b' at rest. */
+  /* Damaged and crafted copies: each refused, a fresh b at rest and left so
+   * (untouched, or rebuilt from the scene when a topology restore failed). */
+  runtime_destroy(&b);
+  CHECK(load(&b, SPLEEN_XPBD));
+  size_t ns0 = b.organs[0].model->nsurf;
   if (n > 1000) {
     size_t body = n - 8;
     uint64_t nn, blob_len;
@@ -298,9 +303,6 @@ static void test_cut_xpbd(void) {
       }
       write_bad(bytes, cases[k].len, cases[k].reseal);
       if (cases[k].at != SIZE_MAX) memcpy(bytes + cases[k].at, &save, 8);
-      runtime_destroy(&b);
-      CHECK(load(&b, SPLEEN_XPBD));
-      size_t ns0 = b.organs[0].model->nsurf;
       CHECK(checkpoint_load(bad, &b, tb, lb, &err) == -1);
       if (!strstr(err.msg, cases[k].why)) fprintf(stderr, "  case %zu: %s\n", k, err.msg);
       CHECK(strstr(err.msg, cases[k].why) != NULL && strstr(err.msg, "starting from rest") != NULL);
