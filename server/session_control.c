@@ -70,15 +70,16 @@ static const char *edit_material(scene_material_t *m, const double v[4]) {
 }
 
 /* The task a START_TASK names: by name in `text`, or by index values[0]
- * when text is "". Returns NULL with *idx set, or why not. */
-static const char *find_task(const viscera_SessionControl *c, const scene_t *scene, int *idx) {
+ * when text is "". Returns NULL with *idx set, or why not (in why). */
+static const char *find_task(const viscera_SessionControl *c, const scene_t *scene, int *idx, char *why, size_t n) {
   if (c->text[0]) {
     for (size_t i = 0; i < scene->ntasks; i++)
       if (!strcmp(scene->tasks[i].name, c->text)) {
         *idx = (int)i;
         return NULL;
       }
-    return "no task of that name in the scene";
+    snprintf(why, n, "no task of that name in the scene ('%.40s'; %zu task(s))", c->text, scene->ntasks);
+    return why;
   }
   double v = c->values[0];
   if (!isfinite(v) || v != floor(v) || v < 0 || v >= (double)scene->ntasks) return "task index out of range";
@@ -138,7 +139,8 @@ int session_control_apply(session_control_t *sc, const viscera_SessionControl *c
   }
   case viscera_CONTROL_START_TASK: {
     int k = -1;
-    const char *bad = find_task(c, scene, &k);
+    char why[96];
+    const char *bad = find_task(c, scene, &k, why, sizeof why);
     if (bad) return refuse(sc, c, text, n, bad);
     sc->start_task = k;
     sc->applied++;
