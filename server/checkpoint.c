@@ -284,11 +284,9 @@ static int rebuild_at_rest(runtime_t *rt, verr_t *err) {
 }
 
 /* Restores the changed topologies (organs with topo > 0); 0, or -1 with
- * err (rt at rest: untouched when nothing was restored yet, the failing
- * model's hook changing nothing; rebuilt otherwise), or -2 when the
- * rebuild failed too. */
+ * err (rt rebuilt at rest: a hook that fails after its checks may have
+ * changed its model), or -2 when the rebuild failed too. */
 static int restore_topologies(runtime_t *rt, const buf_t *b, const organ_at_t *at, verr_t *err) {
-  int touched = 0;
   for (size_t i = 0; i < rt->norgans; i++) {
     if (at[i].topo == 0) continue;
     model_t *m = rt->organs[i].model;
@@ -306,7 +304,6 @@ static int restore_topologies(runtime_t *rt, const buf_t *b, const organ_at_t *a
       if (rc == 0 && (tb.at != tb.len || m->nnodes != at[i].nnodes)) {
         verr_set(&sub, "topology data of unexpected length");
         rc = -1;
-        touched = 1; /* the hook did change the model */
       }
     }
     free(x);
@@ -314,10 +311,8 @@ static int restore_topologies(runtime_t *rt, const buf_t *b, const organ_at_t *a
     if (rc) {
       verr_set(err, "organ '%s': cannot restore its topology: %s", rt->organs[i].cfg->name, sub.msg);
       verr_t e2;
-      if (!touched) return -1;
       return rebuild_at_rest(rt, &e2) ? -2 : -1;
     }
-    touched = 1;
     runtime_topology_restored(rt, i);
   }
   return 0;

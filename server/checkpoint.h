@@ -5,10 +5,11 @@
  * What is saved (format 2): simulated time and step count; every organ's
  * node positions and velocities and, for an organ whose topology changed
  * (a cut, an adaptive refinement; topology_version > 0), what its model
- * needs to rebuild that topology (model.h save/restore_topology: the pbd
- * and xpbd models after cuts; other models without those hooks cannot be
- * checkpointed once their topology changed, and the file keeps the last
- * state that could be saved); the stones (position, held or not, removed);
+ * needs to rebuild that topology (model.h save/restore_topology: pbd,
+ * xpbd and mass_spring_surface after cuts; a model without those hooks,
+ * adaptive_mass_spring after refinement, cannot be checkpointed once its
+ * topology changed, and the file keeps the last state that could be
+ * saved); the stones (position, held or not, removed);
  * the tasks (started, completed, start and end times); each tool's
  * palpation measures (thresholds.h) and tally (tool_metrics.h: grasps,
  * time holding).
