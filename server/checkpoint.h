@@ -6,10 +6,10 @@
  * node positions and velocities and, for an organ whose topology changed
  * (a cut, an adaptive refinement; topology_version > 0), what its model
  * needs to rebuild that topology (model.h save/restore_topology: pbd,
- * xpbd and mass_spring_surface after cuts; a model without those hooks,
- * adaptive_mass_spring after refinement, cannot be checkpointed once its
- * topology changed, and the file keeps the last state that could be
- * saved); the stones (position, held or not, removed);
+ * xpbd and mass_spring_surface after cuts, adaptive_mass_spring after
+ * refinement; a model without those hooks could not be checkpointed once
+ * its topology changed, and the file would keep the last state that could
+ * be saved); the stones (position, held or not, removed);
  * the tasks (started, completed, start and end times); each tool's
  * palpation measures (thresholds.h) and tally (tool_metrics.h: grasps,
  * time holding).
