@@ -36,6 +36,7 @@ static const char *const scene_integrators[] = {"symplectic_euler", "explicit_eu
 static const char *const scene_tool_kinds[] = {"probe", "grasper", "scalpel", "extractor", "syringe"};
 static const char *const scene_object_kinds[] = {"stone"};
 static const char *const scene_task_kinds[] = {"stone_removal", "palpate_target", "grasp_pull"};
+static const char *const scene_task_starts[] = {"first_command", "instructor"};
 
 /* ---- the tree ---------------------------------------------------------- */
 
@@ -486,11 +487,11 @@ enum { J_NAME, J_KIND, J_RADIUS, J_POSITION, J_ORGAN, J_COLOR, J_NKEYS };
 static const char *const object_keys[J_NKEYS] = {[J_NAME] = "name",         [J_KIND] = "kind",   [J_RADIUS] = "radius",
                                                  [J_POSITION] = "position", [J_ORGAN] = "organ", [J_COLOR] = "color"};
 
-enum { K_NAME, K_KIND, K_TOOL, K_OBJECT, K_TARGET, K_TARGET_RADIUS, K_DISTANCE, K_NKEYS };
+enum { K_NAME, K_KIND, K_TOOL, K_OBJECT, K_TARGET, K_TARGET_RADIUS, K_DISTANCE, K_START, K_NKEYS };
 static const char *const task_keys[K_NKEYS] = {
     [K_NAME] = "name",        [K_KIND] = "kind",     [K_TOOL] = "tool",
     [K_OBJECT] = "object",    [K_TARGET] = "target", [K_TARGET_RADIUS] = "target_radius",
-    [K_DISTANCE] = "distance"};
+    [K_DISTANCE] = "distance", [K_START] = "start"};
 
 /* In the order they must rise: ST < MPF <= SFT (seed 002 ch. 6). */
 enum { H_ST, H_MPF, H_SFT, H_NKEYS };
@@ -918,6 +919,12 @@ static int parse_task(const ctx_t *c, const node_t *n, size_t idx, scene_t *s) {
                        s->tasks[j].line);
   join(fp, sizeof fp, path, "kind");
   if (get_choice(c, v[K_KIND], fp, scene_task_kinds, COUNT(scene_task_kinds), t->kind, sizeof t->kind)) return -1;
+  if (v[K_START]) {
+    char start[16];
+    join(fp, sizeof fp, path, "start");
+    if (get_choice(c, v[K_START], fp, scene_task_starts, COUNT(scene_task_starts), start, sizeof start)) return -1;
+    t->start_instructor = !strcmp(start, "instructor");
+  }
   join(fp, sizeof fp, path, "tool");
   if (find_name(c, v[K_TOOL], fp, "tool", s->tools[0].name, sizeof s->tools[0], s->ntools, &t->tool)) return -1;
   const char *tk = s->tools[t->tool].kind;

@@ -145,7 +145,10 @@ typedef struct scene_object {
  *                   target_radius of target (its time is the exploration
  *                   time to the target, seed 002 ch. 6).
  *   grasp_pull      tool: a grasper; distance; completes when the tool,
- *                   holding tissue, is `distance` from where it grasped. */
+ *                   holding tissue, is `distance` from where it grasped.
+ * start: first_command (default: the clock starts at the tool's first
+ * command) or instructor (nothing runs until a SessionControl
+ * CONTROL_START_TASK names the task; the tool moving does not start it). */
 typedef struct scene_task {
   char name[SCENE_NAME_LEN];
   char kind[32];
@@ -154,6 +157,7 @@ typedef struct scene_task {
   double target[3];     /* m (palpate_target) */
   double target_radius; /* m (palpate_target, default 0.005) */
   double distance;      /* m (grasp_pull, default 0.01) */
+  int start_instructor; /* 1: `start: instructor`, 0: `start: first_command` */
   int line;
 } scene_task_t;
 

@@ -208,6 +208,37 @@ static void build_patch(runtime_t *rt, tool_rt_t *tool) {
   for (size_t j = 0; j < tool->npatch; j++) tool->patch_w[j] /= sum;
 }
 
+/* The organ's model changed its topology: fresh tree (its boxes are
+ * current), proxies re-attached where they were (anchors), patches from the
+ * new vertices, grasps of it released, shading normals of the new surface. */
+static void follow_organ(runtime_t *rt, size_t i, const topo_anchor_t anchors[SCENE_MAX_TOOLS]) {
+  organ_rt_t *o = &rt->organs[i];
+  topo_follow(rt, i, anchors, NULL);
+  for (size_t t = 0; t < rt->ntools; t++) {
+    if (anchors[t].in_contact) build_patch(rt, &rt->tools[t]);
+    /* Held tissue is a list of vertex indices of the old surface: the
+     * jaws let go (the trainee closes them again) rather than hold
+     * vertices that now mean something else. */
+    if (rt->tools[t].grasp.active && rt->tools[t].grasp.organ == (int)o->id) grasp_release(&rt->tools[t].grasp);
+  }
+  /* Force-shading normals of the new surface (rest shape); if memory
+   * runs out shading stays off for this organ (facet normals). */
+  double *vn = o->model->nsurf ? realloc(o->vn_rest, 3 * o->model->nsurf * sizeof *vn) : NULL;
+  if (vn) {
+    o->vn_rest = vn;
+    proxy_vertex_normals(o->model->nsurf, o->model->surf_rest, o->model->nsurf_tris, o->model->surf_tris, vn);
+    rt->surfaces[i].vn = vn;
+    rt->surfaces[i].nvn = o->model->nsurf;
+  }
+}
+
+void runtime_topology_restored(runtime_t *rt, size_t organ) {
+  topo_anchor_t none[SCENE_MAX_TOOLS];
+  memset(none, 0, sizeof none);
+  for (size_t t = 0; t < SCENE_MAX_TOOLS; t++) none[t].face = UINT32_MAX;
+  follow_organ(rt, organ, none);
+}
+
 int runtime_step(runtime_t *rt) {
   double dt = rt->scene.dt;
   interact_before_step(rt);
@@ -231,25 +262,7 @@ int runtime_step(runtime_t *rt) {
      * follow-up below runs before anything reads the surface again. */
     scalpel_after_organ_step(rt, i);
     if (o->model->topology_version != o->topology_version) {
-      /* New surface: fresh tree (its boxes are current), proxies re-attached
-       * where they were, patches from the new vertices. */
-      topo_follow(rt, i, anchors, NULL);
-      for (size_t t = 0; t < rt->ntools; t++) {
-        if (anchors[t].in_contact) build_patch(rt, &rt->tools[t]);
-        /* Held tissue is a list of vertex indices of the old surface: the
-         * jaws let go (the trainee closes them again) rather than hold
-         * vertices that now mean something else. */
-        if (rt->tools[t].grasp.active && rt->tools[t].grasp.organ == (int)o->id) grasp_release(&rt->tools[t].grasp);
-      }
-      /* Force-shading normals of the new surface (rest shape); if memory
-       * runs out shading stays off for this organ (facet normals). */
-      double *vn = o->model->nsurf ? realloc(o->vn_rest, 3 * o->model->nsurf * sizeof *vn) : NULL;
-      if (vn) {
-        o->vn_rest = vn;
-        proxy_vertex_normals(o->model->nsurf, o->model->surf_rest, o->model->nsurf_tris, o->model->surf_tris, vn);
-        rt->surfaces[i].vn = vn;
-        rt->surfaces[i].nvn = o->model->nsurf;
-      }
+      follow_organ(rt, i, anchors);
     } else if (o->tree.ntris) {
       /* Every step, rolled back or not: the proxy trusts the boxes. */
       aabb_tree_refit(&o->tree, o->model->surf_x);

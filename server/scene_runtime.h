@@ -109,6 +109,11 @@ void runtime_set_orientation(runtime_t *rt, size_t t, const double q[4]);
 /* Tool no longer driven (client gone): releases contact, stops acting. */
 void runtime_release_tool(runtime_t *rt, size_t t);
 
+/* After a model's topology was restored from a checkpoint (checkpoint.c):
+ * rebuilds what depends on its surface, as after a cut in a step (tree,
+ * proxies, normals; grasps of it released). */
+void runtime_topology_restored(runtime_t *rt, size_t organ);
+
 /* One scene step of scene.dt: contact, then physics. Returns the number of
  * organs whose step was rolled back because it produced NaN/Inf. */
 int runtime_step(runtime_t *rt);

@@ -357,6 +357,13 @@ static int rebuild_runtime(server_t *s, const scene_t *sc, const scene_t *old, v
   return rc;
 }
 
+/* An instructor's START_TASK (session_control.h): the task (re)starts now,
+ * reported as a TASK_STARTED whose text carries the station tag. */
+static void start_task(server_t *s, int k, const char *text) {
+  tasks_start(&s->rt.tasks[k], s->rt.sim_time);
+  publish_event(s, viscera_EVENT_TASK_STARTED, -1, s->rt.scene.tasks[k].tool, 1, text);
+}
+
 /* Applies pending instructor commands (session_control.h); each outcome is
  * logged and published, so the recording shows who changed what and when. */
 static int read_controls(server_t *s) {
@@ -407,6 +414,10 @@ static int read_controls(server_t *s) {
           snprintf(text + len, sizeof text - len, "; refused by the models: %.200s (scene unchanged, restarted)",
                    e.msg);
         }
+      }
+      if (r == SESSION_CONTROL_START_TASK) {
+        r = 0;
+        start_task(s, s->control.start_task, text);
       }
       free(edit);
       free(old);
@@ -683,14 +694,29 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
   char resumed[300] = "";
   if (opts->checkpoint) {
     verr_t e;
-    int r = checkpoint_load(opts->checkpoint, &s.rt, s.thr, &e);
+    int r = checkpoint_load(opts->checkpoint, &s.rt, s.thr, s.tally, &e);
+    if (r == -2) {
+      verr_set(err, "%s (cannot rebuild the scene after it)", e.msg);
+      teardown(&s);
+      return -1;
+    }
     if (r < 0) {
       fprintf(stderr, "server: %s\n", e.msg);
+      /* A topology restore that failed midway rebuilt the runtime: the
+       * publishers must drop the old models' surfaces they borrow. */
+      for (size_t i = 0; i < s.rt.norgans; i++) {
+        const model_t *m = s.rt.organs[i].model;
+        if (s.pubs[i].tris != m->surf_tris &&
+            mesh_publisher_retopo(&s.pubs[i], s.rt.organs[i].topology_version, m->nsurf, m->surf_tris, m->nsurf_tris,
+                                  m->surf_x, 0, &e))
+          fprintf(stderr, "server: %s\n", e.msg);
+      }
     } else if (r == 1) {
       stats->resumed = 1;
       snprintf(resumed, sizeof resumed, "resumed from checkpoint %s at t = %.3f s (step %llu)", opts->checkpoint,
                s.rt.sim_time, (unsigned long long)s.rt.steps);
       if (!opts->quiet) fprintf(stderr, "server: %s\n", resumed);
+      follow_topology(&s); /* a restored cut: keyframes of its topology before anything else */
     }
     if (!(ckpt = checkpointer_start(opts->checkpoint, err))) {
       teardown(&s);
@@ -739,7 +765,7 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
       publish_metrics(&s, metrics_every);
       publish_tool_metrics(&s);
     }
-    if (ckpt && s.rt.steps % ckpt_every == 0) checkpointer_submit(ckpt, &s.rt, s.thr);
+    if (ckpt && s.rt.steps % ckpt_every == 0) checkpointer_submit(ckpt, &s.rt, s.thr, s.tally);
     next += dt_ns;
     if (t1 > next + 100 * 1000000ull) { /* far behind (debugger, overload): resynchronise */
       stats->overruns++;
@@ -751,7 +777,7 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
   publish_metrics(&s, metrics_every);
   publish_tool_metrics(&s);
   if (ckpt) {
-    checkpointer_submit(ckpt, &s.rt, s.thr);
+    checkpointer_submit(ckpt, &s.rt, s.thr, s.tally);
     verr_t e;
     if (checkpointer_stop(ckpt, &stats->checkpoints_written, &e)) fprintf(stderr, "server: %s\n", e.msg);
   }

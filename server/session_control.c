@@ -83,6 +83,24 @@ static int apply_roles(session_control_t *sc, const viscera_SessionControl *c, c
   return 0;
 }
 
+/* The task a START_TASK names: by name in `text`, or by index values[0]
+ * when text is "". Returns NULL with *idx set, or why not (in why). */
+static const char *find_task(const viscera_SessionControl *c, const scene_t *scene, int *idx, char *why, size_t n) {
+  if (c->text[0]) {
+    for (size_t i = 0; i < scene->ntasks; i++)
+      if (!strcmp(scene->tasks[i].name, c->text)) {
+        *idx = (int)i;
+        return NULL;
+      }
+    snprintf(why, n, "no task of that name in the scene ('%.40s'; %zu task(s))", c->text, scene->ntasks);
+    return why;
+  }
+  double v = c->values[0];
+  if (!isfinite(v) || v != floor(v) || v < 0 || v >= (double)scene->ntasks) return "task index out of range";
+  *idx = (int)v;
+  return NULL;
+}
+
 int session_control_apply(session_control_t *sc, const viscera_SessionControl *c, thr_tracker_t *thr, size_t ntools,
                           const double *tool_max_force, scene_t *scene, char *text, size_t n) {
   switch (c->kind) {
@@ -133,11 +151,21 @@ int session_control_apply(session_control_t *sc, const viscera_SessionControl *c
     tag(c, text, n);
     return SESSION_CONTROL_REBUILD;
   }
+  case viscera_CONTROL_START_TASK: {
+    int k = -1;
+    char why[96];
+    const char *bad = find_task(c, scene, &k, why, sizeof why);
+    if (bad) return refuse(sc, c, text, n, bad);
+    sc->start_task = k;
+    sc->applied++;
+    snprintf(text, n, "task '%s' started by the instructor (tool '%s')", scene->tasks[k].name,
+             scene->tools[scene->tasks[k].tool].name);
+    tag(c, text, n);
+    return SESSION_CONTROL_START_TASK;
+  }
   case viscera_CONTROL_ASSIGN_TOOL:
   case viscera_CONTROL_GUIDE:
     return apply_roles(sc, c, text, n);
-  case viscera_CONTROL_START_TASK:
-    break; /* being built (issue 7): refused as unknown until then */
   }
   return refuse(sc, c, text, n, "unknown command kind");
 }

@@ -36,6 +36,7 @@ typedef struct session_control {
   /* Who drives each tool (CONTROL_ASSIGN_TOOL, CONTROL_GUIDE), owned by the
    * server; NULL: those commands are refused. */
   struct tool_roles *roles;
+  int start_task; /* the task index the last SESSION_CONTROL_START_TASK names */
 } session_control_t;
 
 /* Returns 1 (and does nothing else) when `c` is a resent copy of a command
@@ -56,6 +57,12 @@ int session_control_duplicate(session_control_t *sc, const viscera_SessionContro
  * `text` (size n) says what was done or why not, for the log and a
  * SessionEvent. */
 #define SESSION_CONTROL_REBUILD 1
+/* START_TASK names a task of `scene` by name (text) or index (values[0]
+ * when text is ""): an unknown one is refused; otherwise sc->start_task is
+ * set, `text` says "task 'NAME' started by the instructor ..." and
+ * SESSION_CONTROL_START_TASK returned: the caller starts (or restarts) the
+ * runtime's task (tasks_start) and publishes EVENT_TASK_STARTED with `text`. */
+#define SESSION_CONTROL_START_TASK 2
 int session_control_apply(session_control_t *sc, const viscera_SessionControl *c, thr_tracker_t *thr, size_t ntools,
                           const double *tool_max_force, scene_t *scene, char *text, size_t n);
 

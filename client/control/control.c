@@ -33,6 +33,8 @@ static void usage(FILE *f) {
              "  takeover T STATION    guide with authority 1: STATION drives T, the owner's hand is led\n"
              "  release T             end guiding: tool T is its owner's again\n"
              "  (STATION: a haptic client's --station name, 1..31 of A-Z a-z 0-9 _ . -)\n"
+             "  start-task NAME|INDEX start (or restart) a task now, by its scene name or index;\n"
+             "                        a restart replaces the earlier run (clock from now)\n"
              "  --domain N            DDS domain id (default: $VISCERA_DOMAIN or 0)\n"
              "  --partition P         the seat's partition (default: " VDDS_DEFAULT_PARTITION ")\n"
              "  --station ID          this instructor console's number (SessionControl source_id, default\n"
@@ -199,6 +201,24 @@ int main(int argc, char **argv) {
   } else if (verb && (strcmp(verb, "assign") == 0 || strcmp(verb, "guide") == 0 || strcmp(verb, "takeover") == 0 ||
                       strcmp(verb, "release") == 0)) {
     if (parse_role(verb, argc - optind, argv + optind, *text != 0, &cmd)) return 2;
+  } else if (verb && strcmp(verb, "start-task") == 0 && argc - optind == 2) {
+    /* A name goes in `text` (so --text is not used); all digits is an index. */
+    cmd.kind = viscera_CONTROL_START_TASK;
+    const char *arg = argv[optind + 1];
+    if (*arg && strspn(arg, "0123456789") == strlen(arg)) {
+      if (strlen(arg) > 4) {
+        fprintf(stderr, "viscera-control: start-task: task index too large: '%s'\n", arg);
+        return 2;
+      }
+      cmd.text[0] = 0;
+      cmd.values[0] = atof(arg);
+    } else {
+      if (!*arg || strlen(arg) >= sizeof cmd.text) {
+        fprintf(stderr, "viscera-control: start-task: not a task name: '%s'\n", arg);
+        return 2;
+      }
+      snprintf(cmd.text, sizeof cmd.text, "%s", arg);
+    }
   } else {
     usage(stderr);
     return 2;

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "tet_mesh.h"
+#include "state_blob.h"
 #include "tet_split.h"
 #include "vmath.h"
 #include "vtime.h"
@@ -706,4 +707,110 @@ size_t tet_cut_boundary(const tet_cut_t *c, uint32_t **tris) {
   free(f);
   *tris = out;
   return count;
+}
+
+/* ---- checkpoints ---------------------------------------------------------- */
+
+void tet_cut_save(const tet_cut_t *c, state_blob_t *b) {
+  sb_put_u64(b, c->n);
+  sb_put_u64(b, c->ntets);
+  sb_put(b, c->x_rest, 3 * c->n * sizeof(double));
+  sb_put(b, c->attr, 2 * c->n * sizeof(double));
+  sb_put(b, c->fixed, c->n);
+  sb_put(b, c->tet, 4 * c->ntets * sizeof(uint32_t));
+  sb_put(b, c->tflag, c->ntets);
+  sb_put_f64(b, c->snap);
+  sb_put_f64(b, c->min_edge);
+  sb_put_f64(b, c->min_quality);
+  sb_put_u64(b, c->version);
+  const struct tet_cut_priv *p = c->priv;
+  sb_put_u64(b, p->seq);
+  sb_put_u64(b, p->eh_count);
+  for (size_t s = 0; s < p->eh_cap; s++)
+    if (p->eh[s].key) {
+      sb_put_u64(b, p->eh[s].key);
+      sb_put_u64(b, (uint64_t)p->eh[s].node << 32 | p->eh[s].seq);
+      sb_put_f64(b, p->eh[s].t);
+    }
+  sb_put_u64(b, p->fh_count);
+  for (size_t s = 0; s < p->fh_cap; s++)
+    if (p->fh[s]) sb_put_u64(b, p->fh[s]);
+}
+
+static int load_fail(tet_cut_t *c, void *a, void *f, void *t, verr_t *err, const char *what) {
+  free(a);
+  free(f);
+  free(t);
+  if (c->priv || c->x) tet_cut_destroy(c);
+  return verr_set(err, "tet_cut: %s", what);
+}
+
+int tet_cut_load(tet_cut_t *c, state_blob_t *b, verr_t *err) {
+  memset(c, 0, sizeof *c);
+  /* Per node at least 41 bytes follow (rest position, attribute, flag),
+   * per tetrahedron 17 (indices, flag): counts beyond the bytes left are
+   * refused before anything is allocated. */
+  size_t n = sb_count(b, 41);
+  size_t nt = b->bad ? 0 : (size_t)sb_count(b, 0);
+  if (b->bad || nt > (b->len - b->at) / 17 || n == 0 || nt == 0 || n >= TC_MAX_NODES / 2)
+    return load_fail(c, NULL, NULL, NULL, err, "bad node or tetrahedron count");
+  size_t bytes_x = 3 * n * sizeof(double);
+  double *xr = malloc(bytes_x);
+  uint8_t *fixed = malloc(n);
+  uint32_t *tets = malloc(4 * nt * sizeof *tets);
+  if (!xr || !fixed || !tets) return load_fail(c, xr, fixed, tets, err, "out of memory");
+  sb_get(b, xr, bytes_x);
+  size_t attr_at = b->at;
+  b->at += 2 * n * sizeof(double); /* after create, which overwrites attributes */
+  sb_get(b, fixed, n);
+  sb_get(b, tets, 4 * nt * sizeof *tets);
+  if (b->bad) return load_fail(c, xr, fixed, tets, err, "truncated mesh");
+  for (size_t i = 0; i < n; i++)
+    if (fixed[i] > 1) return load_fail(c, xr, fixed, tets, err, "bad fixed flag");
+  verr_t sub;
+  if (tet_cut_create(c, n, xr, NULL, NULL, fixed, nt, tets, &sub)) return load_fail(c, xr, fixed, tets, err, sub.msg);
+  free(xr);
+  free(fixed);
+  free(tets);
+  memcpy(c->attr, b->p + attr_at, 2 * n * sizeof(double));
+  for (size_t k = 0; k < 2 * n; k++)
+    if (!isfinite(c->attr[k])) return load_fail(c, NULL, NULL, NULL, err, "non-finite attribute");
+  sb_get(b, c->tflag, nt);
+  for (size_t t = 0; t < nt; t++) {
+    if (c->tflag[t] & ~(TC_PENDING | TC_FROZEN)) return load_fail(c, NULL, NULL, NULL, err, "bad tetrahedron flag");
+    c->tflag[t] &= (uint8_t)~TC_PENDING; /* no cut in progress after a restore */
+  }
+  c->snap = sb_get_f64(b);
+  c->min_edge = sb_get_f64(b);
+  c->min_quality = sb_get_f64(b);
+  uint64_t version = sb_get_u64(b), seq = sb_get_u64(b);
+  if (b->bad || !(c->snap > 0 && c->snap < 0.5) || !isfinite(c->min_edge) || !isfinite(c->min_quality) ||
+      version > UINT32_MAX || seq > UINT32_MAX)
+    return load_fail(c, NULL, NULL, NULL, err, "bad cutter parameters");
+  c->version = (uint32_t)version;
+  struct tet_cut_priv *p = c->priv;
+  size_t ne = sb_count(b, 24);
+  for (size_t e = 0; e < ne && !b->bad; e++) {
+    uint64_t key = sb_get_u64(b), ns = sb_get_u64(b);
+    double t = sb_get_f64(b);
+    uint32_t i = (uint32_t)(key >> 32), j = (uint32_t)key, node = (uint32_t)(ns >> 32);
+    if (b->bad || i >= j || j >= n || (node != TC_NONE && node >= n) || !(t >= 0 && t <= 1) || edge_find(p, i, j))
+      return load_fail(c, NULL, NULL, NULL, err, "bad cut edge");
+    eslot_t *sl = edge_insert(p, i, j);
+    if (!sl) return load_fail(c, NULL, NULL, NULL, err, "out of memory");
+    sl->node = node;
+    sl->seq = (uint32_t)ns;
+    sl->t = t;
+  }
+  size_t nf = sb_count(b, 8);
+  for (size_t f = 0; f < nf && !b->bad; f++) {
+    uint64_t key = sb_get_u64(b);
+    if (b->bad || !key || (key >> 42) >= n || ((key >> 21) & (TC_MAX_NODES - 1)) >= n ||
+        (key & (TC_MAX_NODES - 1)) >= n || (key >> 63))
+      return load_fail(c, NULL, NULL, NULL, err, "bad cut face");
+    if (face_add(p, key)) return load_fail(c, NULL, NULL, NULL, err, "out of memory");
+  }
+  if (b->bad) return load_fail(c, NULL, NULL, NULL, err, "truncated cutter state");
+  p->seq = (uint32_t)seq;
+  return 0;
 }

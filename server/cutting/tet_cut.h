@@ -131,6 +131,21 @@ int tet_cut_advance(tet_cut_t *c, const double tip[3], const double handle[3], v
 int tet_cut_end(tet_cut_t *c, verr_t *err);
 int tet_cut_active(const tet_cut_t *c);
 
+/* Checkpoints (the pbd/xpbd model's topology hooks, physics/model.h):
+ * tet_cut_save appends the mesh (rest positions, attributes, fixed flags,
+ * tetrahedra) and the cutter's memory of earlier cuts (cut edges with their
+ * points and creation order, cut faces, the snap and quality gates, the
+ * version) to b; node positions and velocities are not saved (the model
+ * keeps them in its solver). tet_cut_load builds *c from such bytes
+ * (untrusted: counts bounded by the bytes present, indices and values
+ * checked); positions are the rest positions, velocities 0. A cut in
+ * progress when saved is not restored: the restored cutter has none active,
+ * and the tetrahedra that cut had crossed without splitting stay whole.
+ * Returns 0, or -1 with err (*c then empty). */
+struct state_blob;
+void tet_cut_save(const tet_cut_t *c, struct state_blob *b);
+int tet_cut_load(tet_cut_t *c, struct state_blob *b, verr_t *err);
+
 /* Boundary faces (shared by one tetrahedron), outward, 3 per face, into a
  * malloc'ed array (*tris, freed by the caller); returns the count, or
  * (size_t)-1 on OOM. Includes the incision faces. */

@@ -27,7 +27,8 @@ void tasks_update(task_rt_t *tasks, size_t ntasks, const runtime_t *rt, iev_queu
   for (size_t i = 0; i < ntasks; i++) {
     task_rt_t *task = &tasks[i];
     const tool_rt_t *tool = &rt->tools[task->cfg->tool];
-    if (!task->started && tool->first_cmd_time >= 0) {
+    /* An instructor-started task waits for tasks_start(), whatever the tool does. */
+    if (!task->started && !task->cfg->start_instructor && tool->first_cmd_time >= 0) {
       task->started = 1;
       task->t_start = tool->first_cmd_time;
       iev_push(q, (iev_t){.kind = IEV_TASK_STARTED,
@@ -50,6 +51,13 @@ void tasks_update(task_rt_t *tasks, size_t ntasks, const runtime_t *rt, iev_queu
                           .sim_time = rt->sim_time});
     }
   }
+}
+
+void tasks_start(task_rt_t *task, double now) {
+  task->started = 1;
+  task->completed = 0;
+  task->t_start = now;
+  task->t_end = 0;
 }
 
 double task_operation_time(const task_rt_t *t, double now) {

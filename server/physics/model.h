@@ -24,6 +24,7 @@
 #include "verr.h"
 
 typedef struct model model_t;
+struct state_blob; /* server/state_blob.h */
 
 typedef struct model_ops {
   const char *name; /* the scene file's model name */
@@ -38,6 +39,22 @@ typedef struct model_ops {
   double (*error_estimate)(const model_t *m);
   /* Adds force f (N) at surface vertex i for the current sub-step. */
   void (*add_surface_force)(model_t *m, uint32_t i, const double f[3]);
+  /* Checkpoints of a changed topology (server/checkpoint.h), optional: a
+   * model without them cannot be checkpointed once its topology_version is
+   * above 0 (the checkpoint says so and keeps the last one it could write).
+   * save_topology appends to b everything the model needs to rebuild its
+   * nodes and surface as they are (node positions and velocities excepted:
+   * the checkpoint stores those for every model). restore_topology, on a
+   * model freshly built from the same scene, rebuilds from those bytes
+   * (untrusted: every count bounded, every index checked), then takes the
+   * node positions x and velocities v (3 nnodes each; a rebuild to another
+   * node count is refused) and
+   * brings its surface to them; it changes m only when all succeeded.
+   * Afterwards nodes, surface and topology_version are as when saved.
+   * 0, or -1 with err. */
+  int (*save_topology)(const model_t *m, struct state_blob *b);
+  int (*restore_topology)(model_t *m, struct state_blob *b, size_t nnodes, const double *x, const double *v,
+                          verr_t *err);
 } model_ops_t;
 
 struct model {

@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "adaptive.h"
+#include "state_blob.h"
 
 static void am_pre(void *ctx) {
   model_t *m = ctx;
@@ -53,6 +54,51 @@ static void am_add_force(model_t *m, uint32_t i, const double f[3]) {
   adaptive_add_force(&((adaptive_model_t *)m)->ad, i, f);
 }
 
+/* Checkpoints (model.h save/restore_topology). The refined mesh is a
+ * function of the refinement centre alone (the coarse mesh never changes,
+ * refinement reads rest areas, new rest positions are midpoints of coarse
+ * rest positions), so the centre, the release timer and the version are
+ * the whole topology: restoring refines the fresh model at that centre
+ * again and then takes the saved positions and velocities. */
+static int am_save_topology(const model_t *m, state_blob_t *b) {
+  const adaptive_t *ad = &((const adaptive_model_t *)m)->ad;
+  sb_put_u64(b, (uint64_t)ad->refined);
+  sb_put_u64(b, ad->centre);
+  sb_put_f64(b, ad->release_timer);
+  sb_put_u64(b, ad->topology_version);
+  return b->bad ? -1 : 0;
+}
+
+static int am_restore_topology(model_t *m, state_blob_t *b, size_t nnodes, const double *x, const double *v,
+                               verr_t *err) {
+  adaptive_model_t *am = (adaptive_model_t *)m;
+  adaptive_t *ad = &am->ad;
+  uint64_t refined = sb_get_u64(b), centre = sb_get_u64(b);
+  double timer = sb_get_f64(b);
+  uint64_t version = sb_get_u64(b);
+  if (b->bad || refined > 1 || (refined && centre >= ad->n0) || !isfinite(timer) || timer < 0 || version == 0 ||
+      version > UINT32_MAX)
+    return verr_set(err, "refinement: bad centre, timer or version");
+  if (ad->refined) adaptive_simplify(ad); /* a fresh model is coarse; be sure */
+  /* A refinement that ran out of capacity leaves the coarse mesh, as it did
+   * when saved: the node count decides. */
+  if (refined) adaptive_refine(ad, (uint32_t)centre);
+  if (ad->n != nnodes) {
+    adaptive_simplify(ad);
+    am_sync(am);
+    m->topology_version = 0;
+    ad->topology_version = 0;
+    return verr_set(err, "refinement at vertex %llu gives %zu nodes, the checkpoint has %zu",
+                    (unsigned long long)centre, ad->n, nnodes);
+  }
+  memcpy(ad->x, x, 3 * nnodes * sizeof(double));
+  memcpy(ad->v, v, 3 * nnodes * sizeof(double));
+  ad->release_timer = timer;
+  ad->topology_version = (uint32_t)version;
+  am_sync(am);
+  return 0;
+}
+
 static const model_ops_t adaptive_ops = {
     .name = "adaptive_mass_spring",
     .step = am_step,
@@ -60,6 +106,8 @@ static const model_ops_t adaptive_ops = {
     .energy = am_energy,
     .error_estimate = am_error,
     .add_surface_force = am_add_force,
+    .save_topology = am_save_topology,
+    .restore_topology = am_restore_topology,
 };
 
 model_t *model_adaptive_create(const model_params_t *p, verr_t *err) {

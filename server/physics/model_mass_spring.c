@@ -47,6 +47,7 @@
 #include "mass_spring.h"
 #include "model.h"
 #include "model_mass_spring.h"
+#include "state_blob.h"
 #include "tet_mesh.h"
 #include "vmath.h"
 
@@ -213,12 +214,18 @@ static void tet_add_force(model_t *m, uint32_t i, const double f[3]) {
   }
 }
 
+static int surface_save_topology(const model_t *m, state_blob_t *b);
+static int surface_restore_topology(model_t *m, state_blob_t *b, size_t nnodes, const double *x, const double *v,
+                                    verr_t *err);
+
 static const model_ops_t SURFACE_OPS = {.name = "mass_spring_surface",
                                         .step = ms_step,
                                         .destroy = ms_destroy,
                                         .energy = ms_energy,
                                         .error_estimate = surface_error,
-                                        .add_surface_force = surface_add_force};
+                                        .add_surface_force = surface_add_force,
+                                        .save_topology = surface_save_topology,
+                                        .restore_topology = surface_restore_topology};
 static const model_ops_t TET_OPS = {.name = "mass_spring_tet",
                                     .step = ms_step,
                                     .destroy = ms_destroy,
@@ -505,4 +512,115 @@ int model_mass_spring_refine(model_t *m, int iterations, verr_t *err) {
   double lk = fmin(1.02 * mm->refine_lambda, mm->lam_k);
   if (!(lk > 0)) return 0;
   return substeps_from_k(mm, lk, err) ? -1 : 1;
+}
+
+/* ---- checkpoints (model.h save/restore_topology) ---------------------------- */
+
+/* A cut surface model is its nodes (rest positions, masses, residual
+ * forces), its triangles (the springs are their unique edges, rest lengths
+ * from the rest positions: model_mass_spring_commit, as after a cut) and
+ * the sub-steps it had chosen. */
+static int surface_save_topology(const model_t *m, state_blob_t *b) {
+  const ms_model_t *mm = (const ms_model_t *)m;
+  const mass_spring_t *ms = &mm->ms;
+  sb_put_u64(b, ms->n);
+  sb_put_u64(b, m->nsurf_tris);
+  sb_put(b, ms->x_rest, 3 * ms->n * sizeof(double));
+  sb_put(b, ms->mass, ms->n * sizeof(double));
+  sb_put(b, ms->inv_mass, ms->n * sizeof(double));
+  sb_put_u64(b, ms->f_res != NULL);
+  if (ms->f_res) sb_put(b, ms->f_res, 3 * ms->n * sizeof(double));
+  sb_put(b, mm->tris, 3 * m->nsurf_tris * sizeof(uint32_t));
+  sb_put_u64(b, (uint64_t)m->substeps);
+  sb_put_u64(b, m->topology_version);
+  return b->bad ? -1 : 0;
+}
+
+static int all_finite(const double *p, size_t n) {
+  double s = 0;
+  for (size_t i = 0; i < n; i++) s += p[i] * 0.0;
+  return s == 0.0; /* NaN or Inf anywhere makes it NaN */
+}
+
+static int surface_restore_topology(model_t *m, state_blob_t *b, size_t nnodes, const double *x, const double *v,
+                                    verr_t *err) {
+  ms_model_t *mm = (ms_model_t *)m;
+  /* Per node at least 40 bytes follow (rest position, mass, inverse mass),
+   * per triangle 12: counts beyond the bytes left are refused first. */
+  size_t n = sb_count(b, 40);
+  size_t nt = b->bad ? 0 : sb_count(b, 12);
+  if (b->bad || n == 0 || nt == 0 || n != nnodes) return verr_set(err, "cut surface: bad node or triangle count");
+  double *xr = malloc(3 * n * sizeof *xr), *mass = malloc(n * sizeof *mass), *im = malloc(n * sizeof *im);
+  double *fres = NULL;
+  uint32_t *tris = malloc(3 * nt * sizeof *tris);
+  int rc = -1;
+  if (!xr || !mass || !im || !tris) {
+    verr_set(err, "cut surface: out of memory");
+    goto out;
+  }
+  sb_get(b, xr, 3 * n * sizeof *xr);
+  sb_get(b, mass, n * sizeof *mass);
+  sb_get(b, im, n * sizeof *im);
+  uint64_t has_fres = sb_get_u64(b);
+  if (has_fres == 1) {
+    if (!(fres = malloc(3 * n * sizeof *fres))) {
+      verr_set(err, "cut surface: out of memory");
+      goto out;
+    }
+    sb_get(b, fres, 3 * n * sizeof *fres);
+  }
+  sb_get(b, tris, 3 * nt * sizeof *tris);
+  uint64_t substeps = sb_get_u64(b), version = sb_get_u64(b);
+  if (b->bad || has_fres > 1) {
+    verr_set(err, "cut surface: truncated");
+    goto out;
+  }
+  if (!all_finite(xr, 3 * n) || !all_finite(mass, n) || !all_finite(im, n) || (fres && !all_finite(fres, 3 * n))) {
+    verr_set(err, "cut surface: non-finite node data");
+    goto out;
+  }
+  for (size_t i = 0; i < n; i++)
+    if (!(mass[i] > 0) || im[i] < 0 || (im[i] > 0 && fabs(im[i] * mass[i] - 1) > 1e-9)) {
+      verr_set(err, "cut surface: node %zu: bad mass", i);
+      goto out;
+    }
+  for (size_t k = 0; k < 3 * nt; k++)
+    if (tris[k] >= n) {
+      verr_set(err, "cut surface: triangle %zu refers to node %u of %zu", k / 3, tris[k], n);
+      goto out;
+    }
+  if (substeps < 1 || substeps > 256 || version == 0 || version > UINT32_MAX) {
+    verr_set(err, "cut surface: bad sub-steps or topology version");
+    goto out;
+  }
+  /* From here the model changes (the checkpoint loader rebuilds the scene
+   * if anything below fails). A prepared model (one a scalpel may cut)
+   * gets its dominant vector anew for the new topology. */
+  int prepared = mm->eig_k != NULL;
+  if (model_mass_spring_reserve(m, n, fres != NULL, err)) goto out;
+  memcpy(mm->ms.x, x, 3 * n * sizeof(double));
+  memcpy(mm->ms.v, v, 3 * n * sizeof(double));
+  memcpy(mm->ms.x_rest, xr, 3 * n * sizeof(double));
+  memcpy(mm->ms.mass, mass, n * sizeof(double));
+  memcpy(mm->ms.inv_mass, im, n * sizeof(double));
+  if (fres)
+    memcpy(mm->ms.f_res, fres, 3 * n * sizeof(double));
+  else if (mm->ms.f_res)
+    memset(mm->ms.f_res, 0, 3 * mm->ms.cap * sizeof(double));
+  free(mm->eig_k);
+  free(mm->eig_y);
+  mm->eig_k = mm->eig_y = NULL;
+  mm->refining = 0;
+  if (model_mass_spring_commit(m, n, NULL, 0, tris, nt, err)) goto out;
+  if (prepared && model_mass_spring_prepare(m, err)) goto out;
+  m->substeps = (int)substeps; /* as the running model had them (its re-estimates are not saved) */
+  m->topology_version = (uint32_t)version;
+  rc = 0;
+out:
+  free(xr);
+  free(mass);
+  free(im);
+  free(fres);
+  free(tris);
+  return rc;
 }

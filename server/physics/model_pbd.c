@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "pbd.h"
+#include "state_blob.h"
 #include "tet_cut.h"
 #include "tet_mesh.h"
 
@@ -111,10 +112,26 @@ static void pbd_model_add_surface_force(model_t *m, uint32_t i, const double f[3
   }
 }
 
-static const model_ops_t PBD_OPS = {
-    "pbd", pbd_model_step, pbd_model_destroy, pbd_model_energy, pbd_model_error, pbd_model_add_surface_force};
-static const model_ops_t XPBD_OPS = {"xpbd",           pbd_model_step,  pbd_model_destroy,
-                                     pbd_model_energy, pbd_model_error, pbd_model_add_surface_force};
+static int pbd_save_topology(const model_t *m, state_blob_t *b);
+static int pbd_restore_topology(model_t *m, state_blob_t *b, size_t nnodes, const double *x, const double *v,
+                                verr_t *err);
+
+static const model_ops_t PBD_OPS = {.name = "pbd",
+                                    .step = pbd_model_step,
+                                    .destroy = pbd_model_destroy,
+                                    .energy = pbd_model_energy,
+                                    .error_estimate = pbd_model_error,
+                                    .add_surface_force = pbd_model_add_surface_force,
+                                    .save_topology = pbd_save_topology,
+                                    .restore_topology = pbd_restore_topology};
+static const model_ops_t XPBD_OPS = {.name = "xpbd",
+                                     .step = pbd_model_step,
+                                     .destroy = pbd_model_destroy,
+                                     .energy = pbd_model_energy,
+                                     .error_estimate = pbd_model_error,
+                                     .add_surface_force = pbd_model_add_surface_force,
+                                     .save_topology = pbd_save_topology,
+                                     .restore_topology = pbd_restore_topology};
 
 model_t *model_pbd_create(const model_params_t *p, verr_t *err) {
   const scene_organ_t *cfg = p->cfg;
@@ -360,4 +377,53 @@ const struct tet_cut *model_pbd_cutter(const model_t *m) {
 const double *model_pbd_surface_attr(const model_t *m) {
   if (!m || (m->ops != &PBD_OPS && m->ops != &XPBD_OPS)) return NULL;
   return ((const model_pbd_t *)m)->surf_attr;
+}
+
+/* ---- checkpoints (model.h save/restore_topology) ---------------------------- */
+
+/* A cut model is its cutter's mesh: the solver and the surface are rebuilt
+ * from it exactly as after the last cut (rebuild above), so saving the
+ * cutter (tet_cut_save) and the topology version is enough. */
+static int pbd_save_topology(const model_t *m, state_blob_t *b) {
+  const model_pbd_t *mp = (const model_pbd_t *)m;
+  if (!mp->cut || mp->cut_broken) return -1;
+  tet_cut_save(mp->cut, b);
+  sb_put_u64(b, m->topology_version);
+  return b->bad ? -1 : 0;
+}
+
+static int pbd_restore_topology(model_t *m, state_blob_t *b, size_t nnodes, const double *x, const double *v,
+                                verr_t *err) {
+  model_pbd_t *mp = (model_pbd_t *)m;
+  tet_cut_t *nc = calloc(1, sizeof *nc);
+  if (!nc) return verr_set(err, "out of memory for the cutter");
+  verr_t sub;
+  if (tet_cut_load(nc, b, &sub)) {
+    free(nc);
+    return verr_set(err, "cut mesh: %s", sub.msg);
+  }
+  uint64_t version = sb_get_u64(b);
+  if (b->bad || version == 0 || version > UINT32_MAX || nc->n != nnodes) {
+    tet_cut_destroy(nc);
+    free(nc);
+    return verr_set(err, "cut mesh: bad topology version or node count");
+  }
+  tet_cut_t *old = mp->cut;
+  mp->cut = nc;
+  if (rebuild(mp, err)) { /* the model is unchanged: back to the old cutter */
+    mp->cut = old;
+    mp->cut_broken = 0;
+    tet_cut_destroy(nc);
+    free(nc);
+    return -1;
+  }
+  if (old) tet_cut_destroy(old);
+  free(old);
+  m->topology_version = (uint32_t)version;
+  memcpy(mp->s.x, x, 3 * m->nnodes * sizeof(double));
+  memcpy(mp->s.v, v, 3 * m->nnodes * sizeof(double));
+  memcpy(nc->x, x, 3 * m->nnodes * sizeof(double));
+  memcpy(nc->v, v, 3 * m->nnodes * sizeof(double));
+  surface_from_nodes(mp, mp->s.x);
+  return 0;
 }

@@ -6,3 +6,5 @@ viscera_unit_test(NAME test_tool_actions SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_
 viscera_unit_test(NAME test_proxy_friction SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_proxy_friction.c LIBS viscera_server_core)
 # Tool shafts: the cylinder node test and segment-triangle crossings (tree vs scan).
 viscera_unit_test(NAME test_shaft SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_shaft.c LIBS viscera_server_core)
+# Tasks started by the instructor (scene `start:`, SessionControl START_TASK).
+viscera_unit_test(NAME test_task_start SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_task_start.c LIBS viscera_server_core)
