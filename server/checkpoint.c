@@ -63,9 +63,12 @@ static void put_tracker(buf_t *b, const thr_tracker_t *t) {
  *   ntools, per tool: tracker measures, tally (grasps, grasp_time)
  *   ntasks, per task: started completed t_start t_end
  *   nstones, per stone: pos[3] held_by removed
+ *   nroles (0 when saved without roles, else ntools), per tool:
+ *     owner[32] guide[32] authority coupling
  *   crc32 (as u64) of everything before it (seal(): the checkpointer's
  *   writer thread computes it, not the physics loop). */
-static int serialise(buf_t *b, const runtime_t *rt, const thr_tracker_t *thr, const tool_tally_t *tally, verr_t *err) {
+static int serialise(buf_t *b, const runtime_t *rt, const thr_tracker_t *thr, const tool_tally_t *tally,
+                     const tool_roles_t *roles, verr_t *err) {
   b->len = 0;
   b->bad = 0;
   char name[SCENE_NAME_LEN] = {0};
@@ -117,6 +120,18 @@ static int serialise(buf_t *b, const runtime_t *rt, const thr_tracker_t *thr, co
     sb_put_u64(b, (uint64_t)(int64_t)st->held_by);
     sb_put_u64(b, (uint64_t)st->removed);
   }
+  size_t nroles = roles ? roles->ntools : 0;
+  sb_put_u64(b, nroles);
+  for (size_t t = 0; t < nroles; t++) {
+    const tool_role_t *tr = &roles->tool[t];
+    char owner[TOOL_ROLE_STATION_MAX] = {0}, guide[TOOL_ROLE_STATION_MAX] = {0}; /* no stray bytes on disk */
+    snprintf(owner, sizeof owner, "%s", tr->owner);
+    snprintf(guide, sizeof guide, "%s", tr->guide);
+    sb_put(b, owner, sizeof owner);
+    sb_put(b, guide, sizeof guide);
+    sb_put_f64(b, tr->authority);
+    sb_put_f64(b, tr->coupling);
+  }
   return b->bad ? verr_set(err, "checkpoint: out of memory") : 0;
 }
 
@@ -145,9 +160,9 @@ static int write_atomic(const char *path, const unsigned char *p, size_t len, ve
 }
 
 int checkpoint_save(const char *path, const runtime_t *rt, const thr_tracker_t *thr, const tool_tally_t *tally,
-                    verr_t *err) {
+                    const tool_roles_t *roles, verr_t *err) {
   buf_t b = {0};
-  int bad = serialise(&b, rt, thr, tally, err);
+  int bad = serialise(&b, rt, thr, tally, roles, err);
   if (!bad) {
     seal(&b);
     if (b.bad) bad = verr_set(err, "checkpoint: out of memory");
@@ -224,12 +239,13 @@ checkpointer_t *checkpointer_start(const char *path, verr_t *err) {
   return c;
 }
 
-void checkpointer_submit(checkpointer_t *c, const runtime_t *rt, const thr_tracker_t *thr, const tool_tally_t *tally) {
+void checkpointer_submit(checkpointer_t *c, const runtime_t *rt, const thr_tracker_t *thr, const tool_tally_t *tally,
+                         const tool_roles_t *roles) {
   /* Never block the physics loop: if the writer holds the lock right now,
    * skip this checkpoint; the next one comes soon. */
   if (pthread_mutex_trylock(&c->lock)) return;
   verr_t err;
-  if (serialise(&c->pending, rt, thr, tally, &err) == 0) {
+  if (serialise(&c->pending, rt, thr, tally, roles, &err) == 0) {
     c->have_pending = 1;
     pthread_cond_signal(&c->cond);
   } else if (c->refused++ == 0) {
@@ -318,7 +334,8 @@ static int restore_topologies(runtime_t *rt, const buf_t *b, const organ_at_t *a
   return 0;
 }
 
-int checkpoint_load(const char *path, runtime_t *rt, thr_tracker_t *thr, tool_tally_t *tally, verr_t *err) {
+int checkpoint_load(const char *path, runtime_t *rt, thr_tracker_t *thr, tool_tally_t *tally, tool_roles_t *roles,
+                    verr_t *err) {
   FILE *f = fopen(path, "rb");
   if (!f) {
     if (errno == ENOENT) return 0;
@@ -439,6 +456,22 @@ int checkpoint_load(const char *path, runtime_t *rt, thr_tracker_t *thr, tool_ta
       return refuse(&b, err, path, "bad object state");
     removed[k] = (int)rem;
   }
+  uint64_t nroles = sb_get_u64(&b);
+  if (nroles != 0 && nroles != rt->ntools) return refuse(&b, err, path, "tool role count differs from the scene");
+  struct {
+    char owner[TOOL_ROLE_STATION_MAX], guide[TOOL_ROLE_STATION_MAX];
+    double a, k;
+  } role[SCENE_MAX_TOOLS];
+  for (size_t t = 0; t < nroles; t++) {
+    sb_get(&b, role[t].owner, sizeof role[t].owner);
+    sb_get(&b, role[t].guide, sizeof role[t].guide);
+    role[t].a = sb_get_f64(&b);
+    role[t].k = sb_get_f64(&b);
+    /* Names must end inside their field: a missing NUL is a crafted file. */
+    if (b.bad || !memchr(role[t].owner, 0, sizeof role[t].owner) || !memchr(role[t].guide, 0, sizeof role[t].guide) ||
+        (roles && tool_roles_valid(roles, t, role[t].owner, role[t].guide, role[t].a, role[t].k)))
+      return refuse(&b, err, path, "bad tool role");
+  }
   if (b.bad || b.at != b.len) return refuse(&b, err, path, "truncated or trailing data");
   int rc = restore_topologies(rt, &b, at, err);
   if (rc) {
@@ -466,6 +499,9 @@ int checkpoint_load(const char *path, runtime_t *rt, thr_tracker_t *thr, tool_ta
     st->removed = removed[k];
     memset(st->force, 0, sizeof st->force);
   }
+  if (roles)
+    for (size_t t = 0; t < nroles; t++)
+      tool_roles_restore(roles, t, role[t].owner, role[t].guide, role[t].a, role[t].k);
   rt->sim_time = sim_time;
   rt->steps = steps;
   free(b.p);

@@ -12,7 +12,8 @@
  * be saved); the stones (position, held or not, removed);
  * the tasks (started, completed, start and end times); each tool's
  * palpation measures (thresholds.h) and tally (tool_metrics.h: grasps,
- * time holding).
+ * time holding); each tool's role (tool_roles.h: owner, guide, authority,
+ * coupling), so an instructor's assignment or take-over outlives a crash.
  * What is not: tool contact and grasps (tools re-enter from outside after a
  * restart: a restarted server never pushes a hand that is already inside,
  * a held stone is dropped where it was, held tissue let go), a cut in
@@ -34,16 +35,18 @@
 
 #include "scene_runtime.h"
 #include "thresholds.h"
+#include "tool_roles.h"
 #include "tool_metrics.h"
 #include "verr.h"
 
 #include <stdint.h>
 
 /* Writes the state of `rt`, the per-tool trackers `thr` and tallies
- * `tally` (rt->ntools each) to `path`. -1 with err when it cannot (a model
+ * `tally` (rt->ntools each) and the tools' roles (`roles`, NULL: none
+ * saved; on load NULL ignores the file's) to `path`. -1 with err when it cannot (a model
  * that cannot save its changed topology, out of memory, write error). */
 int checkpoint_save(const char *path, const runtime_t *rt, const thr_tracker_t *thr, const tool_tally_t *tally,
-                    verr_t *err);
+                    const tool_roles_t *roles, verr_t *err);
 
 /* Restores a checkpoint written for the same scene into `rt`, `thr` and
  * `tally`. Returns 1 when restored (organs with a restored topology already
@@ -52,7 +55,8 @@ int checkpoint_save(const char *path, const runtime_t *rt, const thr_tracker_t *
  * format or for another scene (rt, thr and tally are then as from rest:
  * unchanged, or rebuilt from the scene when a topology restore failed
  * midway), -2 when that rebuild failed too (out of memory: rt is unusable). */
-int checkpoint_load(const char *path, runtime_t *rt, thr_tracker_t *thr, tool_tally_t *tally, verr_t *err);
+int checkpoint_load(const char *path, runtime_t *rt, thr_tracker_t *thr, tool_tally_t *tally, tool_roles_t *roles,
+                    verr_t *err);
 
 /* Periodic checkpoints from the physics loop without waiting on the disk:
  * submit() copies the state (no allocation once the buffers have grown;
@@ -61,7 +65,8 @@ int checkpoint_load(const char *path, runtime_t *rt, thr_tracker_t *thr, tool_ta
  * joins the thread and frees it; -1 with err if any write failed. */
 typedef struct checkpointer checkpointer_t;
 checkpointer_t *checkpointer_start(const char *path, verr_t *err);
-void checkpointer_submit(checkpointer_t *c, const runtime_t *rt, const thr_tracker_t *thr, const tool_tally_t *tally);
+void checkpointer_submit(checkpointer_t *c, const runtime_t *rt, const thr_tracker_t *thr, const tool_tally_t *tally,
+                         const tool_roles_t *roles);
 int checkpointer_stop(checkpointer_t *c, uint64_t *written, verr_t *err);
 
 #endif

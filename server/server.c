@@ -694,7 +694,7 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
   char resumed[300] = "";
   if (opts->checkpoint) {
     verr_t e;
-    int r = checkpoint_load(opts->checkpoint, &s.rt, s.thr, s.tally, &e);
+    int r = checkpoint_load(opts->checkpoint, &s.rt, s.thr, s.tally, &s.roles, &e);
     if (r == -2) {
       verr_set(err, "%s (cannot rebuild the scene after it)", e.msg);
       teardown(&s);
@@ -765,7 +765,7 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
       publish_metrics(&s, metrics_every);
       publish_tool_metrics(&s);
     }
-    if (ckpt && s.rt.steps % ckpt_every == 0) checkpointer_submit(ckpt, &s.rt, s.thr, s.tally);
+    if (ckpt && s.rt.steps % ckpt_every == 0) checkpointer_submit(ckpt, &s.rt, s.thr, s.tally, &s.roles);
     next += dt_ns;
     if (t1 > next + 100 * 1000000ull) { /* far behind (debugger, overload): resynchronise */
       stats->overruns++;
@@ -777,7 +777,7 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
   publish_metrics(&s, metrics_every);
   publish_tool_metrics(&s);
   if (ckpt) {
-    checkpointer_submit(ckpt, &s.rt, s.thr, s.tally);
+    checkpointer_submit(ckpt, &s.rt, s.thr, s.tally, &s.roles);
     verr_t e;
     if (checkpointer_stop(ckpt, &stats->checkpoints_written, &e)) fprintf(stderr, "server: %s\n", e.msg);
   }

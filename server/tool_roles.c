@@ -223,6 +223,21 @@ int tool_roles_apply(tool_roles_t *r, const viscera_SessionControl *c, char *tex
   return c->kind == viscera_CONTROL_ASSIGN_TOOL ? apply_assign(r, t, c->text, text, n) : apply_guide(r, t, c, text, n);
 }
 
+int tool_roles_valid(const tool_roles_t *r, size_t t, const char *owner, const char *guide, double a, double k) {
+  if (t >= r->ntools) return -1;
+  if (owner[0] && !vdds_station_valid(owner)) return -1;
+  if (!guide[0]) return 0;
+  if (!vdds_station_valid(guide) || !strcmp(guide, owner)) return -1;
+  if (!isfinite(a) || a < 0 || a > 1 || !isfinite(k) || !(k > 0) || k > r->tool[t].max_coupling) return -1;
+  return 0;
+}
+
+int tool_roles_restore(tool_roles_t *r, size_t t, const char *owner, const char *guide, double a, double k) {
+  if (tool_roles_valid(r, t, owner, guide, a, k)) return -1;
+  set_role(r, t, owner, guide, guide[0] ? a : 0, guide[0] ? k : 0);
+  return 0;
+}
+
 void tool_roles_fill(const tool_roles_t *r, size_t t, uint64_t sim_time_ns, viscera_ToolRole *out) {
   memset(out, 0, sizeof *out);
   if (t >= r->ntools) return;

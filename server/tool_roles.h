@@ -109,6 +109,17 @@ void tool_roles_forget_all(tool_roles_t *r);
  * when anything did), -1 refused (text says why). Other kinds: -1. */
 int tool_roles_apply(tool_roles_t *r, const viscera_SessionControl *c, char *text, size_t n);
 
+/* A role read back from a checkpoint (untrusted): 0 when owner is "" or a
+ * valid station, guide is "" or a valid station other than the owner, and
+ * with a guide the authority is in 0..1 and the coupling in (0, the tool's
+ * stiffness]; -1 otherwise. restore() installs a valid one like a control
+ * command would (version + 1 and marked changed when it differs; without a
+ * guide authority and coupling are 0) and returns -1 for an invalid one. */
+int tool_roles_valid(const tool_roles_t *r, size_t t, const char *owner, const char *guide, double authority,
+                     double coupling);
+int tool_roles_restore(tool_roles_t *r, size_t t, const char *owner, const char *guide, double authority,
+                       double coupling);
+
 /* The ToolRole sample of tool t. */
 void tool_roles_fill(const tool_roles_t *r, size_t t, uint64_t sim_time_ns, viscera_ToolRole *out);
 

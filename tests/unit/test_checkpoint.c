@@ -64,8 +64,8 @@ int main(void) {
   ta[0].path_length = 0.03;
   verr_t err;
   unlink(path);
-  CHECK(checkpoint_load(path, &b, tb, lb, &err) == 0); /* no file: fresh start */
-  CHECK(checkpoint_save(path, &a, ta, la, &err) == 0);
+  CHECK(checkpoint_load(path, &b, tb, lb, NULL, &err) == 0); /* no file: fresh start */
+  CHECK(checkpoint_save(path, &a, ta, la, NULL, &err) == 0);
 
   /* Damaged copies first: each refused, b untouched (still at rest). */
   FILE *f = fopen(path, "rb");
@@ -89,21 +89,21 @@ int main(void) {
     fwrite(bytes, 1, cases[k].len, g);
     fclose(g);
     if (cases[k].flip >= 0) bytes[cases[k].flip] = save;
-    CHECK(checkpoint_load(bad, &b, tb, lb, &err) == -1);
+    CHECK(checkpoint_load(bad, &b, tb, lb, NULL, &err) == -1);
     CHECK(strstr(err.msg, cases[k].expect) != NULL);
     CHECK(b.sim_time == 0 && b.steps == 0);
     CHECK(max_diff(a.organs[0].model, b.organs[0].model) > 1e-3); /* still at rest, a is pressed */
   }
   /* Another scene (name) and another organ (node count): refused. */
   CHECK(make(&c, src, "other", "spleen.obj") == 0);
-  CHECK(checkpoint_load(path, &c, tb, lb, &err) == -1 && strstr(err.msg, "another scene"));
+  CHECK(checkpoint_load(path, &c, tb, lb, NULL, &err) == -1 && strstr(err.msg, "another scene"));
   runtime_destroy(&c);
   CHECK(make(&c, src, "ck", "kidney.obj") == 0);
-  CHECK(checkpoint_load(path, &c, tb, lb, &err) == -1 && strstr(err.msg, "node count"));
+  CHECK(checkpoint_load(path, &c, tb, lb, NULL, &err) == -1 && strstr(err.msg, "node count"));
   runtime_destroy(&c);
 
   /* The real one: restored exactly, and both continue identically. */
-  CHECK(checkpoint_load(path, &b, tb, lb, &err) == 1);
+  CHECK(checkpoint_load(path, &b, tb, lb, NULL, &err) == 1);
   CHECK(b.sim_time == a.sim_time && b.steps == a.steps);
   CHECK(max_diff(a.organs[0].model, b.organs[0].model) == 0);
   CHECK(tb[0].time_above[THR_ST] == 0.25 && tb[0].path_length == 0.03);
@@ -122,12 +122,12 @@ int main(void) {
   if (w) {
     for (int s = 0; s < 20; s++) {
       runtime_step(&a);
-      checkpointer_submit(w, &a, ta, la);
+      checkpointer_submit(w, &a, ta, la, NULL);
     }
     uint64_t written = 0;
     CHECK(checkpointer_stop(w, &written, &err) == 0);
     CHECK(written >= 1);
-    CHECK(checkpoint_load(path, &b, tb, lb, &err) == 1);
+    CHECK(checkpoint_load(path, &b, tb, lb, NULL, &err) == 1);
     CHECK(b.steps == a.steps);
     CHECK(max_diff(a.organs[0].model, b.organs[0].model) == 0);
   }

@@ -15,6 +15,8 @@
  * - a refined adaptive kidney is restored bit for bit (the refinement
  *   redone at its centre) and runs on identically; a crafted centre is
  *   refused;
+ * - tool roles (owner, guide, authority, coupling) restored, and a crafted
+ *   role (authority out of range, a count unlike the scene's) refused;
  * - damaged, truncated, older-format and crafted files (a valid CRC around
  *   huge node, byte and cutter counts, out-of-range task and object
  *   states) are refused and leave the runtime at rest. */
@@ -33,6 +35,7 @@ static runtime_t a, b; /* large */
 static scene_t sc;
 static thr_tracker_t ta[SCENE_MAX_TOOLS], tb[SCENE_MAX_TOOLS];
 static tool_tally_t la[SCENE_MAX_TOOLS], lb[SCENE_MAX_TOOLS];
+static tool_roles_t ra, rb;
 static char path[200], bad[240];
 static verr_t err;
 
@@ -122,10 +125,17 @@ static void test_objects_tasks_tallies(void) {
   CHECK(!a.stones[1].removed && a.stones[1].held_by == 0 && a.tasks[1].started && !a.tasks[1].completed);
   CHECK(la[0].grasps == 2 && la[0].grasp_time > 1.0 && la[0].was_holding);
   ta[0].time_above[THR_MPF] = 0.125; /* measures ride along as before */
-  CHECK(checkpoint_save(path, &a, ta, la, &err) == 0);
+  tool_roles_init(&ra, &sc);
+  CHECK(tool_roles_restore(&ra, 0, "alice", "drsmith", 0.5, 150) == 0);
+  CHECK(tool_roles_restore(&ra, 0, "alice", "alice", 0.5, 150) == -1); /* the owner cannot guide */
+  CHECK(checkpoint_save(path, &a, ta, la, &ra, &err) == 0);
 
   CHECK(load(&b, KIDNEY_STONES));
-  CHECK(checkpoint_load(path, &b, tb, lb, &err) == 1);
+  tool_roles_init(&rb, &sc);
+  rb.changed = 0;
+  CHECK(checkpoint_load(path, &b, tb, lb, &rb, &err) == 1);
+  CHECK(!strcmp(rb.tool[0].owner, "alice") && !strcmp(rb.tool[0].guide, "drsmith"));
+  CHECK(rb.tool[0].authority == 0.5 && rb.tool[0].coupling == 150 && rb.tool[0].version == 2 && (rb.changed & 1u));
   CHECK(b.sim_time == a.sim_time && b.steps == a.steps);
   for (size_t k = 0; k < 2; k++) {
     CHECK(memcmp(b.stones[k].pos, a.stones[k].pos, sizeof a.stones[k].pos) == 0);
@@ -153,9 +163,12 @@ static void test_objects_tasks_tallies(void) {
   CHECK(n > 200);
   if (n > 200) {
     size_t body = n - 8;
-    /* The last stone's `removed` is the last u64 of the body; the stones
-     * (40 bytes each) follow their count, which follows the tasks. */
-    size_t removed_at = body - 8, held_at = body - 16, count_at = body - 2 * 40 - 8;
+    /* The roles close the body: their count, then per tool two 32-byte
+     * names, authority, coupling. Before them the last stone's `removed`;
+     * the stones (40 bytes each) follow their count, which follows the
+     * tasks. */
+    size_t roles_at = body - (8 + 80), authority_at = roles_at + 8 + 64;
+    size_t removed_at = roles_at - 8, held_at = roles_at - 16, count_at = roles_at - 2 * 40 - 8;
     size_t task1_started = count_at - 32;
     struct {
       size_t at;
@@ -165,14 +178,16 @@ static void test_objects_tasks_tallies(void) {
                       {held_at, 5, "bad object state"},
                       {count_at, 1u << 30, "object count"},
                       {task1_started, 7, "bad task state"},
-                      {count_at - 2 * 32 - 8, 3, "task count"}};
+                      {count_at - 2 * 32 - 8, 3, "task count"},
+                      {roles_at, 3, "tool role count"},
+                      {authority_at, 0x4000000000000000ull /* 2.0 */, "bad tool role"}};
     for (size_t k = 0; k < sizeof bad_fields / sizeof bad_fields[0]; k++) {
       uint64_t save;
       memcpy(&save, bytes + bad_fields[k].at, 8);
       memcpy(bytes + bad_fields[k].at, &bad_fields[k].v, 8);
       write_bad(bytes, body, 1);
       memcpy(bytes + bad_fields[k].at, &save, 8);
-      CHECK(checkpoint_load(bad, &b, tb, lb, &err) == -1); /* b stays at rest: no reload needed */
+      CHECK(checkpoint_load(bad, &b, tb, lb, &rb, &err) == -1); /* b stays at rest: no reload needed */
       if (!strstr(err.msg, bad_fields[k].why)) fprintf(stderr, "  case %zu: %s\n", k, err.msg);
       CHECK(strstr(err.msg, bad_fields[k].why) != NULL);
       CHECK(b.steps == 0 && !b.tasks[0].started && !b.stones[0].removed);
@@ -217,11 +232,11 @@ static void test_cut_xpbd(void) {
   const model_t *ma = a.organs[0].model;
   CHECK(ma->topology_version > 0 && ma->nsurf > nv0);
   uint64_t t0 = vtime_mono_ns();
-  CHECK(checkpoint_save(path, &a, ta, la, &err) == 0);
+  CHECK(checkpoint_save(path, &a, ta, la, NULL, &err) == 0);
   double save_ms = (double)(vtime_mono_ns() - t0) * 1e-6;
   CHECK(load(&b, SPLEEN_XPBD));
   t0 = vtime_mono_ns();
-  int r = checkpoint_load(path, &b, tb, lb, &err);
+  int r = checkpoint_load(path, &b, tb, lb, NULL, &err);
   double load_ms = (double)(vtime_mono_ns() - t0) * 1e-6;
   if (r != 1) fprintf(stderr, "  %s\n", err.msg);
   CHECK(r == 1);
@@ -237,7 +252,7 @@ static void test_cut_xpbd(void) {
   if (w) {
     for (int k = 0; k < 5; k++) {
       t0 = vtime_mono_ns();
-      checkpointer_submit(w, &a, ta, la);
+      checkpointer_submit(w, &a, ta, la, NULL);
       double us = (double)(vtime_mono_ns() - t0) * 1e-3;
       if (k == 0)
         first_us = us; /* buffers grow */
@@ -308,7 +323,7 @@ static void test_cut_xpbd(void) {
       }
       write_bad(bytes, cases[k].len, cases[k].reseal);
       if (cases[k].at != SIZE_MAX) memcpy(bytes + cases[k].at, &save, 8);
-      CHECK(checkpoint_load(bad, &b, tb, lb, &err) == -1);
+      CHECK(checkpoint_load(bad, &b, tb, lb, NULL, &err) == -1);
       if (!strstr(err.msg, cases[k].why)) fprintf(stderr, "  case %zu: %s\n", k, err.msg);
       CHECK(strstr(err.msg, cases[k].why) != NULL && strstr(err.msg, "starting from rest") != NULL);
       const model_t *m = b.organs[0].model;
@@ -334,9 +349,9 @@ static void test_cut_ms(void) {
   drive(&a, 0, mid, above, 100, 0);
   const model_t *ma = a.organs[0].model;
   CHECK(ma->topology_version > 0 && ma->nsurf != nv0);
-  CHECK(checkpoint_save(path, &a, ta, la, &err) == 0);
+  CHECK(checkpoint_save(path, &a, ta, la, NULL, &err) == 0);
   CHECK(load(&b, BLOCK_MS));
-  int r = checkpoint_load(path, &b, tb, lb, &err);
+  int r = checkpoint_load(path, &b, tb, lb, NULL, &err);
   if (r != 1) fprintf(stderr, "  %s\n", err.msg);
   CHECK(r == 1);
   const model_t *mb = b.organs[0].model;
@@ -372,7 +387,7 @@ static void test_cut_ms(void) {
     uint32_t big = (uint32_t)nn + 5;
     memcpy(bytes + tri_at + 4, &big, 4);
     write_bad(bytes, n - 8, 1);
-    CHECK(checkpoint_load(bad, &b, tb, lb, &err) == -1);
+    CHECK(checkpoint_load(bad, &b, tb, lb, NULL, &err) == -1);
     CHECK(strstr(err.msg, "triangle") && strstr(err.msg, "starting from rest"));
     CHECK(b.steps == 0 && b.organs[0].model->topology_version == 0 && b.organs[0].model->nsurf == nv0);
   }
@@ -409,9 +424,9 @@ static void test_adaptive(void) {
   }
   const model_t *ma = a.organs[0].model;
   CHECK(ma->topology_version > 0 && ma->nsurf > nv0);
-  CHECK(checkpoint_save(path, &a, ta, la, &err) == 0);
+  CHECK(checkpoint_save(path, &a, ta, la, NULL, &err) == 0);
   CHECK(load_adaptive(&b));
-  int r = checkpoint_load(path, &b, tb, lb, &err);
+  int r = checkpoint_load(path, &b, tb, lb, NULL, &err);
   if (r != 1) fprintf(stderr, "  %s\n", err.msg);
   CHECK(r == 1);
   const model_t *mb = b.organs[0].model;
@@ -439,7 +454,7 @@ static void test_adaptive(void) {
     write_bad(bytes, n - 8, 1);
     runtime_destroy(&b);
     CHECK(load_adaptive(&b));
-    CHECK(checkpoint_load(bad, &b, tb, lb, &err) == -1);
+    CHECK(checkpoint_load(bad, &b, tb, lb, NULL, &err) == -1);
     CHECK(strstr(err.msg, "bad centre") != NULL);
     CHECK(b.organs[0].model->topology_version == 0 && b.organs[0].model->nsurf == nv0);
   }
