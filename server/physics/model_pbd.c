@@ -116,22 +116,16 @@ static int pbd_save_topology(const model_t *m, state_blob_t *b);
 static int pbd_restore_topology(model_t *m, state_blob_t *b, size_t nnodes, const double *x, const double *v,
                                 verr_t *err);
 
-static const model_ops_t PBD_OPS = {.name = "pbd",
-                                    .step = pbd_model_step,
-                                    .destroy = pbd_model_destroy,
-                                    .energy = pbd_model_energy,
-                                    .error_estimate = pbd_model_error,
-                                    .add_surface_force = pbd_model_add_surface_force,
-                                    .save_topology = pbd_save_topology,
-                                    .restore_topology = pbd_restore_topology};
-static const model_ops_t XPBD_OPS = {.name = "xpbd",
-                                     .step = pbd_model_step,
-                                     .destroy = pbd_model_destroy,
-                                     .energy = pbd_model_energy,
-                                     .error_estimate = pbd_model_error,
-                                     .add_surface_force = pbd_model_add_surface_force,
-                                     .save_topology = pbd_save_topology,
-                                     .restore_topology = pbd_restore_topology};
+/* pbd and xpbd share every operation; only the name (and the mode the
+ * model was created with) differ. */
+#define PBD_FAMILY_OPS(model_name)                                                                                     \
+  {                                                                                                                    \
+    .name = model_name, .step = pbd_model_step, .destroy = pbd_model_destroy, .energy = pbd_model_energy,              \
+    .error_estimate = pbd_model_error, .add_surface_force = pbd_model_add_surface_force,                               \
+    .save_topology = pbd_save_topology, .restore_topology = pbd_restore_topology                                       \
+  }
+static const model_ops_t PBD_OPS = PBD_FAMILY_OPS("pbd");
+static const model_ops_t XPBD_OPS = PBD_FAMILY_OPS("xpbd");
 
 model_t *model_pbd_create(const model_params_t *p, verr_t *err) {
   const scene_organ_t *cfg = p->cfg;

@@ -11,13 +11,8 @@
 # runs on (2 s) and exits cleanly. Two recordings per case, one per server
 # life. usage: checkpoint_cut_test.sh BUILD SRC OUT
 set -euo pipefail
-BUILD="$1"; SRC="$2"; OUT="$3"
-PIDS=()
-cleanup() { for p in "${PIDS[@]}"; do kill -9 "$p" 2>/dev/null || true; done; }
-trap cleanup EXIT
-fail() { echo "FAIL: $*" >&2; for f in "$OUT"/*.log; do echo "--- $f"; tail -6 "$f"; done >&2; exit 1; }
+source "$(dirname "${BASH_SOURCE[0]}")/prelude.sh"
 wait_for() { for _ in $(seq 1 "${3:-300}"); do grep -q "$2" "$1" 2>/dev/null && return 0; sleep 0.1; done; return 1; }
-rm -rf "$OUT"; mkdir -p "$OUT"
 BASE="$OUT"
 run_case() { # scene trajectory mesh
   local scene=$1 traj=$2 mesh=$3

@@ -6,13 +6,8 @@
 # mesh); new material is applied (the server says so) and a bad organ id is
 # refused with a reason. usage: control_test.sh BUILD SRC OUT
 set -euo pipefail
-BUILD="$1"; SRC="$2"; OUT="$3"
+source "$(dirname "${BASH_SOURCE[0]}")/prelude.sh"
 PART=test/control
-PIDS=()
-cleanup() { for p in "${PIDS[@]}"; do kill -9 "$p" 2>/dev/null || true; done; }
-trap cleanup EXIT
-fail() { echo "FAIL: $*" >&2; for f in "$OUT"/*.log; do echo "--- $f"; tail -6 "$f"; done >&2; exit 1; }
-rm -rf "$OUT"; mkdir -p "$OUT"
 CTL=("$BUILD/client/control/viscera-control" --partition $PART --wait 8)
 "$BUILD/server/viscera-server" --scene "$SRC/assets/scenes/default.yaml" --partition $PART --duration 14 \
   --final-mesh "$OUT/server.obj" > "$OUT/server.out" 2> "$OUT/server.log" & SRV=$!; PIDS+=($SRV)

@@ -6,12 +6,7 @@
 # scene; PNG grids were written.
 # usage: dashboard_test.sh BUILD SRC OUT
 set -euo pipefail
-BUILD="$1"; SRC="$2"; OUT="$3"
-PIDS=()
-cleanup() { for p in "${PIDS[@]}"; do kill -9 "$p" 2>/dev/null || true; done; }
-trap cleanup EXIT
-fail() { echo "FAIL: $*" >&2; for f in "$OUT"/*.log; do echo "--- $f"; tail -6 "$f"; done >&2; exit 1; }
-rm -rf "$OUT"; mkdir -p "$OUT"
+source "$(dirname "${BASH_SOURCE[0]}")/prelude.sh"
 for s in seat01 seat02; do
   "$BUILD/server/viscera-server" --scene "$SRC/assets/scenes/default.yaml" --partition lab/$s --duration 12 \
     > "$OUT/server_$s.log" 2>&1 & PIDS+=($!)

@@ -20,13 +20,9 @@
 # silence, as designed) does not fail it either.
 # usage: guide_test.sh BUILD SRC OUT
 set -euo pipefail
-BUILD="$1"; SRC="$2"; OUT="$3"
+source "$(dirname "${BASH_SOURCE[0]}")/prelude.sh"
+FAIL_TAIL=12
 PART=test/guide
-PIDS=()
-cleanup() { for p in "${PIDS[@]}"; do kill -9 "$p" 2>/dev/null || true; done; }
-trap cleanup EXIT
-fail() { echo "FAIL: $*" >&2; for f in "$OUT"/*.log; do echo "--- $f"; tail -12 "$f"; done >&2; exit 1; }
-rm -rf "$OUT"; mkdir -p "$OUT"
 # A trainee, B instructor (above the kidney's top, z 0.0346 at x 0.012).
 AX=0.032; BX=0.012; Y=0.004; Z=0.070; PRESS_Z=0.029
 printf '0 %s %s %s\n' $AX $Y $Z > "$OUT/alice.traj"

@@ -14,12 +14,7 @@
 #      not exist is named by Cyclone ("does not match an available interface").
 # usage: lan_config_test.sh BUILD SRC OUT
 set -euo pipefail
-BUILD="$1"; SRC="$2"; OUT="$3"
-PIDS=()
-cleanup() { for p in "${PIDS[@]}"; do kill -9 "$p" 2>/dev/null || true; done; }
-trap cleanup EXIT
-fail() { echo "FAIL: $*" >&2; for f in "$OUT"/*.log; do echo "--- $f"; tail -6 "$f"; done >&2; exit 1; }
-rm -rf "$OUT"; mkdir -p "$OUT"
+source "$(dirname "${BASH_SOURCE[0]}")/prelude.sh"
 SRV="$BUILD/server/viscera-server"; HAP="$BUILD/client/haptic/viscera-haptic"
 SCENE="$SRC/assets/scenes/default.yaml"; SEAT=lan/seat01
 LAN="file://$SRC/deploy/cyclonedds-lan.xml"

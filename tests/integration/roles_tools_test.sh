@@ -17,13 +17,9 @@
 #   rejected while the tool was alice's alone.
 # usage: roles_tools_test.sh BUILD SRC OUT
 set -euo pipefail
-BUILD="$1"; SRC="$2"; OUT="$3"
+source "$(dirname "${BASH_SOURCE[0]}")/prelude.sh"
+FAIL_TAIL=8 FAIL_LOGS="$OUT/*.txt"
 PART=test/roles
-PIDS=()
-cleanup() { for p in "${PIDS[@]}"; do kill -9 "$p" 2>/dev/null || true; done; }
-trap cleanup EXIT
-fail() { echo "FAIL: $*" >&2; for f in "$OUT"/*.log "$OUT"/*.txt; do echo "--- $f"; tail -8 "$f"; done >&2; exit 1; }
-rm -rf "$OUT"; mkdir -p "$OUT"
 # Free space above the default kidney (its top is at z = 0.035 m).
 A=0.000,0.004,0.070; B=0.030,0.004,0.070; M=0.015,0.004,0.070
 printf '# alice holds still at A\n0 %s\n100 %s\n' "${A//,/ }" "${A//,/ }" > "$OUT/alice.traj"
