@@ -9,7 +9,9 @@
 #   3. a trainee certificate cannot publish SessionControl (viscera-control
 #      cannot create its writer), the instructor's can (answered by the server);
 #   4. a trainee certificate cannot publish into another seat (its haptic
-#      client is refused in lab/seat02).
+#      client is refused in lab/seat02);
+#   5. an observer certificate publishes nothing: its SessionControl and its
+#      haptic client's ToolCommand are refused.
 # usage: security_test.sh BUILD SRC OUT
 set -euo pipefail
 BUILD="$1"; SRC="$2"; OUT="$3"
@@ -53,6 +55,17 @@ if CYCLONEDDS_URI="$(as trainee-seat01)" timeout 20 "$HAP" --trajectory "$SRC/as
   fail "trainee-seat01 ran a haptic client in lab/seat02"
 fi
 grep -q "Not Allowed By Security" "$OUT/haptic_seat02.log" || fail "seat02 not refused by access control"
+
+# 5. An observer only views: refused SessionControl and ToolCommand alike.
+if CYCLONEDDS_URI="$(as observer)" "$CTL" --partition $SEAT --wait 3 pause > "$OUT/ctl_observer.log" 2>&1; then
+  fail "an observer identity sent SessionControl"
+fi
+grep -q "Not Allowed By Security" "$OUT/ctl_observer.log" || fail "observer SessionControl not refused by access control"
+if CYCLONEDDS_URI="$(as observer)" timeout 20 "$HAP" --trajectory "$SRC/assets/trajectories/palpate_kidney.traj" \
+  --partition $SEAT --wait-server 2 --quiet > "$OUT/haptic_observer.log" 2>&1; then
+  fail "an observer identity drove a tool"
+fi
+grep -q "Not Allowed By Security" "$OUT/haptic_observer.log" || fail "observer ToolCommand not refused by access control"
 
 # 1. The secure seat works.
 wait $HAP_PID || fail "secure haptic client failed"
