@@ -3,6 +3,6 @@
 add_executable(delta_sub ${CMAKE_CURRENT_LIST_DIR}/delta_sub.c)
 target_link_libraries(delta_sub PRIVATE viscera_common)
 add_test(NAME load_bench_smoke COMMAND bash ${PROJECT_SOURCE_DIR}/deploy/load_bench.sh --build ${PROJECT_BINARY_DIR}
-         --out ${CMAKE_CURRENT_BINARY_DIR}/load_smoke --seats 2 --subscribers 4 --duration 12)
+         --out ${CMAKE_CURRENT_BINARY_DIR}/load_smoke --seats 2 --subscribers 4 --duration 12 --baseline 3)
 set_tests_properties(load_bench_smoke PROPERTIES LABELS bench TIMEOUT 120
   ENVIRONMENT "CYCLONEDDS_URI=file://${VISCERA_DDS_CONFIG};VISCERA_DOMAIN=148")
