@@ -43,7 +43,10 @@ expect_seats_recorded() {
     s=$(printf '%s/seat%02d' "$prefix" "$i")
     n=$(sqlite3 "$db" "SELECT count(*) FROM samples s JOIN writers w ON s.writer_id = w.id JOIN topics t ON t.id = s.topic_id
       WHERE t.name = 'viscera_MeshDelta' AND w.partitions = '$s' AND s.kind = 0")
-    [ "${n:-0}" -gt 10 ] || fail "the lab recording has ${n:-0} MeshDelta samples from $s"
+    # At least one: a seat without a trainee publishes few deltas once its
+    # organ has settled (9 in a starved sanitizer run), so a larger bound
+    # would judge the machine's speed, not the partitioning.
+    [ "${n:-0}" -ge 1 ] || fail "the lab recording has no MeshDelta sample from $s"
   done
   servers=$(sqlite3 "$db" "SELECT count(DISTINCT w.partitions), count(DISTINCT substr(w.guid, 1, 24)) FROM writers w
     JOIN topics t ON t.id = w.topic_id WHERE t.name = 'viscera_MeshState'")
