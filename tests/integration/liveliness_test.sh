@@ -20,7 +20,7 @@ trap 'for p in "${pids[@]}"; do kill -9 "$p" 2>/dev/null || true; done' EXIT
 fail() { echo "FAIL: $*" >&2; tail -n 8 "$OUT"/*.log >&2; exit 1; }
 server() { "$BUILD/server/viscera-server" --scene "$SRC/assets/scenes/default.yaml" "${common[@]}" \
   >>"$OUT/server$1.out" 2>>"$OUT/server$1.log" & SERVER=$!; pids+=($SERVER); }
-count() { grep -c "$2" "$1" 2>/dev/null || true; }
+count() { local n; n=$(grep -c "$2" "$1" 2>/dev/null) || true; echo "${n:-0}"; } # 0 also for a file not there yet
 wait_for() { # FILE PATTERN SECONDS [MORE_THAN]: until PATTERN occurs more than MORE_THAN (0) times
   local i=0; while [ "$(count "$1" "$2")" -le "${4:-0}" ]; do sleep 0.1; i=$((i+1)); [ $i -lt $(($3*10)) ] || return 1; done; }
 
