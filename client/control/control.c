@@ -54,6 +54,25 @@ static int parse_double(const char *s, double *out) {
 /* assign / guide / takeover / release (idl CONTROL_ASSIGN_TOOL, CONTROL_GUIDE):
  * the station travels in the command's text, so --text cannot go with them.
  * argv[0] is the verb. Returns 0, or -1 after saying what is wrong. */
+/* "INDEX V1 .. Vn" of the material and thresholds verbs: an index 0..1000
+ * then n numbers; -1 after saying which argument is wrong. */
+static int parse_index_values(const char *verb, const char *index_what, const char *value_what, char **args, int n,
+                              int32_t *index, double *values) {
+  char *end;
+  long i = strtol(args[0], &end, 10);
+  if (!args[0][0] || *end || i < 0 || i > 1000) {
+    fprintf(stderr, "viscera-control: %s: not %s: '%s'\n", verb, index_what, args[0]);
+    return -1;
+  }
+  *index = (int32_t)i;
+  for (int k = 0; k < n; k++)
+    if (parse_double(args[1 + k], &values[k])) {
+      fprintf(stderr, "viscera-control: %s: not %s: '%s'\n", verb, value_what, args[1 + k]);
+      return -1;
+    }
+  return 0;
+}
+
 static int parse_role(const char *verb, int argc, char **argv, int has_text, viscera_SessionControl *cmd) {
   int release = strcmp(verb, "release") == 0, guide = strcmp(verb, "guide") == 0;
   int want_min = release ? 2 : 3, want_max = release ? 2 : guide ? 5 : 3;
@@ -172,32 +191,13 @@ int main(int argc, char **argv) {
     cmd.kind = viscera_CONTROL_RESET;
   } else if (verb && strcmp(verb, "material") == 0 && argc - optind == 6) {
     cmd.kind = viscera_CONTROL_SET_MATERIAL;
-    char *end;
-    long organ = strtol(argv[optind + 1], &end, 10);
-    if (*end || organ < 0 || organ > 1000) {
-      fprintf(stderr, "viscera-control: material: not an organ index: '%s'\n", argv[optind + 1]);
+    if (parse_index_values("material", "an organ index", "a number", argv + optind + 1, 4, &cmd.organ_id, cmd.values))
       return 2;
-    }
-    cmd.organ_id = (int32_t)organ;
-    for (int k = 0; k < 4; k++)
-      if (parse_double(argv[optind + 2 + k], &cmd.values[k])) {
-        fprintf(stderr, "viscera-control: material: not a number: '%s'\n", argv[optind + 2 + k]);
-        return 2;
-      }
   } else if (verb && strcmp(verb, "thresholds") == 0 && argc - optind == 5) {
     cmd.kind = viscera_CONTROL_SET_THRESHOLDS;
-    char *end;
-    long tool = strtol(argv[optind + 1], &end, 10);
-    if (*end || tool < 0 || tool > 1000) {
-      fprintf(stderr, "viscera-control: thresholds: not a tool index: '%s'\n", argv[optind + 1]);
+    if (parse_index_values("thresholds", "a tool index", "a force in N", argv + optind + 1, 3, &cmd.tool_id,
+                           cmd.values))
       return 2;
-    }
-    cmd.tool_id = (int32_t)tool;
-    for (int k = 0; k < 3; k++)
-      if (parse_double(argv[optind + 2 + k], &cmd.values[k])) {
-        fprintf(stderr, "viscera-control: thresholds: not a force in N: '%s'\n", argv[optind + 2 + k]);
-        return 2;
-      }
   } else if (verb && (strcmp(verb, "assign") == 0 || strcmp(verb, "guide") == 0 || strcmp(verb, "takeover") == 0 ||
                       strcmp(verb, "release") == 0)) {
     if (parse_role(verb, argc - optind, argv + optind, *text != 0, &cmd)) return 2;
