@@ -155,6 +155,14 @@ int main(int argc, char **argv) {
           st.steps, st.step_us_median, st.step_us_p99, st.step_us_max, st.overruns, st.rollbacks);
   fprintf(stderr, "server: step CPU time median %.1f us p99 %.1f us; %.3f simulated s per wall s\n",
           st.step_cpu_us_median, st.step_cpu_us_p99, st.realtime_ratio);
+  if (st.sleep_enabled)
+    fprintf(stderr,
+            "server: organs slept %" PRIu64 " times, woke %" PRIu64 " times; every organ asleep in %" PRIu64
+            " of %" PRIu64 " steps (%.1f %%); steps with an organ awake (%zu recent): wall median %.1f us p99 %.1f "
+            "us, CPU median %.1f us p99 %.1f us\n",
+            st.organ_sleeps, st.organ_wakes, st.steps_all_asleep, st.steps,
+            st.steps ? 100.0 * (double)st.steps_all_asleep / (double)st.steps : 0.0, st.awake_samples,
+            st.awake_step_us_median, st.awake_step_us_p99, st.awake_step_cpu_us_median, st.awake_step_cpu_us_p99);
   fprintf(stderr, "server: %" PRIu64 " tool commands applied, %" PRIu64 " rejected (", st.commands, st.rejected_total);
   for (int v = 1; v < TOOLCMD_VERDICT_COUNT; v++)
     fprintf(stderr, "%s%s: %" PRIu64, v > 1 ? ", " : "", tool_command_verdict_str((tool_cmd_verdict_t)v),

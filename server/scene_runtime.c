@@ -14,8 +14,7 @@
 
 static void apply_contacts(model_t *m, void *vctx);
 
-static int organ_init(organ_rt_t *o, runtime_t *rt, const scene_organ_t *cfg, uint32_t id, double tool_k,
-                      verr_t *err) {
+static int organ_init(organ_rt_t *o, runtime_t *rt, const scene_organ_t *cfg, uint32_t id, double tool_k, verr_t *err) {
   const scene_t *sc = &rt->scene;
   memset(o, 0, sizeof *o);
   o->cfg = cfg;
@@ -37,6 +36,12 @@ static int organ_init(organ_rt_t *o, runtime_t *rt, const scene_organ_t *cfg, ui
   }
   o->model->hook = apply_contacts;
   o->model->hook_ctx = o;
+  if (sc->sleep_speed > 0 && organ_sleep_init(&o->sleep, o->model->nsurf, &e)) {
+    model_destroy(o->model);
+    o->model = NULL;
+    mesh_free(&o->rest);
+    return verr_set(err, "%s:%d: organ '%s': %s", sc->path, cfg->line, cfg->name, e.msg);
+  }
   return 0;
 }
 
@@ -70,8 +75,8 @@ int runtime_init(runtime_t *rt, const scene_t *scene, verr_t *err) {
     if (m->nsurf_tris) mean_edge /= 3.0 * (double)m->nsurf_tris;
     for (size_t t = 0; t < scene->ntools; t++) tool_r = fmax(tool_r, scene->tools[t].radius);
     o->patch_radius = fmax(2 * tool_r, 1.5 * mean_edge);
-    rt->surfaces[i] = (proxy_surface_t){.x = m->surf_x, .tris = m->surf_tris, .ntris = m->nsurf_tris,
-                                        .max_edge = 3 * max_edge, .x_rest = m->surf_rest};
+    rt->surfaces[i] = (proxy_surface_t){
+        .x = m->surf_x, .tris = m->surf_tris, .ntris = m->nsurf_tris, .max_edge = 3 * max_edge, .x_rest = m->surf_rest};
     verr_t te;
     if (aabb_tree_build(&o->tree, m->surf_x, m->nsurf, m->surf_tris, m->nsurf_tris, &te)) {
       verr_set(err, "%s:%d: organ '%s': %s", rt->scene.path, o->cfg->line, o->cfg->name, te.msg);
@@ -124,6 +129,7 @@ void runtime_destroy(runtime_t *rt) {
     free(rt->organs[i].vn_rest);
     rt->organs[i].vn_rest = NULL;
     mesh_free(&rt->organs[i].rest);
+    organ_sleep_free(&rt->organs[i].sleep);
   }
   rt->norgans = 0;
 }
@@ -239,8 +245,36 @@ void runtime_topology_restored(runtime_t *rt, size_t organ) {
   follow_organ(rt, organ, none);
 }
 
+/* 1 when anything could touch organ i in this step: a driven tool's tip or
+ * shaft (or the stone it holds) within reach of the organ's current
+ * bounding box, its god-object on any surface, a grasp of this organ, a
+ * cut under way. The reach adds a margin of max(1 cm, 3 tool radii): a
+ * hand moves at most a few mm per ms, so the organ is awake several steps
+ * before the tool can arrive. */
+static int organ_disturbed(const runtime_t *rt, size_t i) {
+  const organ_rt_t *o = &rt->organs[i];
+  for (size_t t = 0; t < rt->ntools; t++) {
+    const tool_rt_t *tool = &rt->tools[t];
+    if (!tool->active) continue;
+    if (tool->proxy.in_contact || (tool->grasp.active && tool->grasp.organ == (int)o->id) || scalpel_cutting(rt, t))
+      return 1;
+    double r = tool->cfg->radius, reach = r + fmax(0.01, 3 * r), end[3];
+    v3_copy(end, tool->device);
+    v3_axpy(end, tool->axis, tool->cfg->length);
+    if (organ_sleep_box_near(o->tree.lo, o->tree.hi, tool->device, end, reach)) return 1;
+    if (tool->stone >= 0) {
+      const stone_t *st = &rt->stones[tool->stone];
+      if (organ_sleep_box_near(o->tree.lo, o->tree.hi, st->pos, st->pos, st->radius + reach)) return 1;
+    }
+  }
+  return 0;
+}
+
 int runtime_step(runtime_t *rt) {
   double dt = rt->scene.dt;
+  /* Stillness over sleep_after, in whole steps (at least 2, scene.c). */
+  uint32_t need = (uint32_t)fmin(4e9, ceil(rt->scene.sleep_after / dt - 1e-9));
+  rt->organs_stepped = 0;
   interact_before_step(rt);
   for (size_t t = 0; t < rt->ntools; t++) {
     tool_rt_t *tool = &rt->tools[t];
@@ -252,9 +286,23 @@ int runtime_step(runtime_t *rt) {
   int rolled = 0;
   for (size_t i = 0; i < rt->norgans; i++) {
     organ_rt_t *o = &rt->organs[i];
+    int sleeping = rt->scene.sleep_speed > 0, disturbed = 0;
+    if (sleeping) {
+      disturbed = organ_disturbed(rt, i);
+      if (o->sleep.asleep) {
+        if (!disturbed) {
+          o->sleep.slept_steps++;
+          continue; /* nothing moves it: no step, no refit (the boxes still fit) */
+        }
+        organ_sleep_wake(&o->sleep);
+      }
+    }
+    rt->organs_stepped++;
     topo_anchor_t anchors[SCENE_MAX_TOOLS];
     topo_capture(rt, i, anchors);
-    if (o->model->ops->step(o->model, dt) < 0) {
+    uint32_t topo = o->topology_version;
+    int bad = o->model->ops->step(o->model, dt) < 0;
+    if (bad) {
       o->rollbacks++;
       rolled++;
     }
@@ -267,6 +315,10 @@ int runtime_step(runtime_t *rt) {
       /* Every step, rolled back or not: the proxy trusts the boxes. */
       aabb_tree_refit(&o->tree, o->model->surf_x);
     }
+    /* A rolled-back or re-meshed step is no evidence of rest. */
+    if (sleeping)
+      organ_sleep_observe(&o->sleep, o->model->surf_x, o->model->nsurf, rt->scene.sleep_speed * dt, need,
+                          disturbed || bad || o->topology_version != topo);
   }
   /* Report the force at the end of the step, with the proxy on the moved surface. */
   for (size_t t = 0; t < rt->ntools; t++) {

@@ -19,6 +19,7 @@
 #include "interaction/stone.h"
 #include "interaction/tasks.h"
 #include "mesh.h"
+#include "organ_sleep.h"
 #include "physics/model.h"
 #include "scene.h"
 #include "tool_input.h"
@@ -45,18 +46,21 @@ typedef struct organ_rt {
   uint32_t topology_version;
   uint64_t topology_changes; /* rebuilds so far */
   double last_follow_us;     /* the last rebuild's time (tree, surface view, re-attach), us */
+  /* Sleeping at rest (organ_sleep.h); unused (prev NULL) when the scene's
+   * sleep_speed is 0. */
+  organ_sleep_t sleep;
 } organ_rt_t;
 
 #define TOOL_PATCH_MAX 128
 
 typedef struct tool_rt {
   const scene_tool_t *cfg;
-  int active;          /* a valid command has been received */
-  double device[3];    /* commanded tip, m */
-  double max_force;    /* N: min(tool, device capability) */
+  int active;       /* a valid command has been received */
+  double device[3]; /* commanded tip, m */
+  double max_force; /* N: min(tool, device capability) */
   proxy_t proxy;
-  double force[3];     /* N on the tool, last step */
-  double peak_force;   /* N since start */
+  double force[3];   /* N on the tool, last step */
+  double peak_force; /* N since start */
   /* Contact patch: the tissue vertices that share the reaction force, with
    * weights summing to 1. A rigid tip presses an area, not three vertices;
    * spreading the load keeps the dent smooth and the contact normal steady. */
@@ -88,10 +92,11 @@ typedef struct runtime {
   stone_t stones[SCENE_MAX_OBJECTS];
   size_t ntasks;
   task_rt_t tasks[SCENE_MAX_TASKS];
-  iev_queue_t events; /* interaction events; the caller drains (clears n) */
+  iev_queue_t events;      /* interaction events; the caller drains (clears n) */
   struct scalpel *scalpel; /* cutting (interaction/scalpel.h); NULL in a scene without a scalpel */
   uint64_t steps;
-  double sim_time; /* s */
+  double sim_time;       /* s */
+  size_t organs_stepped; /* organs stepped by the last runtime_step (the others slept) */
 } runtime_t;
 
 /* Imports every organ mesh and builds its model (model_create: the model
@@ -115,7 +120,9 @@ void runtime_release_tool(runtime_t *rt, size_t t);
 void runtime_topology_restored(runtime_t *rt, size_t organ);
 
 /* One scene step of scene.dt: contact, then physics. Returns the number of
- * organs whose step was rolled back because it produced NaN/Inf. */
+ * organs whose step was rolled back because it produced NaN/Inf. With the
+ * scene's sleep_speed > 0 an organ at rest with nothing within reach is
+ * skipped (organ_sleep.h; organs_stepped tells how many were stepped). */
 int runtime_step(runtime_t *rt);
 
 #endif

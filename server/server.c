@@ -42,8 +42,9 @@ typedef struct server {
   thr_tracker_t thr[SCENE_MAX_TOOLS];
   session_control_t control;
   uint64_t event_seq;
-  double *step_us;     /* ring of recent step times */
-  double *step_cpu_us; /* the same steps' thread CPU times */
+  double *step_us;           /* ring of recent step times */
+  double *step_cpu_us;       /* the same steps' thread CPU times */
+  unsigned char *step_awake; /* the same steps: 1 when an organ was stepped (not all asleep, not paused) */
   size_t nstep_us;
   server_stats_t *stats;
 } server_t;
@@ -154,7 +155,8 @@ static int setup(server_t *s, const scene_t *scene, verr_t *err) {
   }
   s->step_us = calloc(STEP_RING, sizeof(double));
   s->step_cpu_us = calloc(STEP_RING, sizeof(double));
-  if (!s->step_us || !s->step_cpu_us) return verr_set(err, "out of memory");
+  s->step_awake = calloc(STEP_RING, 1);
+  if (!s->step_us || !s->step_cpu_us || !s->step_awake) return verr_set(err, "out of memory");
   return 0;
 }
 
@@ -165,6 +167,7 @@ static void teardown(server_t *s) {
   liveliness_watch_destroy(&s->lw);
   free(s->step_us);
   free(s->step_cpu_us);
+  free(s->step_awake);
 }
 
 /* Releases every tool whose commanding writer lost its liveliness (the
@@ -286,8 +289,8 @@ static void read_commands(server_t *s, uint64_t now) {
                      c->tool_id, station[0] ? tool_roles_who(station, who, sizeof who) : "an anonymous station",
                      s->roles.tool[c->tool_id].owner, r);
           else
-            snprintf(text, sizeof text, "ToolCommand from tool %u rejected: %s (%" PRIu64 " rejected so far)", c->tool_id,
-                     tool_command_verdict_str(v), r);
+            snprintf(text, sizeof text, "ToolCommand from tool %u rejected: %s (%" PRIu64 " rejected so far)",
+                     c->tool_id, tool_command_verdict_str(v), r);
           if (!s->opts->quiet) fprintf(stderr, "server: %s\n", text);
           publish_event(s, viscera_EVENT_INPUT_REJECTED, -1, (int)(c->tool_id < 1u << 30 ? c->tool_id : 0), (double)r,
                         text);
@@ -479,6 +482,27 @@ static void track_thresholds(server_t *s) {
                     contact ? tool->fb_organ : -1, (int)t, ev[i].level, text);
     }
   }
+}
+
+/* The recent steps that stepped an organ: what a step of physics costs,
+ * without the near-free steps of sleeping organs diluting the median. */
+static void summarise_awake(const server_t *s, size_t n, server_stats_t *stats) {
+  double *w = malloc((n + 1) * sizeof *w), *c = malloc((n + 1) * sizeof *c);
+  size_t k = 0;
+  if (w && c)
+    for (size_t i = 0; i < n; i++)
+      if (s->step_awake[i]) {
+        w[k] = s->step_us[i];
+        c[k++] = s->step_cpu_us[i];
+      }
+  vstats_summary_t sw = vstats_summarise(w, k), sc = vstats_summarise(c, k);
+  stats->awake_samples = k;
+  stats->awake_step_us_median = sw.median;
+  stats->awake_step_us_p99 = sw.p99;
+  stats->awake_step_cpu_us_median = sc.median;
+  stats->awake_step_cpu_us_p99 = sc.p99;
+  free(w);
+  free(c);
 }
 
 static void publish_metrics(server_t *s, uint64_t window_steps) {
@@ -760,6 +784,9 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
     if (s.rt.steps % publish_every == 0) publish_frames(&s);
     uint64_t t1 = vtime_mono_ns();
     s.step_cpu_us[s.nstep_us % STEP_RING] = (double)(vtime_thread_cpu_ns() - c0) * 1e-3;
+    int awake = !s.control.paused && s.rt.organs_stepped > 0;
+    s.step_awake[s.nstep_us % STEP_RING] = (unsigned char)awake;
+    if (!s.control.paused && !awake) stats->steps_all_asleep++;
     s.step_us[s.nstep_us++ % STEP_RING] = (double)(t1 - t0) * 1e-3;
     if (s.rt.steps % metrics_every == 0) {
       publish_metrics(&s, metrics_every);
@@ -806,6 +833,13 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
   vstats_summary_t sc = vstats_summarise(s.step_cpu_us, n);
   stats->step_cpu_us_median = sc.median;
   stats->step_cpu_us_p99 = sc.p99;
+  summarise_awake(&s, n, stats);
+  stats->sleep_enabled = scene->sleep_speed > 0;
+  for (size_t i = 0; i < s.rt.norgans; i++) {
+    stats->organ_sleeps += s.rt.organs[i].sleep.sleeps;
+    stats->organ_wakes += s.rt.organs[i].sleep.wakes;
+    stats->organ_slept_steps += s.rt.organs[i].sleep.slept_steps;
+  }
   double wall = (double)(vtime_mono_ns() - start) * 1e-9;
   stats->realtime_ratio = wall > 0 ? (s.rt.sim_time - sim0) / wall : 0;
   scalpel_print_summary(&s.rt, stdout);

@@ -36,6 +36,14 @@ typedef struct server_stats {
    * wall time grows while this stays put). */
   double step_cpu_us_median, step_cpu_us_p99;
   double realtime_ratio; /* simulated s per wall s over the run */
+  /* Organ sleeping (organ_sleep.h): steps in which every organ slept, over
+   * the run, and the step times above restricted to the steps that
+   * stepped an organ (the physics work), over the same recent steps. */
+  uint64_t steps_all_asleep;
+  uint64_t organ_sleeps, organ_wakes, organ_slept_steps; /* summed over the organs */
+  int sleep_enabled;                                     /* the scene's sleep_speed > 0 */
+  size_t awake_samples;                                  /* how many of the recent steps stepped an organ */
+  double awake_step_us_median, awake_step_us_p99, awake_step_cpu_us_median, awake_step_cpu_us_p99;
   size_t ntools;
   thr_tracker_t thr[SCENE_MAX_TOOLS];         /* palpation measures per tool at the end */
   viscera_ToolMetrics tools[SCENE_MAX_TOOLS]; /* per-tool measures at the end */
