@@ -826,6 +826,7 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
   for (size_t i = 0; i < s.rt.nstones; i++) stats->stone_removed[i] = s.rt.stones[i].removed;
   for (size_t t = 0; t < s.rt.ntools; t++) stats->peak_force = fmax(stats->peak_force, s.rt.tools[t].peak_force);
   size_t n = s.nstep_us < STEP_RING ? s.nstep_us : STEP_RING;
+  summarise_awake(&s, n, stats); /* first: the summaries below sort the rings in place */
   vstats_summary_t st = vstats_summarise(s.step_us, n);
   stats->step_us_median = st.median;
   stats->step_us_p99 = st.p99;
@@ -833,7 +834,6 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
   vstats_summary_t sc = vstats_summarise(s.step_cpu_us, n);
   stats->step_cpu_us_median = sc.median;
   stats->step_cpu_us_p99 = sc.p99;
-  summarise_awake(&s, n, stats);
   stats->sleep_enabled = scene->sleep_speed > 0;
   for (size_t i = 0; i < s.rt.norgans; i++) {
     stats->organ_sleeps += s.rt.organs[i].sleep.sleeps;
