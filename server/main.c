@@ -10,6 +10,7 @@
 #include "server.h"
 #include "vsignal.h"
 #include "vdds.h"
+#include "vrt.h"
 
 static volatile sig_atomic_t g_stop = 0;
 static void on_signal(int sig) {
@@ -28,6 +29,9 @@ static void usage(FILE *f) {
              "  --checkpoint FILE   resume from FILE when it holds this scene's state (kill -9, crash), and\n"
              "                      write the state there every --checkpoint-every s and at exit\n"
              "  --checkpoint-every S  simulated seconds between checkpoints (default 1)\n"
+             "  --rt-priority N     run the physics loop thread SCHED_FIFO at priority N (1..99), memory\n"
+             "                      locked (needs root or CAP_SYS_NICE; warns and runs on otherwise): its\n"
+             "                      steps then keep their pace on a crowded machine\n"
              "  --check             load and validate the scene, build its models, print per organ the model,\n"
              "                      integrator, nodes, tetrahedra, sub-steps and stable dt, exit\n"
              "  --quiet             only errors on stderr\n"
@@ -55,10 +59,11 @@ int main(int argc, char **argv) {
                                      {"quiet", no_argument, 0, 'q'},
                                      {"checkpoint", required_argument, 0, 'K'},
                                      {"checkpoint-every", required_argument, 0, 'E'},
+                                     {"rt-priority", required_argument, 0, 'R'},
                                      {"help", no_argument, 0, 'h'},
                                      {0, 0, 0, 0}};
   int c;
-  while ((c = getopt_long(argc, argv, "s:d:p:t:f:T:cqh", lo, NULL)) != -1) {
+  while ((c = getopt_long(argc, argv, "s:d:p:t:f:T:R:cqh", lo, NULL)) != -1) {
     char *end = NULL;
     switch (c) {
     case 's':
@@ -97,6 +102,12 @@ int main(int argc, char **argv) {
       opts.checkpoint_every = strtod(optarg, &end);
       if (*end || !(opts.checkpoint_every > 0)) {
         fprintf(stderr, "viscera-server: --checkpoint-every '%s' is not a number of seconds > 0\n", optarg);
+        return 2;
+      }
+      break;
+    case 'R':
+      if ((opts.rt_priority = vrt_parse_priority(optarg)) < 0) {
+        fprintf(stderr, "viscera-server: --rt-priority '%s' must be 1..99\n", optarg);
         return 2;
       }
       break;

@@ -16,6 +16,7 @@
 #include "viscera.h"
 #include "vmath.h"
 #include "vstats.h"
+#include "vrt.h"
 #include "vtime.h"
 #include "writer_stations.h"
 
@@ -753,6 +754,10 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
   for (size_t i = 0; i < s.rt.norgans; i++) mesh_publisher_keyframe(&s.pubs[i], s.rt.organs[i].model->surf_x, 0);
   publish_event(&s, viscera_EVENT_SESSION_STARTED, -1, -1, stats->resumed, resumed[0] ? resumed : scene->name);
 
+  /* Real time for this thread only, and only now: the DDS and checkpoint
+   * threads started above keep normal priority (vrt.h). A refusal is a
+   * warning; the loop runs on. */
+  if (opts->rt_priority) vrt_make_realtime(opts->rt_priority, "server", opts->quiet);
   uint64_t dt_ns = (uint64_t)(scene->dt * 1e9);
   uint64_t publish_every = (uint64_t)fmax(1.0, floor(1.0 / (scene->publish_hz * scene->dt) + 0.5));
   uint64_t metrics_every = (uint64_t)fmax(1.0, floor(1.0 / scene->dt + 0.5));

@@ -25,6 +25,7 @@
 #include "vdds.h"
 #include "viscera.h"
 #include "vmath.h"
+#include "vrt.h"
 #include "vstats.h"
 #include "vtime.h"
 
@@ -167,9 +168,8 @@ int main(int argc, char **argv) {
       force_csv = optarg;
       break;
     case 'R':
-      rt_priority = (int)v;
-      if (rt_priority < 1 || rt_priority > 99) {
-        fprintf(stderr, "viscera-haptic: --rt-priority must be 1..99\n");
+      if ((rt_priority = vrt_parse_priority(optarg)) < 0) {
+        fprintf(stderr, "viscera-haptic: --rt-priority '%s' must be 1..99\n", optarg);
         return 2;
       }
       break;
@@ -298,20 +298,9 @@ int main(int argc, char **argv) {
     fprintf(csv, "t,x,y,z,fx,fy,fz,in_contact\n");
   }
 
-  if (rt_priority) {
-    /* A 1 kHz loop sharing two cores with physics and rendering misses its
-     * tick whenever the scheduler prefers them; SCHED_FIFO and locked pages
-     * keep the period. DDS threads stay at normal priority. */
-    struct sched_param sp = {.sched_priority = rt_priority};
-    int rc = pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp);
-    if (rc != 0)
-      fprintf(stderr, "haptic: warning: SCHED_FIFO %d refused (%s); running at normal priority\n", rt_priority,
-              strerror(rc));
-    else if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0)
-      fprintf(stderr, "haptic: warning: mlockall failed (%s)\n", strerror(errno));
-    else if (!quiet)
-      fprintf(stderr, "haptic: loop at SCHED_FIFO priority %d, memory locked\n", rt_priority);
-  }
+  /* A 1 kHz tick sharing two cores with physics and rendering misses its
+   * period whenever the scheduler prefers them (vrt.h). */
+  if (rt_priority) vrt_make_realtime(rt_priority, "haptic", quiet);
   uint64_t period_ns = (uint64_t)(1e9 / rate);
   stats_t st = {0};
   double run_for = duration >= 0 ? duration : 1e300;
