@@ -16,12 +16,24 @@
 # subscribers) for BASELINE s: its step times are the reference that "step
 # time unchanged" is judged against.
 #
+# Servers run their physics loop at SCHED_FIFO RT (--rt-priority), trainees
+# their 1 kHz tick at HRT (higher: the haptic tick is short and the most
+# latency-critical), as a lab would deploy them; 0 = normal scheduling.
+# Without the privilege both warn and run at normal priority (the summary
+# says which). The scene's organ sleeps while the trainee is away
+# (physics.sleep_speed); the summary gives the step times of the steps that
+# stepped the organ next to those of all steps. Also prints every trainee's
+# tick rate and late ticks, and the CPU used by each kind of process
+# (servers, trainees, subscribers) over the run, as % of one core.
+#
 # usage: deploy/load_bench.sh [--build DIR] [--out DIR] [--seats N] [--subscribers M] [--duration S]
-#                             [--baseline S]
-# defaults: build/, out/load, 5 seats, 30 subscribers, 600 s (the issue's setting), baseline 30 s
+#                             [--baseline S] [--rt-priority RT] [--haptic-rt-priority HRT] [--scene FILE]
+# defaults: build/, out/load, 5 seats, 30 subscribers, 600 s (the issue's setting), baseline 30 s,
+# RT 70, HRT 80, assets/scenes/classroom_kidney.yaml
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-BUILD="$ROOT/build" OUT="$ROOT/out/load" SEATS=5 SUBS=30 DURATION=600 BASELINE=30
+BUILD="$ROOT/build" OUT="$ROOT/out/load" SEATS=5 SUBS=30 DURATION=600 BASELINE=30 RT=70 HRT=80
+SCENE="$ROOT/assets/scenes/classroom_kidney.yaml"
 while [ $# -gt 0 ]; do
   case "$1" in
     --build) BUILD="$2"; shift 2 ;;
@@ -30,16 +42,23 @@ while [ $# -gt 0 ]; do
     --subscribers) SUBS="$2"; shift 2 ;;
     --duration) DURATION="$2"; shift 2 ;;
     --baseline) BASELINE="$2"; shift 2 ;;
-    -h|--help) sed -n 2,22p "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --rt-priority) RT="$2"; shift 2 ;;
+    --haptic-rt-priority) HRT="$2"; shift 2 ;;
+    --scene) SCENE="$2"; shift 2 ;;
+    -h|--help) sed -n 2,35p "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "load_bench.sh: unknown option '$1'" >&2; exit 2 ;;
   esac
 done
 for v in SEATS SUBS DURATION BASELINE; do [[ "${!v}" =~ ^[0-9]+$ ]] && [ "${!v}" -ge 1 ] || { echo "load_bench.sh: bad ${v,,}" >&2; exit 2; }; done
+for v in RT HRT; do [[ "${!v}" =~ ^[0-9]+$ ]] && [ "${!v}" -le 99 ] || { echo "load_bench.sh: bad ${v,,} (0..99)" >&2; exit 2; }; done
+[ -f "$SCENE" ] || { echo "load_bench.sh: scene file not found: $SCENE" >&2; exit 2; }
+SRV_RT=(); HAP_RT=()
+[ "$RT" -gt 0 ] && SRV_RT=(--rt-priority "$RT")
+[ "$HRT" -gt 0 ] && HAP_RT=(--rt-priority "$HRT")
 [ -x "$BUILD/tests/bench/delta_sub" ] || { echo "load_bench.sh: $BUILD/tests/bench/delta_sub missing (build with -DVISCERA_BUILD_BENCH=ON)" >&2; exit 1; }
 export CYCLONEDDS_URI="${CYCLONEDDS_URI:-file://$ROOT/deploy/cyclonedds-loopback.xml}"
 export VISCERA_DOMAIN="${VISCERA_DOMAIN:-8}"
 rm -rf "$OUT"; mkdir -p "$OUT"
-SCENE="$ROOT/assets/scenes/classroom_kidney.yaml"
 # Press 8 mm, hold, release, every 4 s, for the whole run.
 TRAJ="$OUT/press_release.traj"
 { t=0; echo "0 0.012 0.004 0.07"; while [ $t -lt $((DURATION + 4)) ]; do
@@ -51,13 +70,26 @@ step_line() { # server log -> "N steps, step wall time ...; step CPU time ...; r
   cpu=$(sed -n 's/^server: step CPU time median \([0-9.]*\) us p99 \([0-9.]*\) us; \([0-9.]*\) simulated.*/step CPU time median \1 us, p99 \2 us; real-time ratio \3/p' "$1")
   echo "$wall; $cpu"
 }
+awake_line() { # server log -> "organ asleep in P % of steps; awake steps: wall ..., CPU ..." (or nothing)
+  sed -n 's/^server: organs slept .* every organ asleep in [0-9]* of [0-9]* steps (\([0-9.]*\) %); steps with an organ awake ([0-9]* recent): wall median \([0-9.]*\) us p99 \([0-9.]*\) us, CPU median \([0-9.]*\) us p99 \([0-9.]*\) us/asleep in \1 % of steps; steps that stepped the organ: wall median \2 us, p99 \3 us; CPU median \4 us, p99 \5 us/p' "$1"
+}
+sched_line() { # log, requested priority -> how its loop was scheduled (--quiet hides the success line)
+  if grep -q "SCHED_FIFO.*refused" "$1"; then echo "normal priority (SCHED_FIFO $2 refused)"
+  elif [ "$2" -gt 0 ]; then echo "SCHED_FIFO priority $2"
+  else echo "normal priority"; fi
+}
+cpu_of() { # pid -> utime+stime in s, or nothing when gone
+  awk -v hz="$(getconf CLK_TCK)" '{ sub(/^.*\) /, ""); print ($12 + $13) / hz }' "/proc/$1/stat" 2>/dev/null || true
+}
+declare -A KIND LASTCPU
+track() { KIND[$1]=$2; }
 # The reference: one seat alone.
 echo "load_bench: baseline, one seat alone for $BASELINE s" >&2
-"$BUILD/server/viscera-server" --scene "$SCENE" --partition "load/alone" --duration $((BASELINE + 2)) --quiet \
+"$BUILD/server/viscera-server" --scene "$SCENE" --partition "load/alone" --duration $((BASELINE + 2)) "${SRV_RT[@]}" \
   > "$OUT/alone-server.out" 2> "$OUT/alone-server.log" &
 alone=$!
 sleep 1
-"$BUILD/client/haptic/viscera-haptic" --partition "load/alone" --trajectory "$TRAJ" --duration "$BASELINE" --quiet \
+"$BUILD/client/haptic/viscera-haptic" --partition "load/alone" --trajectory "$TRAJ" --duration "$BASELINE" --quiet "${HAP_RT[@]}" \
   > "$OUT/alone-haptic.log" 2>&1 || true
 wait "$alone" || true
 pids=()
@@ -66,36 +98,38 @@ trap cleanup EXIT
 servers=()
 for i in $(seq 1 "$SEATS"); do
   s=$(printf 'seat%02d' "$i")
-  "$BUILD/server/viscera-server" --scene "$SCENE" --partition "load/$s" --duration $((DURATION + 3)) --quiet \
+  "$BUILD/server/viscera-server" --scene "$SCENE" --partition "load/$s" --duration $((DURATION + 3)) "${SRV_RT[@]}" \
     > "$OUT/$s-server.out" 2> "$OUT/$s-server.log" &
-  servers+=($!); pids+=($!)
+  servers+=($!); pids+=($!); track $! server
 done
 sleep 1
 for i in $(seq 1 "$SEATS"); do
   s=$(printf 'seat%02d' "$i")
   "$BUILD/client/haptic/viscera-haptic" --partition "load/$s" --trajectory "$TRAJ" --duration "$DURATION" --quiet \
-    > "$OUT/$s-haptic.log" 2>&1 & pids+=($!)
+    "${HAP_RT[@]}" > "$OUT/$s-haptic.log" 2>&1 & pids+=($!); track $! trainee
 done
 late=$((SUBS / 3)); early=$((SUBS - late))
 start_sub() { # index, duration
   local s; s=$(printf 'seat%02d' $(( ($1 % SEATS) + 1 )))
   "$BUILD/tests/bench/delta_sub" --partition "load/$s" --duration "$2" --name "sub$1-$s" > "$OUT/sub$1.out" 2>&1 &
-  pids+=($!)
+  pids+=($!); track $! subscriber
 }
 for k in $(seq 1 "$early"); do start_sub "$k" "$DURATION"; done
 echo "load_bench: $SEATS seats, $SUBS subscribers ($late join late), $DURATION s; samples every 10 s" >&2
 echo "t_s,seat,pid,cpu_s,rss_kb" > "$OUT/load.csv"
 sample() {
-  local t=$1 i=0
+  local t=$1 i=0 p cpu rss
   for p in "${servers[@]}"; do
     i=$((i + 1))
-    [ -r /proc/$p/stat ] || continue
-    # utime + stime in clock ticks (fields 14, 15 after the command name).
-    local cpu rss
-    cpu=$(awk -v hz="$(getconf CLK_TCK)" '{ sub(/^.*\) /, ""); print ($12 + $13) / hz }' /proc/$p/stat)
-    rss=$(awk '/VmRSS/ { print $2 }' /proc/$p/status)
+    # utime + stime in clock ticks (fields 14, 15 after the command name);
+    # a server that has already exited is skipped.
+    cpu=$(cpu_of "$p"); rss=$(awk '/VmRSS/ { print $2 }' "/proc/$p/status" 2>/dev/null || true)
+    [ -n "$cpu" ] && [ -n "$rss" ] || continue
     echo "$t,seat$(printf %02d $i),$p,$cpu,$rss" >> "$OUT/load.csv"
   done
+  # Every process's CPU so far (the last sample before it exits counts).
+  for p in "${!KIND[@]}"; do cpu=$(cpu_of "$p"); [ -n "$cpu" ] && LASTCPU[$p]=$cpu; done
+  return 0
 }
 t=0; late_started=0
 while [ $t -lt "$DURATION" ]; do
@@ -117,6 +151,25 @@ pids=()
   for i in $(seq 1 "$SEATS"); do
     s=$(printf 'seat%02d' "$i")
     echo "  $s: $(step_line "$OUT/$s-server.log")"
+  done
+  if [ -n "$(awake_line "$OUT/alone-server.log")" ]; then
+    echo "  organ sleeping (the scene's physics.sleep_speed): alone: $(awake_line "$OUT/alone-server.log")"
+    for i in $(seq 1 "$SEATS"); do
+      s=$(printf 'seat%02d' "$i"); echo "    $s: $(awake_line "$OUT/$s-server.log")"
+    done
+  fi
+  echo "  scheduling: servers' physics loop $(sched_line "$OUT/seat01-server.log" "$RT"), trainees' tick $(sched_line "$OUT/seat01-haptic.log" "$HRT")"
+  for i in $(seq 1 "$SEATS"); do
+    s=$(printf 'seat%02d' "$i")
+    sed -n "s/^SUMMARY ticks=\([0-9]*\) rate_hz=\([0-9.]*\) .*latency_us_median=\([0-9.]*\) latency_us_p99=\([0-9.]*\) .*late_ticks=\([0-9]*\).*/  $s trainee: \1 ticks at \2 Hz, \5 later than 1 ms; command->feedback latency median \3 us, p99 \4 us/p" "$OUT/$s-haptic.log"
+  done
+  for k in server trainee subscriber; do
+    tot=0; n=0
+    for p in "${!KIND[@]}"; do
+      [ "${KIND[$p]}" = "$k" ] && [ -n "${LASTCPU[$p]:-}" ] || continue
+      tot=$(awk -v a="$tot" -v b="${LASTCPU[$p]}" 'BEGIN { print a + b }'); n=$((n + 1))
+    done
+    awk -v k="$k" -v t="$tot" -v n="$n" -v d="$DURATION" 'BEGIN { if (n) printf "  CPU of the %ss: %d processes, %.1f %% of one core in all over the run (%.2f %% each)\n", k, n, 100 * t / d, 100 * t / d / n }'
   done
   field() { sed -n "s/^SUB.* $1=\([0-9.e+-]*\).*/\1/p" "$OUT"/sub*.out | sort -g; }
   n=$(grep -h '^SUB' "$OUT"/sub*.out | wc -l)
