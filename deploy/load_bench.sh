@@ -85,7 +85,7 @@ declare -A KIND LASTCPU
 track() { KIND[$1]=$2; }
 # The reference: one seat alone.
 echo "load_bench: baseline, one seat alone for $BASELINE s" >&2
-"$BUILD/server/viscera-server" --scene "$SCENE" --partition "load/alone" --duration $((BASELINE + 2)) "${SRV_RT[@]}" \
+"$BUILD/server/viscera-server" --scene "$SCENE" --partition "load/alone" --duration $((BASELINE + 2)) --quiet "${SRV_RT[@]}" \
   > "$OUT/alone-server.out" 2> "$OUT/alone-server.log" &
 alone=$!
 sleep 1
@@ -98,7 +98,7 @@ trap cleanup EXIT
 servers=()
 for i in $(seq 1 "$SEATS"); do
   s=$(printf 'seat%02d' "$i")
-  "$BUILD/server/viscera-server" --scene "$SCENE" --partition "load/$s" --duration $((DURATION + 3)) "${SRV_RT[@]}" \
+  "$BUILD/server/viscera-server" --scene "$SCENE" --partition "load/$s" --duration $((DURATION + 3)) --quiet "${SRV_RT[@]}" \
     > "$OUT/$s-server.out" 2> "$OUT/$s-server.log" &
   servers+=($!); pids+=($!); track $! server
 done
