@@ -409,10 +409,10 @@ static int missing(const ctx_t *c, const node_t *owner, const char *prefix, cons
 
 /* ---- the schema -------------------------------------------------------- */
 
-enum { P_DT, P_PUBLISH_HZ, P_QUANT_STEP, P_GRAVITY, P_SLEEP_SPEED, P_SLEEP_AFTER, P_NKEYS };
+enum { P_DT, P_PUBLISH_HZ, P_QUANT_STEP, P_GRAVITY, P_SLEEP_SPEED, P_SLEEP_AFTER, P_PUBLISH_KEEPALIVE, P_NKEYS };
 static const char *const physics_keys[P_NKEYS] = {
     [P_DT] = "dt", [P_PUBLISH_HZ] = "publish_hz", [P_QUANT_STEP] = "quant_step", [P_GRAVITY] = "gravity",
-    [P_SLEEP_SPEED] = "sleep_speed", [P_SLEEP_AFTER] = "sleep_after"};
+    [P_SLEEP_SPEED] = "sleep_speed", [P_SLEEP_AFTER] = "sleep_after", [P_PUBLISH_KEEPALIVE] = "publish_keepalive"};
 
 enum {
   M_MASS, M_STIFFNESS, M_DAMPING, M_HOME_STIFFNESS, M_HOME_DAMPING,
@@ -559,6 +559,7 @@ static int parse_physics(const ctx_t *c, const node_t *n, scene_t *s) {
   static const range_t g_range = {B_INCL, -100, B_INCL, 100};
   static const range_t sleep_speed_range = {B_INCL, 0, B_INCL, 0.1};
   static const range_t sleep_after_range = {B_EXCL, 0, B_INCL, 60};
+  static const range_t keepalive_range = {B_INCL, 0, B_INCL, 60};
   if (get_fields(c, n, "physics", physics_keys, P_NKEYS, v)) return -1;
   if (opt_number(c, v[P_DT], "physics", "dt", &dt_range, &s->dt)) return -1;
   if (opt_number(c, v[P_PUBLISH_HZ], "physics", "publish_hz", &hz_range, &s->publish_hz)) return -1;
@@ -566,6 +567,8 @@ static int parse_physics(const ctx_t *c, const node_t *n, scene_t *s) {
   if (v[P_GRAVITY] && get_vec3(c, v[P_GRAVITY], "physics.gravity", &g_range, s->gravity)) return -1;
   if (opt_number(c, v[P_SLEEP_SPEED], "physics", "sleep_speed", &sleep_speed_range, &s->sleep_speed)) return -1;
   if (opt_number(c, v[P_SLEEP_AFTER], "physics", "sleep_after", &sleep_after_range, &s->sleep_after)) return -1;
+  if (opt_number(c, v[P_PUBLISH_KEEPALIVE], "physics", "publish_keepalive", &keepalive_range, &s->publish_keepalive))
+    return -1;
   /* Fewer than two steps of stillness is no evidence of rest. */
   if (v[P_SLEEP_AFTER] && s->sleep_after < 2 * s->dt)
     return field_err(c, v[P_SLEEP_AFTER], "physics.sleep_after", "must be at least two steps (2 dt)");

@@ -174,6 +174,10 @@ typedef struct scene {
    * stepped until a tool comes near. */
   double sleep_speed;         /* m/s; 0 (the default) = organs never sleep */
   double sleep_after;         /* s (default 0.1), >= 2 dt */
+  /* s of wall time: a MeshDelta equal to the last one written is skipped
+   * unless this long passed (server/mesh_publisher.h); 0 (the default)
+   * writes every frame. */
+  double publish_keepalive;
   size_t norgans;             /* >= 1 */
   scene_organ_t organs[SCENE_MAX_ORGANS];
   size_t ntools;

@@ -186,6 +186,9 @@ int main(int argc, char **argv) {
     fprintf(stderr,
             "server: %" PRIu64 " client liveliness lapse(s) while still sending (kept, see liveliness_watch.h)\n",
             st.liveliness_blips);
+  if (st.deltas_skipped)
+    fprintf(stderr, "server: %" PRIu64 " MeshDelta frames written, %" PRIu64 " skipped (unchanged mesh)\n",
+            st.published[VT_MESH_DELTA], st.deltas_skipped);
   printf("SUMMARY steps=%" PRIu64 " peak_force=%.3f rejected=%" PRIu64 " rollbacks=%" PRIu64 " step_us_median=%.1f\n",
          st.steps, st.peak_force, st.rejected_total, st.rollbacks, st.step_us_median);
   /* What went on the wire, per topic, so a recording can be checked for drops. */

@@ -5,6 +5,7 @@
 
 #include "mesh_delta.h"
 #include "viscera.h"
+#include "vtime.h"
 
 /* Buffers for at least n vertices; keeps the contents' prefix. */
 static int grow(mesh_publisher_t *mp, size_t n) {
@@ -15,7 +16,11 @@ static int grow(mesh_publisher_t *mp, size_t n) {
   if (idx) mp->idx = idx;
   int16_t *dq = realloc(mp->dq, (3 * n + 1) * sizeof *dq);
   if (dq) mp->dq = dq;
-  if (!key || !idx || !dq) return -1;
+  uint32_t *widx = realloc(mp->written_idx, (n + 1) * sizeof *widx);
+  if (widx) mp->written_idx = widx;
+  int16_t *wdq = realloc(mp->written_dq, (3 * n + 1) * sizeof *wdq);
+  if (wdq) mp->written_dq = wdq;
+  if (!key || !idx || !dq || !widx || !wdq) return -1;
   mp->cap_verts = n;
   return 0;
 }
@@ -41,6 +46,8 @@ void mesh_publisher_destroy(mesh_publisher_t *mp) {
   free(mp->key);
   free(mp->idx);
   free(mp->dq);
+  free(mp->written_idx);
+  free(mp->written_dq);
   memset(mp, 0, sizeof *mp);
 }
 
@@ -51,6 +58,7 @@ int mesh_publisher_keyframe(mesh_publisher_t *mp, const double *x, uint64_t sim_
   mp->keyframes++;
   mp->keyframe_payload_bytes += mesh_publisher_keyframe_bytes(mp);
   mp->last_count = 0;
+  mp->have_written = 0; /* deltas of a new keyframe are new samples */
   if (!mp->w_state) return 0;
   viscera_MeshState s;
   memset(&s, 0, sizeof s);
@@ -74,6 +82,20 @@ int mesh_publisher_frame(mesh_publisher_t *mp, const double *x, uint64_t sim_tim
     if (mesh_publisher_keyframe(mp, x, sim_time_ns) < 0) return -1;
     n = 0;
     keyed = 1;
+  }
+  uint64_t now = mp->keepalive_ns ? vtime_mono_ns() : 0;
+  if (mp->keepalive_ns && !keyed && mp->have_written && n == mp->written_count &&
+      now - mp->written_ns < mp->keepalive_ns && !memcmp(mp->idx, mp->written_idx, (size_t)n * sizeof *mp->idx) &&
+      !memcmp(mp->dq, mp->written_dq, 3 * (size_t)n * sizeof *mp->dq)) {
+    mp->skipped++;
+    return 0;
+  }
+  if (mp->keepalive_ns) {
+    memcpy(mp->written_idx, mp->idx, (size_t)n * sizeof *mp->idx);
+    memcpy(mp->written_dq, mp->dq, 3 * (size_t)n * sizeof *mp->dq);
+    mp->written_count = n;
+    mp->written_ns = now;
+    mp->have_written = 1;
   }
   mp->frame_seq++;
   mp->frames++;

@@ -9,7 +9,21 @@
  * (organ_id key) for its whole life: a topology change is a new sample of
  * the same instance, never a new instance. Owns its buffers (allocated at
  * init, grown on a topology change, none per frame). Keeps byte counters
- * for the benchmarks. */
+ * for the benchmarks.
+ *
+ * Quiet frames (keepalive_ns > 0, scene key physics.publish_keepalive): a
+ * frame whose delta equals the last one written (same keyframe, same
+ * vertices, same quantised offsets: the organ has not moved by a
+ * quantisation step) is not written, unless keepalive_ns of wall time
+ * passed since the last write. Why: an organ at rest (asleep, or settled)
+ * would send its viewers the same sample publish_hz times a second, each a
+ * wake-up of every subscriber process. MeshDelta is transient-local
+ * keep-last 1, so a late joiner still gets the last written delta, which
+ * is the current shape. Wall time, not simulated time: a paused session's
+ * viewers still see a sample every keepalive. A keyframe (range overflow,
+ * retopo) always resets the comparison. frame_seq and `frames` count the
+ * deltas written (a receiver sees no gap for a skipped frame), `skipped`
+ * the others. keepalive_ns = 0 (the init value) writes every frame. */
 #ifndef VISCERA_MESH_PUBLISHER_H
 #define VISCERA_MESH_PUBLISHER_H
 
@@ -37,6 +51,14 @@ typedef struct mesh_publisher {
   /* Counters. */
   uint64_t frames, keyframes, delta_payload_bytes, keyframe_payload_bytes, retopos;
   long last_count; /* vertices in the last delta */
+  /* Quiet frames (above). */
+  uint64_t keepalive_ns;  /* 0: write every frame */
+  uint64_t skipped;       /* frames not written: equal to the last written delta */
+  int have_written;       /* written_idx/dq hold the last written delta of the current keyframe */
+  long written_count;     /* vertices in it */
+  uint64_t written_ns;    /* vtime_mono_ns() of its write */
+  uint32_t *written_idx;  /* cap_verts */
+  int16_t *written_dq;    /* 3 cap_verts */
 } mesh_publisher_t;
 
 int mesh_publisher_init(mesh_publisher_t *mp, uint32_t organ_id, size_t nverts, const uint32_t *tris, size_t ntris,
@@ -45,7 +67,8 @@ void mesh_publisher_destroy(mesh_publisher_t *mp);
 /* Publishes x (3 nverts, double) as a new keyframe. */
 int mesh_publisher_keyframe(mesh_publisher_t *mp, const double *x, uint64_t sim_time_ns);
 /* Publishes a delta against the current keyframe, or a new keyframe when out
- * of range. Returns 1 if a keyframe was published, 0 for a delta, -1 on error. */
+ * of range. Returns 1 if a keyframe was published, 0 for a delta (written,
+ * or skipped as a quiet frame: see above), -1 on error. */
 int mesh_publisher_frame(mesh_publisher_t *mp, const double *x, uint64_t sim_time_ns);
 /* Wire payload of the last delta (indices + components + fixed fields), bytes. */
 size_t mesh_publisher_last_delta_bytes(const mesh_publisher_t *mp);

@@ -153,6 +153,7 @@ static int setup(server_t *s, const scene_t *scene, verr_t *err) {
     if (mesh_publisher_init(&s->pubs[i], o->id, o->model->nsurf, o->model->surf_tris, o->model->nsurf_tris,
                             (float)scene->quant_step, s->w_state, s->w_delta, err))
       return -1;
+    s->pubs[i].keepalive_ns = (uint64_t)(scene->publish_keepalive * 1e9);
   }
   s->step_us = calloc(STEP_RING, sizeof(double));
   s->step_cpu_us = calloc(STEP_RING, sizeof(double));
@@ -820,6 +821,7 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
   for (size_t i = 0; i < s.rt.norgans; i++) {
     stats->published[VT_MESH_STATE] += s.pubs[i].keyframes;
     stats->published[VT_MESH_DELTA] += s.pubs[i].frames;
+    stats->deltas_skipped += s.pubs[i].skipped;
   }
   stats->ntools = s.rt.ntools;
   memcpy(stats->thr, s.thr, sizeof stats->thr);

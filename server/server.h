@@ -53,6 +53,7 @@ typedef struct server_stats {
   int stone_removed[SCENE_MAX_OBJECTS];
   double sim_time;              /* s simulated */
   uint64_t published[VT_COUNT]; /* samples written per topic (vdds ids), for drop accounting */
+  uint64_t deltas_skipped;      /* MeshDelta frames not written: equal to the last one (mesh_publisher.h) */
 } server_stats_t;
 
 /* Runs a whole session: set-up, loop until *stop or the duration, shutdown.

@@ -5,7 +5,11 @@
 # The server must put the kidney to sleep while the probe is away (before
 # and after the press), wake it before the probe arrives so the trainee
 # feels the press (peak above the 0.5 N ST threshold, the ST crossing
-# logged), and report the sleeping steps in its summary.
+# logged), and report the sleeping steps in its summary. The scene's
+# publish_keepalive (1 s): most MeshDelta frames of the still kidney are
+# skipped, and a viewer joining after the kidney fell asleep again still
+# gets the current shape (the last delta written, transient-local): its
+# mesh equals the server's final mesh within half a quantisation step.
 set -euo pipefail
 # shellcheck source=prelude.sh
 source "$(dirname "${BASH_SOURCE[0]}")/prelude.sh"
@@ -13,12 +17,19 @@ SCENE="$SRC/assets/scenes/classroom_kidney.yaml"
 TRAJ="$OUT/press.traj"
 printf '%s\n' "0 0.012 0.004 0.07" "2.0 0.012 0.004 0.07" "3.0 0.012 0.004 0.027" "3.5 0.012 0.004 0.027" \
   "4.5 0.012 0.004 0.07" "7 0.012 0.004 0.07" > "$TRAJ"
-"$BUILD/server/viscera-server" --scene "$SCENE" --partition sleep/seat --duration 8 \
+"$BUILD/server/viscera-server" --scene "$SCENE" --partition sleep/seat --duration 8 --final-mesh "$OUT/final.obj" \
   > "$OUT/server.out" 2> "$OUT/server.log" &
 srv=$!; PIDS+=("$srv")
 sleep 0.5
 "$BUILD/client/haptic/viscera-haptic" --partition sleep/seat --trajectory "$TRAJ" --duration 6.5 --quiet \
-  > "$OUT/haptic.log" 2>&1 || fail "haptic client failed"
+  > "$OUT/haptic.log" 2>&1 &
+hap=$!; PIDS+=("$hap")
+# The press ends (probe away) at 4.5 s of the trajectory; the kidney settles
+# and sleeps within about 0.2 s. A viewer joining at 5.7 s sees no new delta.
+sleep 5.7
+"$BUILD/client/viewer/viscera-viewer" --partition sleep/seat --out "$OUT/late" --interval-ms 100 --max-frames 3 \
+  --duration 2 --dump-mesh "$OUT/late.obj" --quiet > "$OUT/viewer.out" 2> "$OUT/viewer.log" || fail "late viewer failed"
+wait "$hap" || fail "haptic client failed"
 wait "$srv" || fail "server exited with an error"
 line=$(grep '^server: organs slept' "$OUT/server.log") || fail "no sleep summary in the server log"
 echo "$line"
@@ -33,4 +44,14 @@ peak=$(sed -n 's/^SUMMARY .*peak_force=\([0-9.]*\).*/\1/p' "$OUT/haptic.log")
 echo "trainee's peak force ${peak:-none} N"
 awk -v p="${peak:-0}" 'BEGIN { exit !(p > 0.5) }' || fail "the trainee felt ${peak:-no} N: the kidney did not wake for the press"
 grep -q "ST crossed up" "$OUT/server.log" || fail "the server logged no ST crossing for the press"
-echo "PASS: slept $sleeps times, woke $wakes, asleep in $asleep of $steps steps, press felt at $peak N"
+read -r written skipped < <(sed -n 's/^server: \([0-9]*\) MeshDelta frames written, \([0-9]*\) skipped.*/\1 \2/p' "$OUT/server.log")
+echo "MeshDelta: ${written:-?} written, ${skipped:-?} skipped"
+[ -n "${skipped:-}" ] && [ "$skipped" -gt "$written" ] || fail "the still kidney's deltas were not skipped (${written:-?} written, ${skipped:-0} skipped)"
+head -1 "$OUT/late.obj" | grep -q 'frame [0-9]' || fail "the late viewer applied no delta: $(head -1 "$OUT/late.obj")"
+# Same vertex count and every coordinate within quant_step/2 (+ float rounding).
+diff=$(awk '/^v / { if (FNR == NR) { a[++n] = $2 " " $3 " " $4 } else { split(a[++m], p, " ");
+         for (k = 1; k <= 3; k++) { d = p[k] - $(k + 1); if (d < 0) d = -d; if (d > w) w = d } } }
+       END { if (n != m || n == 0) print "count " n " vs " m; else printf "%.3g\n", w }' "$OUT/final.obj" "$OUT/late.obj")
+echo "late viewer's mesh vs the server's final mesh: max difference $diff m"
+awk -v d="$diff" 'BEGIN { exit !(d + 0 == d && d <= 5.1e-6) }' || fail "the late viewer's mesh differs from the server's: $diff"
+echo "PASS: slept $sleeps times, woke $wakes, asleep in $asleep of $steps steps, press felt at $peak N; $skipped of $((written + skipped)) deltas skipped; late viewer within $diff m"

@@ -3,8 +3,8 @@
  *   vertex moving more than the limit, a NaN, a disturbance or a new
  *   topology restart the count; waking counts only a sleeping organ;
  * - the reach test (box around a swollen segment), NaN = near;
- * - scene keys physics.sleep_speed / sleep_after: defaults, ranges, the
- *   2-step minimum refused with the line;
+ * - scene keys physics.sleep_speed / sleep_after / publish_keepalive:
+ *   defaults, ranges, the 2-step minimum refused with the line;
  * - on the real runtime (kidney, mass-spring, probe), two scenes that
  *   differ only in sleeping, driven by the same probe path: the sleeping
  *   one skips most steps while the probe is away, wakes before the probe
@@ -109,6 +109,9 @@ static void test_keys(void) {
   CHECK(strstr(e.msg, "sleep_speed") != NULL);
   CHECK(!load(KIDNEY("sleep_speed: 1"), &sc, NULL));
   CHECK(!load(KIDNEY("sleep_after: 0"), &sc, NULL));
+  CHECK(load(KIDNEY("publish_keepalive: 1.5"), &sc, NULL) && sc.publish_keepalive == 1.5);
+  CHECK(!load(KIDNEY("publish_keepalive: -1"), &sc, NULL));
+  CHECK(strstr(e.msg, "physics.publish_keepalive") != NULL);
 }
 
 /* Both runtimes one step with the probe at p; returns |f_on - f_off|. */
