@@ -22,6 +22,9 @@
 #   --secure            DDS Security on (PKI in --pki DIR)
 #   --pki DIR           the lab's PKI (default OUT/pki; made by pki.sh when missing)
 #   --no-record         no lab recorder
+#   --rt-priority N     servers' physics loops at SCHED_FIFO N (1..99), trainees' ticks at N+10
+#                       (needs root or CAP_SYS_NICE; without, they warn and run at normal
+#                       priority); 0 (default): normal scheduling
 # SIGINT (Ctrl-C) or SIGTERM stops the lab: every process it started gets
 # SIGTERM (SIGKILL if still running 10 s later), then the summary is printed.
 # Exit status: 0 when every process ended cleanly, 1 when one failed (named
@@ -31,7 +34,7 @@
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD="$ROOT/build" OUT="$ROOT/out/lab" SEATS=3 FIRST=1 PREFIX=lab SCENE="$ROOT/assets/scenes/default.yaml"
-TRAINEES=0 VIEWERS=1 DURATION=20 SECURE=0 RECORD=1 PKI=""
+TRAINEES=0 VIEWERS=1 DURATION=20 SECURE=0 RECORD=1 PKI="" RT=0
 STOP_GRACE_S="${VISCERA_LAB_STOP_GRACE:-10}"
 usage() { awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"; }
 while [ $# -gt 0 ]; do
@@ -48,10 +51,14 @@ while [ $# -gt 0 ]; do
     --secure) SECURE=1; shift ;;
     --pki) PKI="$2"; shift 2 ;;
     --no-record) RECORD=0; shift ;;
+    --rt-priority) RT="$2"; shift 2 ;;
     -h|--help) usage; exit 0 ;;
     *) echo "lab.sh: unknown option '$1'" >&2; usage >&2; exit 2 ;;
   esac
 done
+[[ "$RT" =~ ^[0-9]+$ ]] && [ "$RT" -le 89 ] || { echo "lab.sh: --rt-priority must be 0..89 (trainees run at it + 10)" >&2; exit 2; }
+SRV_RT=(); HAP_RT=()
+[ "$RT" -gt 0 ] && SRV_RT=(--rt-priority "$RT") && HAP_RT=(--rt-priority $((RT + 10)))
 for v in SEATS FIRST VIEWERS DURATION; do
   [[ "${!v}" =~ ^[0-9]+$ ]] || { echo "lab.sh: --${v,,} must be a whole number" >&2; exit 2; }
 done
@@ -137,7 +144,8 @@ fi
 for i in $(seq "$FIRST" "$LAST"); do
   s=$(printf 'seat%02d' "$i")
   # shellcheck disable=SC2046
-  start "$s-server" "server-$s" "$BUILD/server/viscera-server" --scene "$SCENE" --partition "$PREFIX/$s" $(dur DURATION)
+  start "$s-server" "server-$s" "$BUILD/server/viscera-server" --scene "$SCENE" --partition "$PREFIX/$s" $(dur DURATION) \
+    "${SRV_RT[@]}"
   for k in $(seq 1 "$VIEWERS"); do
     rm -rf "$OUT/$s-frames$k"
     # shellcheck disable=SC2046
@@ -150,7 +158,7 @@ if [ $TRAINEES = 1 ]; then
   for i in $(seq "$FIRST" "$LAST"); do
     s=$(printf 'seat%02d' "$i")
     start "$s-haptic" "trainee-$s" "$BUILD/client/haptic/viscera-haptic" --partition "$PREFIX/$s" \
-      --trajectory "$ROOT/assets/trajectories/palpate_kidney.traj" --quiet
+      --trajectory "$ROOT/assets/trajectories/palpate_kidney.traj" --quiet "${HAP_RT[@]}"
   done
 fi
 
