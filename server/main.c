@@ -10,6 +10,7 @@
 #include "server.h"
 #include "vsignal.h"
 #include "vdds.h"
+#include "vrt.h"
 
 static volatile sig_atomic_t g_stop = 0;
 static void on_signal(int sig) {
@@ -30,7 +31,11 @@ static void usage(FILE *f) {
              "  --checkpoint-every S  simulated seconds between checkpoints (default 1)\n"
              "  --check             load and validate the scene, build its models, print per organ the model,\n"
              "                      integrator, nodes, tetrahedra, sub-steps and stable dt, exit\n"
-             "  --quiet             only errors on stderr\n"
+             "  --rt-priority N     run the physics loop's thread (only it; DDS threads stay normal)\n"
+             "                      SCHED_FIFO at priority N (1..99) with memory locked (needs root,\n"
+             "                      CAP_SYS_NICE or LimitRTPRIO; if refused: a warning naming the reason,\n"
+             "                      normal priority)\n"
+             "  --quiet             only errors and warnings on stderr\n"
              "  --help              this text\n"
              "DDS configuration comes from CYCLONEDDS_URI (deploy/cyclonedds-loopback.xml for one machine).\n");
 }
@@ -55,6 +60,7 @@ int main(int argc, char **argv) {
                                      {"quiet", no_argument, 0, 'q'},
                                      {"checkpoint", required_argument, 0, 'K'},
                                      {"checkpoint-every", required_argument, 0, 'E'},
+                                     {"rt-priority", required_argument, 0, 'R'},
                                      {"help", no_argument, 0, 'h'},
                                      {0, 0, 0, 0}};
   int c;
@@ -97,6 +103,12 @@ int main(int argc, char **argv) {
       opts.checkpoint_every = strtod(optarg, &end);
       if (*end || !(opts.checkpoint_every > 0)) {
         fprintf(stderr, "viscera-server: --checkpoint-every '%s' is not a number of seconds > 0\n", optarg);
+        return 2;
+      }
+      break;
+    case 'R':
+      if (vrt_parse_priority(optarg, &opts.rt_priority)) {
+        fprintf(stderr, "viscera-server: --rt-priority '%s' is not a SCHED_FIFO priority 1..99\n", optarg);
         return 2;
       }
       break;

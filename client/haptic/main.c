@@ -3,11 +3,8 @@
  * ContactFeedback's local contact model, coupled to the peer station's
  * device while the tool is guided (guide_force.h). Prints rate, jitter,
  * force, latency and guiding statistics on exit. */
-#include <errno.h>
 #include <getopt.h>
 #include <pthread.h>
-#include <sched.h>
-#include <sys/mman.h>
 #include <inttypes.h>
 #include <math.h>
 #include <signal.h>
@@ -25,6 +22,7 @@
 #include "vdds.h"
 #include "viscera.h"
 #include "vmath.h"
+#include "vrt.h"
 #include "vstats.h"
 #include "vtime.h"
 
@@ -57,8 +55,9 @@ static void usage(FILE *f) {
           "  --wait-server S     wait up to S s for the server's scene before starting (default 10)\n"
           "  --duration S        stop after S s (default: end of the trajectory + 0.5 s)\n"
           "  --force-csv FILE    write t,x,y,z,fx,fy,fz,in_contact per tick\n"
-          "  --rt-priority N     run the loop thread SCHED_FIFO at priority N (1..99) with\n"
-          "                      memory locked (needs root or CAP_SYS_NICE; warns otherwise)\n"
+          "  --rt-priority N     run the loop thread (only it) SCHED_FIFO at priority N (1..99) with\n"
+          "                      memory locked (needs root, CAP_SYS_NICE or LimitRTPRIO; if refused:\n"
+          "                      a warning naming the reason, normal priority)\n"
           "  --quiet             only the summary\n"
           "  --help              this text\n",
           device_names());
@@ -107,7 +106,7 @@ int main(int argc, char **argv) {
   while ((c = getopt_long(argc, argv, "j:n:s:d:p:r:m:K:w:t:f:R:D:I:S:O:qh", lo, NULL)) != -1) {
     char *end = NULL;
     double v = 0;
-    if (c == 'r' || c == 'm' || c == 'K' || c == 'w' || c == 't' || c == 'n' || c == 'R' || c == 'I' || c == 'S') {
+    if (c == 'r' || c == 'm' || c == 'K' || c == 'w' || c == 't' || c == 'n' || c == 'I' || c == 'S') {
       v = strtod(optarg, &end);
       if (*end || !isfinite(v) || v < 0) {
         fprintf(stderr, "viscera-haptic: option --%s: '%s' is not a non-negative number\n",
@@ -116,7 +115,6 @@ int main(int argc, char **argv) {
                 : c == 'K' ? "max-stiffness"
                 : c == 'w' ? "wait-server"
                 : c == 't' ? "duration"
-                : c == 'R' ? "rt-priority"
                 : c == 'I' ? "device-index"
                 : c == 'S' ? "workspace-scale"
                            : "tool",
@@ -167,9 +165,8 @@ int main(int argc, char **argv) {
       force_csv = optarg;
       break;
     case 'R':
-      rt_priority = (int)v;
-      if (rt_priority < 1 || rt_priority > 99) {
-        fprintf(stderr, "viscera-haptic: --rt-priority must be 1..99\n");
+      if (vrt_parse_priority(optarg, &rt_priority)) {
+        fprintf(stderr, "viscera-haptic: --rt-priority '%s' is not a SCHED_FIFO priority 1..99\n", optarg);
         return 2;
       }
       break;
@@ -298,20 +295,10 @@ int main(int argc, char **argv) {
     fprintf(csv, "t,x,y,z,fx,fy,fz,in_contact\n");
   }
 
-  if (rt_priority) {
-    /* A 1 kHz loop sharing two cores with physics and rendering misses its
-     * tick whenever the scheduler prefers them; SCHED_FIFO and locked pages
-     * keep the period. DDS threads stay at normal priority. */
-    struct sched_param sp = {.sched_priority = rt_priority};
-    int rc = pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp);
-    if (rc != 0)
-      fprintf(stderr, "haptic: warning: SCHED_FIFO %d refused (%s); running at normal priority\n", rt_priority,
-              strerror(rc));
-    else if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0)
-      fprintf(stderr, "haptic: warning: mlockall failed (%s)\n", strerror(errno));
-    else if (!quiet)
-      fprintf(stderr, "haptic: loop at SCHED_FIFO priority %d, memory locked\n", rt_priority);
-  }
+  /* A 1 kHz loop sharing two cores with physics and rendering misses its
+   * tick whenever the scheduler prefers them; SCHED_FIFO and locked pages
+   * keep the period. DDS threads stay at normal priority (vrt.h). */
+  if (rt_priority) vrt_make_realtime(rt_priority, "haptic", "loop", quiet, stderr);
   uint64_t period_ns = (uint64_t)(1e9 / rate);
   stats_t st = {0};
   double run_for = duration >= 0 ? duration : 1e300;
