@@ -30,6 +30,7 @@ int vrt_parse_priority(const char *s, int *prio) {
   return 0;
 }
 
+#ifndef VRT_ASAN
 /* Whether this thread holds CAP_IPC_LOCK (exempts it from RLIMIT_MEMLOCK). */
 static int has_ipc_lock(void) {
   FILE *f = fopen("/proc/thread-self/status", "r");
@@ -41,6 +42,7 @@ static int has_ipc_lock(void) {
   fclose(f);
   return found && ((eff >> CAP_IPC_LOCK_BIT) & 1ull);
 }
+#endif
 
 static void lock_memory(vrt_status_t *st) {
 #ifdef VRT_ASAN

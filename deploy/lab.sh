@@ -22,6 +22,9 @@
 #   --secure            DDS Security on (PKI in --pki DIR)
 #   --pki DIR           the lab's PKI (default OUT/pki; made by pki.sh when missing)
 #   --no-record         no lab recorder
+#   --rt-priority N     every server's physics loop SCHED_FIFO at N (1..99; default 0: normal
+#                       scheduling); needs root or CAP_SYS_NICE, else each server warns and runs on
+#   --haptic-rt-priority N  the same for the trainees' 1 kHz loops (with --trainees)
 # SIGINT (Ctrl-C) or SIGTERM stops the lab: every process it started gets
 # SIGTERM (SIGKILL if still running 10 s later), then the summary is printed.
 # Exit status: 0 when every process ended cleanly, 1 when one failed (named
@@ -31,7 +34,7 @@
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD="$ROOT/build" OUT="$ROOT/out/lab" SEATS=3 FIRST=1 PREFIX=lab SCENE="$ROOT/assets/scenes/default.yaml"
-TRAINEES=0 VIEWERS=1 DURATION=20 SECURE=0 RECORD=1 PKI=""
+TRAINEES=0 VIEWERS=1 DURATION=20 SECURE=0 RECORD=1 PKI="" RTPRIO=0 HRTPRIO=0
 STOP_GRACE_S="${VISCERA_LAB_STOP_GRACE:-10}"
 usage() { awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"; }
 while [ $# -gt 0 ]; do
@@ -48,6 +51,8 @@ while [ $# -gt 0 ]; do
     --secure) SECURE=1; shift ;;
     --pki) PKI="$2"; shift 2 ;;
     --no-record) RECORD=0; shift ;;
+    --rt-priority) RTPRIO="$2"; shift 2 ;;
+    --haptic-rt-priority) HRTPRIO="$2"; shift 2 ;;
     -h|--help) usage; exit 0 ;;
     *) echo "lab.sh: unknown option '$1'" >&2; usage >&2; exit 2 ;;
   esac
@@ -55,6 +60,15 @@ done
 for v in SEATS FIRST VIEWERS DURATION; do
   [[ "${!v}" =~ ^[0-9]+$ ]] || { echo "lab.sh: --${v,,} must be a whole number" >&2; exit 2; }
 done
+for v in RTPRIO HRTPRIO; do
+  [[ "${!v}" =~ ^[0-9]{1,2}$ ]] ||
+    { echo "lab.sh: --$([ $v = RTPRIO ] || echo haptic-)rt-priority must be 0 (normal) or 1..99" >&2; exit 2; }
+done
+RTPRIO=$((10#$RTPRIO)) HRTPRIO=$((10#$HRTPRIO))
+# The option each server / trainee gets (nothing for 0).
+SRV_RT=() HAP_RT=()
+[ "$RTPRIO" = 0 ] || SRV_RT=(--rt-priority "$RTPRIO")
+[ "$HRTPRIO" = 0 ] || HAP_RT=(--rt-priority "$HRTPRIO")
 [[ "$STOP_GRACE_S" =~ ^[0-9]+$ ]] || { echo "lab.sh: VISCERA_LAB_STOP_GRACE must be a whole number" >&2; exit 2; }
 [ "$SEATS" -ge 1 ] && [ "$FIRST" -ge 1 ] && [ $((FIRST + SEATS - 1)) -le 99 ] || { echo "lab.sh: seats must lie in 1..99" >&2; exit 2; }
 [[ "$PREFIX" =~ ^[A-Za-z0-9_-]+$ ]] || { echo "lab.sh: --prefix: letters, digits, '-' and '_' only" >&2; exit 2; }
@@ -137,7 +151,8 @@ fi
 for i in $(seq "$FIRST" "$LAST"); do
   s=$(printf 'seat%02d' "$i")
   # shellcheck disable=SC2046
-  start "$s-server" "server-$s" "$BUILD/server/viscera-server" --scene "$SCENE" --partition "$PREFIX/$s" $(dur DURATION)
+  start "$s-server" "server-$s" "$BUILD/server/viscera-server" --scene "$SCENE" --partition "$PREFIX/$s" $(dur DURATION) \
+    "${SRV_RT[@]}"
   for k in $(seq 1 "$VIEWERS"); do
     rm -rf "$OUT/$s-frames$k"
     # shellcheck disable=SC2046
@@ -150,7 +165,7 @@ if [ $TRAINEES = 1 ]; then
   for i in $(seq "$FIRST" "$LAST"); do
     s=$(printf 'seat%02d' "$i")
     start "$s-haptic" "trainee-$s" "$BUILD/client/haptic/viscera-haptic" --partition "$PREFIX/$s" \
-      --trajectory "$ROOT/assets/trajectories/palpate_kidney.traj" --quiet
+      --trajectory "$ROOT/assets/trajectories/palpate_kidney.traj" --quiet "${HAP_RT[@]}"
   done
 fi
 

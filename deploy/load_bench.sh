@@ -4,24 +4,36 @@
 # pressing and releasing for the whole run, SUBSCRIBERS light viewers
 # (tests/bench/delta_sub: keyframe + every MeshDelta, latency measured) spread
 # over the seats, a third of them joining late (at a third of the run).
-# Samples every server's CPU time and resident memory every 10 s; at the end
-# prints per-seat step time (median, p99; wall time and the server thread's
-# CPU time, which tells the step's own cost from time spent preempted by the
-# other processes) and real-time ratio, delta latency (median, p99 over all
-# subscribers), the time late joiners waited for their keyframe, and CPU /
-# memory at the start and the end of the run. Writes OUT/load.csv (samples)
-# and OUT/summary.txt.
+# Samples every server's CPU time and resident memory every 10 s, and the CPU
+# time of every process it started (servers, trainees, subscribers) every
+# second; at the end prints per-seat step time (median, p99; wall time and the
+# server thread's CPU time, which tells the step's own cost from time spent
+# preempted by the other processes) and real-time ratio, delta latency
+# (median, p99 over all subscribers), the time late joiners waited for their
+# keyframe, CPU / memory at the start and the end of the run, each trainee's
+# loop rate, late ticks and command->feedback latency, and the CPU the
+# processes of each kind used (% of one core: the machine's total demand).
+# Writes OUT/load.csv (server samples), OUT/cpu.csv (every process, every
+# second) and OUT/summary.txt.
 #
-# Before the lab starts, one seat runs alone (same scene, same trainee, no
-# subscribers) for BASELINE s: its step times are the reference that "step
-# time unchanged" is judged against.
+# Scheduling: the servers' physics loops run SCHED_FIFO at --rt-priority S
+# (default 70) and the trainees' 1 kHz loops at --haptic-rt-priority H
+# (default 80: the haptic tick is the most latency-critical thread and is
+# short); only those threads, DDS threads stay normal; 0 = normal scheduling.
+# Without root or CAP_SYS_NICE the processes warn and run at normal priority
+# (the summary says how many were refused).
+#
+# Before the lab starts, one seat runs alone (same scene, same trainee, same
+# scheduling, no subscribers) for BASELINE s: its step times are the
+# reference that "step time unchanged" is judged against.
 #
 # usage: deploy/load_bench.sh [--build DIR] [--out DIR] [--seats N] [--subscribers M] [--duration S]
-#                             [--baseline S]
-# defaults: build/, out/load, 5 seats, 30 subscribers, 600 s (the issue's setting), baseline 30 s
+#                             [--baseline S] [--rt-priority S] [--haptic-rt-priority H]
+# defaults: build/, out/load, 5 seats, 30 subscribers, 600 s (the issue's setting), baseline 30 s,
+#           servers SCHED_FIFO 70, trainees SCHED_FIFO 80
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-BUILD="$ROOT/build" OUT="$ROOT/out/load" SEATS=5 SUBS=30 DURATION=600 BASELINE=30
+BUILD="$ROOT/build" OUT="$ROOT/out/load" SEATS=5 SUBS=30 DURATION=600 BASELINE=30 RTPRIO=70 HRTPRIO=80
 while [ $# -gt 0 ]; do
   case "$1" in
     --build) BUILD="$2"; shift 2 ;;
@@ -30,11 +42,23 @@ while [ $# -gt 0 ]; do
     --subscribers) SUBS="$2"; shift 2 ;;
     --duration) DURATION="$2"; shift 2 ;;
     --baseline) BASELINE="$2"; shift 2 ;;
-    -h|--help) sed -n 2,22p "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --rt-priority) RTPRIO="$2"; shift 2 ;;
+    --haptic-rt-priority) HRTPRIO="$2"; shift 2 ;;
+    -h|--help) sed -n 2,34p "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "load_bench.sh: unknown option '$1'" >&2; exit 2 ;;
   esac
 done
 for v in SEATS SUBS DURATION BASELINE; do [[ "${!v}" =~ ^[0-9]+$ ]] && [ "${!v}" -ge 1 ] || { echo "load_bench.sh: bad ${v,,}" >&2; exit 2; }; done
+check_prio() {
+  [[ "$2" =~ ^[0-9]{1,2}$ ]] ||
+    { echo "load_bench.sh: $1 '$2' is not 0 (normal scheduling) or a SCHED_FIFO priority 1..99" >&2; exit 2; }
+}
+check_prio --rt-priority "$RTPRIO"; check_prio --haptic-rt-priority "$HRTPRIO"
+RTPRIO=$((10#$RTPRIO)) HRTPRIO=$((10#$HRTPRIO))
+# The options each server and trainee gets (none for 0: normal scheduling).
+SRV_RT=() HAP_RT=()
+[ "$RTPRIO" -gt 0 ] && SRV_RT=(--rt-priority "$RTPRIO")
+[ "$HRTPRIO" -gt 0 ] && HAP_RT=(--rt-priority "$HRTPRIO")
 [ -x "$BUILD/tests/bench/delta_sub" ] || { echo "load_bench.sh: $BUILD/tests/bench/delta_sub missing (build with -DVISCERA_BUILD_BENCH=ON)" >&2; exit 1; }
 export CYCLONEDDS_URI="${CYCLONEDDS_URI:-file://$ROOT/deploy/cyclonedds-loopback.xml}"
 export VISCERA_DOMAIN="${VISCERA_DOMAIN:-8}"
@@ -51,68 +75,99 @@ step_line() { # server log -> "N steps, step wall time ...; step CPU time ...; r
   cpu=$(sed -n 's/^server: step CPU time median \([0-9.]*\) us p99 \([0-9.]*\) us; \([0-9.]*\) simulated.*/step CPU time median \1 us, p99 \2 us; real-time ratio \3/p' "$1")
   echo "$wall; $cpu"
 }
-# The reference: one seat alone.
+# The reference: one seat alone, scheduled as the lab's seats are.
 echo "load_bench: baseline, one seat alone for $BASELINE s" >&2
 "$BUILD/server/viscera-server" --scene "$SCENE" --partition "load/alone" --duration $((BASELINE + 2)) --quiet \
-  > "$OUT/alone-server.out" 2> "$OUT/alone-server.log" &
+  "${SRV_RT[@]}" > "$OUT/alone-server.out" 2> "$OUT/alone-server.log" &
 alone=$!
 sleep 1
 "$BUILD/client/haptic/viscera-haptic" --partition "load/alone" --trajectory "$TRAJ" --duration "$BASELINE" --quiet \
-  > "$OUT/alone-haptic.log" 2>&1 || true
+  "${HAP_RT[@]}" > "$OUT/alone-haptic.log" 2>&1 || true
 wait "$alone" || true
 pids=()
 cleanup() { for p in "${pids[@]}"; do kill -TERM "$p" 2>/dev/null || true; done; wait 2>/dev/null || true; }
 trap cleanup EXIT
+# Every process of the lab, for the CPU by kind: "pid kind name command".
+: > "$OUT/procs.txt"
+register() { echo "$1 $2 $3 $4" >> "$OUT/procs.txt"; }
+now_us() { echo "${EPOCHREALTIME/[.,]/}"; } # bash 5; the decimal sign follows the locale
+T0=$(now_us)
 servers=()
 for i in $(seq 1 "$SEATS"); do
   s=$(printf 'seat%02d' "$i")
   "$BUILD/server/viscera-server" --scene "$SCENE" --partition "load/$s" --duration $((DURATION + 3)) --quiet \
-    > "$OUT/$s-server.out" 2> "$OUT/$s-server.log" &
-  servers+=($!); pids+=($!)
+    "${SRV_RT[@]}" > "$OUT/$s-server.out" 2> "$OUT/$s-server.log" &
+  servers+=($!); pids+=($!); register $! server "$s" viscera-server
 done
 sleep 1
 for i in $(seq 1 "$SEATS"); do
   s=$(printf 'seat%02d' "$i")
   "$BUILD/client/haptic/viscera-haptic" --partition "load/$s" --trajectory "$TRAJ" --duration "$DURATION" --quiet \
-    > "$OUT/$s-haptic.log" 2>&1 & pids+=($!)
+    "${HAP_RT[@]}" > "$OUT/$s-haptic.log" 2>&1 &
+  pids+=($!); register $! trainee "$s" viscera-haptic
 done
 late=$((SUBS / 3)); early=$((SUBS - late))
 start_sub() { # index, duration
   local s; s=$(printf 'seat%02d' $(( ($1 % SEATS) + 1 )))
   "$BUILD/tests/bench/delta_sub" --partition "load/$s" --duration "$2" --name "sub$1-$s" > "$OUT/sub$1.out" 2>&1 &
-  pids+=($!)
+  pids+=($!); register $! subscriber "sub$1-$s" delta_sub
 }
 for k in $(seq 1 "$early"); do start_sub "$k" "$DURATION"; done
-echo "load_bench: $SEATS seats, $SUBS subscribers ($late join late), $DURATION s; samples every 10 s" >&2
+echo "load_bench: $SEATS seats, $SUBS subscribers ($late join late), $DURATION s; samples every 10 s (CPU of every process every 1 s)" >&2
 echo "t_s,seat,pid,cpu_s,rss_kb" > "$OUT/load.csv"
-sample() {
-  local t=$1 i=0
+echo "t_s,kind,name,pid,cpu_s" > "$OUT/cpu.csv"
+HZ=$(getconf CLK_TCK)
+# A process may end at any moment (a server's duration, a crash): everything
+# read from /proc here tolerates a missing file, so `set -e` cannot end the
+# benchmark on it (it did: "awk: cannot open /proc/PID/stat").
+sample() { # servers' CPU time and resident memory -> load.csv
+  local t=$1 i=0 p st cpu rss
   for p in "${servers[@]}"; do
     i=$((i + 1))
-    [ -r /proc/$p/stat ] || continue
-    # utime + stime in clock ticks (fields 14, 15 after the command name).
-    local cpu rss
-    cpu=$(awk -v hz="$(getconf CLK_TCK)" '{ sub(/^.*\) /, ""); print ($12 + $13) / hz }' /proc/$p/stat)
-    rss=$(awk '/VmRSS/ { print $2 }' /proc/$p/status)
+    st=$(cat /proc/"$p"/stat 2>/dev/null) || continue
+    # utime + stime in clock ticks (fields 14, 15; 12, 13 after the command name).
+    cpu=$(echo "${st##*) }" | awk -v hz="$HZ" '{ print ($12 + $13) / hz }')
+    rss=$(awk '/VmRSS/ { print $2 }' /proc/"$p"/status 2>/dev/null || true)
+    [ -n "$rss" ] || continue # ended between the two reads (a zombie has no VmRSS)
     echo "$t,seat$(printf %02d $i),$p,$cpu,$rss" >> "$OUT/load.csv"
   done
 }
-t=0; late_started=0
+sample_cpu() { # every registered process still there (a zombie too: its times are final) -> cpu.csv
+  local files=() p us
+  while read -r p _; do files+=("/proc/$p/stat"); done < "$OUT/procs.txt"
+  [ ${#files[@]} -gt 0 ] || return 0
+  us=$(( $(now_us) - T0 ))
+  { cat "${files[@]}" 2>/dev/null || true; } |
+    awk -v t="$((us / 1000000)).$(printf %03d $(( (us / 1000) % 1000 )))" -v hz="$HZ" '
+      NR == FNR { kind[$1] = $2; name[$1] = $3; comm[$1] = $4; next }
+      { pid = $1; c = $0; sub(/\) .*$/, "", c); sub(/^[^(]*\(/, "", c); sub(/^.*\) /, "")
+        # a pid the kernel gave to another program since is not ours
+        if (pid in kind && c == comm[pid]) printf "%s,%s,%s,%s,%.2f\n", t, kind[pid], name[pid], pid, ($12 + $13) / hz }' \
+      "$OUT/procs.txt" - >> "$OUT/cpu.csv"
+}
+loop0=$(now_us); t=0; late_started=0; next_mem=0
 while [ $t -lt "$DURATION" ]; do
   if [ $late_started = 0 ] && [ $t -ge $((DURATION / 3)) ]; then
     for k in $(seq $((early + 1)) "$SUBS"); do start_sub "$k" $((DURATION - t)); done
     late_started=1
   fi
-  sample $t
-  step=$(( DURATION - t < 10 ? DURATION - t : 10 ))
-  sleep "$step"; t=$((t + step))
+  if [ $t -ge $next_mem ]; then sample $t; next_mem=$((next_mem + 10)); fi
+  sample_cpu
+  sleep 1; t=$(( ($(now_us) - loop0) / 1000000 ))
 done
 sample $t
+sample_cpu
 wait "${servers[@]}" 2>/dev/null || true
 sleep 1
 pids=()
 {
   echo "load_bench: $SEATS seats x classroom_kidney (2,000 vertices, 1 kHz physics, meshes at 60 Hz), $SUBS subscribers ($late late), $DURATION s"
+  sched() { # what PRIO LOG...: the policy asked and how many processes refused it
+    local what=$1 prio=$2; shift 2
+    if [ "$prio" = 0 ]; then echo "$what normal scheduling"; return; fi
+    echo "$what SCHED_FIFO $prio (refused in $(grep -l 'warning: SCHED_FIFO [0-9]* refused' "$@" 2>/dev/null | wc -l) of $#)"
+  }
+  echo "  scheduling: $(sched "servers' physics loops" "$RTPRIO" "$OUT"/*-server.log), $(sched "trainees' loops" "$HRTPRIO" "$OUT"/*-haptic.log)"
   echo "  alone (baseline, $BASELINE s): $(step_line "$OUT/alone-server.log")"
   for i in $(seq 1 "$SEATS"); do
     s=$(printf 'seat%02d' "$i")
@@ -130,4 +185,24 @@ pids=()
   awk -F, 'NR > 1 { if (!($2 in c0)) { c0[$2] = $4; r0[$2] = $5; t0[$2] = $1 } c1[$2] = $4; r1[$2] = $5; t1[$2] = $1 }
     END { for (s in c0) { dt = t1[s] - t0[s]; printf "  %s: CPU %.0f %% of a core, RSS %d kB at start, %d kB at end\n", s,
             (dt > 0 ? 100 * (c1[s] - c0[s]) / dt : 0), r0[s], r1[s] } }' "$OUT/load.csv" | sort
+  # Each trainee's own figures (viscera-haptic's SUMMARY line).
+  trainee() {
+    sed -n 's/^SUMMARY .*rate_hz=\([0-9.]*\) .* latency_us_median=\([0-9.]*\) latency_us_p99=\([0-9.]*\) .* jitter_us_p99=\([0-9.]*\) late_ticks=\([0-9]*\).*/rate \1 Hz, \5 ticks over 1 ms late, jitter p99 \4 us, command->feedback latency median \2 us, p99 \3 us/p' "$1" | grep . ||
+      echo "no SUMMARY line (see $1)"
+  }
+  echo "  alone trainee: $(trainee "$OUT/alone-haptic.log")"
+  for i in $(seq 1 "$SEATS"); do
+    s=$(printf 'seat%02d' "$i")
+    echo "  $s trainee: $(trainee "$OUT/$s-haptic.log")"
+  done
+  # The machine's total demand: CPU time (utime + stime) each process used up
+  # to its last sample, summed by kind, over the lab's wall time so far.
+  awk -F, -v cores="$(nproc)" 'NR > 1 { if ($5 > m[$4]) m[$4] = $5; kind[$4] = $2; if ($1 > wall) wall = $1 }
+    END { for (p in m) { c[kind[p]] += m[p]; n[kind[p]]++; all += m[p] }
+          if (wall <= 0) { print "  CPU by kind: no samples"; exit }
+          printf "  CPU by kind over the lab'\''s %.0f s (%% of one core; %d cores = %d %%):", wall, cores, 100 * cores
+          split("server trainee subscriber", ks, " ")
+          for (i = 1; i <= 3; i++) { k = ks[i]
+            printf " %d %ss %.0f %% (%.1f %% each),", n[k], k, 100 * c[k] / wall, n[k] ? 100 * c[k] / wall / n[k] : 0 }
+          printf " all %.0f %%\n", 100 * all / wall }' "$OUT/cpu.csv"
 } | tee "$OUT/summary.txt"
