@@ -22,9 +22,9 @@
 #   --secure            DDS Security on (PKI in --pki DIR)
 #   --pki DIR           the lab's PKI (default OUT/pki; made by pki.sh when missing)
 #   --no-record         no lab recorder
-#   --rt-priority N     servers' physics loops at SCHED_FIFO N (1..99), trainees' ticks at N+10
-#                       (needs root or CAP_SYS_NICE; without, they warn and run at normal
-#                       priority); 0 (default): normal scheduling
+#   --rt-priority N     every server's physics loop SCHED_FIFO at N (1..99; default 0: normal
+#                       scheduling); needs root or CAP_SYS_NICE, else each server warns and runs on
+#   --haptic-rt-priority N  the same for the trainees' 1 kHz loops (with --trainees)
 # SIGINT (Ctrl-C) or SIGTERM stops the lab: every process it started gets
 # SIGTERM (SIGKILL if still running 10 s later), then the summary is printed.
 # Exit status: 0 when every process ended cleanly, 1 when one failed (named
@@ -34,7 +34,7 @@
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD="$ROOT/build" OUT="$ROOT/out/lab" SEATS=3 FIRST=1 PREFIX=lab SCENE="$ROOT/assets/scenes/default.yaml"
-TRAINEES=0 VIEWERS=1 DURATION=20 SECURE=0 RECORD=1 PKI="" RT=0
+TRAINEES=0 VIEWERS=1 DURATION=20 SECURE=0 RECORD=1 PKI="" RTPRIO=0 HRTPRIO=0
 STOP_GRACE_S="${VISCERA_LAB_STOP_GRACE:-10}"
 usage() { awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"; }
 while [ $# -gt 0 ]; do
@@ -51,17 +51,24 @@ while [ $# -gt 0 ]; do
     --secure) SECURE=1; shift ;;
     --pki) PKI="$2"; shift 2 ;;
     --no-record) RECORD=0; shift ;;
-    --rt-priority) RT="$2"; shift 2 ;;
+    --rt-priority) RTPRIO="$2"; shift 2 ;;
+    --haptic-rt-priority) HRTPRIO="$2"; shift 2 ;;
     -h|--help) usage; exit 0 ;;
     *) echo "lab.sh: unknown option '$1'" >&2; usage >&2; exit 2 ;;
   esac
 done
-[[ "$RT" =~ ^[0-9]+$ ]] && [ "$RT" -le 89 ] || { echo "lab.sh: --rt-priority must be 0..89 (trainees run at it + 10)" >&2; exit 2; }
-SRV_RT=(); HAP_RT=()
-[ "$RT" -gt 0 ] && SRV_RT=(--rt-priority "$RT") && HAP_RT=(--rt-priority $((RT + 10)))
 for v in SEATS FIRST VIEWERS DURATION; do
   [[ "${!v}" =~ ^[0-9]+$ ]] || { echo "lab.sh: --${v,,} must be a whole number" >&2; exit 2; }
 done
+for v in RTPRIO HRTPRIO; do
+  [[ "${!v}" =~ ^[0-9]{1,2}$ ]] ||
+    { echo "lab.sh: --$([ $v = RTPRIO ] || echo haptic-)rt-priority must be 0 (normal) or 1..99" >&2; exit 2; }
+done
+RTPRIO=$((10#$RTPRIO)) HRTPRIO=$((10#$HRTPRIO))
+# The option each server / trainee gets (nothing for 0).
+SRV_RT=() HAP_RT=()
+[ "$RTPRIO" = 0 ] || SRV_RT=(--rt-priority "$RTPRIO")
+[ "$HRTPRIO" = 0 ] || HAP_RT=(--rt-priority "$HRTPRIO")
 [[ "$STOP_GRACE_S" =~ ^[0-9]+$ ]] || { echo "lab.sh: VISCERA_LAB_STOP_GRACE must be a whole number" >&2; exit 2; }
 [ "$SEATS" -ge 1 ] && [ "$FIRST" -ge 1 ] && [ $((FIRST + SEATS - 1)) -le 99 ] || { echo "lab.sh: seats must lie in 1..99" >&2; exit 2; }
 [[ "$PREFIX" =~ ^[A-Za-z0-9_-]+$ ]] || { echo "lab.sh: --prefix: letters, digits, '-' and '_' only" >&2; exit 2; }

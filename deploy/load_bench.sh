@@ -4,36 +4,41 @@
 # pressing and releasing for the whole run, SUBSCRIBERS light viewers
 # (tests/bench/delta_sub: keyframe + every MeshDelta, latency measured) spread
 # over the seats, a third of them joining late (at a third of the run).
-# Samples every server's CPU time and resident memory every 10 s; at the end
-# prints per-seat step time (median, p99; wall time and the server thread's
-# CPU time, which tells the step's own cost from time spent preempted by the
-# other processes) and real-time ratio, delta latency (median, p99 over all
-# subscribers), the time late joiners waited for their keyframe, and CPU /
-# memory at the start and the end of the run. Writes OUT/load.csv (samples)
-# and OUT/summary.txt.
+# Samples every server's CPU time and resident memory every 10 s, and the CPU
+# time of every process it started (servers, trainees, subscribers) every
+# second; at the end prints per-seat step time (median, p99; wall time and the
+# server thread's CPU time, which tells the step's own cost from time spent
+# preempted by the other processes) and real-time ratio, delta latency
+# (median, p99 over all subscribers), the time late joiners waited for their
+# keyframe, CPU / memory at the start and the end of the run, each trainee's
+# loop rate, late ticks and command->feedback latency, and the CPU the
+# processes of each kind used (% of one core: the machine's total demand).
+# Writes OUT/load.csv (server samples), OUT/cpu.csv (every process, every
+# second) and OUT/summary.txt.
 #
-# Before the lab starts, one seat runs alone (same scene, same trainee, no
-# subscribers) for BASELINE s: its step times are the reference that "step
-# time unchanged" is judged against.
+# Scheduling: the servers' physics loops run SCHED_FIFO at --rt-priority S
+# (default 70) and the trainees' 1 kHz loops at --haptic-rt-priority H
+# (default 80: the haptic tick is the most latency-critical thread and is
+# short); only those threads, DDS threads stay normal; 0 = normal scheduling.
+# Without root or CAP_SYS_NICE the processes warn and run at normal priority
+# (the summary says how many were refused).
 #
-# Servers run their physics loop at SCHED_FIFO RT (--rt-priority), trainees
-# their 1 kHz tick at HRT (higher: the haptic tick is short and the most
-# latency-critical), as a lab would deploy them; 0 = normal scheduling.
-# Without the privilege both warn and run at normal priority (the summary
-# says which). The scene's organ sleeps while the trainee is away
-# (physics.sleep_speed); the summary gives the step times of the steps that
-# stepped the organ next to those of all steps. Also prints every trainee's
-# tick rate and late ticks, and the CPU used by each kind of process
-# (servers, trainees, subscribers) over the run, as % of one core.
+# The scene's kidney sleeps while its trainee is away (physics.sleep_speed,
+# assets/scenes/README.md): the summary gives, next to the step times of all
+# steps, those of the steps that stepped the organ (the physics work) and the
+# share of steps in which it slept.
+#
+# Before the lab starts, one seat runs alone (same scene, same trainee, same
+# scheduling, no subscribers) for BASELINE s: its step times are the
+# reference that "step time unchanged" is judged against.
 #
 # usage: deploy/load_bench.sh [--build DIR] [--out DIR] [--seats N] [--subscribers M] [--duration S]
-#                             [--baseline S] [--rt-priority RT] [--haptic-rt-priority HRT] [--scene FILE]
+#                             [--baseline S] [--rt-priority S] [--haptic-rt-priority H]
 # defaults: build/, out/load, 5 seats, 30 subscribers, 600 s (the issue's setting), baseline 30 s,
-# RT 70, HRT 80, assets/scenes/classroom_kidney.yaml
+#           servers SCHED_FIFO 70, trainees SCHED_FIFO 80
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-BUILD="$ROOT/build" OUT="$ROOT/out/load" SEATS=5 SUBS=30 DURATION=600 BASELINE=30 RT=70 HRT=80
-SCENE="$ROOT/assets/scenes/classroom_kidney.yaml"
+BUILD="$ROOT/build" OUT="$ROOT/out/load" SEATS=5 SUBS=30 DURATION=600 BASELINE=30 RTPRIO=70 HRTPRIO=80
 while [ $# -gt 0 ]; do
   case "$1" in
     --build) BUILD="$2"; shift 2 ;;
@@ -42,135 +47,146 @@ while [ $# -gt 0 ]; do
     --subscribers) SUBS="$2"; shift 2 ;;
     --duration) DURATION="$2"; shift 2 ;;
     --baseline) BASELINE="$2"; shift 2 ;;
-    --rt-priority) RT="$2"; shift 2 ;;
-    --haptic-rt-priority) HRT="$2"; shift 2 ;;
-    --scene) SCENE="$2"; shift 2 ;;
-    -h|--help) sed -n 2,35p "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --rt-priority) RTPRIO="$2"; shift 2 ;;
+    --haptic-rt-priority) HRTPRIO="$2"; shift 2 ;;
+    -h|--help) sed -n 2,34p "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "load_bench.sh: unknown option '$1'" >&2; exit 2 ;;
   esac
 done
 for v in SEATS SUBS DURATION BASELINE; do [[ "${!v}" =~ ^[0-9]+$ ]] && [ "${!v}" -ge 1 ] || { echo "load_bench.sh: bad ${v,,}" >&2; exit 2; }; done
-for v in RT HRT; do [[ "${!v}" =~ ^[0-9]+$ ]] && [ "${!v}" -le 99 ] || { echo "load_bench.sh: bad ${v,,} (0..99)" >&2; exit 2; }; done
-[ -f "$SCENE" ] || { echo "load_bench.sh: scene file not found: $SCENE" >&2; exit 2; }
-SRV_RT=(); HAP_RT=()
-[ "$RT" -gt 0 ] && SRV_RT=(--rt-priority "$RT")
-[ "$HRT" -gt 0 ] && HAP_RT=(--rt-priority "$HRT")
+check_prio() {
+  [[ "$2" =~ ^[0-9]{1,2}$ ]] ||
+    { echo "load_bench.sh: $1 '$2' is not 0 (normal scheduling) or a SCHED_FIFO priority 1..99" >&2; exit 2; }
+}
+check_prio --rt-priority "$RTPRIO"; check_prio --haptic-rt-priority "$HRTPRIO"
+RTPRIO=$((10#$RTPRIO)) HRTPRIO=$((10#$HRTPRIO))
+# The options each server and trainee gets (none for 0: normal scheduling).
+SRV_RT=() HAP_RT=()
+[ "$RTPRIO" -gt 0 ] && SRV_RT=(--rt-priority "$RTPRIO")
+[ "$HRTPRIO" -gt 0 ] && HAP_RT=(--rt-priority "$HRTPRIO")
 [ -x "$BUILD/tests/bench/delta_sub" ] || { echo "load_bench.sh: $BUILD/tests/bench/delta_sub missing (build with -DVISCERA_BUILD_BENCH=ON)" >&2; exit 1; }
 export CYCLONEDDS_URI="${CYCLONEDDS_URI:-file://$ROOT/deploy/cyclonedds-loopback.xml}"
 export VISCERA_DOMAIN="${VISCERA_DOMAIN:-8}"
 rm -rf "$OUT"; mkdir -p "$OUT"
+SCENE="$ROOT/assets/scenes/classroom_kidney.yaml"
 # Press 8 mm, hold, release, every 4 s, for the whole run.
 TRAJ="$OUT/press_release.traj"
 { t=0; echo "0 0.012 0.004 0.07"; while [ $t -lt $((DURATION + 4)) ]; do
     echo "$t.5 0.012 0.004 0.07"; echo "$((t + 1)).5 0.012 0.004 0.027"; echo "$((t + 2)).5 0.012 0.004 0.027"
     echo "$((t + 3)).9 0.012 0.004 0.07"; t=$((t + 4)); done; } > "$TRAJ"
+awake_line() { # server log -> "asleep in P % of steps; steps that stepped the organ: ..." (or nothing)
+  sed -n 's/^server: organs slept .* every organ asleep in [0-9]* of [0-9]* steps (\([0-9.]*\) %); steps with an organ awake ([0-9]* recent): wall median \([0-9.]*\) us p99 \([0-9.]*\) us, CPU median \([0-9.]*\) us p99 \([0-9.]*\) us/asleep in \1 % of steps; steps that stepped the organ: wall median \2 us, p99 \3 us; CPU median \4 us, p99 \5 us/p' "$1"
+}
 step_line() { # server log -> "N steps, step wall time ...; step CPU time ...; real-time ratio R"
   local wall cpu
   wall=$(sed -n 's/^server: \([0-9]*\) steps, step time median \([0-9.]*\) us p99 \([0-9.]*\) us.*/\1 steps, step wall time median \2 us, p99 \3 us/p' "$1")
   cpu=$(sed -n 's/^server: step CPU time median \([0-9.]*\) us p99 \([0-9.]*\) us; \([0-9.]*\) simulated.*/step CPU time median \1 us, p99 \2 us; real-time ratio \3/p' "$1")
   echo "$wall; $cpu"
 }
-awake_line() { # server log -> "organ asleep in P % of steps; awake steps: wall ..., CPU ..." (or nothing)
-  sed -n 's/^server: organs slept .* every organ asleep in [0-9]* of [0-9]* steps (\([0-9.]*\) %); steps with an organ awake ([0-9]* recent): wall median \([0-9.]*\) us p99 \([0-9.]*\) us, CPU median \([0-9.]*\) us p99 \([0-9.]*\) us/asleep in \1 % of steps; steps that stepped the organ: wall median \2 us, p99 \3 us; CPU median \4 us, p99 \5 us/p' "$1"
-}
-sched_line() { # log, requested priority -> how its loop was scheduled (--quiet hides the success line)
-  if grep -q "SCHED_FIFO.*refused" "$1"; then echo "normal priority (SCHED_FIFO $2 refused)"
-  elif [ "$2" -gt 0 ]; then echo "SCHED_FIFO priority $2"
-  else echo "normal priority"; fi
-}
-cpu_of() { # pid -> utime+stime in s, or nothing when gone
-  awk -v hz="$(getconf CLK_TCK)" '{ sub(/^.*\) /, ""); print ($12 + $13) / hz }' "/proc/$1/stat" 2>/dev/null || true
-}
-declare -A KIND LASTCPU
-track() { KIND[$1]=$2; }
-# The reference: one seat alone.
+# The reference: one seat alone, scheduled as the lab's seats are.
 echo "load_bench: baseline, one seat alone for $BASELINE s" >&2
-"$BUILD/server/viscera-server" --scene "$SCENE" --partition "load/alone" --duration $((BASELINE + 2)) --quiet "${SRV_RT[@]}" \
-  > "$OUT/alone-server.out" 2> "$OUT/alone-server.log" &
+"$BUILD/server/viscera-server" --scene "$SCENE" --partition "load/alone" --duration $((BASELINE + 2)) --quiet \
+  "${SRV_RT[@]}" > "$OUT/alone-server.out" 2> "$OUT/alone-server.log" &
 alone=$!
 sleep 1
-"$BUILD/client/haptic/viscera-haptic" --partition "load/alone" --trajectory "$TRAJ" --duration "$BASELINE" --quiet "${HAP_RT[@]}" \
-  > "$OUT/alone-haptic.log" 2>&1 || true
+"$BUILD/client/haptic/viscera-haptic" --partition "load/alone" --trajectory "$TRAJ" --duration "$BASELINE" --quiet \
+  "${HAP_RT[@]}" > "$OUT/alone-haptic.log" 2>&1 || true
 wait "$alone" || true
 pids=()
 cleanup() { for p in "${pids[@]}"; do kill -TERM "$p" 2>/dev/null || true; done; wait 2>/dev/null || true; }
 trap cleanup EXIT
+# Every process of the lab, for the CPU by kind: "pid kind name command".
+: > "$OUT/procs.txt"
+register() { echo "$1 $2 $3 $4" >> "$OUT/procs.txt"; }
+now_us() { echo "${EPOCHREALTIME/[.,]/}"; } # bash 5; the decimal sign follows the locale
+T0=$(now_us)
 servers=()
 for i in $(seq 1 "$SEATS"); do
   s=$(printf 'seat%02d' "$i")
-  "$BUILD/server/viscera-server" --scene "$SCENE" --partition "load/$s" --duration $((DURATION + 3)) --quiet "${SRV_RT[@]}" \
-    > "$OUT/$s-server.out" 2> "$OUT/$s-server.log" &
-  servers+=($!); pids+=($!); track $! server
+  "$BUILD/server/viscera-server" --scene "$SCENE" --partition "load/$s" --duration $((DURATION + 3)) --quiet \
+    "${SRV_RT[@]}" > "$OUT/$s-server.out" 2> "$OUT/$s-server.log" &
+  servers+=($!); pids+=($!); register $! server "$s" viscera-server
 done
 sleep 1
 for i in $(seq 1 "$SEATS"); do
   s=$(printf 'seat%02d' "$i")
   "$BUILD/client/haptic/viscera-haptic" --partition "load/$s" --trajectory "$TRAJ" --duration "$DURATION" --quiet \
-    "${HAP_RT[@]}" > "$OUT/$s-haptic.log" 2>&1 & pids+=($!); track $! trainee
+    "${HAP_RT[@]}" > "$OUT/$s-haptic.log" 2>&1 &
+  pids+=($!); register $! trainee "$s" viscera-haptic
 done
 late=$((SUBS / 3)); early=$((SUBS - late))
 start_sub() { # index, duration
   local s; s=$(printf 'seat%02d' $(( ($1 % SEATS) + 1 )))
   "$BUILD/tests/bench/delta_sub" --partition "load/$s" --duration "$2" --name "sub$1-$s" > "$OUT/sub$1.out" 2>&1 &
-  pids+=($!); track $! subscriber
+  pids+=($!); register $! subscriber "sub$1-$s" delta_sub
 }
 for k in $(seq 1 "$early"); do start_sub "$k" "$DURATION"; done
-echo "load_bench: $SEATS seats, $SUBS subscribers ($late join late), $DURATION s; samples every 10 s" >&2
+echo "load_bench: $SEATS seats, $SUBS subscribers ($late join late), $DURATION s; samples every 10 s (CPU of every process every 1 s)" >&2
 echo "t_s,seat,pid,cpu_s,rss_kb" > "$OUT/load.csv"
-sample() {
-  local t=$1 i=0 p cpu rss
+echo "t_s,kind,name,pid,cpu_s" > "$OUT/cpu.csv"
+HZ=$(getconf CLK_TCK)
+# A process may end at any moment (a server's duration, a crash): everything
+# read from /proc here tolerates a missing file, so `set -e` cannot end the
+# benchmark on it (it did: "awk: cannot open /proc/PID/stat").
+sample() { # servers' CPU time and resident memory -> load.csv
+  local t=$1 i=0 p st cpu rss
   for p in "${servers[@]}"; do
     i=$((i + 1))
-    # utime + stime in clock ticks (fields 14, 15 after the command name);
-    # a server that has already exited is skipped.
-    cpu=$(cpu_of "$p"); rss=$(awk '/VmRSS/ { print $2 }' "/proc/$p/status" 2>/dev/null || true)
-    [ -n "$cpu" ] && [ -n "$rss" ] || continue
+    st=$(cat /proc/"$p"/stat 2>/dev/null) || continue
+    # utime + stime in clock ticks (fields 14, 15; 12, 13 after the command name).
+    cpu=$(echo "${st##*) }" | awk -v hz="$HZ" '{ print ($12 + $13) / hz }')
+    rss=$(awk '/VmRSS/ { print $2 }' /proc/"$p"/status 2>/dev/null || true)
+    [ -n "$rss" ] || continue # ended between the two reads (a zombie has no VmRSS)
     echo "$t,seat$(printf %02d $i),$p,$cpu,$rss" >> "$OUT/load.csv"
   done
-  # Every process's CPU so far (the last sample before it exits counts).
-  for p in "${!KIND[@]}"; do cpu=$(cpu_of "$p"); [ -n "$cpu" ] && LASTCPU[$p]=$cpu; done
-  return 0
 }
-t=0; late_started=0
+sample_cpu() { # every registered process still there (a zombie too: its times are final) -> cpu.csv
+  local files=() p us
+  while read -r p _; do files+=("/proc/$p/stat"); done < "$OUT/procs.txt"
+  [ ${#files[@]} -gt 0 ] || return 0
+  us=$(( $(now_us) - T0 ))
+  { cat "${files[@]}" 2>/dev/null || true; } |
+    awk -v t="$((us / 1000000)).$(printf %03d $(( (us / 1000) % 1000 )))" -v hz="$HZ" '
+      NR == FNR { kind[$1] = $2; name[$1] = $3; comm[$1] = $4; next }
+      { pid = $1; c = $0; sub(/\) .*$/, "", c); sub(/^[^(]*\(/, "", c); sub(/^.*\) /, "")
+        # a pid the kernel gave to another program since is not ours
+        if (pid in kind && c == comm[pid]) printf "%s,%s,%s,%s,%.2f\n", t, kind[pid], name[pid], pid, ($12 + $13) / hz }' \
+      "$OUT/procs.txt" - >> "$OUT/cpu.csv"
+}
+loop0=$(now_us); t=0; late_started=0; next_mem=0
 while [ $t -lt "$DURATION" ]; do
   if [ $late_started = 0 ] && [ $t -ge $((DURATION / 3)) ]; then
     for k in $(seq $((early + 1)) "$SUBS"); do start_sub "$k" $((DURATION - t)); done
     late_started=1
   fi
-  sample $t
-  step=$(( DURATION - t < 10 ? DURATION - t : 10 ))
-  sleep "$step"; t=$((t + step))
+  if [ $t -ge $next_mem ]; then sample $t; next_mem=$((next_mem + 10)); fi
+  sample_cpu
+  sleep 1; t=$(( ($(now_us) - loop0) / 1000000 ))
 done
 sample $t
+sample_cpu
 wait "${servers[@]}" 2>/dev/null || true
 sleep 1
 pids=()
 {
   echo "load_bench: $SEATS seats x classroom_kidney (2,000 vertices, 1 kHz physics, meshes at 60 Hz), $SUBS subscribers ($late late), $DURATION s"
+  sched() { # what PRIO LOG...: the policy asked and how many processes refused it
+    local what=$1 prio=$2; shift 2
+    if [ "$prio" = 0 ]; then echo "$what normal scheduling"; return; fi
+    echo "$what SCHED_FIFO $prio (refused in $(grep -l 'warning: SCHED_FIFO [0-9]* refused' "$@" 2>/dev/null | wc -l) of $#)"
+  }
+  echo "  scheduling: $(sched "servers' physics loops" "$RTPRIO" "$OUT"/*-server.log), $(sched "trainees' loops" "$HRTPRIO" "$OUT"/*-haptic.log)"
   echo "  alone (baseline, $BASELINE s): $(step_line "$OUT/alone-server.log")"
   for i in $(seq 1 "$SEATS"); do
     s=$(printf 'seat%02d' "$i")
     echo "  $s: $(step_line "$OUT/$s-server.log")"
   done
   if [ -n "$(awake_line "$OUT/alone-server.log")" ]; then
-    echo "  organ sleeping (the scene's physics.sleep_speed): alone: $(awake_line "$OUT/alone-server.log")"
+    echo "  organ sleeping: alone: $(awake_line "$OUT/alone-server.log")"
     for i in $(seq 1 "$SEATS"); do
       s=$(printf 'seat%02d' "$i"); echo "    $s: $(awake_line "$OUT/$s-server.log")"
     done
   fi
-  echo "  scheduling: servers' physics loop $(sched_line "$OUT/seat01-server.log" "$RT"), trainees' tick $(sched_line "$OUT/seat01-haptic.log" "$HRT")"
-  for i in $(seq 1 "$SEATS"); do
-    s=$(printf 'seat%02d' "$i")
-    sed -n "s/^SUMMARY ticks=\([0-9]*\) rate_hz=\([0-9.]*\) .*latency_us_median=\([0-9.]*\) latency_us_p99=\([0-9.]*\) .*late_ticks=\([0-9]*\).*/  $s trainee: \1 ticks at \2 Hz, \5 later than 1 ms; command->feedback latency median \3 us, p99 \4 us/p" "$OUT/$s-haptic.log"
-  done
-  for k in server trainee subscriber; do
-    tot=0; n=0
-    for p in "${!KIND[@]}"; do
-      [ "${KIND[$p]}" = "$k" ] && [ -n "${LASTCPU[$p]:-}" ] || continue
-      tot=$(awk -v a="$tot" -v b="${LASTCPU[$p]}" 'BEGIN { print a + b }'); n=$((n + 1))
-    done
-    awk -v k="$k" -v t="$tot" -v n="$n" -v d="$DURATION" 'BEGIN { if (n) printf "  CPU of the %ss: %d processes, %.1f %% of one core in all over the run (%.2f %% each)\n", k, n, 100 * t / d, 100 * t / d / n }'
-  done
   field() { sed -n "s/^SUB.* $1=\([0-9.e+-]*\).*/\1/p" "$OUT"/sub*.out | sort -g; }
   n=$(grep -h '^SUB' "$OUT"/sub*.out | wc -l)
   got=$(grep -h '^SUB' "$OUT"/sub*.out | grep -vc ' keyframes=0 ' || true)
@@ -183,4 +199,24 @@ pids=()
   awk -F, 'NR > 1 { if (!($2 in c0)) { c0[$2] = $4; r0[$2] = $5; t0[$2] = $1 } c1[$2] = $4; r1[$2] = $5; t1[$2] = $1 }
     END { for (s in c0) { dt = t1[s] - t0[s]; printf "  %s: CPU %.0f %% of a core, RSS %d kB at start, %d kB at end\n", s,
             (dt > 0 ? 100 * (c1[s] - c0[s]) / dt : 0), r0[s], r1[s] } }' "$OUT/load.csv" | sort
+  # Each trainee's own figures (viscera-haptic's SUMMARY line).
+  trainee() {
+    sed -n 's/^SUMMARY .*rate_hz=\([0-9.]*\) .* latency_us_median=\([0-9.]*\) latency_us_p99=\([0-9.]*\) .* jitter_us_p99=\([0-9.]*\) late_ticks=\([0-9]*\).*/rate \1 Hz, \5 ticks over 1 ms late, jitter p99 \4 us, command->feedback latency median \2 us, p99 \3 us/p' "$1" | grep . ||
+      echo "no SUMMARY line (see $1)"
+  }
+  echo "  alone trainee: $(trainee "$OUT/alone-haptic.log")"
+  for i in $(seq 1 "$SEATS"); do
+    s=$(printf 'seat%02d' "$i")
+    echo "  $s trainee: $(trainee "$OUT/$s-haptic.log")"
+  done
+  # The machine's total demand: CPU time (utime + stime) each process used up
+  # to its last sample, summed by kind, over the lab's wall time so far.
+  awk -F, -v cores="$(nproc)" 'NR > 1 { if ($5 > m[$4]) m[$4] = $5; kind[$4] = $2; if ($1 > wall) wall = $1 }
+    END { for (p in m) { c[kind[p]] += m[p]; n[kind[p]]++; all += m[p] }
+          if (wall <= 0) { print "  CPU by kind: no samples"; exit }
+          printf "  CPU by kind over the lab'\''s %.0f s (%% of one core; %d cores = %d %%):", wall, cores, 100 * cores
+          split("server trainee subscriber", ks, " ")
+          for (i = 1; i <= 3; i++) { k = ks[i]
+            printf " %d %ss %.0f %% (%.1f %% each),", n[k], k, 100 * c[k] / wall, n[k] ? 100 * c[k] / wall / n[k] : 0 }
+          printf " all %.0f %%\n", 100 * all / wall }' "$OUT/cpu.csv"
 } | tee "$OUT/summary.txt"

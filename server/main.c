@@ -29,12 +29,13 @@ static void usage(FILE *f) {
              "  --checkpoint FILE   resume from FILE when it holds this scene's state (kill -9, crash), and\n"
              "                      write the state there every --checkpoint-every s and at exit\n"
              "  --checkpoint-every S  simulated seconds between checkpoints (default 1)\n"
-             "  --rt-priority N     run the physics loop thread SCHED_FIFO at priority N (1..99), memory\n"
-             "                      locked (needs root or CAP_SYS_NICE; warns and runs on otherwise): its\n"
-             "                      steps then keep their pace on a crowded machine\n"
              "  --check             load and validate the scene, build its models, print per organ the model,\n"
              "                      integrator, nodes, tetrahedra, sub-steps and stable dt, exit\n"
-             "  --quiet             only errors on stderr\n"
+             "  --rt-priority N     run the physics loop's thread (only it; DDS threads stay normal)\n"
+             "                      SCHED_FIFO at priority N (1..99) with memory locked (needs root,\n"
+             "                      CAP_SYS_NICE or LimitRTPRIO; if refused: a warning naming the reason,\n"
+             "                      normal priority)\n"
+             "  --quiet             only errors and warnings on stderr\n"
              "  --help              this text\n"
              "DDS configuration comes from CYCLONEDDS_URI (deploy/cyclonedds-loopback.xml for one machine).\n");
 }
@@ -106,8 +107,8 @@ int main(int argc, char **argv) {
       }
       break;
     case 'R':
-      if ((opts.rt_priority = vrt_parse_priority(optarg)) < 0) {
-        fprintf(stderr, "viscera-server: --rt-priority '%s' must be 1..99\n", optarg);
+      if (vrt_parse_priority(optarg, &opts.rt_priority)) {
+        fprintf(stderr, "viscera-server: --rt-priority '%s' is not a SCHED_FIFO priority 1..99\n", optarg);
         return 2;
       }
       break;

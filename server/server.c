@@ -15,8 +15,8 @@
 #include "tool_roles.h"
 #include "viscera.h"
 #include "vmath.h"
-#include "vstats.h"
 #include "vrt.h"
+#include "vstats.h"
 #include "vtime.h"
 #include "writer_stations.h"
 
@@ -755,13 +755,18 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
   for (size_t i = 0; i < s.rt.norgans; i++) mesh_publisher_keyframe(&s.pubs[i], s.rt.organs[i].model->surf_x, 0);
   publish_event(&s, viscera_EVENT_SESSION_STARTED, -1, -1, stats->resumed, resumed[0] ? resumed : scene->name);
 
-  /* Real time for this thread only, and only now: the DDS and checkpoint
-   * threads started above keep normal priority (vrt.h). A refusal is a
-   * warning; the loop runs on. */
-  if (opts->rt_priority) vrt_make_realtime(opts->rt_priority, "server", opts->quiet);
   uint64_t dt_ns = (uint64_t)(scene->dt * 1e9);
   uint64_t publish_every = (uint64_t)fmax(1.0, floor(1.0 / (scene->publish_hz * scene->dt) + 0.5));
   uint64_t metrics_every = (uint64_t)fmax(1.0, floor(1.0 / scene->dt + 0.5));
+  /* Real time for this thread only, after every other thread (DDS, the
+   * checkpoint writer) has started, so they stay SCHED_OTHER. The loop sleeps
+   * to each tick in vtime_sleep_until, so FIFO costs the machine no more CPU
+   * than the steps; but a loop whose steps take longer than dt never sleeps
+   * (it catches up, resynchronising when 100 ms behind) and would hold its
+   * core for good. The kernel's RT throttling (sched_rt_runtime_us: 950 ms of
+   * every second by default) is the safety net that still lets the other
+   * tasks (this server's DDS threads, a shell to stop it) run there. */
+  if (opts->rt_priority) vrt_make_realtime(opts->rt_priority, "server", "physics loop", opts->quiet, stderr);
   uint64_t start = vtime_mono_ns(), next = start;
   double sim0 = s.rt.sim_time; /* a resumed run starts where its checkpoint was */
   while (!*stop && (opts->duration <= 0 || (double)(vtime_mono_ns() - start) * 1e-9 < opts->duration)) {

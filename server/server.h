@@ -22,7 +22,7 @@ typedef struct server_opts {
   double tool_timeout;     /* s without a command before a tool is released */
   const char *checkpoint;  /* state file: resumed from at start when it fits the scene, written periodically */
   double checkpoint_every; /* s of simulated time between checkpoints */
-  int rt_priority;         /* 1..99: the physics loop thread runs SCHED_FIFO at it (vrt.h); 0 = normal */
+  int rt_priority;         /* 1..99: the step loop's thread runs SCHED_FIFO at it (vrt.h); 0 = normal */
 } server_opts_t;
 
 typedef struct server_stats {

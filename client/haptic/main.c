@@ -3,11 +3,8 @@
  * ContactFeedback's local contact model, coupled to the peer station's
  * device while the tool is guided (guide_force.h). Prints rate, jitter,
  * force, latency and guiding statistics on exit. */
-#include <errno.h>
 #include <getopt.h>
 #include <pthread.h>
-#include <sched.h>
-#include <sys/mman.h>
 #include <inttypes.h>
 #include <math.h>
 #include <signal.h>
@@ -58,8 +55,9 @@ static void usage(FILE *f) {
           "  --wait-server S     wait up to S s for the server's scene before starting (default 10)\n"
           "  --duration S        stop after S s (default: end of the trajectory + 0.5 s)\n"
           "  --force-csv FILE    write t,x,y,z,fx,fy,fz,in_contact per tick\n"
-          "  --rt-priority N     run the loop thread SCHED_FIFO at priority N (1..99) with\n"
-          "                      memory locked (needs root or CAP_SYS_NICE; warns otherwise)\n"
+          "  --rt-priority N     run the loop thread (only it) SCHED_FIFO at priority N (1..99) with\n"
+          "                      memory locked (needs root, CAP_SYS_NICE or LimitRTPRIO; if refused:\n"
+          "                      a warning naming the reason, normal priority)\n"
           "  --quiet             only the summary\n"
           "  --help              this text\n",
           device_names());
@@ -108,7 +106,7 @@ int main(int argc, char **argv) {
   while ((c = getopt_long(argc, argv, "j:n:s:d:p:r:m:K:w:t:f:R:D:I:S:O:qh", lo, NULL)) != -1) {
     char *end = NULL;
     double v = 0;
-    if (c == 'r' || c == 'm' || c == 'K' || c == 'w' || c == 't' || c == 'n' || c == 'R' || c == 'I' || c == 'S') {
+    if (c == 'r' || c == 'm' || c == 'K' || c == 'w' || c == 't' || c == 'n' || c == 'I' || c == 'S') {
       v = strtod(optarg, &end);
       if (*end || !isfinite(v) || v < 0) {
         fprintf(stderr, "viscera-haptic: option --%s: '%s' is not a non-negative number\n",
@@ -117,7 +115,6 @@ int main(int argc, char **argv) {
                 : c == 'K' ? "max-stiffness"
                 : c == 'w' ? "wait-server"
                 : c == 't' ? "duration"
-                : c == 'R' ? "rt-priority"
                 : c == 'I' ? "device-index"
                 : c == 'S' ? "workspace-scale"
                            : "tool",
@@ -168,8 +165,8 @@ int main(int argc, char **argv) {
       force_csv = optarg;
       break;
     case 'R':
-      if ((rt_priority = vrt_parse_priority(optarg)) < 0) {
-        fprintf(stderr, "viscera-haptic: --rt-priority '%s' must be 1..99\n", optarg);
+      if (vrt_parse_priority(optarg, &rt_priority)) {
+        fprintf(stderr, "viscera-haptic: --rt-priority '%s' is not a SCHED_FIFO priority 1..99\n", optarg);
         return 2;
       }
       break;
@@ -298,9 +295,10 @@ int main(int argc, char **argv) {
     fprintf(csv, "t,x,y,z,fx,fy,fz,in_contact\n");
   }
 
-  /* A 1 kHz tick sharing two cores with physics and rendering misses its
-   * period whenever the scheduler prefers them (vrt.h). */
-  if (rt_priority) vrt_make_realtime(rt_priority, "haptic", quiet);
+  /* A 1 kHz loop sharing two cores with physics and rendering misses its
+   * tick whenever the scheduler prefers them; SCHED_FIFO and locked pages
+   * keep the period. DDS threads stay at normal priority (vrt.h). */
+  if (rt_priority) vrt_make_realtime(rt_priority, "haptic", "loop", quiet, stderr);
   uint64_t period_ns = (uint64_t)(1e9 / rate);
   stats_t st = {0};
   double run_for = duration >= 0 ? duration : 1e300;
