@@ -268,12 +268,14 @@ static inline void ms_spring_forces(const mass_spring_t *ms, const double *restr
       /* A zero-length spring has no direction: it then pushes nothing, which
        * keeps forces finite when two nodes are moved onto each other. */
       if (len <= MS_TINY) continue;
+      /* With u = d / len: the damping projection is (dv . d) / len and the
+       * force mag u = (mag / len) d, so one reciprocal and no normalised
+       * vector are needed. */
       const double inv = 1.0 / len;
-      const double u0 = d0 * inv, u1 = d1 * inv, u2 = d2 * inv;
-      const double dvu = (v[3 * j] - vi0) * u0 + (v[3 * j + 1] - vi1) * u1 + (v[3 * j + 2] - vi2) * u2;
+      const double dvd = (v[3 * j] - vi0) * d0 + (v[3 * j + 1] - vi1) * d1 + (v[3 * j + 2] - vi2) * d2;
       const double k = scaled ? stiffness * kscale[s] : stiffness;
-      const double mag = k * (len - sp[s].rest) + damping * dvu;
-      const double g0 = mag * u0, g1 = mag * u1, g2 = mag * u2;
+      const double mag = (k * (len - sp[s].rest) + damping * dvd * inv) * inv;
+      const double g0 = mag * d0, g1 = mag * d1, g2 = mag * d2;
       fi0 += g0;
       fi1 += g1;
       fi2 += g2;
