@@ -290,16 +290,25 @@ static inline void ms_spring_forces(const mass_spring_t *ms, const double *restr
 }
 
 void mass_spring_forces(const mass_spring_t *ms, const double *x, const double *v, double *f) {
-  const ms_params_t *p = &ms->p;
-  for (size_t i = 0; i < ms->n; i++) {
-    const double *xi = x + 3 * i, *vi = v + 3 * i, *xr = ms->x_rest + 3 * i;
-    double *fi = f + 3 * i;
-    for (int k = 0; k < 3; k++)
-      fi[k] = ms->f_ext[3 * i + k] + ms->mass[i] * p->gravity[k] - p->home_stiffness * (xi[k] - xr[k]) -
-              p->home_damping * vi[k];
+  /* Node terms. The parameters are copied to locals and the arrays are
+   * restrict-qualified: through plain pointers every store to f could alias
+   * ms->p, so the compiler reloaded gravity and the home coefficients per
+   * node (this loop took a sixth of the spring loop's time). */
+  const double *restrict xr = ms->x_rest, *restrict fext = ms->f_ext, *restrict mass = ms->mass;
+  const double *restrict fres = ms->f_res;
+  const double *restrict xx = x, *restrict vv = v;
+  double *restrict ff = f;
+  const double g0 = ms->p.gravity[0], g1 = ms->p.gravity[1], g2 = ms->p.gravity[2];
+  const double hk = ms->p.home_stiffness, hc = ms->p.home_damping;
+  const size_t n = ms->n;
+  for (size_t i = 0; i < n; i++) {
+    const size_t c = 3 * i;
+    ff[c] = fext[c] + mass[i] * g0 - hk * (xx[c] - xr[c]) - hc * vv[c];
+    ff[c + 1] = fext[c + 1] + mass[i] * g1 - hk * (xx[c + 1] - xr[c + 1]) - hc * vv[c + 1];
+    ff[c + 2] = fext[c + 2] + mass[i] * g2 - hk * (xx[c + 2] - xr[c + 2]) - hc * vv[c + 2];
   }
-  if (ms->f_res)
-    for (size_t c = 0; c < 3 * ms->n; c++) f[c] += ms->f_res[c];
+  if (fres)
+    for (size_t c = 0; c < 3 * n; c++) ff[c] += fres[c];
   if (ms->k_scale)
     ms_spring_forces(ms, x, v, f, 1);
   else
