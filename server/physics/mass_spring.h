@@ -24,7 +24,12 @@
  *
  * Arrays are allocated once in mass_spring_create_*; forces, stiffness_mul,
  * energy and strain allocate nothing. Not thread-safe: one physics thread
- * owns the object. */
+ * owns the object.
+ *
+ * Spring order: forces and stiffness_mul are fastest when springs sharing
+ * node i are consecutive, as built (sorted by (i, j), also after cutting's
+ * set_surface_topology); they are correct for any order (a shuffled array
+ * gives the same forces to rounding, only slower). */
 #ifndef VISCERA_MASS_SPRING_H
 #define VISCERA_MASS_SPRING_H
 
