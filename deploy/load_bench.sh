@@ -166,7 +166,14 @@ done
 sample $t
 sample_cpu
 wait "${servers[@]}" 2>/dev/null || true
-sleep 1
+# The subscribers and trainees end with the run too; wait (at most 15 s) until
+# each has written its summary line, or the report would miss the last ones.
+for _ in $(seq 1 15); do
+  alive=0
+  for p in "${pids[@]}"; do kill -0 "$p" 2>/dev/null && alive=1; done
+  [ $alive = 0 ] && break
+  sleep 1
+done
 pids=()
 {
   echo "load_bench: $SEATS seats x classroom_kidney (2,000 vertices, 1 kHz physics, meshes at 60 Hz), $SUBS subscribers ($late late), $DURATION s"
