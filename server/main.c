@@ -167,7 +167,7 @@ int main(int argc, char **argv) {
           st.steps, st.step_us_median, st.step_us_p99, st.step_us_max, st.overruns, st.rollbacks);
   fprintf(stderr, "server: step CPU time median %.1f us p99 %.1f us; %.3f simulated s per wall s\n",
           st.step_cpu_us_median, st.step_cpu_us_p99, st.realtime_ratio);
-  if (st.sleep_enabled)
+  if (scene.sleep_speed > 0)
     fprintf(stderr,
             "server: organs slept %" PRIu64 " times, woke %" PRIu64 " times; every organ asleep in %" PRIu64
             " of %" PRIu64 " steps (%.1f %%); steps with an organ awake (%zu recent): wall median %.1f us p99 %.1f "

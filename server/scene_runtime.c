@@ -272,8 +272,9 @@ static int organ_disturbed(const runtime_t *rt, size_t i) {
 
 int runtime_step(runtime_t *rt) {
   double dt = rt->scene.dt;
-  /* Stillness over sleep_after, in whole steps (at least 2, scene.c). */
-  uint32_t need = (uint32_t)fmin(4e9, ceil(rt->scene.sleep_after / dt - 1e-9));
+  /* Stillness over sleep_after, in whole steps (at least 2, scene.c); only
+   * worked out when organs may sleep. */
+  uint32_t need = rt->scene.sleep_speed > 0 ? (uint32_t)fmin(4e9, ceil(rt->scene.sleep_after / dt - 1e-9)) : 0;
   rt->organs_stepped = 0;
   interact_before_step(rt);
   for (size_t t = 0; t < rt->ntools; t++) {

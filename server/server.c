@@ -846,11 +846,9 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
   vstats_summary_t sc = vstats_summarise(s.step_cpu_us, n);
   stats->step_cpu_us_median = sc.median;
   stats->step_cpu_us_p99 = sc.p99;
-  stats->sleep_enabled = scene->sleep_speed > 0;
   for (size_t i = 0; i < s.rt.norgans; i++) {
     stats->organ_sleeps += s.rt.organs[i].sleep.sleeps;
     stats->organ_wakes += s.rt.organs[i].sleep.wakes;
-    stats->organ_slept_steps += s.rt.organs[i].sleep.slept_steps;
   }
   double wall = (double)(vtime_mono_ns() - start) * 1e-9;
   stats->realtime_ratio = wall > 0 ? (s.rt.sim_time - sim0) / wall : 0;
