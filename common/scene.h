@@ -82,7 +82,7 @@ typedef struct scene_organ {
  *   scalpel    touches like a probe; with the button (bit 0) pressed its
  *              blade, blade_length along the tool axis from the tip, cuts
  *              pbd, xpbd and mass_spring_surface organs
- *              (server/interaction/scalpel.h).
+ *              (server/runtime/step_cut.h).
  *   extractor  laparoscopic stone extractor: enters through an assumed port,
  *              so it does not collide with organs; closing the jaws within
  *              grasp_radius of a stone's surface grabs the stone and carries it.

@@ -19,8 +19,8 @@
 #include <string.h>
 
 #include "check.h"
-#include "organ_sleep.h"
-#include "scene_runtime.h"
+#include "runtime/organ_sleep.h"
+#include "runtime/scene_runtime.h"
 
 static runtime_t rt_on, rt_off; /* large */
 static scene_t sc_on, sc_off, sc;

@@ -11,10 +11,10 @@
 #include <sqlite3.h>
 
 #include "check.h"
+#include "dds/vdds_ident.h"
 #include "recfile.h"
 #include "replay_pause.h"
 #include "store.h"
-#include "vdds_ident.h"
 
 static void test_format_and_role(void) {
   char buf[VDDS_IDENT_MAX], role[VDDS_ROLE_MAX];

@@ -8,9 +8,9 @@
 #include "check.h"
 #include "scene.h"
 #include "scene_expect.h"
-#include "session_control.h"
-#include "tool_roles.h"
-#include "writer_stations.h"
+#include "session/session_control.h"
+#include "session/tool_roles.h"
+#include "session/writer_stations.h"
 
 #define MS 1000000ull
 
