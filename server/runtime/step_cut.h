@@ -1,4 +1,5 @@
-/* scalpel: the scalpel tool cutting organs in the live runtime (issue 5).
+/* step_cut: the runtime's cut phase (scalpel_*), the scalpel tool cutting
+ * organs in the live runtime (issue 5).
  *
  * A tool of kind `scalpel` whose ToolCommand.buttons bit 0 is set is
  * cutting. Its blade is the segment from the commanded tip (the hand's
@@ -36,8 +37,8 @@
  * a segment the ms cutter could not apply) is counted and its message kept
  * (first ones logged by the caller through scalpel_take_error), never fatal:
  * the model keeps simulating its last topology. */
-#ifndef VISCERA_SCALPEL_H
-#define VISCERA_SCALPEL_H
+#ifndef VISCERA_STEP_CUT_H
+#define VISCERA_STEP_CUT_H
 
 #include <stddef.h>
 #include <stdint.h>

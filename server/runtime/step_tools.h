@@ -1,7 +1,9 @@
-/* tool_actions: what tools do besides the god-object contact (issue 4):
- * graspers grasp, hold, pull and release tissue (grasp.h), extractors take
- * and carry stones (stone.h), tools touch each other, tasks progress
- * (tasks.h). scene_runtime.c calls these at fixed points of its step:
+/* step_tools: the runtime's tool phases (interact_*): what tools do
+ * besides the god-object contact (issue 4). Graspers grasp, hold, pull and
+ * release tissue (interaction/grasp.h), extractors take and carry stones
+ * (interaction/stone.h), tools touch each other, tasks progress
+ * (interaction/tasks.h). scene_runtime.c calls these at fixed points of its
+ * step:
  *
  *   interact_before_step  jaws closing/opening (button bit 0 edges): grab
  *                         or release; held stones follow their tool; tools
@@ -19,8 +21,8 @@
  *                         tasks
  *
  * Events (grasp begin/end, task started/completed) go to rt->events. */
-#ifndef VISCERA_TOOL_ACTIONS_H
-#define VISCERA_TOOL_ACTIONS_H
+#ifndef VISCERA_STEP_TOOLS_H
+#define VISCERA_STEP_TOOLS_H
 
 #include "runtime/scene_runtime.h"
 

@@ -1,4 +1,4 @@
-/* test_organ_sleep: organs at rest are not stepped (server/organ_sleep.h).
+/* test_organ_sleep: organs at rest are not stepped (server/runtime/organ_sleep.h).
  * - the stillness evidence: `need` still steps put an organ to sleep; a
  *   vertex moving more than the limit, a NaN, a disturbance or a new
  *   topology restart the count; waking counts only a sleeping organ;

@@ -1,4 +1,4 @@
-/* test_tool_roles: who drives a tool and where it goes (server/tool_roles.h,
+/* test_tool_roles: who drives a tool and where it goes (server/session/tool_roles.h,
  * the contract above idl ToolRole): command classification per station, the
  * authority mix, an absent side, buttons and orientation of the dominant
  * side, validation of ASSIGN_TOOL / GUIDE, versions, the writer-station
