@@ -16,7 +16,7 @@
 #include <strings.h>
 #include <yaml.h>
 
-#include "vdds.h" /* station names (vdds_station_valid) */
+#include "station.h"
 
 /* A scene is a few kilobytes; the caps keep a hostile or mistaken file (a
  * mesh passed by accident, a YAML bomb) from costing more than a few MB. */
@@ -508,7 +508,7 @@ _Static_assert(P_NKEYS <= SCENE_MAX_KEYS && M_NKEYS <= SCENE_MAX_KEYS && V_NKEYS
                    O_NKEYS <= SCENE_MAX_KEYS && T_NKEYS <= SCENE_MAX_KEYS && H_NKEYS <= SCENE_MAX_KEYS &&
                    S_NKEYS <= SCENE_MAX_KEYS && J_NKEYS <= SCENE_MAX_KEYS && K_NKEYS <= SCENE_MAX_KEYS,
                "raise SCENE_MAX_KEYS");
-_Static_assert(sizeof(((scene_tool_t *)0)->station) == VDDS_STATION_MAX, "scene_tool_t.station: one station name");
+_Static_assert(sizeof(((scene_tool_t *)0)->station) == STATION_NAME_MAX, "scene_tool_t.station: one station name");
 
 static void organ_defaults(scene_organ_t *o) {
   memset(o, 0, sizeof *o);
@@ -828,9 +828,9 @@ static int parse_tool(const ctx_t *c, const node_t *n, size_t idx, scene_t *s) {
   if (v[T_STATION]) { /* the initial owner (idl ToolRole); absent: any station */
     join(fp, sizeof fp, path, "station");
     if (get_string(c, v[T_STATION], fp, t->station, sizeof t->station)) return -1;
-    if (!vdds_station_valid(t->station))
+    if (!station_name_valid(t->station))
       return field_err(c, v[T_STATION], fp, "must be 1..%d characters of A-Z a-z 0-9 _ . - (got '%.*s%s')",
-                       VDDS_STATION_MAX - 1, SHOW(v[T_STATION]));
+                       STATION_NAME_MAX - 1, SHOW(v[T_STATION]));
   }
   return parse_capability(c, v, path, t);
 }

@@ -82,7 +82,7 @@ typedef struct scene_organ {
  *   scalpel    touches like a probe; with the button (bit 0) pressed its
  *              blade, blade_length along the tool axis from the tip, cuts
  *              pbd, xpbd and mass_spring_surface organs
- *              (server/interaction/scalpel.h).
+ *              (server/runtime/step_cut.h).
  *   extractor  laparoscopic stone extractor: enters through an assumed port,
  *              so it does not collide with organs; closing the jaws within
  *              grasp_radius of a stone's surface grabs the stone and carries it.
@@ -169,13 +169,13 @@ typedef struct scene {
   double publish_hz;          /* MeshDelta rate (default 30) */
   double quant_step;          /* m, MeshDelta quantization (default 1e-5) */
   double gravity[3];          /* m/s^2 (default 0 0 0: organs rest on home springs) */
-  /* Organ sleeping (server/organ_sleep.h): an organ whose surface moved
+  /* Organ sleeping (server/runtime/organ_sleep.h): an organ whose surface moved
    * slower than sleep_speed for sleep_after s, with no tool near, is not
    * stepped until a tool comes near. */
   double sleep_speed;         /* m/s; 0 (the default) = organs never sleep */
   double sleep_after;         /* s (default 0.1), >= 2 dt */
   /* s of wall time: a MeshDelta equal to the last one written is skipped
-   * unless this long passed (server/mesh_publisher.h); 0 (the default)
+   * unless this long passed (server/session/mesh_publisher.h); 0 (the default)
    * writes every frame. */
   double publish_keepalive;
   size_t norgans;             /* >= 1 */

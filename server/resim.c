@@ -17,7 +17,7 @@
 #include "resim_recording.h"
 #include "resim_run.h"
 #include "scene.h"
-#include "scene_runtime.h"
+#include "runtime/scene_runtime.h"
 #include "vtime.h"
 
 /* Float rounding of a recorded position (keyframe float plus quantized

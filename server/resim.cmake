@@ -5,7 +5,7 @@
 if(VISCERA_BUILD_RECORDER)
   add_library(viscera_resim STATIC resim_schedule.c resim_run.c resim_recording.c)
   target_include_directories(viscera_resim PUBLIC ${CMAKE_CURRENT_SOURCE_DIR})
-  target_link_libraries(viscera_resim PUBLIC viscera_server_core viscera_rec_decode ${MATH_LIB})
+  target_link_libraries(viscera_resim PUBLIC viscera_sim viscera_rec_decode ${MATH_LIB})
   add_executable(viscera-resim resim.c)
   target_link_libraries(viscera-resim PRIVATE viscera_resim)
 endif()

@@ -20,7 +20,7 @@
 
 #include "resim_recording.h"
 #include "resim_schedule.h"
-#include "scene_runtime.h"
+#include "runtime/scene_runtime.h"
 #include "verr.h"
 
 typedef struct resim_organ_result {

@@ -28,7 +28,7 @@
 #include "dash_draw.h"
 #include "plot_cleanup.h"
 #include "seat.h"
-#include "vdds_ident.h"
+#include "dds/vdds_ident.h"
 #include "vsignal.h"
 #include "vtime.h"
 #ifdef VISCERA_HAVE_WINDOW

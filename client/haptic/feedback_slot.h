@@ -27,7 +27,7 @@
 #include <stdint.h>
 
 #include "contact_model.h"
-#include "vdds.h"
+#include "dds/vdds.h"
 #include "viscera.h"
 
 #define FEEDBACK_SENT_RING 1024

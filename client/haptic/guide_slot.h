@@ -28,7 +28,7 @@
 #include <stdint.h>
 
 #include "guide_force.h"
-#include "vdds.h"
+#include "dds/vdds.h"
 #include "viscera.h"
 
 #define GUIDE_SLOT_STATIONS 8

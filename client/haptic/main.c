@@ -19,7 +19,7 @@
 #include "guide_report.h"
 #include "guide_slot.h"
 #include "vsignal.h"
-#include "vdds.h"
+#include "dds/vdds.h"
 #include "viscera.h"
 #include "vmath.h"
 #include "vrt.h"

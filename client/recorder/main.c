@@ -13,7 +13,7 @@
 #include "session.h"
 #include "vtime.h"
 #include "vsignal.h"
-#include "vdds.h"
+#include "dds/vdds.h"
 
 #ifndef VISCERA_VERSION
 #define VISCERA_VERSION "unknown"

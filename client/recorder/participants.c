@@ -3,7 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "vdds_ident.h"
+#include "dds/vdds_ident.h"
 #include "vtime.h"
 
 struct participants {

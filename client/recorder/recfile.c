@@ -1,5 +1,5 @@
 #include "recfile.h"
-#include "vdds_ident.h"
+#include "dds/vdds_ident.h"
 
 #include <errno.h>
 #include <stdio.h>

@@ -43,10 +43,10 @@
 #include "recording.h"
 #include "replay_pause.h"
 #include "replay_serdata.h"
-#include "vdds_ident.h"
+#include "dds/vdds_ident.h"
 #include "verr.h"
 #include "vsignal.h"
-#include "vdds_ident.h"
+#include "dds/vdds_ident.h"
 
 typedef struct rp_topic {
   int64_t id;

@@ -7,7 +7,7 @@
 #include "capture.h"
 #include "discovery.h"
 #include "participants.h"
-#include "vdds_ident.h"
+#include "dds/vdds_ident.h"
 #include "store.h"
 #include "topic_type.h"
 #include "vtime.h"

@@ -31,7 +31,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "thresholds.h"
+#include "training/thresholds.h"
 
 typedef struct rep_force_sample {
   double t;     /* s, simulated time of the server step */

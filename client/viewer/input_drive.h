@@ -14,7 +14,7 @@
 #include <pthread.h>
 #include <stdint.h>
 
-#include "vdds.h"
+#include "dds/vdds.h"
 #include "verr.h"
 
 typedef struct input_drive {

@@ -22,7 +22,7 @@
 #include "vtime.h"
 #ifdef VISCERA_HAVE_WINDOW
 #include "window.h"
-#include "vdds_ident.h"
+#include "dds/vdds_ident.h"
 #endif
 
 #define POLL_NS 10000000ull /* 10 ms */

@@ -7,7 +7,7 @@
 
 #include "camera.h"
 #include "render.h"
-#include "vdds.h"
+#include "dds/vdds.h"
 
 void options_usage(FILE *f, const char *prog) {
   fprintf(f,

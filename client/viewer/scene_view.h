@@ -18,7 +18,7 @@
 #include <stdint.h>
 
 #include "organ_state.h"
-#include "vdds.h"
+#include "dds/vdds.h"
 #include "verr.h"
 
 /* Bounded like the wire contract (viscera.idl MAX_ORGANS, MAX_TOOLS). */

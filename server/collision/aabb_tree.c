@@ -1,4 +1,4 @@
-#include "aabb_tree.h"
+#include "collision/aabb_tree.h"
 
 #include <math.h>
 #include <stdlib.h>

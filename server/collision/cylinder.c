@@ -1,4 +1,4 @@
-#include "cylinder.h"
+#include "collision/cylinder.h"
 
 #include <math.h>
 

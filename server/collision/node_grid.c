@@ -1,4 +1,4 @@
-#include "node_grid.h"
+#include "collision/node_grid.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -1,4 +1,4 @@
-#include "bezier.h"
+#include "cutting/bezier.h"
 
 #include <math.h>
 

@@ -1,14 +1,14 @@
-#include "ms_cut.h"
+#include "cutting/ms_cut.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
-#include "bezier.h"
-#include "model_mass_spring.h"
-#include "ms_cut_sweep.h"
-#include "node_match.h"
+#include "cutting/bezier.h"
+#include "cutting/ms_cut_sweep.h"
+#include "cutting/node_match.h"
+#include "physics/model_mass_spring.h"
 #include "vmath.h"
 
 #define MS_CUT_REFINE_ITERATIONS 4 /* power iterations per step after a topology change */

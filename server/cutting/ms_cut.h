@@ -65,7 +65,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "model.h"
+#include "physics/model.h"
 #include "verr.h"
 
 typedef struct ms_cut_params {

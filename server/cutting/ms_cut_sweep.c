@@ -1,4 +1,4 @@
-#include "ms_cut_sweep.h"
+#include "cutting/ms_cut_sweep.h"
 
 #include <math.h>
 #include <stdlib.h>

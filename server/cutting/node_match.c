@@ -1,10 +1,10 @@
-#include "node_match.h"
+#include "cutting/node_match.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "bezier.h"
+#include "cutting/bezier.h"
 #include "vmath.h"
 
 #define NM_TABLE 256 /* arc-length table samples */

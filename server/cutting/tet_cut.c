@@ -1,12 +1,12 @@
-#include "tet_cut.h"
+#include "cutting/tet_cut.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "tet_mesh.h"
+#include "cutting/tet_split.h"
 #include "state_blob.h"
-#include "tet_split.h"
+#include "tet_mesh.h"
 #include "vmath.h"
 #include "vtime.h"
 

@@ -1,8 +1,8 @@
-#include "tet_split.h"
+#include "cutting/tet_split.h"
 
 #include <math.h>
 
-#include "tet_cut.h"
+#include "cutting/tet_cut.h"
 
 const int TET_SPLIT_EDGE[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
 

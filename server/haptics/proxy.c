@@ -1,4 +1,4 @@
-#include "proxy.h"
+#include "haptics/proxy.h"
 
 #include <math.h>
 #include <string.h>

@@ -56,7 +56,7 @@ typedef struct proxy {
   double device_prev[3];
   int have_prev;
   /* Settling offset (m), zero except after a topology change under the
-   * proxy (server/topology_follow.h): the proxy keeps its place in space
+   * proxy (runtime/topology_follow.h): the proxy keeps its place in space
    * although the surface point it re-attached to differs (a simplified mesh
    * cannot hold the refined dent), and the offset decays with time constant
    * PROXY_SETTLE_TAU (proxy_settle), so the force ramps instead of jumping. */

@@ -13,7 +13,7 @@ typedef enum iev_kind {
   IEV_GRASP_END,
   IEV_TASK_STARTED,
   IEV_TASK_COMPLETED,
-  IEV_CUT_BEGIN, /* scalpel.h: value = surface vertices when the blade first touched */
+  IEV_CUT_BEGIN, /* runtime/step_cut.h: value = surface vertices when the blade first touched */
   IEV_CUT_END    /* value = topology changes the cut made */
 } iev_kind_t;
 

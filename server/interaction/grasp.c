@@ -1,4 +1,4 @@
-#include "grasp.h"
+#include "interaction/grasp.h"
 
 #include <math.h>
 #include <string.h>

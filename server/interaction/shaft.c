@@ -1,4 +1,4 @@
-#include "shaft.h"
+#include "interaction/shaft.h"
 
 #include <math.h>
 

@@ -1,4 +1,4 @@
-#include "stone.h"
+#include "interaction/stone.h"
 
 #include <math.h>
 #include <string.h>

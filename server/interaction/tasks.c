@@ -1,8 +1,7 @@
-#include "tasks.h"
+#include "interaction/tasks.h"
 
 #include <string.h>
 
-#include "scene_runtime.h"
 #include "vmath.h"
 
 void tasks_init(task_rt_t *tasks, const scene_t *scene) {
@@ -12,21 +11,22 @@ void tasks_init(task_rt_t *tasks, const scene_t *scene) {
   }
 }
 
-static int criterion_met(const task_rt_t *task, const runtime_t *rt) {
+static int criterion_met(const task_rt_t *task, const task_tool_view_t *tools, const stone_t *stones) {
   const scene_task_t *c = task->cfg;
-  const tool_rt_t *tool = &rt->tools[c->tool];
-  if (!strcmp(c->kind, "stone_removal")) return rt->stones[c->object].removed;
+  const task_tool_view_t *tool = &tools[c->tool];
+  if (!strcmp(c->kind, "stone_removal")) return stones[c->object].removed;
   if (!strcmp(c->kind, "palpate_target"))
     return tool->active && tool->fb_contact && tool->fb_organ >= 0 &&
            v3_dist(tool->fb_pos, c->target) <= c->target_radius;
   /* grasp_pull */
-  return tool->active && tool->grasp.active && v3_dist(tool->device, tool->grasp.anchor) >= c->distance;
+  return tool->active && tool->grasp->active && v3_dist(tool->device, tool->grasp->anchor) >= c->distance;
 }
 
-void tasks_update(task_rt_t *tasks, size_t ntasks, const runtime_t *rt, iev_queue_t *q) {
+void tasks_update(task_rt_t *tasks, size_t ntasks, const task_tool_view_t *tools, const stone_t *stones,
+                  double sim_time, iev_queue_t *q) {
   for (size_t i = 0; i < ntasks; i++) {
     task_rt_t *task = &tasks[i];
-    const tool_rt_t *tool = &rt->tools[task->cfg->tool];
+    const task_tool_view_t *tool = &tools[task->cfg->tool];
     /* An instructor-started task waits for tasks_start(), whatever the tool does. */
     if (!task->started && !task->cfg->start_instructor && tool->first_cmd_time >= 0) {
       task->started = 1;
@@ -37,18 +37,18 @@ void tasks_update(task_rt_t *tasks, size_t ntasks, const runtime_t *rt, iev_queu
                           .object = task->cfg->object,
                           .task = (int)i,
                           .value = 0,
-                          .sim_time = rt->sim_time});
+                          .sim_time = sim_time});
     }
-    if (task->started && !task->completed && criterion_met(task, rt)) {
+    if (task->started && !task->completed && criterion_met(task, tools, stones)) {
       task->completed = 1;
-      task->t_end = rt->sim_time;
+      task->t_end = sim_time;
       iev_push(q, (iev_t){.kind = IEV_TASK_COMPLETED,
                           .tool = task->cfg->tool,
                           .organ = -1,
                           .object = task->cfg->object,
                           .task = (int)i,
                           .value = task->t_end - task->t_start,
-                          .sim_time = rt->sim_time});
+                          .sim_time = sim_time});
     }
   }
 }

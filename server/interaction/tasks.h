@@ -8,10 +8,22 @@
 #ifndef VISCERA_TASKS_H
 #define VISCERA_TASKS_H
 
-#include "events.h"
+#include "interaction/events.h"
+#include "interaction/grasp.h"
+#include "interaction/stone.h"
 #include "scene.h"
 
-struct runtime;
+/* What a task's criterion reads of a tool after a step (the runtime's tool
+ * record, runtime/tool_rt.h, seen from here). */
+typedef struct task_tool_view {
+  int active;            /* a valid command has been received */
+  double first_cmd_time; /* s of simulated time of the first command, -1 before */
+  int fb_contact;        /* anything touches (ContactFeedback) */
+  int fb_organ;          /* the organ touched, -1 for stones and tools */
+  const double *fb_pos;  /* [3] the tip the hand feels, m */
+  const double *device;  /* [3] the commanded tip, m */
+  const grasp_t *grasp;  /* what a grasper holds */
+} task_tool_view_t;
 
 typedef struct task_rt {
   const scene_task_t *cfg;
@@ -20,9 +32,11 @@ typedef struct task_rt {
 } task_rt_t;
 
 void tasks_init(task_rt_t *tasks, const scene_t *scene);
-/* Starts and completes tasks from the runtime's state after a step,
- * appending IEV_TASK_STARTED / IEV_TASK_COMPLETED to q. */
-void tasks_update(task_rt_t *tasks, size_t ntasks, const struct runtime *rt, iev_queue_t *q);
+/* Starts and completes tasks from the state after a step (`tools` indexed
+ * by tool, `stones` by object, `sim_time` in s), appending
+ * IEV_TASK_STARTED / IEV_TASK_COMPLETED to q. */
+void tasks_update(task_rt_t *tasks, size_t ntasks, const task_tool_view_t *tools, const stone_t *stones,
+                  double sim_time, iev_queue_t *q);
 /* Starts `task` now (s of simulated time), also when it is running or
  * completed: a restart REPLACES the earlier run (completion cleared, clock
  * from now), so ToolMetrics count it once, as not completed until it

@@ -1,4 +1,4 @@
-#include "adaptive.h"
+#include "physics/adaptive.h"
 
 #include <math.h>
 #include <stdlib.h>

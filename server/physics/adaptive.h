@@ -60,7 +60,7 @@
 #include <stdint.h>
 
 #include "mesh.h"
-#include "model.h"
+#include "physics/model.h"
 #include "verr.h"
 
 #define ADAPT_MAX_LEVELS 5

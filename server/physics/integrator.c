@@ -26,7 +26,7 @@
  * preconditioned with M^-1 (exact for the mass part; the models' masses are
  * equal today, but a model with unequal masses gets the scaling for free).
  * CG stops at ||r|| <= cg_tolerance ||b|| or after cg_max_iterations. */
-#include "integrator.h"
+#include "physics/integrator.h"
 
 #include <complex.h>
 #include <math.h>

@@ -14,7 +14,7 @@
 
 #include <stddef.h>
 
-#include "force_system.h"
+#include "physics/force_system.h"
 #include "verr.h"
 
 typedef enum integrator_kind {

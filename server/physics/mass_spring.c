@@ -1,4 +1,4 @@
-#include "mass_spring.h"
+#include "physics/mass_spring.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -36,8 +36,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "force_system.h"
 #include "mesh.h"
+#include "physics/force_system.h"
 #include "tet_mesh.h"
 #include "verr.h"
 

@@ -24,7 +24,7 @@
 #include "verr.h"
 
 typedef struct model model_t;
-struct state_blob; /* server/state_blob.h */
+struct state_blob; /* common/state_blob.h */
 
 typedef struct model_ops {
   const char *name; /* the scene file's model name */
@@ -39,7 +39,7 @@ typedef struct model_ops {
   double (*error_estimate)(const model_t *m);
   /* Adds force f (N) at surface vertex i for the current sub-step. */
   void (*add_surface_force)(model_t *m, uint32_t i, const double f[3]);
-  /* Checkpoints of a changed topology (server/checkpoint.h), optional: a
+  /* Checkpoints of a changed topology (runtime/checkpoint_state.h), optional: a
    * model without them cannot be checkpointed once its topology_version is
    * above 0 (the checkpoint says so and keeps the last one it could write).
    * save_topology appends to b everything the model needs to rebuild its

@@ -11,7 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "adaptive.h"
+#include "physics/adaptive.h"
 #include "state_blob.h"
 
 static void am_pre(void *ctx) {

@@ -43,10 +43,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "integrator.h"
-#include "mass_spring.h"
-#include "model.h"
-#include "model_mass_spring.h"
+#include "physics/integrator.h"
+#include "physics/mass_spring.h"
+#include "physics/model.h"
+#include "physics/model_mass_spring.h"
 #include "state_blob.h"
 #include "tet_mesh.h"
 #include "vmath.h"

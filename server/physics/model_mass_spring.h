@@ -34,8 +34,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "mass_spring.h"
-#include "model.h"
+#include "physics/mass_spring.h"
+#include "physics/model.h"
 
 /* The force system of a mass_spring_surface model; NULL for any other model
  * (mass_spring_tet included: its surface is embedded, not simulated). */

@@ -40,10 +40,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "integrator.h"
-#include "model.h"
-#include "molecular.h"
-
+#include "physics/integrator.h"
+#include "physics/model.h"
+#include "physics/molecular.h"
 
 model_t *model_molecular_create(const model_params_t *p, verr_t *err);
 

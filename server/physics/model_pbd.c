@@ -7,9 +7,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "pbd.h"
+#include "cutting/tet_cut.h"
+#include "physics/pbd.h"
 #include "state_blob.h"
-#include "tet_cut.h"
 #include "tet_mesh.h"
 
 typedef struct model_pbd {

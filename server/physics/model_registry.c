@@ -14,7 +14,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "model.h"
+#include "physics/model.h"
 
 /* clang-format off */
 #define MODEL_TABLE(X)                                      \

@@ -8,8 +8,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "model.h"
-#include "vertex_based.h"
+#include "physics/model.h"
+#include "physics/vertex_based.h"
 
 typedef struct vb_model {
   model_t base;

@@ -1,4 +1,4 @@
-#include "molecular.h"
+#include "physics/molecular.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -44,8 +44,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "force_system.h"
 #include "mesh.h"
+#include "physics/force_system.h"
 #include "verr.h"
 
 typedef struct mol_params {

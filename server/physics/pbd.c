@@ -1,4 +1,4 @@
-#include "pbd.h"
+#include "physics/pbd.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -40,7 +40,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "model.h"
+#include "physics/model.h"
 #include "verr.h"
 
 /* Constraints are ordered by colour, at most this many (see pbd.c). */

@@ -1,4 +1,4 @@
-#include "vertex_based.h"
+#include "physics/vertex_based.h"
 
 #include <math.h>
 #include <stdlib.h>

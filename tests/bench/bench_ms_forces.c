@@ -12,7 +12,7 @@
 #include <string.h>
 #include <time.h>
 
-#include "mass_spring.h"
+#include "physics/mass_spring.h"
 #include "test_assets.h"
 #include "test_rng.h"
 #include "vmath.h"

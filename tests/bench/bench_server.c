@@ -18,8 +18,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "mesh_publisher.h"
-#include "scene_runtime.h"
+#include "runtime/scene_runtime.h"
+#include "session/mesh_publisher.h"
 #include "vstats.h"
 #include "vtime.h"
 

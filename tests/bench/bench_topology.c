@@ -17,10 +17,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "mesh_publisher.h"
+#include "dds/vdds.h"
 #include "physics/adaptive.h"
-#include "scene_runtime.h"
-#include "vdds.h"
+#include "runtime/scene_runtime.h"
+#include "session/mesh_publisher.h"
 #include "vstats.h"
 #include "vtime.h"
 

@@ -25,8 +25,8 @@
 #include <dds/dds.h>
 #include <dds/ddsi/ddsi_serdata.h>
 
+#include "dds/vdds.h"
 #include "replay_serdata.h"
-#include "vdds.h"
 #include "viscera.h"
 #include "vtime.h"
 

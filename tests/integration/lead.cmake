@@ -5,7 +5,7 @@ target_link_libraries(img_diff PRIVATE PkgConfig::PNG)
 add_executable(obj_compare ${CMAKE_CURRENT_LIST_DIR}/obj_compare.c)
 target_link_libraries(obj_compare PRIVATE ${MATH_LIB})
 add_executable(bad_commands ${CMAKE_CURRENT_LIST_DIR}/bad_commands.c)
-target_link_libraries(bad_commands PRIVATE viscera_common)
+target_link_libraries(bad_commands PRIVATE viscera_dds)
 
 set(VISCERA_IT_ENV "CYCLONEDDS_URI=file://${VISCERA_DDS_CONFIG};VISCERA_SHARED_DIR=${VISCERA_SHARED_DIR}")
 macro(viscera_integration_test name domain script)

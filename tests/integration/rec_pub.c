@@ -19,8 +19,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "dds/vdds.h"
 #include "rec_values.h"
-#include "vdds.h"
 #include "viscera.h"
 #include "vtime.h"
 

@@ -5,7 +5,7 @@
 # still reads, and feeds recinfo a non-recording.
 if(TARGET viscera-recorder AND TARGET viscera-recinfo)
   add_executable(rec_pub ${CMAKE_CURRENT_LIST_DIR}/rec_pub.c)
-  target_link_libraries(rec_pub PRIVATE viscera_common)
+  target_link_libraries(rec_pub PRIVATE viscera_dds)
 
   add_executable(rec_check ${CMAKE_CURRENT_LIST_DIR}/rec_check.c)
   target_include_directories(rec_check PRIVATE ${PROJECT_SOURCE_DIR}/tests/unit)

@@ -19,7 +19,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "vdds.h"
+#include "dds/vdds.h"
 #include "viscera.h"
 #include "vtime.h"
 

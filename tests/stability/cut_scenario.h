@@ -31,10 +31,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cutting/tet_cut.h"
 #include "mesh_import.h"
-#include "pbd.h"
+#include "physics/pbd.h"
 #include "scene.h"
-#include "tet_cut.h"
 #include "vmath.h"
 #include "vtime.h"
 

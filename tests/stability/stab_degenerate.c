@@ -7,7 +7,7 @@
  *  - the octahedron with vertex 0 moved onto vertex 2 (a spring of length 0
  *    and rest length r sqrt 2);
  *  - a tetrahedral bar with one node moved onto a neighbour. */
-#include "mass_spring.h"
+#include "physics/mass_spring.h"
 #include "stab_util.h"
 
 static const char *const INTEGRATORS[] = {"explicit_euler", "symplectic_euler", "verlet", "rk4", "implicit_euler"};

@@ -20,8 +20,8 @@
  * energy is elastic, much of it in the fast modes: its energy may wobble by
  * the scheme's O(h omega) (checked: <= 50 % raw, <= 10 % time-centred), but
  * the same no-trend and momentum checks apply. */
-#include "integrator.h"
-#include "mass_spring.h"
+#include "physics/integrator.h"
+#include "physics/mass_spring.h"
 #include "stab_util.h"
 
 #define STEPS 1000000

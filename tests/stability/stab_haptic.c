@@ -13,7 +13,7 @@
 
 #include "check.h"
 #include "contact_model.h"
-#include "scene_runtime.h"
+#include "runtime/scene_runtime.h"
 #include "vmath.h"
 
 static double rnd(unsigned *s) {

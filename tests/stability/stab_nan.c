@@ -16,7 +16,7 @@
  * rolls that organ back, reports one rolled-back organ, and the other organ steps on. */
 #include <stdint.h>
 
-#include "scene_runtime.h"
+#include "runtime/scene_runtime.h"
 #include "stab_util.h"
 
 static const char *const INTEGRATORS[] = {"explicit_euler", "symplectic_euler", "verlet", "rk4", "implicit_euler"};

@@ -24,9 +24,9 @@
  *    is real: symplectic Euler on the banded mesh stays bounded at 0.9x of it
  *    and diverges at 1.5x.
  * Every run must stay finite. */
-#include "integrator.h"
-#include "mass_spring.h"
-#include "pbd.h"
+#include "physics/integrator.h"
+#include "physics/mass_spring.h"
+#include "physics/pbd.h"
 #include "stab_util.h"
 #include "tet_mesh.h"
 

@@ -9,7 +9,7 @@
 #include <string.h>
 
 #include "check.h"
-#include "model.h"
+#include "physics/model.h"
 #include "scene.h"
 #include "vmath.h"
 

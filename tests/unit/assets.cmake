@@ -12,6 +12,8 @@ test $(ls \"$out\"/*.obj | wc -l) -eq $(ls \"$3\"/*.obj | wc -l)"
   sh ${CMAKE_CURRENT_BINARY_DIR} $<TARGET_FILE:viscera-organ-gen> ${PROJECT_SOURCE_DIR}/assets/meshes)
 set_tests_properties(organ_gen_up_to_date PROPERTIES LABELS unit TIMEOUT 120)
 
+# The asset tool is a client program (absent with VISCERA_SIM_ONLY).
+if(TARGET viscera-asset)
 # viscera-asset: documented options, clean failure (1 unreadable, 2 usage, 3 --strict
 # and a problem: the open tissue patch), and a convert whose output
 # the server's importer reads back at the requested scale and placement.
@@ -39,3 +41,4 @@ add_test(NAME asset_tool_center
   sh $<TARGET_FILE:viscera-asset> ${CMAKE_CURRENT_BINARY_DIR})
 set_tests_properties(asset_tool_center PROPERTIES LABELS unit
   PASS_REGULAR_EXPRESSION "bounds min +-1 -2 0\n +bounds max +1 2 1\n.*no problems found")
+endif()

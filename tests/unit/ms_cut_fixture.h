@@ -16,7 +16,7 @@
 #include "mesh.h"
 #include "mesh_check.h"
 #include "mesh_import.h"
-#include "model.h"
+#include "physics/model.h"
 #include "test_assets.h"
 #include "vmath.h"
 

@@ -11,11 +11,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "adaptive.h"
 #include "check.h"
 #include "mesh.h"
 #include "mesh_import.h"
-#include "model.h"
+#include "physics/adaptive.h"
+#include "physics/model.h"
 #include "test_assets.h"
 #include "vmath.h"
 #include "vtime.h"

@@ -8,7 +8,7 @@
 #include <unistd.h>
 
 #include "check.h"
-#include "checkpoint.h"
+#include "session/checkpoint.h"
 
 static int make(runtime_t *rt, const char *src, const char *name, const char *mesh) {
   char yaml[1024];

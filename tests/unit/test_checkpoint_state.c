@@ -27,8 +27,8 @@
 #include <unistd.h>
 
 #include "check.h"
-#include "checkpoint.h"
 #include "physics/pbd.h"
+#include "session/checkpoint.h"
 #include "vtime.h"
 
 static runtime_t a, b; /* large */

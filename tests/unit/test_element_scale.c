@@ -16,8 +16,8 @@
 #include <string.h>
 
 #include "check.h"
-#include "mass_spring.h"
-#include "pbd.h"
+#include "physics/mass_spring.h"
+#include "physics/pbd.h"
 #include "tet_mesh.h"
 
 static void test_mass_spring_scale(void) {

@@ -8,7 +8,7 @@
 #include <string.h>
 
 #include "check.h"
-#include "integrator.h"
+#include "physics/integrator.h"
 
 /* n independent nodes, each tied to the origin by a spring k and a damper c
  * (x'' = -k/m x - c/m x' per coordinate); node j optionally also tied to

@@ -7,7 +7,7 @@
 
 #include "check.h"
 #include "feedback_slot.h"
-#include "liveliness_watch.h"
+#include "session/liveliness_watch.h"
 
 static dds_liveliness_changed_status_t status(uint32_t alive, uint32_t not_alive, int32_t dalive, int32_t dnot,
                                               dds_instance_handle_t h) {

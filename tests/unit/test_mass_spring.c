@@ -14,9 +14,9 @@
 #include <string.h>
 
 #include "check.h"
-#include "mass_spring.h"
-#include "scene_runtime.h"
-#include "model.h"
+#include "physics/mass_spring.h"
+#include "physics/model.h"
+#include "runtime/scene_runtime.h"
 #include "scene.h"
 #include "vmath.h"
 

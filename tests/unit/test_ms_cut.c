@@ -15,10 +15,10 @@
 #include "cutting/ms_cut.h"
 #include "cutting/ms_cut_sweep.h"
 #include "cutting/node_match.h"
-#include "integrator.h"
-#include "mass_spring.h"
-#include "model_mass_spring.h"
 #include "ms_cut_fixture.h"
+#include "physics/integrator.h"
+#include "physics/mass_spring.h"
+#include "physics/model_mass_spring.h"
 #include "test_rng.h"
 
 static uint64_t rng_state = 0x2545f4914f6cdd1dull;

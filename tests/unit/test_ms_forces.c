@@ -16,7 +16,7 @@
 #include <string.h>
 
 #include "check.h"
-#include "mass_spring.h"
+#include "physics/mass_spring.h"
 #include "test_assets.h"
 #include "test_rng.h"
 

@@ -1,4 +1,4 @@
-/* test_organ_sleep: organs at rest are not stepped (server/organ_sleep.h).
+/* test_organ_sleep: organs at rest are not stepped (server/runtime/organ_sleep.h).
  * - the stillness evidence: `need` still steps put an organ to sleep; a
  *   vertex moving more than the limit, a NaN, a disturbance or a new
  *   topology restart the count; waking counts only a sleeping organ;
@@ -19,8 +19,8 @@
 #include <string.h>
 
 #include "check.h"
-#include "organ_sleep.h"
-#include "scene_runtime.h"
+#include "runtime/organ_sleep.h"
+#include "runtime/scene_runtime.h"
 
 static runtime_t rt_on, rt_off; /* large */
 static scene_t sc_on, sc_off, sc;

@@ -10,7 +10,7 @@
 #include <time.h>
 
 #include "check.h"
-#include "mesh_publisher.h"
+#include "session/mesh_publisher.h"
 
 #define Q 1e-5f
 enum { N = 6 };

@@ -8,7 +8,7 @@
 
 #include "check.h"
 #include "mesh_delta.h"
-#include "mesh_publisher.h"
+#include "session/mesh_publisher.h"
 
 #define Q 1e-5f
 

@@ -1,5 +1,5 @@
 /* Session metadata pieces of issue 6 that are pure or file-only:
- * - the participant announcement (common/vdds_ident): format, bounds,
+ * - the participant announcement (common/dds/vdds_ident): format, bounds,
  *   sanitizing of hostile USER_DATA, role extraction;
  * - the replay pause schedule shift (client/recorder/replay_pause);
  * - the participants table: written by the store, read back by recfile,
@@ -11,10 +11,10 @@
 #include <sqlite3.h>
 
 #include "check.h"
+#include "dds/vdds_ident.h"
 #include "recfile.h"
 #include "replay_pause.h"
 #include "store.h"
-#include "vdds_ident.h"
 
 static void test_format_and_role(void) {
   char buf[VDDS_IDENT_MAX], role[VDDS_ROLE_MAX];

@@ -8,7 +8,7 @@
 #include <string.h>
 
 #include "check.h"
-#include "mesh_publisher.h"
+#include "session/mesh_publisher.h"
 #include "resim_run.h"
 
 enum { N = 420, PUBLISH_EVERY = 33, RELEASE_AT = 330 };

@@ -16,9 +16,9 @@
 #include <string.h>
 
 #include "check.h"
-#include "interaction/scalpel.h"
 #include "physics/pbd.h"
-#include "scene_runtime.h"
+#include "runtime/scene_runtime.h"
+#include "runtime/step_cut.h"
 #include "vmath.h"
 
 static runtime_t rt; /* large */

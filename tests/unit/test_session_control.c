@@ -4,7 +4,7 @@
 #include <string.h>
 
 #include "check.h"
-#include "session_control.h"
+#include "session/session_control.h"
 
 static scene_t scene; /* one organ, defaults; what RESET and SET_MATERIAL edit */
 

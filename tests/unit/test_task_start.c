@@ -17,10 +17,10 @@
 #include <string.h>
 
 #include "check.h"
+#include "runtime/scene_runtime.h"
 #include "scene_expect.h"
-#include "scene_runtime.h"
-#include "session_control.h"
-#include "tool_metrics.h"
+#include "session/session_control.h"
+#include "session/tool_metrics.h"
 
 static runtime_t rt; /* large */
 static scene_t sc;

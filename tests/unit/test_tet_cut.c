@@ -18,12 +18,12 @@
 #include <string.h>
 
 #include "check.h"
+#include "cutting/tet_cut.h"
+#include "cutting/tet_split.h"
 #include "mesh.h"
-#include "pbd.h"
+#include "physics/pbd.h"
 #include "scene.h"
-#include "tet_cut.h"
 #include "tet_mesh.h"
-#include "tet_split.h"
 #include "vmath.h"
 
 static double rest_volume(const tet_cut_t *c) {

@@ -20,7 +20,7 @@
 #include "check.h"
 #include "interaction/grasp.h"
 #include "interaction/stone.h"
-#include "scene_runtime.h"
+#include "runtime/scene_runtime.h"
 #include "vmath.h"
 
 static runtime_t rt; /* large */

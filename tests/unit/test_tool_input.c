@@ -1,19 +1,19 @@
-/* ToolCommand validation: NaN, Inf, absurd positions, bad quaternions, bad
+/* Tool command validation (runtime/tool_command.h): NaN, Inf, absurd positions, bad quaternions, bad
  * ids and capabilities are rejected; a sane command passes. */
 #include <string.h>
 
 #include "check.h"
-#include "tool_input.h"
+#include "runtime/tool_command.h"
 
 int main(void) {
   tool_workspace_t ws = {{-1, -1, -1}, {1, 1, 1}};
-  viscera_ToolCommand c;
+  tool_cmd_t c;
   memset(&c, 0, sizeof c);
   c.orientation[0] = 1;
   c.max_force = 4;
   c.position[2] = 0.05f;
   CHECK(tool_command_check(&c, 1, &ws) == TOOLCMD_OK);
-  viscera_ToolCommand b = c;
+  tool_cmd_t b = c;
   b.tool_id = 1;
   CHECK(tool_command_check(&b, 1, &ws) == TOOLCMD_BAD_ID);
   b = c;

@@ -1,4 +1,4 @@
-/* test_tool_roles: who drives a tool and where it goes (server/tool_roles.h,
+/* test_tool_roles: who drives a tool and where it goes (server/session/tool_roles.h,
  * the contract above idl ToolRole): command classification per station, the
  * authority mix, an absent side, buttons and orientation of the dominant
  * side, validation of ASSIGN_TOOL / GUIDE, versions, the writer-station
@@ -8,9 +8,9 @@
 #include "check.h"
 #include "scene.h"
 #include "scene_expect.h"
-#include "session_control.h"
-#include "tool_roles.h"
-#include "writer_stations.h"
+#include "session/session_control.h"
+#include "session/tool_roles.h"
+#include "session/writer_stations.h"
 
 #define MS 1000000ull
 

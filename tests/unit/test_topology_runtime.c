@@ -12,8 +12,8 @@
 
 #include "check.h"
 #include "physics/adaptive.h"
-#include "scene_runtime.h"
-#include "topology_follow.h"
+#include "runtime/scene_runtime.h"
+#include "runtime/topology_follow.h"
 #include "vmath.h"
 
 /* Largest change of the contact force (N) over the step in which the

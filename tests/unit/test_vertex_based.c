@@ -12,8 +12,8 @@
 #include "check.h"
 #include "mesh.h"
 #include "mesh_import.h"
-#include "model.h"
-#include "vertex_based.h"
+#include "physics/model.h"
+#include "physics/vertex_based.h"
 #include "vmath.h"
 #include "vtime.h"
 

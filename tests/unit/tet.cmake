@@ -4,6 +4,8 @@ viscera_unit_test(NAME test_tet_mesh SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_tet_
 viscera_unit_test(NAME test_tet_mesh_shared SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_tet_mesh.c)
 target_compile_definitions(test_tet_mesh_shared PRIVATE TET_TEST_SHARED=1)
 
+# The asset tool is a client program (absent with VISCERA_SIM_ONLY).
+if(TARGET viscera-asset)
 # viscera-asset tet: the report for an organ, a clear failure (exit 1) on the open
 # tissue patch, and bad usage (exit 2) for a bad --size.
 add_test(NAME asset_tool_tet COMMAND viscera-asset tet ${PROJECT_SOURCE_DIR}/assets/meshes/spleen.obj --size 0.005)
@@ -16,3 +18,4 @@ test $rc -eq 1 && grep -q 'tissue_block.obj: .*nothing is inside' \"$3/tet_patch
 { \"$1\" tet; test $? -eq 2; }"
   sh $<TARGET_FILE:viscera-asset> ${PROJECT_SOURCE_DIR}/assets/meshes ${CMAKE_CURRENT_BINARY_DIR})
 set_tests_properties(asset_tool_tet_fails PROPERTIES LABELS unit)
+endif()

@@ -5,7 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "mass_spring.h"
+#include "physics/mass_spring.h"
 
 static int cmp_edge(const void *a, const void *b) {
   const uint32_t *p = a, *q = b;

@@ -13,11 +13,11 @@
 #include <stdint.h>
 #include <stdio.h>
 
-#include "force_system.h"
-#include "integrator.h"
-#include "model.h"
+#include "physics/force_system.h"
+#include "physics/integrator.h"
+#include "physics/model.h"
 #ifdef NUMERICS_HAVE_PBD
-#include "pbd.h"
+#include "physics/pbd.h"
 #endif
 #include "verr.h"
 

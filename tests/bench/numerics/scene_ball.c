@@ -401,7 +401,7 @@ void scene_ball(nb_t *nb) {
     run_out_free(&ref);
   }
 #else
-  nb_skip(nb, "S7 PBD/XPBD: pbd.c is not in viscera_server_core in this build");
+  nb_skip(nb, "S7 PBD/XPBD: pbd.c is not in viscera_sim in this build");
 #endif
   if (bc.csv) fclose(bc.csv);
 

@@ -25,7 +25,7 @@
 #include <string.h>
 
 #include "bar.h"
-#include "mass_spring.h"
+#include "physics/mass_spring.h"
 #include "plot.h"
 #include "vtime.h"
 
@@ -658,7 +658,7 @@ void scene_bar(nb_t *nb) {
 #ifdef NUMERICS_HAVE_PBD
   sag_study(nb, &b);
 #else
-  nb_skip(nb, "S4 PBD/XPBD, plots 4 and 5: pbd.c is not in viscera_server_core in this build");
+  nb_skip(nb, "S4 PBD/XPBD, plots 4 and 5: pbd.c is not in viscera_sim in this build");
 #endif
   model_error(nb, &b);
   bardemo(nb, &b);

@@ -13,8 +13,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "mass_spring.h"
 #include "numerics.h"
+#include "physics/mass_spring.h"
 #include "plot.h"
 
 #define CN 30

@@ -23,7 +23,7 @@
 #include <string.h>
 
 #include "plot.h"
-#include "scene_runtime.h"
+#include "runtime/scene_runtime.h"
 #include "vstats.h"
 #include "vtime.h"
 

@@ -14,10 +14,10 @@
 #include <string.h>
 
 #include "bar.h"
-#include "tet_mesh.h"
 #include "mesh_import.h"
+#include "tet_mesh.h"
 #ifdef NUMERICS_HAVE_MOLECULAR
-#include "molecular.h"
+#include "physics/molecular.h"
 #endif
 #include "plot.h"
 #include "vstats.h"

@@ -19,7 +19,7 @@
 #include <string.h>
 
 #include "bar.h"
-#include "mass_spring.h"
+#include "physics/mass_spring.h"
 #include "plot.h"
 
 #define NSTIFF 7

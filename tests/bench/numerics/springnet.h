@@ -13,7 +13,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "force_system.h"
+#include "physics/force_system.h"
 #include "verr.h"
 
 typedef struct springnet {

@@ -1,0 +1,337 @@
+#include "runtime/scene_runtime.h"
+
+#include "runtime/topology_follow.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "interaction/shaft.h"
+#include "mesh_import.h"
+#include "runtime/step_cut.h"
+#include "runtime/step_tools.h"
+#include "vmath.h"
+
+static void apply_contacts(model_t *m, void *vctx);
+
+static int organ_init(organ_rt_t *o, runtime_t *rt, const scene_organ_t *cfg, uint32_t id, double tool_k, verr_t *err) {
+  const scene_t *sc = &rt->scene;
+  memset(o, 0, sizeof *o);
+  o->cfg = cfg;
+  o->id = id;
+  o->rt = rt;
+  verr_t e;
+  if (mesh_import(cfg->mesh, &o->rest, &e))
+    return verr_set(err, "%s:%d: organ '%s': %s", sc->path, cfg->line, cfg->name, e.msg);
+  for (size_t i = 0; i < o->rest.nverts; i++)
+    for (int k = 0; k < 3; k++) o->rest.pos[3 * i + k] = o->rest.pos[3 * i + k] * cfg->scale + cfg->position[k];
+  /* The proxy spring acts on the contact vertices like an extra home
+   * spring, so explicit schemes include the stiffest tool in their bound. */
+  model_params_t mp = {.cfg = cfg, .surface = &o->rest, .dt = sc->dt, .tool_stiffness = tool_k};
+  v3_copy(mp.gravity, sc->gravity);
+  o->model = model_create(&mp, &e);
+  if (!o->model) {
+    mesh_free(&o->rest);
+    return verr_set(err, "%s:%d: %s", sc->path, cfg->line, e.msg);
+  }
+  o->model->hook = apply_contacts;
+  o->model->hook_ctx = o;
+  if (sc->sleep_speed > 0 && organ_sleep_init(&o->sleep, o->model->nsurf, &e)) {
+    model_destroy(o->model);
+    o->model = NULL;
+    mesh_free(&o->rest);
+    return verr_set(err, "%s:%d: organ '%s': %s", sc->path, cfg->line, cfg->name, e.msg);
+  }
+  return 0;
+}
+
+int runtime_init(runtime_t *rt, const scene_t *scene, verr_t *err) {
+  memset(rt, 0, sizeof *rt);
+  rt->scene = *scene;
+  double tool_k = 0;
+  for (size_t t = 0; t < scene->ntools; t++)
+    if (scene->tools[t].stiffness > tool_k) tool_k = scene->tools[t].stiffness;
+  double bmin[3] = {INFINITY, INFINITY, INFINITY}, bmax[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (size_t i = 0; i < scene->norgans; i++) {
+    if (organ_init(&rt->organs[i], rt, &rt->scene.organs[i], (uint32_t)i, tool_k, err)) {
+      runtime_destroy(rt);
+      return -1;
+    }
+    rt->norgans++;
+    organ_rt_t *o = &rt->organs[i];
+    const model_t *m = o->model;
+    /* Edges may stretch while deformed; 3x the longest rest edge is far
+     * beyond what the home springs allow and keeps the proxy cull exact.
+     * Each triangle edge counts once per triangle: a closed mesh counts
+     * every edge twice, which leaves the mean as it is. */
+    double max_edge = 0, mean_edge = 0, tool_r = 0;
+    for (size_t t = 0; t < m->nsurf_tris; t++)
+      for (int k = 0; k < 3; k++) {
+        const uint32_t *tri = m->surf_tris + 3 * t;
+        double len = v3_dist(m->surf_rest + 3 * tri[k], m->surf_rest + 3 * tri[(k + 1) % 3]);
+        max_edge = fmax(max_edge, len);
+        mean_edge += len;
+      }
+    if (m->nsurf_tris) mean_edge /= 3.0 * (double)m->nsurf_tris;
+    for (size_t t = 0; t < scene->ntools; t++) tool_r = fmax(tool_r, scene->tools[t].radius);
+    o->patch_radius = fmax(2 * tool_r, 1.5 * mean_edge);
+    rt->surfaces[i] = (proxy_surface_t){
+        .x = m->surf_x, .tris = m->surf_tris, .ntris = m->nsurf_tris, .max_edge = 3 * max_edge, .x_rest = m->surf_rest};
+    verr_t te;
+    if (aabb_tree_build(&o->tree, m->surf_x, m->nsurf, m->surf_tris, m->nsurf_tris, &te)) {
+      verr_set(err, "%s:%d: organ '%s': %s", rt->scene.path, o->cfg->line, o->cfg->name, te.msg);
+      runtime_destroy(rt);
+      return -1;
+    }
+    rt->surfaces[i].tree = &o->tree;
+    o->topology_version = m->topology_version;
+    o->vn_rest = malloc(3 * m->nsurf * sizeof *o->vn_rest);
+    if (!o->vn_rest) {
+      verr_set(err, "%s:%d: organ '%s': out of memory", rt->scene.path, o->cfg->line, o->cfg->name);
+      runtime_destroy(rt);
+      return -1;
+    }
+    proxy_vertex_normals(m->nsurf, m->surf_rest, m->nsurf_tris, m->surf_tris, o->vn_rest);
+    rt->surfaces[i].vn = o->vn_rest;
+    rt->surfaces[i].nvn = m->nsurf;
+    double lo[3], hi[3];
+    mesh_bounds(&o->rest, lo, hi);
+    for (int k = 0; k < 3; k++) {
+      bmin[k] = fmin(bmin[k], lo[k]);
+      bmax[k] = fmax(bmax[k], hi[k]);
+    }
+  }
+  /* Tools may roam a generous box around the organs; beyond it a command is
+   * a corrupt sample, not a hand movement. */
+  double diag = v3_dist(bmin, bmax), margin = fmax(1.0, 2 * diag);
+  for (int k = 0; k < 3; k++) {
+    rt->workspace.min[k] = bmin[k] - margin;
+    rt->workspace.max[k] = bmax[k] + margin;
+  }
+  rt->ntools = scene->ntools;
+  for (size_t t = 0; t < scene->ntools; t++) {
+    rt->tools[t].cfg = &rt->scene.tools[t];
+    proxy_reset(&rt->tools[t].proxy);
+  }
+  if (interact_init(rt, err) || scalpel_init(rt, err)) {
+    runtime_destroy(rt);
+    return -1;
+  }
+  return 0;
+}
+
+void runtime_destroy(runtime_t *rt) {
+  scalpel_destroy(rt); /* before the models it cuts */
+  for (size_t i = 0; i < rt->norgans; i++) {
+    model_destroy(rt->organs[i].model);
+    rt->organs[i].model = NULL;
+    aabb_tree_destroy(&rt->organs[i].tree);
+    free(rt->organs[i].vn_rest);
+    rt->organs[i].vn_rest = NULL;
+    mesh_free(&rt->organs[i].rest);
+    organ_sleep_free(&rt->organs[i].sleep);
+  }
+  rt->norgans = 0;
+}
+
+void runtime_set_tool(runtime_t *rt, size_t t, const double pos[3], double device_max_force) {
+  if (t >= rt->ntools) return;
+  tool_rt_t *tool = &rt->tools[t];
+  v3_copy(tool->device, pos);
+  tool->max_force = fmin(tool->cfg->max_force, device_max_force);
+  tool->active = 1;
+  if (tool->first_cmd_time < 0) tool->first_cmd_time = rt->sim_time;
+}
+
+void runtime_set_buttons(runtime_t *rt, size_t t, uint32_t buttons) {
+  if (t < rt->ntools) rt->tools[t].buttons = buttons;
+}
+
+void runtime_set_orientation(runtime_t *rt, size_t t, const double q[4]) {
+  if (t < rt->ntools) shaft_axis(q, rt->tools[t].axis);
+}
+
+void runtime_release_tool(runtime_t *rt, size_t t) {
+  if (t >= rt->ntools) return;
+  interact_release_tool(rt, t);
+  rt->tools[t].active = 0;
+  proxy_reset(&rt->tools[t].proxy);
+  v3_set(rt->tools[t].force, 0, 0, 0);
+}
+
+/* The model's hook, before every sub-step: re-evaluates every proxy spring
+ * attached to this organ at the sub-step's surface positions and spreads
+ * the reaction -f over the contact patch. */
+static void apply_contacts(model_t *m, void *vctx) {
+  organ_rt_t *o = vctx;
+  runtime_t *rt = o->rt;
+  for (size_t t = 0; t < rt->ntools; t++) {
+    tool_rt_t *tool = &rt->tools[t];
+    proxy_t *p = &tool->proxy;
+    if (!tool->active || !p->in_contact || (size_t)p->surface != o->id) continue;
+    proxy_follow_surface(p, rt->surfaces, rt->norgans);
+    double f[3];
+    proxy_spring_force(p, tool->device, tool->cfg->stiffness, tool->max_force, f);
+    for (size_t j = 0; j < tool->npatch; j++) {
+      double fk[3];
+      v3_scale(fk, f, -tool->patch_w[j]);
+      m->ops->add_surface_force(m, tool->patch[j], fk);
+    }
+  }
+  interact_apply(rt, o, m);
+}
+
+/* The vertices within the patch radius of the proxy, weighted by a smooth
+ * kernel (1 - d/r)^2; the contact triangle's vertices always belong, so a
+ * patch is never empty. Keeps the TOOL_PATCH_MAX heaviest if more qualify. */
+static void build_patch(runtime_t *rt, tool_rt_t *tool) {
+  tool->npatch = 0;
+  if (!tool->proxy.in_contact) return;
+  const organ_rt_t *o = &rt->organs[tool->proxy.surface];
+  const model_t *m = o->model;
+  double r = fmax(o->patch_radius, 1e-6), sum = 0;
+  const uint32_t *tri = m->surf_tris + 3 * tool->proxy.tri;
+  for (size_t i = 0; i < m->nsurf; i++) {
+    double d = v3_dist(m->surf_x + 3 * i, tool->proxy.pos);
+    int in_tri = i == tri[0] || i == tri[1] || i == tri[2];
+    if (d >= r && !in_tri) continue;
+    double w = d < r ? (1 - d / r) * (1 - d / r) : 0;
+    if (in_tri) w = fmax(w, 1e-3);
+    size_t slot = tool->npatch;
+    if (slot == TOOL_PATCH_MAX) { /* full: replace the lightest if this is heavier */
+      size_t lightest = 0;
+      for (size_t j = 1; j < TOOL_PATCH_MAX; j++)
+        if (tool->patch_w[j] < tool->patch_w[lightest]) lightest = j;
+      if (tool->patch_w[lightest] >= w) continue;
+      slot = lightest;
+    } else {
+      tool->npatch++;
+    }
+    tool->patch[slot] = (uint32_t)i;
+    tool->patch_w[slot] = w;
+  }
+  for (size_t j = 0; j < tool->npatch; j++) sum += tool->patch_w[j];
+  for (size_t j = 0; j < tool->npatch; j++) tool->patch_w[j] /= sum;
+}
+
+/* The organ's model changed its topology: fresh tree (its boxes are
+ * current), proxies re-attached where they were (anchors), patches from the
+ * new vertices, grasps of it released, shading normals of the new surface. */
+static void follow_organ(runtime_t *rt, size_t i, const topo_anchor_t anchors[SCENE_MAX_TOOLS]) {
+  organ_rt_t *o = &rt->organs[i];
+  topo_follow(rt, i, anchors, NULL);
+  for (size_t t = 0; t < rt->ntools; t++) {
+    if (anchors[t].in_contact) build_patch(rt, &rt->tools[t]);
+    /* Held tissue is a list of vertex indices of the old surface: the
+     * jaws let go (the trainee closes them again) rather than hold
+     * vertices that now mean something else. */
+    if (rt->tools[t].grasp.active && rt->tools[t].grasp.organ == (int)o->id) grasp_release(&rt->tools[t].grasp);
+  }
+  /* Force-shading normals of the new surface (rest shape); if memory
+   * runs out shading stays off for this organ (facet normals). */
+  double *vn = o->model->nsurf ? realloc(o->vn_rest, 3 * o->model->nsurf * sizeof *vn) : NULL;
+  if (vn) {
+    o->vn_rest = vn;
+    proxy_vertex_normals(o->model->nsurf, o->model->surf_rest, o->model->nsurf_tris, o->model->surf_tris, vn);
+    rt->surfaces[i].vn = vn;
+    rt->surfaces[i].nvn = o->model->nsurf;
+  }
+}
+
+void runtime_topology_restored(runtime_t *rt, size_t organ) {
+  topo_anchor_t none[SCENE_MAX_TOOLS];
+  memset(none, 0, sizeof none);
+  for (size_t t = 0; t < SCENE_MAX_TOOLS; t++) none[t].face = UINT32_MAX;
+  follow_organ(rt, organ, none);
+}
+
+/* 1 when anything could touch organ i in this step: a driven tool's tip or
+ * shaft (or the stone it holds) within reach of the organ's current
+ * bounding box, its god-object on any surface, a grasp of this organ, a
+ * cut under way. The reach adds a margin of max(1 cm, 3 tool radii): a
+ * hand moves at most a few mm per ms, so the organ is awake several steps
+ * before the tool can arrive. */
+static int organ_disturbed(const runtime_t *rt, size_t i) {
+  const organ_rt_t *o = &rt->organs[i];
+  for (size_t t = 0; t < rt->ntools; t++) {
+    const tool_rt_t *tool = &rt->tools[t];
+    if (!tool->active) continue;
+    if (tool->proxy.in_contact || (tool->grasp.active && tool->grasp.organ == (int)o->id) || scalpel_cutting(rt, t))
+      return 1;
+    double r = tool->cfg->radius, reach = r + fmax(0.01, 3 * r), end[3];
+    v3_copy(end, tool->device);
+    v3_axpy(end, tool->axis, tool->cfg->length);
+    if (organ_sleep_box_near(o->tree.lo, o->tree.hi, tool->device, end, reach)) return 1;
+    if (tool->stone >= 0) {
+      const stone_t *st = &rt->stones[tool->stone];
+      if (organ_sleep_box_near(o->tree.lo, o->tree.hi, st->pos, st->pos, st->radius + reach)) return 1;
+    }
+  }
+  return 0;
+}
+
+int runtime_step(runtime_t *rt) {
+  double dt = rt->scene.dt;
+  /* Stillness over sleep_after, in whole steps (at least 2, scene.c); only
+   * worked out when organs may sleep. */
+  uint32_t need = rt->scene.sleep_speed > 0 ? (uint32_t)fmin(4e9, ceil(rt->scene.sleep_after / dt - 1e-9)) : 0;
+  rt->organs_stepped = 0;
+  interact_before_step(rt);
+  for (size_t t = 0; t < rt->ntools; t++) {
+    tool_rt_t *tool = &rt->tools[t];
+    if (!tool->active || !interact_uses_proxy(rt, t)) continue;
+    proxy_update_friction(&tool->proxy, tool->device, rt->surfaces, rt->norgans, tool->cfg->stiffness, tool->max_force,
+                          tool->cfg->friction, tool->force);
+    build_patch(rt, tool);
+  }
+  int rolled = 0;
+  for (size_t i = 0; i < rt->norgans; i++) {
+    organ_rt_t *o = &rt->organs[i];
+    int sleeping = rt->scene.sleep_speed > 0, disturbed = 0;
+    if (sleeping) {
+      disturbed = organ_disturbed(rt, i);
+      if (o->sleep.asleep) {
+        if (!disturbed) {
+          o->sleep.slept_steps++;
+          continue; /* nothing moves it: no step, no refit (the boxes still fit) */
+        }
+        organ_sleep_wake(&o->sleep);
+      }
+    }
+    rt->organs_stepped++;
+    topo_anchor_t anchors[SCENE_MAX_TOOLS];
+    topo_capture(rt, i, anchors);
+    uint32_t topo = o->topology_version;
+    int bad = o->model->ops->step(o->model, dt) < 0;
+    if (bad) {
+      o->rollbacks++;
+      rolled++;
+    }
+    /* Between model steps: a cut changes the topology here, and the
+     * follow-up below runs before anything reads the surface again. */
+    scalpel_after_organ_step(rt, i);
+    if (o->model->topology_version != o->topology_version) {
+      follow_organ(rt, i, anchors);
+    } else if (o->tree.ntris) {
+      /* Every step, rolled back or not: the proxy trusts the boxes. */
+      aabb_tree_refit(&o->tree, o->model->surf_x);
+    }
+    /* A rolled-back or re-meshed step is no evidence of rest. */
+    if (sleeping)
+      organ_sleep_observe(&o->sleep, o->model->surf_x, o->model->nsurf, rt->scene.sleep_speed * dt, need,
+                          disturbed || bad || o->topology_version != topo);
+  }
+  /* Report the force at the end of the step, with the proxy on the moved surface. */
+  for (size_t t = 0; t < rt->ntools; t++) {
+    tool_rt_t *tool = &rt->tools[t];
+    if (!tool->active) continue;
+    proxy_settle(&tool->proxy, dt);
+    proxy_follow_surface(&tool->proxy, rt->surfaces, rt->norgans);
+    double mag = proxy_spring_force(&tool->proxy, tool->device, tool->cfg->stiffness, tool->max_force, tool->force);
+    if (mag > tool->peak_force) tool->peak_force = mag;
+  }
+  rt->steps++;
+  rt->sim_time = (double)rt->steps * dt;
+  interact_after_step(rt);
+  return rolled;
+}

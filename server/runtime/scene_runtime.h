@@ -1,0 +1,69 @@
+/* scene_runtime: the simulated scene without any networking: organs with
+ * their deformation models, tools with their haptic proxies, and the fixed
+ * step. The server wraps it with DDS; benchmarks and tests drive it directly.
+ *
+ * runtime_init builds only what the scene needs (one model per organ, one
+ * proxy per tool). runtime_step allocates nothing, except after a step in
+ * which a model changed its surface topology (topology_follow.h: the tree
+ * is rebuilt, contacts re-attached). Single-threaded. */
+#ifndef VISCERA_SCENE_RUNTIME_H
+#define VISCERA_SCENE_RUNTIME_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "haptics/proxy.h"
+#include "interaction/events.h"
+#include "interaction/stone.h"
+#include "interaction/tasks.h"
+#include "runtime/organ_rt.h"
+#include "runtime/tool_command.h"
+#include "runtime/tool_rt.h"
+#include "scene.h"
+#include "verr.h"
+
+typedef struct runtime {
+  scene_t scene;
+  size_t norgans, ntools;
+  organ_rt_t organs[SCENE_MAX_ORGANS];
+  tool_rt_t tools[SCENE_MAX_TOOLS];
+  proxy_surface_t surfaces[SCENE_MAX_ORGANS];
+  tool_workspace_t workspace;
+  size_t nstones;
+  stone_t stones[SCENE_MAX_OBJECTS];
+  size_t ntasks;
+  task_rt_t tasks[SCENE_MAX_TASKS];
+  iev_queue_t events;      /* interaction events; the caller drains (clears n) */
+  struct scalpel *scalpel; /* cutting (runtime/step_cut.h); NULL in a scene without a scalpel */
+  uint64_t steps;
+  double sim_time;       /* s */
+  size_t organs_stepped; /* organs stepped by the last runtime_step (the others slept) */
+} runtime_t;
+
+/* Imports every organ mesh and builds its model (model_create: the model
+ * chooses its sub-steps from the scene's dt and the stiffest tool). Errors
+ * name the scene file, the organ's line and the organ. */
+int runtime_init(runtime_t *rt, const scene_t *scene, verr_t *err);
+void runtime_destroy(runtime_t *rt);
+
+/* Applies a validated command for tool `t`. */
+void runtime_set_tool(runtime_t *rt, size_t t, const double pos[3], double device_max_force);
+/* The command's buttons (bit 0: close the jaws), applied at the next step. */
+void runtime_set_buttons(runtime_t *rt, size_t t, uint32_t buttons);
+/* The command's orientation (unit quaternion w, x, y, z): the shaft axis. */
+void runtime_set_orientation(runtime_t *rt, size_t t, const double q[4]);
+/* Tool no longer driven (client gone): releases contact, stops acting. */
+void runtime_release_tool(runtime_t *rt, size_t t);
+
+/* After a model's topology was restored from a checkpoint (checkpoint.c):
+ * rebuilds what depends on its surface, as after a cut in a step (tree,
+ * proxies, normals; grasps of it released). */
+void runtime_topology_restored(runtime_t *rt, size_t organ);
+
+/* One scene step of scene.dt: contact, then physics. Returns the number of
+ * organs whose step was rolled back because it produced NaN/Inf. With the
+ * scene's sleep_speed > 0 an organ at rest with nothing within reach is
+ * skipped (organ_sleep.h; organs_stepped tells how many were stepped). */
+int runtime_step(runtime_t *rt);
+
+#endif

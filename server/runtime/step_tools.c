@@ -1,0 +1,387 @@
+#include "runtime/step_tools.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "interaction/shaft.h"
+#include "runtime/step_cut.h"
+#include "vmath.h"
+
+/* The removal test scans the organ's rest surface (O(triangles)): every
+ * STONE_CHECK_EVERY steps while a stone is held is plenty for a hand. */
+#define STONE_CHECK_EVERY 20
+
+static int is_kind(const tool_rt_t *tool, const char *kind) { return !strcmp(tool->cfg->kind, kind); }
+
+static void push_event(runtime_t *rt, iev_kind_t kind, int tool, int organ, int object, double value) {
+  iev_push(&rt->events, (iev_t){.kind = kind,
+                                .tool = tool,
+                                .organ = organ,
+                                .object = object,
+                                .task = -1,
+                                .value = value,
+                                .sim_time = rt->sim_time});
+}
+
+int interact_init(runtime_t *rt, verr_t *err) {
+  const scene_t *sc = &rt->scene;
+  rt->nstones = sc->nobjects;
+  for (size_t i = 0; i < sc->nobjects; i++) {
+    const scene_object_t *ob = &sc->objects[i];
+    stone_init(&rt->stones[i], ob->radius, ob->organ, ob->position);
+    const model_t *m = rt->organs[ob->organ].model;
+    double wn = stone_winding_number(m->surf_rest, m->surf_tris, m->nsurf_tris, ob->position);
+    if (!(wn > 0.5))
+      return verr_set(err, "%s:%d: object '%s': centre [%g, %g, %g] is not inside organ '%s' (winding number %.2f)",
+                      sc->path, ob->line, ob->name, ob->position[0], ob->position[1], ob->position[2],
+                      sc->organs[ob->organ].name, wn);
+  }
+  for (size_t t = 0; t < rt->ntools; t++) {
+    grasp_init(&rt->tools[t].grasp);
+    rt->tools[t].stone = -1;
+    rt->tools[t].first_cmd_time = -1;
+    v3_set(rt->tools[t].axis, 0, 0, 1);
+  }
+  rt->ntasks = sc->ntasks;
+  tasks_init(rt->tasks, sc);
+  return 0;
+}
+
+int interact_uses_proxy(const runtime_t *rt, size_t t) {
+  const tool_rt_t *tool = &rt->tools[t];
+  /* A cutting scalpel's blade goes into the tissue (runtime/step_cut.h). */
+  return !is_kind(tool, "extractor") && !tool->grasp.active && !scalpel_cutting(rt, t);
+}
+
+/* Grasper closing: the organ with a surface vertex nearest the tip. */
+static void try_grasp_tissue(runtime_t *rt, size_t t) {
+  tool_rt_t *tool = &rt->tools[t];
+  int best = -1;
+  double best_d = INFINITY;
+  for (size_t i = 0; i < rt->norgans; i++) {
+    const model_t *m = rt->organs[i].model;
+    for (size_t v = 0; v < m->nsurf; v++) {
+      double d = v3_dist(m->surf_x + 3 * v, tool->device);
+      if (d < best_d) {
+        best_d = d;
+        best = (int)i;
+      }
+    }
+  }
+  if (best < 0 || best_d > tool->cfg->grasp_radius) return;
+  const model_t *m = rt->organs[best].model;
+  size_t n = grasp_take(&tool->grasp, best, m->surf_x, m->nsurf, tool->device, tool->cfg->grasp_radius);
+  if (n) push_event(rt, IEV_GRASP_BEGIN, (int)t, best, -1, (double)n);
+}
+
+/* Extractor closing: the nearest free stone within reach. */
+static void try_grasp_stone(runtime_t *rt, size_t t) {
+  tool_rt_t *tool = &rt->tools[t];
+  int best = -1;
+  double best_d = INFINITY;
+  for (size_t i = 0; i < rt->nstones; i++) {
+    const stone_t *s = &rt->stones[i];
+    double d = v3_dist(s->pos, tool->device) - s->radius;
+    if (s->held_by < 0 && stone_within_reach(s, tool->device, tool->cfg->grasp_radius) && d < best_d) {
+      best_d = d;
+      best = (int)i;
+    }
+  }
+  if (best < 0) return;
+  stone_grab(&rt->stones[best], (int)t, tool->device);
+  tool->stone = best;
+  push_event(rt, IEV_GRASP_BEGIN, (int)t, -1, best, 1);
+}
+
+static void release_held(runtime_t *rt, size_t t) {
+  tool_rt_t *tool = &rt->tools[t];
+  if (tool->grasp.active) {
+    int organ = tool->grasp.organ;
+    grasp_release(&tool->grasp);
+    push_event(rt, IEV_GRASP_END, (int)t, organ, -1, 0);
+  }
+  if (tool->stone >= 0) {
+    stone_t *s = &rt->stones[tool->stone];
+    stone_release(s);
+    /* Where it was let go decides removal: check now, not in 20 steps. */
+    const model_t *m = rt->organs[s->organ].model;
+    stone_check_removed(s, m->surf_rest, m->surf_tris, m->nsurf_tris);
+    push_event(rt, IEV_GRASP_END, (int)t, -1, tool->stone, 0);
+    tool->stone = -1;
+  }
+}
+
+void interact_release_tool(runtime_t *rt, size_t t) {
+  if (t >= rt->ntools) return;
+  release_held(rt, t);
+  rt->tools[t].buttons = rt->tools[t].prev_buttons = 0;
+  rt->tools[t].fb_contact = 0;
+}
+
+void interact_before_step(runtime_t *rt) {
+  for (size_t t = 0; t < rt->ntools; t++) {
+    tool_rt_t *tool = &rt->tools[t];
+    if (!tool->active) continue;
+    int closed = (tool->buttons & 1u) != 0, was = (tool->prev_buttons & 1u) != 0;
+    tool->prev_buttons = tool->buttons;
+    if (closed && !was) {
+      if (is_kind(tool, "grasper")) try_grasp_tissue(rt, t);
+      if (is_kind(tool, "extractor")) try_grasp_stone(rt, t);
+    } else if (!closed && was) {
+      release_held(rt, t);
+    }
+    if (tool->stone >= 0) stone_follow(&rt->stones[tool->stone], tool->device);
+    if (!interact_uses_proxy(rt, t)) {
+      proxy_reset(&tool->proxy);
+      tool->npatch = 0;
+    }
+  }
+}
+
+/* The shaft of a driven tool that meets tissue (not the extractor: it
+ * enters through its port); its tip is where the hand's tip is held. */
+static int shaft_of(const runtime_t *rt, size_t t, double p0[3], double p1[3]) {
+  const tool_rt_t *tool = &rt->tools[t];
+  /* A cutting scalpel parts the tissue instead of pushing it (runtime/step_cut.h). */
+  if (!tool->active || is_kind(tool, "extractor") || scalpel_cutting(rt, t)) return 0;
+  const double *tip = tool->proxy.in_contact ? tool->proxy.pos : tool->device;
+  shaft_segment(tip, tool->axis, tool->cfg->radius, tool->cfg->length, p0, p1);
+  return 1;
+}
+
+/* 1 when tool's god-object is in contact with organ `organ`. */
+static int tip_on(const tool_rt_t *tool, size_t organ) {
+  return tool->proxy.in_contact && tool->proxy.surface >= 0 && (size_t)tool->proxy.surface == organ;
+}
+
+static void add_force(void *ctx, uint32_t i, const double f[3]) {
+  model_t *m = ctx;
+  m->ops->add_surface_force(m, i, f);
+}
+
+void interact_apply(runtime_t *rt, organ_rt_t *o, model_t *m) {
+  for (size_t t = 0; t < rt->ntools; t++) {
+    tool_rt_t *tool = &rt->tools[t];
+    if (!tool->active || !tool->grasp.active || tool->grasp.organ != (int)o->id) continue;
+    /* Held vertex indices belong to the surface they were taken from; a
+     * topology change (refinement, a cut) renumbers it, and the runtime
+     * lets go then. Never index past the current surface meanwhile. */
+    int stale = 0;
+    for (size_t j = 0; j < tool->grasp.n; j++) stale |= tool->grasp.v[j] >= m->nsurf;
+    if (stale) {
+      grasp_release(&tool->grasp);
+      continue;
+    }
+    double fv[GRASP_MAX_VERTS][3], ft[3];
+    grasp_force(&tool->grasp, m->surf_x, tool->device, tool->cfg->stiffness, tool->max_force, fv, ft);
+    for (size_t j = 0; j < tool->grasp.n; j++) m->ops->add_surface_force(m, tool->grasp.v[j], fv[j]);
+  }
+  /* The shafts' crossing test reads the organ's tree as refit at the start
+   * of the step, so the surface may have moved since: the slack (shaft.h)
+   * covers a shaft radius of it. After a topology change inside the step
+   * the tree is the old surface's: scan instead. */
+  const aabb_tree_t *tree = o->tree.ntris && m->topology_version == o->topology_version ? &o->tree : NULL;
+  for (size_t t = 0; t < rt->ntools; t++) {
+    tool_rt_t *tool = &rt->tools[t];
+    double p0[3], p1[3], ft[3] = {0, 0, 0};
+    if (!shaft_of(rt, t, p0, p1)) continue;
+    double radius = SHAFT_RADIUS_FRACTION * tool->cfg->radius;
+    if (tip_on(tool, o->id)) {
+      /* The tip presses this organ: the shaft rises out of the tip's own dent,
+       * whose walls its axis can graze when the dent is deep; pushing those
+       * triangles aside would open the dent under the god-object (stability
+       * case 9 lost its contact that way). Only the node test here. */
+      shaft_push(p0, p1, radius, tool->cfg->stiffness, m->surf_x, m->nsurf, add_force, m, ft);
+      continue;
+    }
+    shaft_surface_t surf = {m->surf_x, m->nsurf, m->surf_tris, m->nsurf_tris, tree, radius};
+    shaft_contact(p0, p1, radius, tool->cfg->stiffness, &surf, add_force, m, ft, NULL);
+  }
+  for (size_t i = 0; i < rt->nstones; i++) {
+    stone_t *s = &rt->stones[i];
+    if (s->organ != (int)o->id) continue;
+    double k = s->held_by >= 0 ? rt->tools[s->held_by].cfg->stiffness : STONE_REST_STIFFNESS;
+    stone_push(s, m->surf_x, m->nsurf, k, add_force, m);
+  }
+}
+
+/* Force f on the tool, clamped; the client is told a contact plane through
+ * device + f / k with normal f / |f|, which renders f at the device. */
+static void set_pulled(tool_rt_t *tool, const double f_in[3], int organ) {
+  double f[3];
+  v3_copy(f, f_in);
+  double mag = v3_norm(f);
+  if (mag > tool->max_force && mag > 0) v3_scale(f, f, tool->max_force / mag);
+  v3_copy(tool->force, f);
+  tool->fb_contact = 1;
+  tool->fb_organ = organ;
+  v3_copy(tool->fb_normal, f);
+  if (v3_normalize(tool->fb_normal) <= 0) v3_set(tool->fb_normal, 0, 0, 1);
+  v3_copy(tool->fb_pos, tool->device);
+  v3_axpy(tool->fb_pos, f, 1.0 / tool->cfg->stiffness);
+}
+
+static void add_nothing(void *ctx, uint32_t i, const double f[3]) {
+  (void)ctx;
+  (void)i;
+  (void)f;
+}
+
+/* The shaft's reaction at the end of the step: added to what the tip
+ * feels; a shaft touching while the tip is free is a contact of its own. */
+static void shaft_feedback(runtime_t *rt, size_t t) {
+  tool_rt_t *tool = &rt->tools[t];
+  double p0[3], p1[3], ft[3] = {0, 0, 0};
+  if (!shaft_of(rt, t, p0, p1)) return;
+  size_t hits = 0;
+  int organ = -1;
+  for (size_t i = 0; i < rt->norgans; i++) {
+    const organ_rt_t *o = &rt->organs[i];
+    const model_t *m = o->model;
+    /* After the step the runtime has refit (or rebuilt) the tree. */
+    shaft_surface_t surf = {m->surf_x,
+                            m->nsurf,
+                            m->surf_tris,
+                            m->nsurf_tris,
+                            o->tree.ntris && m->topology_version == o->topology_version ? &o->tree : NULL,
+                            0};
+    size_t h = tip_on(tool, i)
+                   ? shaft_push(p0, p1, SHAFT_RADIUS_FRACTION * tool->cfg->radius, tool->cfg->stiffness, m->surf_x,
+                                m->nsurf, add_nothing, NULL, ft)
+                   : shaft_contact(p0, p1, SHAFT_RADIUS_FRACTION * tool->cfg->radius, tool->cfg->stiffness, &surf,
+                                   add_nothing, NULL, ft, NULL);
+    if (h && organ < 0) organ = (int)i;
+    hits += h;
+  }
+  if (!hits) return;
+  double f[3];
+  v3_add(f, tool->force, ft);
+  if (tool->fb_contact) {
+    double mag = v3_norm(f);
+    if (mag > tool->max_force && mag > 0) v3_scale(f, f, tool->max_force / mag);
+    v3_copy(tool->force, f);
+  } else {
+    set_pulled(tool, f, organ);
+  }
+}
+
+/* The extractor's tip against a stone it does not hold: a god-object on
+ * the sphere of radius stone + tip. */
+static void stone_touch(runtime_t *rt, tool_rt_t *tool) {
+  for (size_t i = 0; i < rt->nstones; i++) {
+    const stone_t *s = &rt->stones[i];
+    double d[3], reach = s->radius + tool->cfg->radius;
+    v3_sub(d, tool->device, s->pos);
+    double len = v3_norm(d);
+    if (!(len < reach) || len < 1e-12) continue;
+    double p[3], f[3];
+    v3_copy(p, s->pos);
+    v3_axpy(p, d, reach / len);
+    v3_sub(f, p, tool->device);
+    v3_scale(f, f, tool->cfg->stiffness);
+    double mag = v3_norm(f);
+    if (mag > tool->max_force) v3_scale(f, f, tool->max_force / mag);
+    v3_copy(tool->force, f);
+    tool->fb_contact = 1;
+    tool->fb_organ = -1;
+    v3_copy(tool->fb_pos, p);
+    v3_scale(tool->fb_normal, d, 1 / len);
+    return;
+  }
+}
+
+/* Keeps every pair of tips at least r_i + r_j apart: each of the two moves
+ * half the overlap along the line between them (a few Gauss-Seidel passes
+ * for three or more tools in a cluster). A moved tip is a contact: the tool
+ * feels K (tip - device), clamped. */
+static void tool_tool_contact(runtime_t *rt) {
+  int moved[SCENE_MAX_TOOLS] = {0};
+  for (int pass = 0; pass < 4; pass++) {
+    int any = 0;
+    for (size_t a = 0; a < rt->ntools; a++)
+      for (size_t b = a + 1; b < rt->ntools; b++) {
+        tool_rt_t *ta = &rt->tools[a], *tb = &rt->tools[b];
+        if (!ta->active || !tb->active) continue;
+        double d[3], need = ta->cfg->radius + tb->cfg->radius;
+        v3_sub(d, ta->fb_pos, tb->fb_pos);
+        double len = v3_norm(d);
+        if (len >= need) continue;
+        if (len < 1e-12) v3_set(d, 0, 0, 1), len = 1; /* coincident: any direction */
+        double push = 0.5 * (need - len) * (1 + 1e-9), n[3];
+        v3_scale(n, d, 1 / len);
+        v3_axpy(ta->fb_pos, n, push);
+        v3_axpy(tb->fb_pos, n, -push);
+        moved[a] = moved[b] = 1;
+        any = 1;
+      }
+    if (!any) break;
+  }
+  for (size_t t = 0; t < rt->ntools; t++) {
+    if (!moved[t]) continue;
+    tool_rt_t *tool = &rt->tools[t];
+    double f[3];
+    v3_sub(f, tool->fb_pos, tool->device);
+    v3_scale(f, f, tool->cfg->stiffness);
+    double mag = v3_norm(f);
+    if (mag > tool->max_force) v3_scale(f, f, tool->max_force / mag);
+    v3_copy(tool->force, f);
+    tool->fb_contact = 1;
+    if (tool->fb_organ < 0 || !tool->proxy.in_contact) {
+      tool->fb_organ = -1;
+      v3_copy(tool->fb_normal, f);
+      if (v3_normalize(tool->fb_normal) <= 0) v3_set(tool->fb_normal, 0, 0, 1);
+    }
+  }
+}
+
+void interact_after_step(runtime_t *rt) {
+  for (size_t t = 0; t < rt->ntools; t++) {
+    tool_rt_t *tool = &rt->tools[t];
+    tool->fb_contact = 0;
+    tool->fb_organ = -1;
+    if (!tool->active) continue;
+    if (tool->grasp.active) {
+      const model_t *m = rt->organs[tool->grasp.organ].model;
+      double fv[GRASP_MAX_VERTS][3], ft[3];
+      grasp_force(&tool->grasp, m->surf_x, tool->device, tool->cfg->stiffness, tool->max_force, fv, ft);
+      set_pulled(tool, ft, tool->grasp.organ);
+    } else if (tool->stone >= 0) {
+      set_pulled(tool, rt->stones[tool->stone].force, -1);
+    } else if (is_kind(tool, "extractor")) {
+      v3_set(tool->force, 0, 0, 0);
+      v3_copy(tool->fb_pos, tool->device);
+      v3_set(tool->fb_normal, 0, 0, 1);
+      stone_touch(rt, tool);
+    } else {
+      tool->fb_contact = tool->proxy.in_contact;
+      tool->fb_organ = tool->proxy.in_contact ? tool->proxy.surface : -1;
+      v3_copy(tool->fb_pos, tool->proxy.pos);
+      v3_copy(tool->fb_normal, tool->proxy.normal);
+    }
+    shaft_feedback(rt, t);
+  }
+  tool_tool_contact(rt);
+  for (size_t t = 0; t < rt->ntools; t++) {
+    tool_rt_t *tool = &rt->tools[t];
+    double mag = tool->active ? v3_norm(tool->force) : 0;
+    if (mag > tool->peak_force) tool->peak_force = mag;
+  }
+  for (size_t i = 0; i < rt->nstones; i++) {
+    stone_t *s = &rt->stones[i];
+    if (s->held_by < 0 || s->removed || rt->steps % STONE_CHECK_EVERY) continue;
+    const model_t *m = rt->organs[s->organ].model;
+    stone_check_removed(s, m->surf_rest, m->surf_tris, m->nsurf_tris);
+  }
+  task_tool_view_t views[SCENE_MAX_TOOLS];
+  for (size_t t = 0; t < rt->ntools; t++) {
+    const tool_rt_t *tool = &rt->tools[t];
+    views[t] = (task_tool_view_t){.active = tool->active,
+                                  .first_cmd_time = tool->first_cmd_time,
+                                  .fb_contact = tool->fb_contact,
+                                  .fb_organ = tool->fb_organ,
+                                  .fb_pos = tool->fb_pos,
+                                  .device = tool->device,
+                                  .grasp = &tool->grasp};
+  }
+  tasks_update(rt->tasks, rt->ntasks, views, rt->stones, rt->sim_time, &rt->events);
+}

@@ -1,0 +1,42 @@
+/* tool_command: validation of tool commands from outside the core (idl
+ * ToolCommand samples from the network, converted by the session:
+ * session/command_intake.h). Every field is untrusted: a command with a bad
+ * id, a non-finite or absurd position (outside the scene's workspace box), a
+ * non-unit quaternion or an invalid force capability is rejected with a
+ * reason and never applied. */
+#ifndef VISCERA_TOOL_COMMAND_H
+#define VISCERA_TOOL_COMMAND_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+/* A tool command as the core sees it: the fields of idl ToolCommand that
+ * drive a tool, in the wire's precision (float), so the check judges exactly
+ * what arrived. */
+typedef struct tool_cmd {
+  uint32_t tool_id;
+  float position[3];    /* m, tool tip in scene frame */
+  float orientation[4]; /* unit quaternion w, x, y, z */
+  uint32_t buttons;     /* bit 0: primary (grasp/cut) */
+  float max_force;      /* N, device capability */
+} tool_cmd_t;
+
+typedef enum tool_cmd_verdict {
+  TOOLCMD_OK = 0,
+  TOOLCMD_BAD_ID,
+  TOOLCMD_NONFINITE,
+  TOOLCMD_OUT_OF_WORKSPACE,
+  TOOLCMD_BAD_ORIENTATION,
+  TOOLCMD_BAD_MAX_FORCE,
+  TOOLCMD_NOT_ASSIGNED, /* well-formed, but the tool is assigned to another station (tool_roles.h) */
+  TOOLCMD_VERDICT_COUNT
+} tool_cmd_verdict_t;
+
+typedef struct tool_workspace {
+  double min[3], max[3]; /* m; positions outside are absurd */
+} tool_workspace_t;
+
+tool_cmd_verdict_t tool_command_check(const tool_cmd_t *c, size_t ntools, const tool_workspace_t *ws);
+const char *tool_command_verdict_str(tool_cmd_verdict_t v);
+
+#endif

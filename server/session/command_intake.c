@@ -1,0 +1,9 @@
+#include "session/command_intake.h"
+
+void command_from_dds(const viscera_ToolCommand *in, tool_cmd_t *out) {
+  out->tool_id = in->tool_id;
+  for (int k = 0; k < 3; k++) out->position[k] = in->position[k];
+  for (int k = 0; k < 4; k++) out->orientation[k] = in->orientation[k];
+  out->buttons = in->buttons;
+  out->max_force = in->max_force;
+}

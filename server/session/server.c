@@ -1,0 +1,863 @@
+#include "session/server.h"
+
+#include <inttypes.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mesh.h"
+#include "runtime/step_cut.h"
+#include "session/checkpoint.h"
+#include "session/command_intake.h"
+#include "session/liveliness_watch.h"
+#include "session/session_control.h"
+#include "session/tool_metrics.h"
+#include "session/tool_roles.h"
+#include "session/writer_stations.h"
+#include "viscera.h"
+#include "vmath.h"
+#include "vrt.h"
+#include "vstats.h"
+#include "vtime.h"
+
+#define STEP_RING 65536
+
+typedef struct server {
+  const server_opts_t *opts;
+  runtime_t rt;
+  vdds_t dds;
+  dds_entity_t w_scene, w_state, w_delta, w_feedback, w_event, w_metrics, r_cmd, r_control;
+  dds_entity_t w_objects, w_tool_metrics, w_role;
+  tool_tally_t tally[SCENE_MAX_TOOLS];
+  mesh_publisher_t pubs[SCENE_MAX_ORGANS];
+  uint64_t cmd_seq[SCENE_MAX_TOOLS], cmd_echo[SCENE_MAX_TOOLS], last_cmd_mono[SCENE_MAX_TOOLS];
+  int was_contact[SCENE_MAX_TOOLS];
+  /* Loss detection: the writers driving each tool are in roles (per side),
+   * and whether the tool was released for a lost client (to report its return). */
+  liveliness_watch_t lw;
+  int tool_lost[SCENE_MAX_TOOLS];
+  /* Who drives each tool and each side's latest command (tool_roles.h);
+   * the station of each command writer (writer_stations.h). */
+  tool_roles_t roles;
+  writer_stations_t stations;
+  thr_tracker_t thr[SCENE_MAX_TOOLS];
+  session_control_t control;
+  uint64_t event_seq;
+  double *step_us;           /* ring of recent step times */
+  double *step_cpu_us;       /* the same steps' thread CPU times */
+  unsigned char *step_awake; /* the same steps: 1 when an organ was stepped (not all asleep, not paused) */
+  size_t nstep_us;
+  server_stats_t *stats;
+} server_t;
+
+static uint64_t sim_ns(const server_t *s) { return (uint64_t)(s->rt.sim_time * 1e9); }
+
+static void publish_event(server_t *s, viscera_EventKind kind, int organ, int tool, double value, const char *text) {
+  viscera_SessionEvent e;
+  memset(&e, 0, sizeof e);
+  e.source_id = 0;
+  e.seq = ++s->event_seq;
+  e.sim_time_ns = sim_ns(s);
+  e.kind = kind;
+  e.organ_id = organ;
+  e.tool_id = tool;
+  e.value = value;
+  snprintf(e.text, sizeof e.text, "%s", text);
+  if (dds_write(s->w_event, &e) >= 0) s->stats->published[VT_SESSION_EVENT]++;
+}
+
+static void publish_scene_info(server_t *s) {
+  const scene_t *sc = &s->rt.scene;
+  viscera_SceneInfo si;
+  memset(&si, 0, sizeof si);
+  viscera_OrganInfo organs[SCENE_MAX_ORGANS];
+  viscera_ToolInfo tools[SCENE_MAX_TOOLS];
+  memset(organs, 0, sizeof organs);
+  memset(tools, 0, sizeof tools);
+  snprintf(si.scene, sizeof si.scene, "%s", sc->name);
+  snprintf(si.description, sizeof si.description, "%s", sc->description);
+  si.physics_dt = sc->dt;
+  si.publish_hz = sc->publish_hz;
+  si.quant_step = (float)sc->quant_step;
+  for (size_t i = 0; i < s->rt.norgans; i++) {
+    const organ_rt_t *o = &s->rt.organs[i];
+    organs[i].organ_id = o->id;
+    snprintf(organs[i].name, sizeof organs[i].name, "%s", o->cfg->name);
+    snprintf(organs[i].model, sizeof organs[i].model, "%s", o->cfg->model);
+    snprintf(organs[i].integrator, sizeof organs[i].integrator, "%s", o->cfg->integrator);
+    organs[i].vertex_count = (uint32_t)o->model->nsurf;
+    organs[i].triangle_count = (uint32_t)o->model->nsurf_tris;
+    memcpy(organs[i].color, o->cfg->color, sizeof organs[i].color);
+  }
+  for (size_t t = 0; t < s->rt.ntools; t++) {
+    const scene_tool_t *c = s->rt.tools[t].cfg;
+    tools[t].tool_id = (uint32_t)t;
+    snprintf(tools[t].name, sizeof tools[t].name, "%s", c->name);
+    snprintf(tools[t].kind, sizeof tools[t].kind, "%s", c->kind);
+    tools[t].radius = (float)c->radius;
+    tools[t].length = (float)c->length;
+    tools[t].stiffness = (float)c->stiffness;
+    tools[t].max_force = (float)c->max_force;
+    tools[t].st = (float)c->st;
+    tools[t].mpf = (float)c->mpf;
+    tools[t].sft = (float)c->sft;
+  }
+  si.organs._buffer = organs;
+  si.organs._length = si.organs._maximum = (uint32_t)s->rt.norgans;
+  si.tools._buffer = tools;
+  si.tools._length = si.tools._maximum = (uint32_t)s->rt.ntools;
+  if (dds_write(s->w_scene, &si) >= 0) s->stats->published[VT_SCENE_INFO]++;
+}
+
+/* The ToolCommand reader. Its topic keeps the last sample per tool, but two
+ * writers share a tool when it is guided (tool_roles.h): with depth 1 one
+ * station's sample would overwrite the other's before the loop takes it.
+ * 16 per tool covers both at 1 kHz through an 8 ms stall of the loop. */
+#define CMD_READER_DEPTH 16
+static dds_entity_t command_reader(server_t *s, const dds_listener_t *l, verr_t *err) {
+  dds_qos_t *q = dds_create_qos();
+  dds_return_t rc = dds_get_qos(s->dds.topics[VT_TOOL_COMMAND], q); /* the table's QoS (liveliness, best effort) */
+  dds_qset_history(q, DDS_HISTORY_KEEP_LAST, CMD_READER_DEPTH);
+  dds_entity_t r = rc < 0 ? rc : dds_create_reader(s->dds.subscriber, s->dds.topics[VT_TOOL_COMMAND], q, l);
+  dds_delete_qos(q);
+  if (r < 0) verr_set(err, "DDS: cannot create the ToolCommand reader: %s", dds_strretcode(r));
+  return r;
+}
+
+static int setup(server_t *s, const scene_t *scene, verr_t *err) {
+  liveliness_watch_init(&s->lw); /* first: teardown always destroys it */
+  if (runtime_init(&s->rt, scene, err)) return -1;
+  if (vdds_open(&s->dds, s->opts->domain, s->opts->partition, err)) return -1;
+  s->w_scene = vdds_writer(&s->dds, VT_SCENE_INFO, err);
+  s->w_state = vdds_writer(&s->dds, VT_MESH_STATE, err);
+  s->w_delta = vdds_writer(&s->dds, VT_MESH_DELTA, err);
+  s->w_feedback = vdds_writer(&s->dds, VT_CONTACT_FEEDBACK, err);
+  s->w_event = vdds_writer(&s->dds, VT_SESSION_EVENT, err);
+  s->w_metrics = vdds_writer(&s->dds, VT_METRICS, err);
+  dds_listener_t *l = dds_create_listener(&s->lw);
+  liveliness_watch_listen(&s->lw, l);
+  s->r_cmd = command_reader(s, l, err);
+  dds_delete_listener(l);
+  s->r_control = vdds_reader(&s->dds, VT_SESSION_CONTROL, err);
+  s->w_objects = vdds_writer(&s->dds, VT_OBJECT_STATE, err);
+  s->w_tool_metrics = vdds_writer(&s->dds, VT_TOOL_METRICS, err);
+  s->w_role = vdds_writer(&s->dds, VT_TOOL_ROLE, err);
+  if (s->w_scene < 0 || s->w_state < 0 || s->w_delta < 0 || s->w_feedback < 0 || s->w_event < 0 || s->w_metrics < 0 ||
+      s->r_cmd < 0 || s->r_control < 0 || s->w_objects < 0 || s->w_tool_metrics < 0 || s->w_role < 0)
+    return -1;
+  tool_roles_init(&s->roles, &s->rt.scene);
+  writer_stations_init(&s->stations);
+  s->control.roles = &s->roles;
+  for (size_t i = 0; i < s->rt.norgans; i++) {
+    organ_rt_t *o = &s->rt.organs[i];
+    if (mesh_publisher_init(&s->pubs[i], o->id, o->model->nsurf, o->model->surf_tris, o->model->nsurf_tris,
+                            (float)scene->quant_step, s->w_state, s->w_delta, err))
+      return -1;
+    s->pubs[i].keepalive_ns = (uint64_t)(scene->publish_keepalive * 1e9);
+  }
+  s->step_us = calloc(STEP_RING, sizeof(double));
+  s->step_cpu_us = calloc(STEP_RING, sizeof(double));
+  s->step_awake = calloc(STEP_RING, 1);
+  if (!s->step_us || !s->step_cpu_us || !s->step_awake) return verr_set(err, "out of memory");
+  return 0;
+}
+
+static void teardown(server_t *s) {
+  for (size_t i = 0; i < s->rt.norgans; i++) mesh_publisher_destroy(&s->pubs[i]);
+  runtime_destroy(&s->rt);
+  vdds_close(&s->dds); /* stops the listener before the watch goes */
+  liveliness_watch_destroy(&s->lw);
+  free(s->step_us);
+  free(s->step_cpu_us);
+  free(s->step_awake);
+}
+
+/* Releases every tool whose commanding writer lost its liveliness (the
+ * client process died): at the next step instead of after the command
+ * timeout. */
+static void release_lost_writers(server_t *s, uint64_t now) {
+  liveliness_lost_t e;
+  while (liveliness_watch_pop(&s->lw, now, LIVELINESS_CONFIRM_NS, &e)) {
+    for (size_t t = 0; t < s->rt.ntools; t++) {
+      int side = tool_roles_side_of_writer(&s->roles, t, e.writer);
+      if (!s->rt.tools[t].active || side < 0) continue;
+      uint64_t last = s->roles.tool[t].side[side].mono_ns;
+      if (e.expired && (e.regained || last > e.mono_ns)) {
+        /* Alive after all: this process was starved past the lease (see
+         * liveliness_watch.h). Keep the tool; say so a few times. */
+        if (++s->stats->liveliness_blips <= 3 && !s->opts->quiet)
+          fprintf(stderr,
+                  "server: tool %zu: client liveliness lapsed while it kept sending (machine overloaded?); "
+                  "kept\n",
+                  t);
+        continue;
+      }
+      /* One side of a guided tool gone: its hand stops counting at once and
+       * the other side drives alone (tool_roles.h); the tool stays, so no
+       * CLIENT_LOST (which says the tool was released, e.g. to viscera-resim). */
+      char who[TOOL_ROLE_STATION_MAX + 16];
+      const char *st = s->roles.tool[t].side[side].station;
+      snprintf(who, sizeof who, st[0] ? "station '%s'" : "anonymous%s", st);
+      tool_roles_forget(&s->roles, t, (tool_side_t)side);
+      tool_effective_t eff;
+      /* A guide never takes the tool away with it; the owner's loss
+       * releases it unless the guide is driving right now. */
+      if (side == TOOL_SIDE_GUIDE || tool_roles_effective(&s->roles, t, now, &eff)) {
+        if (!s->opts->quiet)
+          fprintf(stderr, "server: tool %zu: %s client (%s) lost: the %s drives on alone\n", t,
+                  side ? "guide" : "owner", who, side ? "owner" : "guide");
+        continue;
+      }
+      runtime_release_tool(&s->rt, t);
+      s->tool_lost[t] = 1;
+      /* From the last command taken to the listener's report, and to this
+       * release (which adds the confirmation delay and the step). */
+      double heard_ms = e.mono_ns > last ? (double)(e.mono_ns - last) * 1e-6 : 0;
+      double released_ms = (double)(now - last) * 1e-6;
+      char text[200];
+      if (e.expired)
+        snprintf(text, sizeof text,
+                 "haptic client lost (liveliness lost %.0f ms after its last command, lease %d ms; released at "
+                 "%.0f ms): tool released",
+                 heard_ms, VDDS_TOOL_LEASE_MS, released_ms);
+      else
+        snprintf(text, sizeof text, "haptic client left (its command writer was deleted): tool released");
+      if (!s->opts->quiet) fprintf(stderr, "server: tool %zu: %s\n", t, text);
+      publish_event(s, viscera_EVENT_CLIENT_LOST, -1, (int)t, (double)(now - last) * 1e-9, text);
+    }
+  }
+}
+
+/* Moves tool t to the pose its stations give it now (tool_roles.h: the
+ * owner's, the guide's, or their mix). */
+static void drive_tool(server_t *s, size_t t, uint64_t now) {
+  tool_effective_t eff;
+  if (!tool_roles_effective(&s->roles, t, now, &eff)) return;
+  if (s->tool_lost[t]) {
+    s->tool_lost[t] = 0;
+    if (!s->opts->quiet) fprintf(stderr, "server: tool %zu: haptic client back\n", t);
+  }
+  runtime_set_tool(&s->rt, t, eff.pos, eff.max_force);
+  runtime_set_buttons(&s->rt, t, eff.buttons);
+  runtime_set_orientation(&s->rt, t, eff.q);
+  s->cmd_seq[t] = eff.seq;
+  s->cmd_echo[t] = eff.echo;
+}
+
+/* Publishes the ToolRole of every tool whose role changed (or all, after
+ * start and after a reset). */
+static void publish_roles(server_t *s) {
+  uint32_t changed = s->roles.changed;
+  s->roles.changed = 0;
+  for (size_t t = 0; t < s->roles.ntools; t++) {
+    if (!(changed & (1u << t))) continue;
+    viscera_ToolRole m;
+    tool_roles_fill(&s->roles, t, sim_ns(s), &m);
+    if (dds_write(s->w_role, &m) >= 0) s->stats->published[VT_TOOL_ROLE]++;
+  }
+}
+
+/* Takes every pending ToolCommand; applies valid ones, counts and reports the rest. */
+static void read_commands(server_t *s, uint64_t now) {
+  enum { MAXS = 16 };
+  void *samples[MAXS] = {0};
+  dds_sample_info_t infos[MAXS];
+  uint32_t fresh = 0; /* tools with a new command this step */
+  for (;;) {
+    int n = dds_take(s->r_cmd, samples, infos, MAXS, MAXS);
+    if (n <= 0) break;
+    for (int i = 0; i < n; i++) {
+      if (!infos[i].valid_data) continue;
+      const viscera_ToolCommand *c = samples[i];
+      tool_cmd_t cmd;
+      command_from_dds(c, &cmd);
+      tool_cmd_verdict_t v = tool_command_check(&cmd, s->rt.ntools, &s->rt.workspace);
+      const char *station = "";
+      tool_side_t side = TOOL_SIDE_REJECTED;
+      if (v == TOOLCMD_OK) { /* well-formed: does its station drive this tool? */
+        station = writer_stations_get(&s->stations, s->r_cmd, infos[i].publication_handle);
+        side = tool_roles_classify(&s->roles, c->tool_id, station);
+        if (side == TOOL_SIDE_REJECTED) v = TOOLCMD_NOT_ASSIGNED;
+      }
+      if (v != TOOLCMD_OK) {
+        s->stats->rejected[v]++;
+        uint64_t r = ++s->stats->rejected_total;
+        /* Report the first few and then every 1000th, so a flood of garbage
+         * cannot flood the event topic or the log. */
+        if (r <= 5 || r % 1000 == 0) {
+          char text[200], who[64];
+          if (v == TOOLCMD_NOT_ASSIGNED)
+            snprintf(text, sizeof text,
+                     "ToolCommand for tool %u from %s rejected: tool assigned to station '%s' (%" PRIu64
+                     " rejected so far)",
+                     c->tool_id, station[0] ? tool_roles_who(station, who, sizeof who) : "an anonymous station",
+                     s->roles.tool[c->tool_id].owner, r);
+          else
+            snprintf(text, sizeof text, "ToolCommand from tool %u rejected: %s (%" PRIu64 " rejected so far)",
+                     c->tool_id, tool_command_verdict_str(v), r);
+          if (!s->opts->quiet) fprintf(stderr, "server: %s\n", text);
+          publish_event(s, viscera_EVENT_INPUT_REJECTED, -1, (int)(c->tool_id < 1u << 30 ? c->tool_id : 0), (double)r,
+                        text);
+        }
+        continue;
+      }
+      tool_roles_note(&s->roles, c->tool_id, side, station, infos[i].publication_handle, c, now);
+      fresh |= 1u << c->tool_id;
+      s->last_cmd_mono[c->tool_id] = now;
+      s->stats->commands++;
+    }
+    dds_return_loan(s->r_cmd, samples, n);
+    if (n < MAXS) break;
+  }
+  /* Once per step, after every side's latest command is in. */
+  for (size_t t = 0; t < s->rt.ntools; t++)
+    if (fresh & (1u << t)) drive_tool(s, t, now);
+  release_lost_writers(s, now);
+  for (size_t t = 0; t < s->rt.ntools; t++) {
+    if (s->rt.tools[t].active && now - s->last_cmd_mono[t] > (uint64_t)(s->opts->tool_timeout * 1e9)) {
+      runtime_release_tool(&s->rt, t);
+      s->tool_lost[t] = 1;
+      if (!s->opts->quiet)
+        fprintf(stderr, "server: tool %zu: no commands for %.1f s, released\n", t, s->opts->tool_timeout);
+      publish_event(s, viscera_EVENT_CLIENT_LOST, -1, (int)t, s->opts->tool_timeout,
+                    "haptic client lost (no commands): tool released");
+    }
+  }
+}
+
+/* Applies pending instructor commands (session_control.h); each outcome is
+ * logged and published, so the recording shows who changed what and when. */
+/* Restarts the scene from `sc` (a reset, or a reset with new material):
+ * the runtime is rebuilt (models, trees, proxies, tools released, tasks and
+ * stones back), measures restart, and every organ's publisher adopts the
+ * new surface with a keyframe of a new topology version, so viewers and
+ * late joiners follow as after a cut. When `sc` cannot be built (a material
+ * the models refuse) the running scene `old` is rebuilt instead and -1
+ * returned with err; if even that fails the server cannot go on (-2). */
+static int rebuild_runtime(server_t *s, const scene_t *sc, const scene_t *old, verr_t *err) {
+  runtime_destroy(&s->rt);
+  int rc = 0;
+  if (runtime_init(&s->rt, sc, err)) {
+    verr_t e2;
+    runtime_destroy(&s->rt);
+    if (runtime_init(&s->rt, old, &e2)) {
+      fprintf(stderr, "server: cannot rebuild the scene after a refused change: %s\n", e2.msg);
+      return -2;
+    }
+    rc = -1;
+  }
+  for (size_t t = 0; t < s->rt.ntools; t++) {
+    const scene_tool_t *c = s->rt.tools[t].cfg;
+    thr_init(&s->thr[t], c->st, c->mpf, c->sft);
+    memset(&s->tally[t], 0, sizeof s->tally[t]);
+    s->was_contact[t] = 0;
+  }
+  tool_roles_forget_all(&s->roles); /* tools released; roles kept and published again */
+  for (size_t i = 0; i < s->rt.norgans; i++) {
+    const organ_rt_t *o = &s->rt.organs[i];
+    const model_t *m = o->model;
+    verr_t e;
+    if (mesh_publisher_retopo(&s->pubs[i], o->topology_version, m->nsurf, m->surf_tris, m->nsurf_tris, m->surf_x,
+                              sim_ns(s), &e))
+      fprintf(stderr, "server: %s\n", e.msg);
+  }
+  return rc;
+}
+
+/* An instructor's START_TASK (session_control.h): the task (re)starts now,
+ * reported as a TASK_STARTED whose text carries the station tag. */
+static void start_task(server_t *s, int k, const char *text) {
+  tasks_start(&s->rt.tasks[k], s->rt.sim_time);
+  publish_event(s, viscera_EVENT_TASK_STARTED, -1, s->rt.scene.tasks[k].tool, 1, text);
+}
+
+/* Applies pending instructor commands (session_control.h); each outcome is
+ * logged and published, so the recording shows who changed what and when. */
+static int read_controls(server_t *s) {
+  void *samples[1] = {0};
+  dds_sample_info_t info;
+  while (dds_take(s->r_control, samples, &info, 1, 1) == 1) {
+    if (info.valid_data && !session_control_duplicate(&s->control, samples[0])) {
+      const viscera_SessionControl *c = samples[0];
+      double maxf[SCENE_MAX_TOOLS];
+      for (size_t t = 0; t < s->rt.ntools; t++) maxf[t] = s->rt.tools[t].cfg->max_force;
+      char text[300];
+      /* The scene lives in the runtime, which a rebuild destroys: work on
+       * copies (heap: a scene is tens of kB). */
+      scene_t *edit = malloc(sizeof *edit), *old = malloc(sizeof *old);
+      int r = -1;
+      if (edit && old) {
+        *edit = s->rt.scene;
+        *old = s->rt.scene;
+        r = session_control_apply(&s->control, c, s->thr, s->rt.ntools, maxf, edit, text, sizeof text);
+      } else {
+        snprintf(text, sizeof text, "SessionControl refused: out of memory");
+      }
+      if (r == SESSION_CONTROL_REBUILD) {
+        verr_t e;
+        int b = rebuild_runtime(s, edit, old, &e);
+        if (b == -2) {
+          free(edit);
+          free(old);
+          dds_return_loan(s->r_control, samples, 1);
+          return -1;
+        }
+        if (b == 0) {
+          s->control.applied++;
+          r = 0;
+          /* A stiff material is accepted as in a scene file, but the
+           * instructor should know when the step may no longer keep time. */
+          for (size_t i = 0; i < s->rt.norgans; i++) {
+            const model_t *m = s->rt.organs[i].model;
+            size_t len = strlen(text);
+            if (m->substeps > 16 && len < sizeof text)
+              snprintf(text + len, sizeof text - len,
+                       "; organ '%.40s' now needs %d sub-steps per step (may not keep real time)",
+                       s->rt.organs[i].cfg->name, m->substeps);
+          }
+        } else {
+          s->control.refused++;
+          size_t len = strlen(text);
+          snprintf(text + len, sizeof text - len, "; refused by the models: %.200s (scene unchanged, restarted)",
+                   e.msg);
+        }
+      }
+      if (r == SESSION_CONTROL_START_TASK) {
+        r = 0;
+        start_task(s, s->control.start_task, text);
+      }
+      free(edit);
+      free(old);
+      if (!s->opts->quiet) fprintf(stderr, "server: %s\n", text);
+      publish_event(s, r == 0 ? viscera_EVENT_CONTROL_APPLIED : viscera_EVENT_INPUT_REJECTED, c->organ_id, c->tool_id,
+                    (double)c->kind, text);
+    }
+    dds_return_loan(s->r_control, samples, 1);
+  }
+  return 0;
+}
+
+static void publish_feedback(server_t *s) {
+  for (size_t t = 0; t < s->rt.ntools; t++) {
+    const tool_rt_t *tool = &s->rt.tools[t];
+    if (!tool->active) continue;
+    viscera_ContactFeedback fb;
+    memset(&fb, 0, sizeof fb);
+    fb.tool_id = (uint32_t)t;
+    fb.cmd_seq = s->cmd_seq[t];
+    fb.cmd_client_mono_ns = s->cmd_echo[t];
+    fb.sim_time_ns = sim_ns(s);
+    /* fb_*: the god-object, or what a grasp, a stone or another tool
+     * makes the hand feel (runtime/step_tools.c). */
+    fb.in_contact = tool->fb_contact != 0;
+    fb.organ_id = tool->fb_contact ? tool->fb_organ : -1;
+    fb.stiffness = (float)tool->cfg->stiffness;
+    for (int k = 0; k < 3; k++) {
+      fb.proxy_position[k] = (float)tool->fb_pos[k];
+      fb.normal[k] = (float)tool->fb_normal[k];
+      fb.force[k] = (float)tool->force[k];
+    }
+    if (dds_write(s->w_feedback, &fb) >= 0) s->stats->published[VT_CONTACT_FEEDBACK]++;
+    int c = tool->fb_contact != 0;
+    if (c != s->was_contact[t]) {
+      publish_event(s, c ? viscera_EVENT_CONTACT_BEGIN : viscera_EVENT_CONTACT_END, fb.organ_id, (int)t, 0,
+                    c ? "contact begins" : "contact ends");
+      s->was_contact[t] = c;
+    }
+  }
+}
+
+/* Feeds every tool's contact force and tip to its threshold tracker and
+ * publishes the crossings. */
+static void track_thresholds(server_t *s) {
+  for (size_t t = 0; t < s->rt.ntools; t++) {
+    const tool_rt_t *tool = &s->rt.tools[t];
+    double f = tool->active ? v3_norm(tool->force) : 0.0;
+    int contact = tool->active && tool->fb_contact;
+    thr_event_t ev[THR_COUNT];
+    int n = thr_update(&s->thr[t], s->rt.scene.dt, f, contact, tool->active ? tool->device : NULL, ev);
+    for (int i = 0; i < n; i++) {
+      char text[200];
+      snprintf(text, sizeof text, "%s %s: tool '%s' force %.3f N %s %.3f N", thr_name(ev[i].which),
+               ev[i].up ? "crossed up" : "crossed down", tool->cfg->name, f, ev[i].up ? "above" : "back below",
+               ev[i].level);
+      if (!s->opts->quiet) fprintf(stderr, "server: %s\n", text);
+      publish_event(s, ev[i].up ? viscera_EVENT_THRESHOLD_CROSSED_UP : viscera_EVENT_THRESHOLD_CROSSED_DOWN,
+                    contact ? tool->fb_organ : -1, (int)t, ev[i].level, text);
+    }
+  }
+}
+
+/* The recent steps that stepped an organ: what a step of physics costs,
+ * without the near-free steps of sleeping organs diluting the median. */
+static void summarise_awake(const server_t *s, size_t n, server_stats_t *stats) {
+  double *w = malloc((n + 1) * sizeof *w), *c = malloc((n + 1) * sizeof *c);
+  size_t k = 0;
+  if (w && c)
+    for (size_t i = 0; i < n; i++)
+      if (s->step_awake[i]) {
+        w[k] = s->step_us[i];
+        c[k++] = s->step_cpu_us[i];
+      }
+  vstats_summary_t sw = vstats_summarise(w, k), sc = vstats_summarise(c, k);
+  stats->awake_samples = k;
+  stats->awake_step_us_median = sw.median;
+  stats->awake_step_us_p99 = sw.p99;
+  stats->awake_step_cpu_us_median = sc.median;
+  stats->awake_step_cpu_us_p99 = sc.p99;
+  free(w);
+  free(c);
+}
+
+static void publish_metrics(server_t *s, uint64_t window_steps) {
+  size_t n = s->nstep_us < STEP_RING ? s->nstep_us : STEP_RING;
+  size_t take = window_steps < n ? window_steps : n;
+  double *tmp = malloc((take + 1) * sizeof(double));
+  if (!tmp) return;
+  for (size_t i = 0; i < take; i++) tmp[i] = s->step_us[(s->nstep_us - 1 - i) % STEP_RING];
+  vstats_summary_t st = vstats_summarise(tmp, take);
+  free(tmp);
+  double peak = 0;
+  for (size_t t = 0; t < s->rt.ntools; t++) peak = fmax(peak, s->rt.tools[t].peak_force);
+  double above[THR_COUNT] = {0}, contact = 0, fint = 0, path = 0;
+  for (size_t t = 0; t < s->rt.ntools; t++) {
+    const thr_tracker_t *tr = &s->thr[t];
+    for (int k = 0; k < THR_COUNT; k++) above[k] += tr->time_above[k];
+    contact += tr->contact_time;
+    fint += tr->contact_force_integral;
+    path += tr->path_length;
+  }
+  for (size_t i = 0; i < s->rt.norgans; i++) {
+    viscera_Metrics m;
+    memset(&m, 0, sizeof m);
+    m.organ_id = s->rt.organs[i].id;
+    m.sim_time_ns = sim_ns(s);
+    m.step_time_us_median = st.median;
+    m.step_time_us_p99 = st.p99;
+    m.steps_per_s = (double)take;
+    const model_t *model = s->rt.organs[i].model;
+    m.error_estimate = model->ops->error_estimate(model);
+    snprintf(m.error_kind, sizeof m.error_kind, "%s", model->error_kind ? model->error_kind : "");
+    m.peak_force = peak;
+    m.rejected_commands = s->stats->rejected_total;
+    m.time_above_st = above[THR_ST];
+    m.time_above_mpf = above[THR_MPF];
+    m.time_above_sft = above[THR_SFT];
+    m.contact_time = contact;
+    m.mean_contact_force = contact > 0 ? fint / contact : 0.0;
+    m.path_length = path;
+    if (dds_write(s->w_metrics, &m) >= 0) s->stats->published[VT_METRICS]++;
+  }
+}
+
+/* Grasp and task events from the runtime's queue, as SessionEvents. */
+static void publish_interactions(server_t *s) {
+  const scene_t *sc = &s->rt.scene;
+  for (size_t i = 0; i < s->rt.events.n; i++) {
+    const iev_t *e = &s->rt.events.ev[i];
+    const char *tool = e->tool >= 0 ? sc->tools[e->tool].name : "?";
+    char text[200];
+    viscera_EventKind kind = viscera_EVENT_GRASP_BEGIN;
+    switch (e->kind) {
+    case IEV_GRASP_BEGIN:
+    case IEV_GRASP_END:
+      kind = e->kind == IEV_GRASP_BEGIN ? viscera_EVENT_GRASP_BEGIN : viscera_EVENT_GRASP_END;
+      if (e->object >= 0)
+        snprintf(text, sizeof text, "tool '%s' %s stone '%s'", tool, e->kind == IEV_GRASP_BEGIN ? "grasps" : "releases",
+                 sc->objects[e->object].name);
+      else
+        snprintf(text, sizeof text, "tool '%s' %s organ '%s'%s", tool,
+                 e->kind == IEV_GRASP_BEGIN ? "grasps" : "releases", e->organ >= 0 ? sc->organs[e->organ].name : "?",
+                 e->kind == IEV_GRASP_BEGIN ? " tissue" : "");
+      break;
+    case IEV_TASK_STARTED:
+      kind = viscera_EVENT_TASK_STARTED;
+      snprintf(text, sizeof text, "task '%s' started (tool '%s')", sc->tasks[e->task].name, tool);
+      break;
+    case IEV_TASK_COMPLETED:
+      kind = viscera_EVENT_TASK_COMPLETED;
+      snprintf(text, sizeof text, "task '%s' completed in %.3f s (tool '%s')", sc->tasks[e->task].name, e->value, tool);
+      break;
+    case IEV_CUT_BEGIN:
+      kind = viscera_EVENT_CUT_BEGIN;
+      snprintf(text, sizeof text, "tool '%s' cuts organ '%s' (%.0f surface vertices)", tool, sc->organs[e->organ].name,
+               e->value);
+      break;
+    case IEV_CUT_END: {
+      kind = viscera_EVENT_CUT_END;
+      const model_t *m = s->rt.organs[e->organ].model;
+      double wmean = 0, wmax = 0;
+      size_t nw = scalpel_incision_width(&s->rt, (size_t)e->organ, &wmean, &wmax);
+      int k = snprintf(text, sizeof text, "tool '%s' ends its cut of organ '%s': %.0f topology change(s), %zu vertices",
+                       tool, sc->organs[e->organ].name, e->value, m->nsurf);
+      if (nw && k > 0 && (size_t)k < sizeof text)
+        snprintf(text + k, sizeof text - (size_t)k, ", incision width %.2f mm mean, %.2f mm max", wmean * 1e3,
+                 wmax * 1e3);
+      break;
+    }
+    }
+    if (!s->opts->quiet) fprintf(stderr, "server: %s\n", text);
+    publish_event(s, kind, e->organ, e->tool, e->value, text);
+  }
+  s->rt.events.n = 0;
+  /* A refused cut is logged (the first few, then every 100th), never fatal. */
+  char msg[240];
+  uint64_t r = scalpel_take_error(&s->rt, msg, sizeof msg);
+  if (r && (r <= 5 || r % 100 == 0) && !s->opts->quiet)
+    fprintf(stderr, "server: %s (%" PRIu64 " refused so far)\n", msg, r);
+}
+
+static void publish_objects(server_t *s) {
+  for (size_t i = 0; i < s->rt.nstones; i++) {
+    const stone_t *st = &s->rt.stones[i];
+    const scene_object_t *c = &s->rt.scene.objects[i];
+    viscera_ObjectState o;
+    memset(&o, 0, sizeof o);
+    o.object_id = (uint32_t)i;
+    o.sim_time_ns = sim_ns(s);
+    snprintf(o.name, sizeof o.name, "%s", c->name);
+    snprintf(o.kind, sizeof o.kind, "%s", c->kind);
+    for (int k = 0; k < 3; k++) {
+      o.position[k] = (float)st->pos[k];
+      o.color[k] = c->color[k];
+    }
+    o.radius = (float)st->radius;
+    o.organ_id = st->organ;
+    o.held_by = st->held_by;
+    o.removed = st->removed != 0;
+    dds_write(s->w_objects, &o);
+  }
+}
+
+static void publish_tool_metrics(server_t *s) {
+  for (size_t t = 0; t < s->rt.ntools; t++) {
+    viscera_ToolMetrics m;
+    tool_metrics_fill(&m, &s->rt, t, &s->thr[t], &s->tally[t], sim_ns(s));
+    dds_write(s->w_tool_metrics, &m);
+  }
+}
+
+static void publish_frames(server_t *s) {
+  publish_objects(s);
+  for (size_t i = 0; i < s->rt.norgans; i++)
+    mesh_publisher_frame(&s->pubs[i], s->rt.organs[i].model->surf_x, sim_ns(s));
+}
+
+/* An organ whose runtime rebuilt for a new topology (topology_follow.h)
+ * gets a keyframe of its new surface at once and a SessionEvent. */
+static void follow_topology(server_t *s) {
+  for (size_t i = 0; i < s->rt.norgans; i++) {
+    const organ_rt_t *o = &s->rt.organs[i];
+    mesh_publisher_t *mp = &s->pubs[i];
+    if (o->topology_version == mp->model_version || mp->broken) continue;
+    const model_t *m = o->model;
+    verr_t e;
+    char text[200];
+    if (mesh_publisher_retopo(mp, o->topology_version, m->nsurf, m->surf_tris, m->nsurf_tris, m->surf_x, sim_ns(s),
+                              &e)) {
+      fprintf(stderr, "server: %s\n", e.msg);
+      continue;
+    }
+    snprintf(text, sizeof text, "organ '%s': topology %u: %zu vertices, %zu triangles", o->cfg->name,
+             mp->topology_version, m->nsurf, m->nsurf_tris);
+    if (!s->opts->quiet && mp->retopos <= 5) fprintf(stderr, "server: %s\n", text);
+    publish_event(s, viscera_EVENT_TOPOLOGY_CHANGED, (int)i, -1, (double)m->nsurf, text);
+  }
+}
+
+static void write_final_mesh(server_t *s) {
+  /* Exact positions of the last published frame, so a test can compare a
+   * viewer's reconstruction with the server's state at the same frame. */
+  for (size_t i = 0; i < s->rt.norgans; i++) {
+    char path[1100];
+    if (s->rt.norgans == 1)
+      snprintf(path, sizeof path, "%s", s->opts->final_mesh);
+    else
+      snprintf(path, sizeof path, "%s.%zu", s->opts->final_mesh, i);
+    const model_t *model = s->rt.organs[i].model;
+    mesh_t m = {
+        .nverts = model->nsurf, .ntris = model->nsurf_tris, .pos = model->surf_x, .tris = (uint32_t *)model->surf_tris};
+    char comment[160];
+    snprintf(comment, sizeof comment, "organ %zu topology %u keyframe %u frame %u", i, s->pubs[i].topology_version,
+             s->pubs[i].keyframe_seq, s->pubs[i].frame_seq);
+    verr_t e;
+    if (mesh_write_obj(&m, path, comment, &e)) fprintf(stderr, "server: %s\n", e.msg);
+  }
+}
+
+int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_atomic_t *stop, server_stats_t *stats,
+               verr_t *err) {
+  server_t s;
+  memset(&s, 0, sizeof s);
+  memset(stats, 0, sizeof *stats);
+  s.opts = opts;
+  s.stats = stats;
+  if (setup(&s, scene, err)) {
+    teardown(&s);
+    return -1;
+  }
+  if (!opts->quiet) {
+    for (size_t i = 0; i < s.rt.norgans; i++) {
+      const organ_rt_t *o = &s.rt.organs[i];
+      const model_t *m = o->model;
+      fprintf(stderr,
+              "server: organ '%s': %s, %s, %zu nodes, %zu tetrahedra, surface %zu vertices / %zu triangles, "
+              "%d sub-step(s) per %.3g ms (stable below %.3g ms)\n",
+              o->cfg->name, m->ops->name, o->cfg->integrator, m->nnodes, m->ntets, m->nsurf, m->nsurf_tris, m->substeps,
+              scene->dt * 1e3, m->stable_dt * 1e3);
+      if (m->substeps > 0 && scene->dt / m->substeps > m->stable_dt)
+        fprintf(stderr,
+                "server: organ '%s': warning: solver.substeps %d gives %.3g ms sub-steps, above the "
+                "stable %.3g ms: expect rollbacks\n",
+                o->cfg->name, m->substeps, scene->dt / m->substeps * 1e3, m->stable_dt * 1e3);
+    }
+    fprintf(stderr, "server: scene '%s' running on domain %d, partition '%s'\n", scene->name, opts->domain,
+            opts->partition ? opts->partition : VDDS_DEFAULT_PARTITION);
+  }
+  for (size_t t = 0; t < s.rt.ntools; t++) {
+    const scene_tool_t *c = s.rt.tools[t].cfg;
+    thr_init(&s.thr[t], c->st, c->mpf, c->sft);
+  }
+  checkpointer_t *ckpt = NULL;
+  char resumed[300] = "";
+  if (opts->checkpoint) {
+    verr_t e;
+    int r = checkpoint_load(opts->checkpoint, &s.rt, s.thr, s.tally, &s.roles, &e);
+    if (r == -2) {
+      verr_set(err, "%s (cannot rebuild the scene after it)", e.msg);
+      teardown(&s);
+      return -1;
+    }
+    if (r < 0) {
+      fprintf(stderr, "server: %s\n", e.msg);
+      /* A topology restore that failed midway rebuilt the runtime: the
+       * publishers must drop the old models' surfaces they borrow. */
+      for (size_t i = 0; i < s.rt.norgans; i++) {
+        const model_t *m = s.rt.organs[i].model;
+        if (s.pubs[i].tris != m->surf_tris &&
+            mesh_publisher_retopo(&s.pubs[i], s.rt.organs[i].topology_version, m->nsurf, m->surf_tris, m->nsurf_tris,
+                                  m->surf_x, 0, &e))
+          fprintf(stderr, "server: %s\n", e.msg);
+      }
+    } else if (r == 1) {
+      stats->resumed = 1;
+      snprintf(resumed, sizeof resumed, "resumed from checkpoint %s at t = %.3f s (step %llu)", opts->checkpoint,
+               s.rt.sim_time, (unsigned long long)s.rt.steps);
+      if (!opts->quiet) fprintf(stderr, "server: %s\n", resumed);
+      follow_topology(&s); /* a restored cut: keyframes of its topology before anything else */
+    }
+    if (!(ckpt = checkpointer_start(opts->checkpoint, err))) {
+      teardown(&s);
+      return -1;
+    }
+  }
+  uint64_t ckpt_every = (uint64_t)fmax(1.0, floor(opts->checkpoint_every / scene->dt + 0.5));
+  publish_scene_info(&s);
+  publish_roles(&s);
+  for (size_t i = 0; i < s.rt.norgans; i++) mesh_publisher_keyframe(&s.pubs[i], s.rt.organs[i].model->surf_x, 0);
+  publish_event(&s, viscera_EVENT_SESSION_STARTED, -1, -1, stats->resumed, resumed[0] ? resumed : scene->name);
+
+  uint64_t dt_ns = (uint64_t)(scene->dt * 1e9);
+  uint64_t publish_every = (uint64_t)fmax(1.0, floor(1.0 / (scene->publish_hz * scene->dt) + 0.5));
+  uint64_t metrics_every = (uint64_t)fmax(1.0, floor(1.0 / scene->dt + 0.5));
+  /* Real time for this thread only, after every other thread (DDS, the
+   * checkpoint writer) has started, so they stay SCHED_OTHER. The loop sleeps
+   * to each tick in vtime_sleep_until, so FIFO costs the machine no more CPU
+   * than the steps; but a loop whose steps take longer than dt never sleeps
+   * (it catches up, resynchronising when 100 ms behind) and would hold its
+   * core for good. The kernel's RT throttling (sched_rt_runtime_us: 950 ms of
+   * every second by default) is the safety net that still lets the other
+   * tasks (this server's DDS threads, a shell to stop it) run there. */
+  if (opts->rt_priority) vrt_make_realtime(opts->rt_priority, "server", "physics loop", opts->quiet, stderr);
+  uint64_t start = vtime_mono_ns(), next = start;
+  double sim0 = s.rt.sim_time; /* a resumed run starts where its checkpoint was */
+  while (!*stop && (opts->duration <= 0 || (double)(vtime_mono_ns() - start) * 1e-9 < opts->duration)) {
+    uint64_t t0 = vtime_mono_ns(), c0 = vtime_thread_cpu_ns();
+    read_commands(&s, t0);
+    if (read_controls(&s)) {
+      stats->overruns++;
+      break; /* the scene could not be rebuilt: nothing left to simulate */
+    }
+    if (s.roles.changed) publish_roles(&s);
+    /* Paused: the organs and the measures freeze; commands are still read
+     * (so nothing queues up) and the last contact model keeps going out. */
+    int rolled = s.control.paused ? 0 : runtime_step(&s.rt);
+    if (rolled) {
+      stats->rollbacks += (uint64_t)rolled;
+      publish_event(&s, viscera_EVENT_STEP_ROLLED_BACK, -1, -1, rolled, "non-finite state: step rolled back");
+      if (!opts->quiet) fprintf(stderr, "server: step %" PRIu64 ": non-finite state, rolled back\n", s.rt.steps);
+    }
+    follow_topology(&s);
+    publish_feedback(&s);
+    if (!s.control.paused) {
+      track_thresholds(&s);
+      for (size_t t = 0; t < s.rt.ntools; t++) tool_tally_update(&s.tally[t], &s.rt.tools[t], scene->dt);
+      publish_interactions(&s); /* the events of the step just taken */
+    }
+    if (s.rt.steps % publish_every == 0) publish_frames(&s);
+    uint64_t t1 = vtime_mono_ns();
+    s.step_cpu_us[s.nstep_us % STEP_RING] = (double)(vtime_thread_cpu_ns() - c0) * 1e-3;
+    int awake = !s.control.paused && s.rt.organs_stepped > 0;
+    s.step_awake[s.nstep_us % STEP_RING] = (unsigned char)awake;
+    if (!s.control.paused && !awake) stats->steps_all_asleep++;
+    s.step_us[s.nstep_us++ % STEP_RING] = (double)(t1 - t0) * 1e-3;
+    if (s.rt.steps % metrics_every == 0) {
+      publish_metrics(&s, metrics_every);
+      publish_tool_metrics(&s);
+    }
+    if (ckpt && s.rt.steps % ckpt_every == 0) checkpointer_submit(ckpt, &s.rt, s.thr, s.tally, &s.roles);
+    next += dt_ns;
+    if (t1 > next + 100 * 1000000ull) { /* far behind (debugger, overload): resynchronise */
+      stats->overruns++;
+      next = t1;
+    }
+    vtime_sleep_until(next);
+  }
+  publish_frames(&s);
+  publish_metrics(&s, metrics_every);
+  publish_tool_metrics(&s);
+  if (ckpt) {
+    checkpointer_submit(ckpt, &s.rt, s.thr, s.tally, &s.roles);
+    verr_t e;
+    if (checkpointer_stop(ckpt, &stats->checkpoints_written, &e)) fprintf(stderr, "server: %s\n", e.msg);
+  }
+  if (opts->final_mesh) write_final_mesh(&s);
+  publish_event(&s, viscera_EVENT_SESSION_STOPPED, -1, -1, 0, scene->name);
+
+  stats->steps = s.rt.steps;
+  for (size_t i = 0; i < s.rt.norgans; i++) {
+    stats->published[VT_MESH_STATE] += s.pubs[i].keyframes;
+    stats->published[VT_MESH_DELTA] += s.pubs[i].frames;
+    stats->deltas_skipped += s.pubs[i].skipped;
+  }
+  stats->ntools = s.rt.ntools;
+  memcpy(stats->thr, s.thr, sizeof stats->thr);
+  for (size_t t = 0; t < s.rt.ntools; t++)
+    tool_metrics_fill(&stats->tools[t], &s.rt, t, &s.thr[t], &s.tally[t], sim_ns(&s));
+  stats->ntasks = s.rt.ntasks;
+  stats->sim_time = s.rt.sim_time;
+  memcpy(stats->tasks, s.rt.tasks, sizeof stats->tasks);
+  for (size_t i = 0; i < s.rt.nstones; i++) stats->stone_removed[i] = s.rt.stones[i].removed;
+  for (size_t t = 0; t < s.rt.ntools; t++) stats->peak_force = fmax(stats->peak_force, s.rt.tools[t].peak_force);
+  size_t n = s.nstep_us < STEP_RING ? s.nstep_us : STEP_RING;
+  summarise_awake(&s, n, stats); /* first: the summaries below sort the rings in place */
+  vstats_summary_t st = vstats_summarise(s.step_us, n);
+  stats->step_us_median = st.median;
+  stats->step_us_p99 = st.p99;
+  stats->step_us_max = st.max;
+  vstats_summary_t sc = vstats_summarise(s.step_cpu_us, n);
+  stats->step_cpu_us_median = sc.median;
+  stats->step_cpu_us_p99 = sc.p99;
+  for (size_t i = 0; i < s.rt.norgans; i++) {
+    stats->organ_sleeps += s.rt.organs[i].sleep.sleeps;
+    stats->organ_wakes += s.rt.organs[i].sleep.wakes;
+  }
+  double wall = (double)(vtime_mono_ns() - start) * 1e-9;
+  stats->realtime_ratio = wall > 0 ? (s.rt.sim_time - sim0) / wall : 0;
+  scalpel_print_summary(&s.rt, stdout);
+  /* Give reliable late samples (last frame, stop event) a moment to leave. */
+  dds_sleepfor(DDS_MSECS(100));
+  teardown(&s);
+  return 0;
+}

@@ -1,0 +1,65 @@
+/* server: the scene runtime wired to DDS. Reads ToolCommand, steps physics in
+ * real time at the scene's fixed dt, publishes ContactFeedback every step,
+ * MeshDelta at publish_hz, MeshState keyframes, SceneInfo, SessionEvent and
+ * Metrics (once per second). One thread; DDS reads never block the loop. */
+#ifndef VISCERA_SERVER_H
+#define VISCERA_SERVER_H
+
+#include <signal.h>
+#include <stdint.h>
+
+#include "dds/vdds.h"
+#include "runtime/scene_runtime.h"
+#include "session/mesh_publisher.h"
+#include "training/thresholds.h"
+#include "viscera.h"
+
+typedef struct server_opts {
+  int domain;
+  const char *partition;
+  double duration;        /* s of wall time; 0 = until stopped */
+  const char *final_mesh; /* write exact positions of the last published frame here (OBJ) */
+  int quiet;
+  double tool_timeout;     /* s without a command before a tool is released */
+  const char *checkpoint;  /* state file: resumed from at start when it fits the scene, written periodically */
+  double checkpoint_every; /* s of simulated time between checkpoints */
+  int rt_priority;         /* 1..99: the step loop's thread runs SCHED_FIFO at it (vrt.h); 0 = normal */
+} server_opts_t;
+
+typedef struct server_stats {
+  uint64_t checkpoints_written;
+  int resumed; /* started from a checkpoint */
+  uint64_t steps, overruns, rollbacks, rejected[TOOLCMD_VERDICT_COUNT], rejected_total, commands;
+  uint64_t liveliness_blips; /* client liveliness lapses that were not a lost client */
+  double peak_force;
+  double step_us_median, step_us_p99, step_us_max;
+  /* The same steps in this thread's CPU time: the work a step costs, apart
+   * from time the scheduler gave to other processes (on a crowded machine
+   * wall time grows while this stays put). */
+  double step_cpu_us_median, step_cpu_us_p99;
+  double realtime_ratio; /* simulated s per wall s over the run */
+  /* Organ sleeping (organ_sleep.h): steps in which every organ slept, over
+   * the run, and the step times above restricted to the steps that
+   * stepped an organ (the physics work), over the same recent steps. */
+  uint64_t steps_all_asleep;
+  uint64_t organ_sleeps, organ_wakes, organ_slept_steps; /* summed over the organs */
+  int sleep_enabled;                                     /* the scene's sleep_speed > 0 */
+  size_t awake_samples;                                  /* how many of the recent steps stepped an organ */
+  double awake_step_us_median, awake_step_us_p99, awake_step_cpu_us_median, awake_step_cpu_us_p99;
+  size_t ntools;
+  thr_tracker_t thr[SCENE_MAX_TOOLS];         /* palpation measures per tool at the end */
+  viscera_ToolMetrics tools[SCENE_MAX_TOOLS]; /* per-tool measures at the end */
+  size_t ntasks;
+  task_rt_t tasks[SCENE_MAX_TASKS]; /* cfg points into the server's scene copy: use the index, not cfg */
+  int stone_removed[SCENE_MAX_OBJECTS];
+  double sim_time;              /* s simulated */
+  uint64_t published[VT_COUNT]; /* samples written per topic (vdds ids), for drop accounting */
+  uint64_t deltas_skipped;      /* MeshDelta frames not written: equal to the last one (mesh_publisher.h) */
+} server_stats_t;
+
+/* Runs a whole session: set-up, loop until *stop or the duration, shutdown.
+ * Returns 0, or -1 with err on set-up failure. */
+int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_atomic_t *stop, server_stats_t *stats,
+               verr_t *err);
+
+#endif
