@@ -34,7 +34,7 @@
 #define VISCERA_CHECKPOINT_H
 
 #include "scene_runtime.h"
-#include "thresholds.h"
+#include "training/thresholds.h"
 #include "tool_roles.h"
 #include "tool_metrics.h"
 #include "verr.h"

@@ -10,7 +10,7 @@
 
 #include "mesh_publisher.h"
 #include "scene_runtime.h"
-#include "thresholds.h"
+#include "training/thresholds.h"
 #include "vdds.h"
 
 typedef struct server_opts {

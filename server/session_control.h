@@ -16,7 +16,7 @@
 #include <stdint.h>
 
 #include "scene.h"
-#include "thresholds.h"
+#include "training/thresholds.h"
 #include "viscera.h"
 
 /* Stations remembered for de-duplication; a deployment has a handful of

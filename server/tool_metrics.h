@@ -8,7 +8,7 @@
 #include <stdint.h>
 
 #include "scene_runtime.h"
-#include "thresholds.h"
+#include "training/thresholds.h"
 #include "viscera.h"
 
 typedef struct tool_tally {

@@ -5,8 +5,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "camera.h"
-#include "render.h"
+#include "view/camera.h"
+#include "view/render.h"
 #include "vdds.h"
 
 void options_usage(FILE *f, const char *prog) {

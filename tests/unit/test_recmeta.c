@@ -11,9 +11,9 @@
 #include <sqlite3.h>
 
 #include "check.h"
-#include "recfile.h"
+#include "recording/recfile.h"
 #include "replay_pause.h"
-#include "store.h"
+#include "recording/store.h"
 #include "vdds_ident.h"
 
 static void test_format_and_role(void) {

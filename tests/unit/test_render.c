@@ -9,10 +9,10 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "camera.h"
+#include "view/camera.h"
 #include "check.h"
-#include "png_write.h"
-#include "render.h"
+#include "view/png_write.h"
+#include "view/render.h"
 
 #define W 200
 #define H 150

@@ -9,7 +9,7 @@
 
 #include "check.h"
 #include "mesh_publisher.h"
-#include "resim_run.h"
+#include "resim/resim_run.h"
 
 enum { N = 420, PUBLISH_EVERY = 33, RELEASE_AT = 330 };
 

@@ -8,7 +8,7 @@
 #include <string.h>
 
 #include "check.h"
-#include "resim_schedule.h"
+#include "resim/resim_schedule.h"
 
 #define MAXS 4096
 

@@ -6,7 +6,7 @@
 #include <string.h>
 
 #include "check.h"
-#include "thresholds.h"
+#include "training/thresholds.h"
 
 static const double DT = 0.001;
 
