@@ -3,7 +3,7 @@
  * arrays).
  *
  * Force measures replay the ContactFeedback force magnitudes of one tool
- * through the server's own threshold tracker (server/thresholds.c), so the
+ * through the server's own threshold tracker (training/thresholds.c), so the
  * hysteresis, "time above" and crossing rules are the server's by
  * construction, not a second implementation. Each sample stands for the
  * time since the previous one (its server step, dt_nominal when samples are

@@ -210,12 +210,8 @@ int scene_view_open(scene_view_t *sv, int domain, const char *partition, scene_v
   struct {
     dds_entity_t *rd;
     vdds_topic_id_t topic;
-  } rds[] = {{&sv->rd_scene, VT_SCENE_INFO},
-             {&sv->rd_state, VT_MESH_STATE},
-             {&sv->rd_delta, VT_MESH_DELTA},
-             {&sv->rd_cmd, VT_TOOL_COMMAND},
-             {&sv->rd_contact, VT_CONTACT_FEEDBACK},
-             {&sv->rd_object, VT_OBJECT_STATE}};
+  } rds[] = {{&sv->rd_scene, VT_SCENE_INFO}, {&sv->rd_state, VT_MESH_STATE},         {&sv->rd_delta, VT_MESH_DELTA},
+             {&sv->rd_cmd, VT_TOOL_COMMAND}, {&sv->rd_contact, VT_CONTACT_FEEDBACK}, {&sv->rd_object, VT_OBJECT_STATE}};
   for (size_t i = 0; i < sizeof rds / sizeof rds[0]; i++) {
     *rds[i].rd = vdds_reader(&sv->dds, rds[i].topic, err);
     if (*rds[i].rd < 0) {

@@ -44,7 +44,7 @@ typedef struct sv_tool {
   int listed;
   char name[65];
   float radius, length, max_force; /* m, m, N */
-  float st, mpf, sft;               /* N, palpation thresholds; 0 = unset */
+  float st, mpf, sft;              /* N, palpation thresholds; 0 = unset */
   int have_pose;
   float tip[3];     /* m, from ToolCommand */
   int have_contact; /* a ContactFeedback arrived */

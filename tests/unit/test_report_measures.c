@@ -1,6 +1,6 @@
 /* Report measures on synthetic sample arrays: a ramp up, hold and ramp down
  * whose threshold times are known in closed form, with and without the
- * hysteresis of server/thresholds.c, gaps in the samples, force chatter at
+ * hysteresis of common/training/thresholds.c, gaps in the samples, force chatter at
  * a level, path length with gaps and non-finite positions, first motion,
  * and pairing of task events. */
 #include <math.h>

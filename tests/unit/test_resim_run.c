@@ -1,4 +1,4 @@
-/* resim_run (server/resim_run.h) without DDS: a reference run of the default
+/* resim_run (server/resim/resim_run.h) without DDS: a reference run of the default
  * scene (probe pressed 8 mm into the kidney, held, released) writes its
  * frames as the server's publisher encodes them, with one feedback per step
  * and the release, into a resim_recording_t; a fresh runtime must reproduce
