@@ -4,7 +4,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "scene_draw.h"
+#include "view/scene_draw.h"
 #include "viscera.h"
 
 #define CURVE_R 0.55

@@ -21,7 +21,7 @@
 
 #include <cairo.h>
 
-#include "render.h"
+#include "view/render.h"
 #include "seat.h"
 
 #define DASH_HEADER_H 22 /* tile header, px */

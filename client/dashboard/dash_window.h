@@ -21,8 +21,8 @@
 #include <stdint.h>
 
 #include "dash_draw.h"
-#include "input_script.h"
-#include "sdl_window.h"
+#include "window/input_script.h"
+#include "window/sdl_window.h"
 
 #define DASH_WINDOW_FOOTER_H 22
 

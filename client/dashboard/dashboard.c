@@ -26,7 +26,7 @@
 #include <cairo.h>
 
 #include "dash_draw.h"
-#include "plot_cleanup.h"
+#include "plot/plot_cleanup.h"
 #include "seat.h"
 #include "dds/vdds_ident.h"
 #include "vsignal.h"

@@ -14,8 +14,8 @@
 
 #include <stdint.h>
 
-#include "camera.h"
-#include "scene_view.h"
+#include "view/camera.h"
+#include "view/scene_view.h"
 #include "seat_text.h"
 
 #define SEAT_HISTORY 600      /* force samples kept (60 s at 10 Hz) */

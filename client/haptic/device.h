@@ -3,7 +3,7 @@
  * Contract (every implementation):
  * - read() returns the tool tip in the SCENE frame: metres, z up, the same
  *   frame as the scene file and ToolCommand. A real device converts its own
- *   axes and units (device_to_scene, below) and applies the workspace
+ *   axes and units (device_to_scene, device_frame.h) and applies the workspace
  *   mapping of device_config_t: scene = offset + scale * device.
  * - write_force() receives the force to render in the scene frame, newtons,
  *   already clamped to max_force; a real device rotates it back to its axes
@@ -76,10 +76,6 @@ int device_open(device_t *d, const char *name, const device_config_t *cfg, verr_
 
 /* The device names this build contains, e.g. "scripted dhd". */
 const char *device_names(void);
-
-/* Workspace mapping for real devices: p (device axes already turned to
- * scene axes, metres) -> scene position. */
-void device_to_scene(const device_config_t *c, const double p[3], double out[3]);
 
 /* Scripted device playing `trajectory_path`; max_force is its stated capability. */
 int device_scripted_open(device_t *d, const char *trajectory_path, double max_force, verr_t *err);

@@ -10,7 +10,7 @@
 //
 // Axes and units: DHD is x towards the user, y right, z up, metres, origin
 // at the workspace centre; the scene is x right, y away from the user, z up:
-// scene = (y, -x, z), then the workspace mapping (device.h).
+// scene = (y, -x, z), then the workspace mapping (device_frame.h).
 #include <dhdc.h>
 
 #include <cstdlib>
@@ -18,6 +18,7 @@
 
 extern "C" {
 #include "device.h"
+#include "device_frame.h"
 }
 
 namespace {

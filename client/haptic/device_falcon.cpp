@@ -12,7 +12,7 @@
 // the grip axis) with the workspace centre near z = 0.11 m
 // (FALCON_CENTRE_Z), metres; the scene is x right, y away from the user,
 // z up: scene = (x, 0.11 - z, y) (a rotation, no mirror), then the workspace
-// mapping (device.h). The Falcon is rated for about 9 N.
+// mapping (device_frame.h). The Falcon is rated for about 9 N.
 #include <falcon/core/FalconDevice.h>
 #include <falcon/firmware/FalconFirmwareNovintSDK.h>
 #include <falcon/grip/FalconGripFourButton.h>
@@ -27,6 +27,7 @@
 
 extern "C" {
 #include "device.h"
+#include "device_frame.h"
 }
 
 namespace {

@@ -9,13 +9,14 @@
  *
  * Axes and units: HD is x right, y up, z towards the user, millimetres;
  * the scene is x right, y away from the user, z up, metres:
- * scene = (x, -z, y) / 1000, then the workspace mapping (device.h). */
+ * scene = (x, -z, y) / 1000, then the workspace mapping (device_frame.h). */
 #include <HD/hd.h>
 #include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "device.h"
+#include "device_frame.h"
 
 typedef struct hd_dev {
   HHD handle;

@@ -1,5 +1,4 @@
-/* device_registry: device names -> open functions, and the pieces every
- * real device shares (workspace mapping). Devices whose SDK was not found at
+/* device_registry: device names -> open functions. Devices whose SDK was not found at
  * configure time are still listed, so asking for one says why it is absent
  * instead of "unknown device". */
 #include <string.h>
@@ -50,10 +49,6 @@ const char *device_names(void) {
     }
   }
   return names;
-}
-
-void device_to_scene(const device_config_t *c, const double p[3], double out[3]) {
-  for (int k = 0; k < 3; k++) out[k] = c->offset[k] + c->scale * p[k];
 }
 
 static int open_named(device_t *d, const char *name, const device_config_t *cfg, verr_t *err) {

@@ -7,7 +7,7 @@
 
 #include "discovery.h"
 #include "handle_set.h"
-#include "recording.h"
+#include "recording/recording.h"
 #include "vtime.h"
 
 /* Samples per dds_takecdr: big enough to amortise the call, small enough

@@ -20,7 +20,7 @@
 
 #include <dds/dds.h>
 
-#include "store.h"
+#include "recording/store.h"
 #include "verr.h"
 
 typedef struct capture capture_t;

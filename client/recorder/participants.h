@@ -19,7 +19,7 @@
 
 #include <dds/dds.h>
 
-#include "store.h"
+#include "recording/store.h"
 #include "verr.h"
 
 #define PARTICIPANTS_MAX 1024

@@ -12,8 +12,8 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "recfile.h"
-#include "recording.h"
+#include "recording/recfile.h"
+#include "recording/recording.h"
 
 enum { EXIT_OK = 0, EXIT_BAD_FILE = 1, EXIT_USAGE = 2, EXIT_NOT_MONOTONIC = 3 };
 

@@ -39,8 +39,8 @@
 #include <dds/ddsi/ddsi_serdata_default.h>
 #include <sqlite3.h>
 
-#include "recfile.h"
-#include "recording.h"
+#include "recording/recfile.h"
+#include "recording/recording.h"
 #include "replay_pause.h"
 #include "replay_serdata.h"
 #include "dds/vdds_ident.h"

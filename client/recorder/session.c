@@ -8,7 +8,7 @@
 #include "discovery.h"
 #include "participants.h"
 #include "dds/vdds_ident.h"
-#include "store.h"
+#include "recording/store.h"
 #include "topic_type.h"
 #include "vtime.h"
 

@@ -5,8 +5,8 @@
 #include <stdlib.h>
 
 #include "measure_table.h"
-#include "plot.h"
-#include "plot_bars.h"
+#include "plot/plot.h"
+#include "plot/plot_bars.h"
 
 /* Threshold colours match the viewer's force bar: orange above ST, red
  * above MPF; SFT, the hard stop, in black. */

@@ -16,7 +16,7 @@
 
 #include "charts.h"
 #include "measure_table.h"
-#include "plot_cleanup.h"
+#include "plot/plot_cleanup.h"
 #include "recording_data.h"
 #include "report_write.h"
 

@@ -6,7 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "rec_decode.h"
+#include "recording/rec_decode.h"
 #include "viscera.h"
 
 /* A tool tip that moved less than this has not started moving (m): the

@@ -15,8 +15,8 @@
 #include <stdbool.h>
 #include <stddef.h>
 
-#include "measures.h"
-#include "recfile.h"
+#include "training/measures.h"
+#include "recording/recfile.h"
 #include "verr.h"
 
 #define REP_MAX_TOOLS 8

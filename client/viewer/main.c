@@ -11,14 +11,14 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "camera.h"
-#include "frame_log.h"
+#include "view/camera.h"
+#include "view/frame_log.h"
 #include "mesh_dump.h"
 #include "options.h"
-#include "png_write.h"
-#include "render.h"
-#include "scene_draw.h"
-#include "scene_view.h"
+#include "view/png_write.h"
+#include "view/render.h"
+#include "view/scene_draw.h"
+#include "view/scene_view.h"
 #include "vtime.h"
 #ifdef VISCERA_HAVE_WINDOW
 #include "window.h"

@@ -10,7 +10,7 @@
 #ifndef VISCERA_VIEWER_MESH_DUMP_H
 #define VISCERA_VIEWER_MESH_DUMP_H
 
-#include "scene_view.h"
+#include "view/scene_view.h"
 #include "verr.h"
 
 /* Returns the number of files written (0 when no organ has a keyframe), or

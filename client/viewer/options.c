@@ -5,9 +5,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "camera.h"
-#include "render.h"
 #include "dds/vdds.h"
+#include "view/camera.h"
+#include "view/render.h"
 
 void options_usage(FILE *f, const char *prog) {
   fprintf(f,

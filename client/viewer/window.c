@@ -6,16 +6,16 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "camera.h"
-#include "frame_log.h"
+#include "view/camera.h"
+#include "view/frame_log.h"
 #include "input_drive.h"
-#include "input_map.h"
-#include "input_script.h"
-#include "png_write.h"
-#include "render.h"
-#include "scene_draw.h"
-#include "scene_view.h"
-#include "sdl_window.h"
+#include "window/input_map.h"
+#include "window/input_script.h"
+#include "view/png_write.h"
+#include "view/render.h"
+#include "view/scene_draw.h"
+#include "view/scene_view.h"
+#include "window/sdl_window.h"
 #include "vtime.h"
 
 #define SUPERSAMPLE 2

@@ -1,5 +1,5 @@
 /* plot: cairo rendering of line charts. See plot.h. */
-#include "plot.h"
+#include "plot/plot.h"
 
 #include <cairo.h>
 #include <math.h>

@@ -1,12 +1,12 @@
 /* plot_bars: cairo bar charts. See plot_bars.h. */
-#include "plot_bars.h"
+#include "plot/plot_bars.h"
 
 #include <cairo.h>
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
 
-#include "plot.h"
+#include "plot/plot.h"
 
 #define FONT "DejaVu Sans"
 

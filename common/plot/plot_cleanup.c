@@ -1,4 +1,4 @@
-#include "plot_cleanup.h"
+#include "plot/plot_cleanup.h"
 
 #include <cairo.h>
 #include <fontconfig/fontconfig.h>

@@ -21,8 +21,8 @@
 #include <sys/stat.h>
 
 #include "ms_cut_fixture.h"
-#include "plot.h"
-#include "plot_cleanup.h"
+#include "plot/plot.h"
+#include "plot/plot_cleanup.h"
 #include "vstats.h"
 #include "vtime.h"
 

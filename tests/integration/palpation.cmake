@@ -4,6 +4,6 @@
 # Domain 70.
 if(TARGET viscera-recorder)
   add_executable(rec_palpation ${CMAKE_CURRENT_LIST_DIR}/rec_palpation.c ${CMAKE_CURRENT_LIST_DIR}/rec_read.c)
-  target_link_libraries(rec_palpation PRIVATE viscera_rec_decode)
+  target_link_libraries(rec_palpation PRIVATE viscera_recording)
   viscera_integration_test(palpation_thresholds 70 palpation_test.sh)
 endif()

@@ -18,7 +18,7 @@
 #include <sqlite3.h>
 
 #include "check.h"
-#include "rec_decode.h"
+#include "recording/rec_decode.h"
 #include "rec_values.h"
 #include "viscera.h"
 

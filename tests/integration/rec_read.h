@@ -8,8 +8,8 @@
 #ifndef VISCERA_TEST_REC_READ_H
 #define VISCERA_TEST_REC_READ_H
 
-#include "rec_decode.h"
-#include "recfile.h"
+#include "recording/rec_decode.h"
+#include "recording/recfile.h"
 
 /* Calls `cb` for every decodable data sample of `topic`, in recording
  * order; a topic absent from the recording calls nothing. Returns the

@@ -9,8 +9,8 @@ if(TARGET viscera-recorder AND TARGET viscera-recinfo)
 
   add_executable(rec_check ${CMAKE_CURRENT_LIST_DIR}/rec_check.c)
   target_include_directories(rec_check PRIVATE ${PROJECT_SOURCE_DIR}/tests/unit)
-  target_link_libraries(rec_check PRIVATE viscera_rec_decode PkgConfig::SQLITE3)
-  # ddsi_cdrstream.h pulls in GNU `asm` (see client/recorder/CMakeLists.txt)
+  target_link_libraries(rec_check PRIVATE viscera_recording PkgConfig::SQLITE3)
+  # ddsi_cdrstream.h pulls in GNU `asm` (see common/recording/CMakeLists.txt)
   set_target_properties(rec_check PROPERTIES C_EXTENSIONS ON)
 
   add_test(NAME recorder_generic

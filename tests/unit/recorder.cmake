@@ -14,16 +14,16 @@ if(TARGET viscera_recording)
   viscera_unit_test(NAME test_store_full SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_store_full.c LIBS viscera_recording)
 endif()
 
-# Decoding stored samples into the compiled-in types (client/recorder/rec_decode.c).
-if(TARGET viscera_rec_decode)
-  viscera_unit_test(NAME test_rec_decode SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_rec_decode.c LIBS viscera_rec_decode)
-  # ddsi_cdrstream.h pulls in GNU `asm` (see client/recorder/CMakeLists.txt)
+# Decoding stored samples into the compiled-in types (common/recording/rec_decode.c).
+if(TARGET viscera_recording)
+  viscera_unit_test(NAME test_rec_decode SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_rec_decode.c LIBS viscera_recording)
+  # ddsi_cdrstream.h pulls in GNU `asm` (see common/recording/CMakeLists.txt)
   set_target_properties(test_rec_decode PROPERTIES C_EXTENSIONS ON)
 endif()
 
 # Issue 6 metadata: participant announcement and sanitizing (vdds_ident),
 # the replay pause schedule shift, the optional participants table.
-if(TARGET viscera_recording)
+if(TARGET viscera_recording AND TARGET viscera_replay)
   viscera_unit_test(NAME test_recmeta SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_recmeta.c
-    ${PROJECT_SOURCE_DIR}/client/recorder/replay_pause.c LIBS viscera_recording)
+    LIBS viscera_replay viscera_recording)
 endif()

@@ -9,6 +9,7 @@
 #include "check.h"
 #include "contact_model.h"
 #include "device.h"
+#include "device_frame.h"
 
 static void expect_error(const char *name, const device_config_t *cfg, const char *text) {
   device_t d;

@@ -6,10 +6,10 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "camera.h"
+#include "view/camera.h"
 #include "check.h"
-#include "input_map.h"
-#include "input_script.h"
+#include "window/input_map.h"
+#include "window/input_script.h"
 #include "test_tmpfile.h"
 
 static double dist_to_eye(const input_state_t *s) {

@@ -7,7 +7,7 @@
 #include <string.h>
 
 #include "check.h"
-#include "organ_state.h"
+#include "view/organ_state.h"
 
 static const float KEY[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
 static const uint32_t TRIS[12] = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};

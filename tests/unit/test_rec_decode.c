@@ -10,7 +10,7 @@
 #include <dds/ddsi/ddsi_cdrstream.h>
 
 #include "check.h"
-#include "rec_decode.h"
+#include "recording/rec_decode.h"
 #include "viscera.h"
 
 /* The 4-byte CDR_LE header + payload, as stored; *len set. Caller frees. */

@@ -19,9 +19,9 @@
 #include <sqlite3.h>
 
 #include "check.h"
-#include "recfile.h"
-#include "recording.h"
-#include "store.h"
+#include "recording/recfile.h"
+#include "recording/recording.h"
+#include "recording/store.h"
 #include "viscera.h"
 
 #define N_SAMPLES 6000

@@ -12,9 +12,9 @@
 
 #include "check.h"
 #include "dds/vdds_ident.h"
-#include "recfile.h"
+#include "recording/recfile.h"
+#include "recording/store.h"
 #include "replay_pause.h"
-#include "store.h"
 
 static void test_format_and_role(void) {
   char buf[VDDS_IDENT_MAX], role[VDDS_ROLE_MAX];

@@ -9,10 +9,10 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "camera.h"
+#include "view/camera.h"
 #include "check.h"
-#include "png_write.h"
-#include "render.h"
+#include "view/png_write.h"
+#include "view/render.h"
 
 #define W 200
 #define H 150
@@ -235,7 +235,7 @@ int main(void) {
     memcpy(bar, render_end(r), sizeof bar);
     const uint8_t *p = px(bar, bx, by);
     printf("force bar at %.1f N: rgb %d %d %d\n", forces[i], p[0], p[1], p[2]);
-    if (i == 0) CHECK(p[1] > p[0] && p[1] > p[2]);                           /* green */
+    if (i == 0) CHECK(p[1] > p[0] && p[1] > p[2]);                          /* green */
     if (i == 1) CHECK(p[0] > 200 && p[1] > 110 && p[1] < 205 && p[2] < 80); /* orange */
     if (i == 2) CHECK(p[0] > 200 && p[1] < 100 && p[2] < 80);               /* red */
     const double lv[3] = {0.6, 0.9, 1.5};

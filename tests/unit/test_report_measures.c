@@ -8,7 +8,7 @@
 #include <string.h>
 
 #include "check.h"
-#include "measures.h"
+#include "training/measures.h"
 
 #define DT 1e-3
 

@@ -1,4 +1,4 @@
-/* resim_run (server/resim_run.h) without DDS: a reference run of the default
+/* resim_run (server/resim/resim_run.h) without DDS: a reference run of the default
  * scene (probe pressed 8 mm into the kidney, held, released) writes its
  * frames as the server's publisher encodes them, with one feedback per step
  * and the release, into a resim_recording_t; a fresh runtime must reproduce
@@ -8,8 +8,8 @@
 #include <string.h>
 
 #include "check.h"
+#include "resim/resim_run.h"
 #include "session/mesh_publisher.h"
-#include "resim_run.h"
 
 enum { N = 420, PUBLISH_EVERY = 33, RELEASE_AT = 330 };
 

@@ -1,4 +1,4 @@
-/* Schedule reconstruction of viscera-resim (server/resim_schedule.h) on
+/* Schedule reconstruction of viscera-resim (server/resim/resim_schedule.h) on
  * synthetic command / feedback arrays: exact when nothing is missing, gaps
  * bridged or estimated and counted, releases honoured, unrecorded commands
  * replaced and counted, conflicts and garbage handled; and a property run:
@@ -8,7 +8,7 @@
 #include <string.h>
 
 #include "check.h"
-#include "resim_schedule.h"
+#include "resim/resim_schedule.h"
 
 #define MAXS 4096
 

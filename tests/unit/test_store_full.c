@@ -14,9 +14,9 @@
 #include <unistd.h>
 
 #include "check.h"
-#include "recfile.h"
-#include "recording.h"
-#include "store.h"
+#include "recording/recfile.h"
+#include "recording/recording.h"
+#include "recording/store.h"
 #include "viscera.h"
 
 #define BATCH 100u

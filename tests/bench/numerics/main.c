@@ -19,7 +19,7 @@
 #include <sys/stat.h>
 
 #include "numerics.h"
-#include "plot_cleanup.h"
+#include "plot/plot_cleanup.h"
 #include "vtime.h"
 
 #ifndef NUMERICS_SOURCE_DIR

@@ -33,7 +33,7 @@
 #include <string.h>
 
 #include "mesh.h"
-#include "plot.h"
+#include "plot/plot.h"
 #include "scene.h"
 
 #include "numerics.h"

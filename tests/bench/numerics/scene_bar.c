@@ -26,7 +26,7 @@
 
 #include "bar.h"
 #include "physics/mass_spring.h"
-#include "plot.h"
+#include "plot/plot.h"
 #include "vtime.h"
 
 #define BAR_H 0.02

@@ -15,7 +15,7 @@
 
 #include "numerics.h"
 #include "physics/mass_spring.h"
-#include "plot.h"
+#include "plot/plot.h"
 
 #define CN 30
 #define CH 0.01

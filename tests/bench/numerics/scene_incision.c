@@ -38,7 +38,7 @@
 
 #include "cutting/ms_cut.h"
 #include "mesh_import.h"
-#include "plot.h"
+#include "plot/plot.h"
 #include "vstats.h"
 #include "vtime.h"
 

@@ -22,7 +22,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "plot.h"
+#include "plot/plot.h"
 #include "runtime/scene_runtime.h"
 #include "vstats.h"
 #include "vtime.h"

@@ -19,7 +19,7 @@
 #ifdef NUMERICS_HAVE_MOLECULAR
 #include "physics/molecular.h"
 #endif
-#include "plot.h"
+#include "plot/plot.h"
 #include "vstats.h"
 #include "vtime.h"
 

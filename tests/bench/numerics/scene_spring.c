@@ -17,7 +17,7 @@
 #include <string.h>
 
 #include "numerics.h"
-#include "plot.h"
+#include "plot/plot.h"
 #include "springnet.h"
 
 static const integrator_kind_t KINDS[] = {INT_EXPLICIT_EULER, INT_SYMPLECTIC_EULER, INT_VERLET, INT_RK4,

@@ -20,7 +20,7 @@
 
 #include "bar.h"
 #include "physics/mass_spring.h"
-#include "plot.h"
+#include "plot/plot.h"
 
 #define NSTIFF 7
 #define CAP 0.1

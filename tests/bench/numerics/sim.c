@@ -6,7 +6,7 @@
 #include <string.h>
 
 #include "numerics.h"
-#include "plot.h"
+#include "plot/plot.h"
 #include "vstats.h"
 #include "vtime.h"
 

@@ -1,0 +1,347 @@
+#include "view/scene_view.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "viscera.h"
+
+/* Samples taken per dds_take call; the loop repeats until a reader is empty. */
+#define TAKE_BATCH 16
+
+static void reject(scene_view_t *sv, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void reject(scene_view_t *sv, const char *fmt, ...) {
+  sv->rejected++;
+  if (!sv->log) return;
+  char msg[VERR_MSG_LEN + 128];
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(msg, sizeof msg, fmt, ap);
+  va_end(ap);
+  sv->log(sv->log_ctx, msg);
+}
+
+static int finite3(const float *v) { return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]); }
+
+static void tool_defaults(sv_tool_t *t) {
+  t->listed = 0;
+  t->name[0] = 0;
+  t->radius = SCENE_VIEW_TOOL_RADIUS;
+  t->length = SCENE_VIEW_TOOL_LENGTH;
+  t->max_force = SCENE_VIEW_TOOL_MAX_FORCE;
+  t->st = t->mpf = t->sft = 0;
+}
+
+/* A threshold from the wire: kept only when finite and in (0, max_force]. */
+static float thr_level(float v, float max_force) { return isfinite(v) && v > 0 && v <= max_force ? v : 0.0f; }
+
+static void organ_defaults(sv_organ_t *o) {
+  const float rgb[3] = SCENE_VIEW_ORGAN_RGB;
+  o->listed = 0;
+  o->name[0] = 0;
+  memcpy(o->rgb, rgb, sizeof rgb);
+}
+
+/* A SceneInfo replaces the previous one: the scene may have been reloaded. */
+static void on_scene_info(scene_view_t *sv, const viscera_SceneInfo *s) {
+  /* The sequences are unbounded on the wire (see viscera.idl): enforce the
+   * contract's bounds here, before anything is replaced. */
+  if (s->organs._length > SCENE_VIEW_MAX_ORGANS || s->tools._length > SCENE_VIEW_MAX_TOOLS) {
+    reject(sv, "SceneInfo '%.64s': %u organs, %u tools (at most %d, %d)", s->scene, s->organs._length, s->tools._length,
+           SCENE_VIEW_MAX_ORGANS, SCENE_VIEW_MAX_TOOLS);
+    return;
+  }
+  for (int i = 0; i < SCENE_VIEW_MAX_ORGANS; i++) organ_defaults(&sv->organs[i]);
+  for (int i = 0; i < SCENE_VIEW_MAX_TOOLS; i++) tool_defaults(&sv->tools[i]);
+  sv->have_scene = 1;
+  snprintf(sv->scene_name, sizeof sv->scene_name, "%s", s->scene);
+  for (uint32_t i = 0; i < s->organs._length; i++) {
+    const viscera_OrganInfo *oi = &s->organs._buffer[i];
+    if (oi->organ_id >= SCENE_VIEW_MAX_ORGANS) {
+      reject(sv, "SceneInfo organ entry %u: organ_id %u out of range (0..%d)", i, oi->organ_id,
+             SCENE_VIEW_MAX_ORGANS - 1);
+      continue;
+    }
+    if (!finite3(oi->color)) {
+      reject(sv, "SceneInfo organ %u: colour is not finite", oi->organ_id);
+      continue;
+    }
+    sv_organ_t *o = &sv->organs[oi->organ_id];
+    o->listed = 1;
+    snprintf(o->name, sizeof o->name, "%s", oi->name);
+    /* Scene colours are display (sRGB) values as people pick them; lighting
+     * works in linear RGB. */
+    for (int k = 0; k < 3; k++) {
+      float c = oi->color[k] < 0 ? 0 : oi->color[k] > 1 ? 1 : oi->color[k];
+      o->rgb[k] = c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f);
+    }
+  }
+  for (uint32_t i = 0; i < s->tools._length; i++) {
+    const viscera_ToolInfo *ti = &s->tools._buffer[i];
+    if (ti->tool_id >= SCENE_VIEW_MAX_TOOLS) {
+      reject(sv, "SceneInfo tool entry %u: tool_id %u out of range (0..%d)", i, ti->tool_id, SCENE_VIEW_MAX_TOOLS - 1);
+      continue;
+    }
+    /* Sizes are drawn: anything not a plausible positive length is refused
+     * rather than drawn as a tool covering the scene. */
+    if (!(ti->radius > 0 && ti->radius < 1) || !(ti->length >= 0 && ti->length < 10) ||
+        !(ti->max_force > 0 && isfinite(ti->max_force))) {
+      reject(sv, "SceneInfo tool %u: radius %g, length %g or max_force %g out of range", ti->tool_id,
+             (double)ti->radius, (double)ti->length, (double)ti->max_force);
+      continue;
+    }
+    sv_tool_t *t = &sv->tools[ti->tool_id];
+    t->listed = 1;
+    snprintf(t->name, sizeof t->name, "%s", ti->name);
+    t->radius = ti->radius;
+    t->length = ti->length;
+    t->max_force = ti->max_force;
+    t->st = thr_level(ti->st, ti->max_force);
+    t->mpf = thr_level(ti->mpf, ti->max_force);
+    t->sft = thr_level(ti->sft, ti->max_force);
+  }
+}
+
+static void on_mesh_state(scene_view_t *sv, const viscera_MeshState *s) {
+  if (s->organ_id >= SCENE_VIEW_MAX_ORGANS) {
+    reject(sv, "MeshState: organ_id %u out of range (0..%d)", s->organ_id, SCENE_VIEW_MAX_ORGANS - 1);
+    return;
+  }
+  verr_t err;
+  int rc = organ_state_set_keyframe(&sv->organs[s->organ_id].mesh, s->topology_version, s->keyframe_seq, s->sim_time_ns,
+                                    s->positions._buffer, s->positions._length, s->triangles._buffer,
+                                    s->triangles._length, &err);
+  if (rc < 0)
+    reject(sv, "MeshState organ %u (topology %u keyframe %u): %s", s->organ_id, s->topology_version, s->keyframe_seq,
+           err.msg);
+  else if (rc > 0)
+    reject(sv, "MeshDelta organ %u kept for keyframe %u: %s", s->organ_id, s->keyframe_seq, err.msg);
+}
+
+static void on_mesh_delta(scene_view_t *sv, const viscera_MeshDelta *s) {
+  if (s->organ_id >= SCENE_VIEW_MAX_ORGANS) {
+    reject(sv, "MeshDelta: organ_id %u out of range (0..%d)", s->organ_id, SCENE_VIEW_MAX_ORGANS - 1);
+    return;
+  }
+  const organ_delta_t d = {.topology_version = s->topology_version,
+                           .keyframe_seq = s->keyframe_seq,
+                           .frame_seq = s->frame_seq,
+                           .sim_time_ns = s->sim_time_ns,
+                           .quant_step = s->quant_step,
+                           .indices = s->indices._buffer,
+                           .count = s->indices._length,
+                           .dq = s->dq._buffer,
+                           .dq_len = s->dq._length};
+  verr_t err;
+  if (organ_state_delta(&sv->organs[s->organ_id].mesh, &d, &err) < 0)
+    reject(sv, "MeshDelta organ %u (topology %u keyframe %u frame %u): %s", s->organ_id, s->topology_version,
+           s->keyframe_seq, s->frame_seq, err.msg);
+}
+
+static void on_tool_command(scene_view_t *sv, const viscera_ToolCommand *s) {
+  if (s->tool_id >= SCENE_VIEW_MAX_TOOLS) {
+    reject(sv, "ToolCommand: tool_id %u out of range (0..%d)", s->tool_id, SCENE_VIEW_MAX_TOOLS - 1);
+    return;
+  }
+  if (!finite3(s->position)) {
+    reject(sv, "ToolCommand tool %u: position is not finite", s->tool_id);
+    return;
+  }
+  sv_tool_t *t = &sv->tools[s->tool_id];
+  memcpy(t->tip, s->position, sizeof t->tip);
+  t->have_pose = 1;
+}
+
+static void on_contact(scene_view_t *sv, const viscera_ContactFeedback *s) {
+  if (s->tool_id >= SCENE_VIEW_MAX_TOOLS) {
+    reject(sv, "ContactFeedback: tool_id %u out of range (0..%d)", s->tool_id, SCENE_VIEW_MAX_TOOLS - 1);
+    return;
+  }
+  /* Read the boolean's byte: a value other than 0/1 must be refused, and
+   * loading it as a C bool would already be undefined behaviour. */
+  unsigned char contact;
+  memcpy(&contact, &s->in_contact, 1);
+  if (contact > 1 || !finite3(s->proxy_position) || !finite3(s->force)) {
+    reject(sv, "ContactFeedback tool %u: in_contact byte %u, or proxy or force not finite", s->tool_id, contact);
+    return;
+  }
+  sv_tool_t *t = &sv->tools[s->tool_id];
+  t->have_contact = 1;
+  t->in_contact = contact;
+  memcpy(t->proxy, s->proxy_position, sizeof t->proxy);
+  memcpy(t->force, s->force, sizeof t->force);
+}
+
+static void on_object(scene_view_t *sv, const viscera_ObjectState *s) {
+  if (s->object_id >= SCENE_VIEW_MAX_OBJECTS) {
+    reject(sv, "ObjectState: object_id %u out of range (0..%d)", s->object_id, SCENE_VIEW_MAX_OBJECTS - 1);
+    return;
+  }
+  unsigned char removed;
+  memcpy(&removed, &s->removed, 1);
+  int colour_ok = 1;
+  for (int k = 0; k < 3; k++) colour_ok &= s->color[k] >= 0 && s->color[k] <= 1;
+  /* A stone is millimetres; anything beyond 10 cm is a corrupt sample. */
+  if (removed > 1 || !finite3(s->position) || !(s->radius > 0 && s->radius <= 0.1f) || !colour_ok) {
+    reject(sv,
+           "ObjectState object %u: position not finite, radius not in (0, 0.1] m, colour outside 0..1 or "
+           "removed byte %u",
+           s->object_id, removed);
+    return;
+  }
+  sv_object_t *o = &sv->objects[s->object_id];
+  o->have = 1;
+  memcpy(o->pos, s->position, sizeof o->pos);
+  o->radius = s->radius;
+  memcpy(o->rgb, s->color, sizeof o->rgb);
+  o->held = s->held_by >= 0;
+  o->removed = removed;
+}
+
+int scene_view_open(scene_view_t *sv, int domain, const char *partition, scene_view_log_fn log, void *log_ctx,
+                    verr_t *err) {
+  memset(sv, 0, sizeof *sv);
+  sv->log = log;
+  sv->log_ctx = log_ctx;
+  for (int i = 0; i < SCENE_VIEW_MAX_ORGANS; i++) organ_defaults(&sv->organs[i]);
+  for (int i = 0; i < SCENE_VIEW_MAX_TOOLS; i++) tool_defaults(&sv->tools[i]);
+  if (vdds_open(&sv->dds, (dds_domainid_t)domain, partition, err)) return -1;
+  struct {
+    dds_entity_t *rd;
+    vdds_topic_id_t topic;
+  } rds[] = {{&sv->rd_scene, VT_SCENE_INFO}, {&sv->rd_state, VT_MESH_STATE},         {&sv->rd_delta, VT_MESH_DELTA},
+             {&sv->rd_cmd, VT_TOOL_COMMAND}, {&sv->rd_contact, VT_CONTACT_FEEDBACK}, {&sv->rd_object, VT_OBJECT_STATE}};
+  for (size_t i = 0; i < sizeof rds / sizeof rds[0]; i++) {
+    *rds[i].rd = vdds_reader(&sv->dds, rds[i].topic, err);
+    if (*rds[i].rd < 0) {
+      vdds_close(&sv->dds);
+      return -1;
+    }
+  }
+  return 0;
+}
+
+void scene_view_close(scene_view_t *sv) {
+  vdds_close(&sv->dds);
+  for (int i = 0; i < SCENE_VIEW_MAX_ORGANS; i++) organ_state_free(&sv->organs[i].mesh);
+}
+
+/* A tool whose writer is gone (haptic client quit, server stopped) would
+ * otherwise stay frozen on screen at its last pose. Meshes are kept: the
+ * last state of a stopped session is still worth looking at. */
+static void on_tool_gone(scene_view_t *sv, const viscera_ToolCommand *s) {
+  if (s->tool_id < SCENE_VIEW_MAX_TOOLS) sv->tools[s->tool_id].have_pose = 0;
+}
+
+static void on_contact_gone(scene_view_t *sv, const viscera_ContactFeedback *s) {
+  if (s->tool_id < SCENE_VIEW_MAX_TOOLS) sv->tools[s->tool_id].have_contact = 0;
+}
+
+typedef void (*handler_fn)(scene_view_t *sv, const void *sample);
+
+/* Takes with loans (no copies of large meshes) until the reader is empty.
+ * `gone` (may be NULL) runs for an instance that is no longer alive; its
+ * sample's key fields are valid even when the data is not. */
+static int take_all(scene_view_t *sv, dds_entity_t rd, handler_fn handle, handler_fn gone, const char *topic,
+                    verr_t *err) {
+  int taken = 0;
+  for (;;) {
+    void *samples[TAKE_BATCH] = {NULL};
+    dds_sample_info_t infos[TAKE_BATCH];
+    dds_return_t n = dds_take(rd, samples, infos, TAKE_BATCH, TAKE_BATCH);
+    if (n < 0) return verr_set(err, "DDS: take on %s failed: %s", topic, dds_strretcode(n));
+    for (int i = 0; i < n; i++) {
+      if (infos[i].valid_data) {
+        handle(sv, samples[i]);
+        taken++;
+      }
+      if (gone && infos[i].instance_state != DDS_IST_ALIVE) gone(sv, samples[i]);
+    }
+    if (n > 0) dds_return_loan(rd, samples, n);
+    if (n < TAKE_BATCH) return taken;
+  }
+}
+
+static void h_scene(scene_view_t *sv, const void *s) { on_scene_info(sv, s); }
+static void h_state(scene_view_t *sv, const void *s) { on_mesh_state(sv, s); }
+static void h_delta(scene_view_t *sv, const void *s) { on_mesh_delta(sv, s); }
+static void h_cmd(scene_view_t *sv, const void *s) { on_tool_command(sv, s); }
+static void h_contact(scene_view_t *sv, const void *s) { on_contact(sv, s); }
+static void h_tool_gone(scene_view_t *sv, const void *s) { on_tool_gone(sv, s); }
+static void h_contact_gone(scene_view_t *sv, const void *s) { on_contact_gone(sv, s); }
+static void h_object(scene_view_t *sv, const void *s) { on_object(sv, s); }
+
+int scene_view_poll(scene_view_t *sv, verr_t *err) {
+  /* SceneInfo first (colours), keyframes before deltas so that a keyframe
+   * and its first delta arriving together apply in one poll. */
+  const struct {
+    dds_entity_t rd;
+    handler_fn h, gone;
+    const char *name;
+  } order[] = {{sv->rd_scene, h_scene, NULL, "SceneInfo"},
+               {sv->rd_state, h_state, NULL, "MeshState"},
+               {sv->rd_delta, h_delta, NULL, "MeshDelta"},
+               {sv->rd_cmd, h_cmd, h_tool_gone, "ToolCommand"},
+               {sv->rd_contact, h_contact, h_contact_gone, "ContactFeedback"},
+               {sv->rd_object, h_object, NULL, "ObjectState"}};
+  int total = 0;
+  for (size_t i = 0; i < sizeof order / sizeof order[0]; i++) {
+    int n = take_all(sv, order[i].rd, order[i].h, order[i].gone, order[i].name, err);
+    if (n < 0) return -1;
+    total += n;
+  }
+  return total;
+}
+
+int scene_view_any_keyframe(const scene_view_t *sv) {
+  for (int i = 0; i < SCENE_VIEW_MAX_ORGANS; i++)
+    if (sv->organs[i].mesh.have_key) return 1;
+  return 0;
+}
+
+int scene_view_complete(const scene_view_t *sv) {
+  if (!scene_view_any_keyframe(sv)) return 0;
+  for (int i = 0; i < SCENE_VIEW_MAX_ORGANS; i++)
+    if (sv->organs[i].listed && !sv->organs[i].mesh.have_key) return 0;
+  return 1;
+}
+
+int scene_view_key_bounds(const scene_view_t *sv, double bmin[3], double bmax[3]) {
+  int any = 0;
+  for (int k = 0; k < 3; k++) bmin[k] = INFINITY, bmax[k] = -INFINITY;
+  for (int i = 0; i < SCENE_VIEW_MAX_ORGANS; i++) {
+    const organ_state_t *o = &sv->organs[i].mesh;
+    if (!o->have_key) continue;
+    any = 1;
+    for (size_t v = 0; v < o->nverts; v++)
+      for (int k = 0; k < 3; k++) {
+        double x = o->key[3 * v + k];
+        if (x < bmin[k]) bmin[k] = x;
+        if (x > bmax[k]) bmax[k] = x;
+      }
+  }
+  return any ? 0 : -1;
+}
+
+uint64_t scene_view_sim_time_ns(const scene_view_t *sv) {
+  uint64_t t = 0;
+  for (int i = 0; i < SCENE_VIEW_MAX_ORGANS; i++)
+    if (sv->organs[i].mesh.have_key && sv->organs[i].mesh.sim_time_ns > t) t = sv->organs[i].mesh.sim_time_ns;
+  return t;
+}
+
+long long scene_view_frame_seq(const scene_view_t *sv) {
+  long long f = -1;
+  for (int i = 0; i < SCENE_VIEW_MAX_ORGANS; i++) {
+    long long s = organ_state_frame_seq(&sv->organs[i].mesh);
+    if (s > f) f = s;
+  }
+  return f;
+}
+
+int scene_view_primary_tool(const scene_view_t *sv) {
+  for (int i = 0; i < SCENE_VIEW_MAX_TOOLS; i++)
+    if (sv->tools[i].have_pose || sv->tools[i].have_contact) return i;
+  return -1;
+}

@@ -1,0 +1,299 @@
+#include "resim/resim_recording.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "recording/recfile.h"
+#include "recording/rec_decode.h"
+#include "viscera.h"
+
+typedef struct caps {
+  size_t fb[SCENE_MAX_TOOLS], cmd[SCENE_MAX_TOOLS], rel[SCENE_MAX_TOOLS], keys, deltas;
+} caps_t;
+
+typedef struct load_ctx {
+  resim_recording_t *rec;
+  caps_t caps; /* allocated lengths of the arrays in rec */
+  int oom;
+} load_ctx_t;
+
+static void skip(resim_recording_t *rec, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void skip(resim_recording_t *rec, const char *fmt, ...) {
+  if (rec->skipped++ == 0) {
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(rec->first_skip, sizeof rec->first_skip, fmt, ap);
+    va_end(ap);
+  }
+}
+
+/* Grows *arr (element size `size`) to hold one more; 0 or -1 (out of memory). */
+static int grow(void **arr, size_t *cap, size_t n, size_t size) {
+  if (n < *cap) return 0;
+  size_t nc = *cap ? 2 * *cap : 64;
+  void *p = realloc(*arr, nc * size);
+  if (!p) return -1;
+  *arr = p;
+  *cap = nc;
+  return 0;
+}
+
+/* The server step of a sim time; UINT64_MAX beyond RESIM_MAX_SIM_S (a
+ * garbled time must not size the schedule). */
+static uint64_t step_of(const resim_recording_t *rec, uint64_t sim_time_ns) {
+  double s = (double)sim_time_ns * 1e-9;
+  if (s > RESIM_MAX_SIM_S) return UINT64_MAX;
+  return (uint64_t)llround(s / rec->dt);
+}
+
+static int on_scene(void *arg, const void *sample, const recfile_row_t *row) {
+  resim_recording_t *rec = ((load_ctx_t *)arg)->rec;
+  const viscera_SceneInfo *si = sample;
+  if (!(si->physics_dt > 0 && si->physics_dt < 1) || si->organs._length > SCENE_MAX_ORGANS ||
+      si->tools._length > SCENE_MAX_TOOLS || !(si->quant_step > 0)) {
+    skip(rec, "SceneInfo sample %lld: dt %g, %u organs, %u tools, quant_step %g out of range", (long long)row->id,
+         si->physics_dt, si->organs._length, si->tools._length, (double)si->quant_step);
+  } else {
+    rec->have_scene = 1;
+    snprintf(rec->scene, sizeof rec->scene, "%s", si->scene);
+    rec->dt = si->physics_dt;
+    rec->publish_hz = si->publish_hz;
+    rec->quant_step = si->quant_step;
+    rec->norgans = si->organs._length;
+    rec->ntools = si->tools._length;
+    for (uint32_t i = 0; i < si->organs._length; i++) {
+      snprintf(rec->organs[i].name, sizeof rec->organs[i].name, "%s", si->organs._buffer[i].name);
+      rec->organs[i].nverts = si->organs._buffer[i].vertex_count;
+      rec->organs[i].ntris = si->organs._buffer[i].triangle_count;
+    }
+  }
+  return 0;
+}
+
+static int on_command(void *arg, const void *sample, const recfile_row_t *row) {
+  load_ctx_t *ctx = arg;
+  resim_recording_t *rec = ctx->rec;
+  const viscera_ToolCommand *c = sample;
+  if (c->tool_id >= rec->ntools) {
+    skip(rec, "ToolCommand sample %lld: tool %u not in the scene", (long long)row->id, c->tool_id);
+    return 0;
+  }
+  resim_tool_input_t *t = &rec->tools[c->tool_id];
+  if (grow((void **)&t->cmd, &ctx->caps.cmd[c->tool_id], t->ncmd, sizeof *t->cmd)) return ctx->oom = 1;
+  resim_cmd_t *o = &t->cmd[t->ncmd++];
+  o->seq = c->seq;
+  o->wall_ns = row->source_ts_ns;
+  for (int k = 0; k < 3; k++) o->pos[k] = c->position[k];
+  o->max_force = c->max_force;
+  return 0;
+}
+
+static int on_feedback(void *arg, const void *sample, const recfile_row_t *row) {
+  load_ctx_t *ctx = arg;
+  resim_recording_t *rec = ctx->rec;
+  const viscera_ContactFeedback *f = sample;
+  if (f->tool_id >= rec->ntools) {
+    skip(rec, "ContactFeedback sample %lld: tool %u not in the scene", (long long)row->id, f->tool_id);
+    return 0;
+  }
+  uint64_t step = step_of(rec, f->sim_time_ns);
+  if (step == UINT64_MAX) {
+    skip(rec, "ContactFeedback sample %lld: sim time %llu ns out of range", (long long)row->id,
+         (unsigned long long)f->sim_time_ns);
+    return 0;
+  }
+  resim_tool_input_t *t = &rec->tools[f->tool_id];
+  if (grow((void **)&t->fb, &ctx->caps.fb[f->tool_id], t->nfb, sizeof *t->fb)) return ctx->oom = 1;
+  t->fb[t->nfb++] = (resim_fb_t){.step = step, .seq = f->cmd_seq, .wall_ns = row->source_ts_ns};
+  return 0;
+}
+
+static int on_event(void *arg, const void *sample, const recfile_row_t *row) {
+  load_ctx_t *ctx = arg;
+  resim_recording_t *rec = ctx->rec;
+  const viscera_SessionEvent *e = sample;
+  if (e->kind != viscera_EVENT_CLIENT_LOST) return 0;
+  if (e->tool_id < 0 || (size_t)e->tool_id >= rec->ntools) {
+    skip(rec, "SessionEvent sample %lld: CLIENT_LOST for tool %d not in the scene", (long long)row->id,
+         (int)e->tool_id);
+    return 0;
+  }
+  uint64_t step = step_of(rec, e->sim_time_ns);
+  if (step == UINT64_MAX) {
+    skip(rec, "SessionEvent sample %lld: sim time %llu ns out of range", (long long)row->id,
+         (unsigned long long)e->sim_time_ns);
+    return 0;
+  }
+  resim_tool_input_t *t = &rec->tools[e->tool_id];
+  if (grow((void **)&t->release, &ctx->caps.rel[e->tool_id], t->nrelease, sizeof *t->release)) return ctx->oom = 1;
+  t->release[t->nrelease++] = step;
+  return 0;
+}
+
+static int on_state(void *arg, const void *sample, const recfile_row_t *row) {
+  load_ctx_t *ctx = arg;
+  resim_recording_t *rec = ctx->rec;
+  const viscera_MeshState *s = sample;
+  int rc = 0;
+  if (step_of(rec, s->sim_time_ns) == UINT64_MAX) {
+    skip(rec, "MeshState sample %lld: sim time %llu ns out of range", (long long)row->id,
+         (unsigned long long)s->sim_time_ns);
+  } else if (s->organ_id >= rec->norgans) {
+    skip(rec, "MeshState sample %lld: organ %u not in the scene", (long long)row->id, s->organ_id);
+  } else if (s->positions._length != 3ull * rec->organs[s->organ_id].nverts) {
+    skip(rec, "MeshState sample %lld: organ %u has %u coordinates, SceneInfo says %u vertices", (long long)row->id,
+         s->organ_id, s->positions._length, rec->organs[s->organ_id].nverts);
+  } else if (grow((void **)&rec->keys, &ctx->caps.keys, rec->nkeys, sizeof *rec->keys)) {
+    rc = ctx->oom = 1;
+  } else {
+    float *pos = malloc(s->positions._length * sizeof(float) + 1);
+    if (!pos) {
+      rc = ctx->oom = 1;
+    } else {
+      memcpy(pos, s->positions._buffer, s->positions._length * sizeof(float));
+      rec->keys[rec->nkeys++] = (resim_keyframe_t){.organ = s->organ_id,
+                                                   .keyframe_seq = s->keyframe_seq,
+                                                   .topology_version = s->topology_version,
+                                                   .step = step_of(rec, s->sim_time_ns),
+                                                   .pos = pos};
+    }
+  }
+  return rc;
+}
+
+static int on_delta(void *arg, const void *sample, const recfile_row_t *row) {
+  load_ctx_t *ctx = arg;
+  resim_recording_t *rec = ctx->rec;
+  const viscera_MeshDelta *d = sample;
+  int rc = 0;
+  if (step_of(rec, d->sim_time_ns) == UINT64_MAX) {
+    skip(rec, "MeshDelta sample %lld: sim time %llu ns out of range", (long long)row->id,
+         (unsigned long long)d->sim_time_ns);
+  } else if (d->organ_id >= rec->norgans) {
+    skip(rec, "MeshDelta sample %lld: organ %u not in the scene", (long long)row->id, d->organ_id);
+  } else if (grow((void **)&rec->deltas, &ctx->caps.deltas, rec->ndeltas, sizeof *rec->deltas)) {
+    rc = ctx->oom = 1;
+  } else {
+    /* Lengths are checked against each other and the mesh when applied
+     * (mesh_delta_apply); here they are only copied. */
+    uint32_t *idx = malloc(d->indices._length * sizeof(uint32_t) + 1);
+    int16_t *dq = malloc(d->dq._length * sizeof(int16_t) + 1);
+    if (!idx || !dq) {
+      free(idx);
+      free(dq);
+      rc = ctx->oom = 1;
+    } else {
+      if (d->indices._length) memcpy(idx, d->indices._buffer, d->indices._length * sizeof(uint32_t));
+      if (d->dq._length) memcpy(dq, d->dq._buffer, d->dq._length * sizeof(int16_t));
+      rec->deltas[rec->ndeltas++] = (resim_delta_t){.organ = d->organ_id,
+                                                    .keyframe_seq = d->keyframe_seq,
+                                                    .topology_version = d->topology_version,
+                                                    .frame_seq = d->frame_seq,
+                                                    .step = step_of(rec, d->sim_time_ns),
+                                                    .quant = d->quant_step,
+                                                    .count = d->indices._length,
+                                                    .idx = idx,
+                                                    .dq = dq,
+                                                    .dq_len = d->dq._length};
+    }
+  }
+  return rc;
+}
+
+static int cmp_key(const void *a, const void *b) {
+  const resim_keyframe_t *x = a, *y = b;
+  if (x->step != y->step) return x->step < y->step ? -1 : 1;
+  if (x->organ != y->organ) return x->organ < y->organ ? -1 : 1;
+  return x->keyframe_seq < y->keyframe_seq ? -1 : x->keyframe_seq > y->keyframe_seq;
+}
+
+static int cmp_delta(const void *a, const void *b) {
+  const resim_delta_t *x = a, *y = b;
+  if (x->step != y->step) return x->step < y->step ? -1 : 1;
+  if (x->organ != y->organ) return x->organ < y->organ ? -1 : 1;
+  return x->frame_seq < y->frame_seq ? -1 : x->frame_seq > y->frame_seq;
+}
+
+typedef struct topic_pass {
+  const char *name;
+  const dds_topic_descriptor_t *desc;
+  rec_decode_cb cb;
+  uint64_t *count; /* data samples read, decodable or not; NULL: not counted */
+} topic_pass_t;
+
+/* Samples that do not decode are skipped like out-of-range ones: counted,
+ * the first one named. */
+static void skip_undecodable(resim_recording_t *rec, const char *topic, const rec_decode_report_t *rep) {
+  if (!rep->undecodable) return;
+  skip(rec, "%s sample %lld does not decode (%llu in all)", topic + strlen("viscera_"),
+       (long long)rep->first_undecodable, (unsigned long long)rep->undecodable);
+  rec->skipped += rep->undecodable - 1;
+}
+
+int resim_recording_load(resim_recording_t *rec, const char *path, verr_t *err) {
+  memset(rec, 0, sizeof *rec);
+  recfile_t *rf = NULL;
+  if (recfile_open(&rf, path, err)) return -1;
+  snprintf(rec->warnings, sizeof rec->warnings, "%s", recfile_warnings(rf));
+  load_ctx_t ctx = {.rec = rec};
+  /* SceneInfo first: dt turns every sim time into a step, and the organ and
+   * tool counts bound every other sample. */
+  const topic_pass_t passes[] = {
+      {"viscera_SceneInfo", &viscera_SceneInfo_desc, on_scene, NULL},
+      {"viscera_ToolCommand", &viscera_ToolCommand_desc, on_command, &rec->n_commands},
+      {"viscera_ContactFeedback", &viscera_ContactFeedback_desc, on_feedback, &rec->n_feedback},
+      {"viscera_SessionEvent", &viscera_SessionEvent_desc, on_event, &rec->n_events},
+      {"viscera_MeshState", &viscera_MeshState_desc, on_state, &rec->n_states},
+      {"viscera_MeshDelta", &viscera_MeshDelta_desc, on_delta, &rec->n_deltas},
+  };
+  int rc = 0;
+  for (size_t p = 0; p < sizeof passes / sizeof passes[0] && !rc; p++) {
+    rec_decode_report_t rep;
+    if (rec_decode_topic(rf, passes[p].name, passes[p].desc, passes[p].cb, &ctx, &rep) < 0) ctx.oom = 1;
+    if (rep.topic_missing) {
+      if (p == 0) rc = verr_set(err, "%s: no SceneInfo topic recorded: cannot tell which scene this is", path);
+      continue; /* e.g. no tool ever connected: nothing to schedule */
+    }
+    if (passes[p].count) *passes[p].count = rep.decoded + rep.undecodable;
+    skip_undecodable(rec, passes[p].name, &rep);
+    if (ctx.oom)
+      rc = verr_set(err, "%s: out of memory reading %s", path, passes[p].name);
+    else if (rep.scan.damaged && !rec->warnings[0])
+      snprintf(rec->warnings, sizeof rec->warnings, "%s: damaged while reading %s: %s", path, passes[p].name,
+               rep.scan.first_error);
+    if (p == 0 && !rc && !rec->have_scene)
+      rc = verr_set(err, "%s: no SceneInfo sample decodes%s%s%s%s", path, rec->skipped ? ": " : "", rec->first_skip,
+                    rep.scan.damaged ? "; the file is damaged: " : "", rep.scan.damaged ? rep.scan.first_error : "");
+  }
+  recfile_close(rf);
+  if (rc) {
+    resim_recording_free(rec);
+    return -1;
+  }
+  if (rec->nkeys) qsort(rec->keys, rec->nkeys, sizeof *rec->keys, cmp_key);
+  if (rec->ndeltas) qsort(rec->deltas, rec->ndeltas, sizeof *rec->deltas, cmp_delta);
+  for (size_t i = 0; i < rec->nkeys; i++)
+    rec->last_step = rec->keys[i].step > rec->last_step ? rec->keys[i].step : rec->last_step;
+  for (size_t i = 0; i < rec->ndeltas; i++)
+    rec->last_step = rec->deltas[i].step > rec->last_step ? rec->deltas[i].step : rec->last_step;
+  return 0;
+}
+
+void resim_recording_free(resim_recording_t *rec) {
+  for (size_t t = 0; t < SCENE_MAX_TOOLS; t++) {
+    free(rec->tools[t].fb);
+    free(rec->tools[t].cmd);
+    free(rec->tools[t].release);
+  }
+  for (size_t i = 0; i < rec->nkeys; i++) free(rec->keys[i].pos);
+  for (size_t i = 0; i < rec->ndeltas; i++) {
+    free(rec->deltas[i].idx);
+    free(rec->deltas[i].dq);
+  }
+  free(rec->keys);
+  free(rec->deltas);
+  memset(rec, 0, sizeof *rec);
+}

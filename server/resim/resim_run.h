@@ -1,0 +1,58 @@
+/* resim_run: re-simulates a recorded session in a fresh runtime and
+ * compares, at every recorded frame, the surface with the recorded mesh.
+ *
+ * resim_check_scene refuses a scene that is not the recorded one (name,
+ * dt, quant_step, organ names and vertex/triangle counts, tool count).
+ * resim_run rebuilds every tool's command schedule (resim_schedule.h), then
+ * steps the runtime from its initial state through the last recorded frame
+ * applying, before each step, the scheduled command (or release) exactly as
+ * the server did, and at every MeshState keyframe and MeshDelta frame of a
+ * step compares the organ's surface with the recording: a keyframe holds
+ * float positions, a delta rebuilds the mesh from its keyframe within
+ * quant_step / 2 per coordinate (mesh_delta.h). Errors are per coordinate
+ * (max) and per vertex (RMS of the distance). A frame is "exact" when
+ * encoding the re-simulated surface against the same keyframe reproduces the
+ * recorded frame bit for bit (what a bit-deterministic runtime gives). */
+#ifndef VISCERA_RESIM_RUN_H
+#define VISCERA_RESIM_RUN_H
+
+#include <stdint.h>
+
+#include "resim/resim_recording.h"
+#include "resim/resim_schedule.h"
+#include "runtime/scene_runtime.h"
+#include "verr.h"
+
+typedef struct resim_organ_result {
+  uint64_t frames;     /* frames compared (keyframes included) */
+  uint64_t keyframes;  /* of which MeshState keyframes */
+  uint64_t exact;      /* frames reproduced bit for bit */
+  uint64_t unmatched;  /* deltas whose keyframe was not recorded or that do not apply: not compared */
+  double max_err;      /* m, largest per-coordinate difference */
+  uint64_t worst_step; /* where */
+  double sum_sq;       /* sum over compared vertices of the squared distance */
+  uint64_t nsq;        /* vertices in sum_sq */
+} resim_organ_result_t;
+
+typedef struct resim_result {
+  uint64_t steps;
+  uint64_t rollbacks;
+  resim_organ_result_t organs[SCENE_MAX_ORGANS];
+  resim_schedule_stats_t sched[SCENE_MAX_TOOLS];
+  char first_unmatched[VERR_MSG_LEN + 128];
+} resim_result_t;
+
+typedef struct resim_hooks {
+  /* Each compared frame (may be NULL). */
+  void (*frame)(void *arg, uint64_t step, uint32_t organ, int keyframe, double max_err, double rms, int exact);
+  /* About every 1 % of the steps (may be NULL). */
+  void (*progress)(void *arg, uint64_t step, uint64_t total);
+  void *arg;
+} resim_hooks_t;
+
+int resim_check_scene(const runtime_t *rt, const resim_recording_t *rec, verr_t *err);
+/* rt fresh from runtime_init; rec from resim_recording_load (its tool
+ * arrays are sorted in place). Returns 0, or -1 with err. */
+int resim_run(runtime_t *rt, resim_recording_t *rec, const resim_hooks_t *hooks, resim_result_t *res, verr_t *err);
+
+#endif
