@@ -41,6 +41,8 @@ static int build_options(const cli_spec_t *s, struct option *lo) {
   return 0;
 }
 
+static int usage_status(const cli_spec_t *s) { return s->usage_status ? s->usage_status : 2; }
+
 static int common_option(const cli_spec_t *s, const char *tag, int code, const char *arg, cli_common_t *c) {
   switch (code) {
   case CLI_OPT_DOMAIN:
@@ -48,13 +50,13 @@ static int common_option(const cli_spec_t *s, const char *tag, int code, const c
       fprintf(stderr, "%s: ", tag);
       fprintf(stderr, s->domain_error ? s->domain_error : "--domain '%s' is not a domain id 0..230", arg);
       fprintf(stderr, "\n");
-      return 2;
+      return usage_status(s);
     }
     return 0;
   case CLI_OPT_PARTITION:
     if (s->partition_error && (!*arg || (s->partition_max && strlen(arg) >= s->partition_max))) {
       fprintf(stderr, "%s: %s\n", tag, s->partition_error);
-      return 2;
+      return usage_status(s);
     }
     c->partition = arg;
     return 0;
@@ -69,7 +71,7 @@ static int common_option(const cli_spec_t *s, const char *tag, int code, const c
     return 0;
   default:
     s->usage(stderr);
-    return 2;
+    return usage_status(s);
   }
 }
 
@@ -86,13 +88,13 @@ int cli_parse(const cli_spec_t *s, int argc, char **argv, cli_common_t *c, void 
     verr_t err = {{0}};
     if ((c->domain = cli_env_domain(&err)) < 0) {
       fprintf(stderr, "%s: %s\n", tag, err.msg);
-      return 2;
+      return usage_status(s);
     }
   }
   struct option lo[CLI_MAX_OPTIONS];
   if (build_options(s, lo)) {
     fprintf(stderr, "%s: too many options\n", tag);
-    return 2;
+    return usage_status(s);
   }
   int code;
   while ((code = getopt_long(argc, argv, s->shortopts ? s->shortopts : "", lo, NULL)) != -1) {

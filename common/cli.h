@@ -61,12 +61,14 @@ typedef struct cli_spec {
   const char *domain_error;     /* a bad --domain, after "TAG: " (one %s, the value); NULL: the default */
   const char *partition_error;  /* non-NULL: an empty --partition is refused with "TAG: " this */
   unsigned partition_max;       /* > 0: a --partition of this many bytes or more is refused too */
+  int usage_status;             /* exit code of a usage error (bad value, unknown option); 0: 2 */
 } cli_spec_t;
 
 /* Parses argv with getopt_long (optind left at the first operand). `c`
  * holds the defaults on entry. Returns CLI_RUN, 0 after --help or --version
- * (printed on stdout), or 2 after a message on stderr (bad value, unknown
- * option, bad $VISCERA_DOMAIN), or the exit code the option callback gave. */
+ * (printed on stdout), or the usage status (2 unless the spec says otherwise)
+ * after a message on stderr (bad value, unknown option, bad $VISCERA_DOMAIN),
+ * or the exit code the option callback gave. */
 int cli_parse(const cli_spec_t *spec, int argc, char **argv, cli_common_t *c, void *ctx);
 
 /* A domain id string 0..230; -1 on bad input. */
