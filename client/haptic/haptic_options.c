@@ -179,10 +179,8 @@ static int on_option(void *ctx, int code, const char *arg) {
     return 0;
   case OPT_WORKSPACE_OFFSET:
     return workspace_offset(o, arg);
-  default:
-    haptic_usage(stderr);
-    return 2;
   }
+  return 0; /* not reached: cli_parse passes only the codes above */
 }
 
 int haptic_options_parse(haptic_options_t *o, int argc, char **argv) {
