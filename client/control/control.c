@@ -5,13 +5,14 @@
  * Only identities allowed to publish SessionControl in the seat's partition
  * can use it when DDS Security is on (deploy/pki.sh): for anyone else the
  * writer cannot be created and the command says so. */
-#include <getopt.h>
 #include <inttypes.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "cli.h"
+#include "control_run.h"
 #include "dds/vdds.h"
 #include "viscera.h"
 #include "vtime.h"
@@ -42,6 +43,7 @@ static void usage(FILE *f) {
              "  --text TEXT           who/why, kept in the recording\n"
              "  --wait S              wait up to S s for the server's answer (default 5)\n"
              "  --help                this text\n"
+             "  --version             print the version and exit\n"
              "Exit status: 0 applied, 1 refused or no answer, 2 usage or DDS error.\n");
 }
 
@@ -118,188 +120,106 @@ static int parse_role(const char *verb, int argc, char **argv, int has_text, vis
   return 0;
 }
 
-int main(int argc, char **argv) {
-  vdds_set_role("control"); /* announced in the participant USER_DATA */
-  static const struct option opts[] = {{"domain", required_argument, 0, 'd'},
-                                       {"partition", required_argument, 0, 'p'},
-                                       {"station", required_argument, 0, 's'},
-                                       {"text", required_argument, 0, 't'},
-                                       {"wait", required_argument, 0, 'w'},
-                                       {"help", no_argument, 0, 'h'},
-                                       {0, 0, 0, 0}};
-  verr_t err;
-  int domain = vdds_env_domain(&err);
-  if (domain < 0) {
-    fprintf(stderr, "viscera-control: %s\n", err.msg);
-    return 2;
-  }
-  const char *partition = NULL, *text = "";
-  unsigned long station = 1;
-  double wait_s = 5;
-  int c;
-  while ((c = getopt_long(argc, argv, "+", opts, NULL)) !=
-         -1) { /* "+": stop at the command, so "-1" values are not options */
-    switch (c) {
-    case 'd':
-      if ((domain = vdds_parse_domain(optarg)) < 0) {
-        fprintf(stderr, "viscera-control: --domain: not a domain id: '%s'\n", optarg);
-        return 2;
-      }
-      break;
-    case 'p':
-      partition = optarg;
-      break;
-    case 's': {
-      char *end;
-      station = strtoul(optarg, &end, 10);
-      if (*optarg == 0 || *end || station > 1000000) {
-        fprintf(stderr, "viscera-control: --station: not a station id: '%s'\n", optarg);
-        return 2;
-      }
-      break;
-    }
-    case 't':
-      text = optarg;
-      break;
-    case 'w':
-      if (parse_double(optarg, &wait_s) || wait_s < 0) {
-        fprintf(stderr, "viscera-control: --wait: not a duration: '%s'\n", optarg);
-        return 2;
-      }
-      break;
-    case 'h':
-      usage(stdout);
-      return 0;
-    default:
-      usage(stderr);
+/* The COMMAND words (argv[0] the verb) into cmd. Returns 0, or 2 after
+ * saying what is wrong. */
+static int parse_command(int argc, char **argv, int has_text, viscera_SessionControl *cmd) {
+  const char *verb = argc > 0 ? argv[0] : NULL;
+  if (verb && strcmp(verb, "pause") == 0 && argc == 1) {
+    cmd->kind = viscera_CONTROL_PAUSE;
+  } else if (verb && strcmp(verb, "resume") == 0 && argc == 1) {
+    cmd->kind = viscera_CONTROL_RESUME;
+  } else if (verb && strcmp(verb, "reset") == 0 && argc == 1) {
+    cmd->kind = viscera_CONTROL_RESET;
+  } else if (verb && strcmp(verb, "material") == 0 && argc == 6) {
+    cmd->kind = viscera_CONTROL_SET_MATERIAL;
+    if (parse_index_values("material", "an organ index", "a number", argv + 1, 4, &cmd->organ_id, cmd->values))
       return 2;
-    }
-  }
-  viscera_SessionControl cmd;
-  memset(&cmd, 0, sizeof cmd);
-  cmd.source_id = (uint32_t)station;
-  cmd.seq = vtime_mono_ns(); /* increasing across invocations of one station */
-  cmd.tool_id = -1;
-  cmd.organ_id = -1;
-  snprintf(cmd.text, sizeof cmd.text, "%s", text);
-  const char *verb = optind < argc ? argv[optind] : NULL;
-  if (verb && strcmp(verb, "pause") == 0 && argc - optind == 1) {
-    cmd.kind = viscera_CONTROL_PAUSE;
-  } else if (verb && strcmp(verb, "resume") == 0 && argc - optind == 1) {
-    cmd.kind = viscera_CONTROL_RESUME;
-  } else if (verb && strcmp(verb, "reset") == 0 && argc - optind == 1) {
-    cmd.kind = viscera_CONTROL_RESET;
-  } else if (verb && strcmp(verb, "material") == 0 && argc - optind == 6) {
-    cmd.kind = viscera_CONTROL_SET_MATERIAL;
-    if (parse_index_values("material", "an organ index", "a number", argv + optind + 1, 4, &cmd.organ_id, cmd.values))
-      return 2;
-  } else if (verb && strcmp(verb, "thresholds") == 0 && argc - optind == 5) {
-    cmd.kind = viscera_CONTROL_SET_THRESHOLDS;
-    if (parse_index_values("thresholds", "a tool index", "a force in N", argv + optind + 1, 3, &cmd.tool_id,
-                           cmd.values))
+  } else if (verb && strcmp(verb, "thresholds") == 0 && argc == 5) {
+    cmd->kind = viscera_CONTROL_SET_THRESHOLDS;
+    if (parse_index_values("thresholds", "a tool index", "a force in N", argv + 1, 3, &cmd->tool_id, cmd->values))
       return 2;
   } else if (verb && (strcmp(verb, "assign") == 0 || strcmp(verb, "guide") == 0 || strcmp(verb, "takeover") == 0 ||
                       strcmp(verb, "release") == 0)) {
-    if (parse_role(verb, argc - optind, argv + optind, *text != 0, &cmd)) return 2;
-  } else if (verb && strcmp(verb, "start-task") == 0 && argc - optind == 2) {
+    if (parse_role(verb, argc, argv, has_text, cmd)) return 2;
+  } else if (verb && strcmp(verb, "start-task") == 0 && argc == 2) {
     /* A name goes in `text` (so --text is not used); all digits is an index. */
-    cmd.kind = viscera_CONTROL_START_TASK;
-    const char *arg = argv[optind + 1];
+    cmd->kind = viscera_CONTROL_START_TASK;
+    const char *arg = argv[1];
     if (*arg && strspn(arg, "0123456789") == strlen(arg)) {
       if (strlen(arg) > 4) {
         fprintf(stderr, "viscera-control: start-task: task index too large: '%s'\n", arg);
         return 2;
       }
-      cmd.text[0] = 0;
-      cmd.values[0] = atof(arg);
+      cmd->text[0] = 0;
+      cmd->values[0] = atof(arg);
     } else {
-      if (!*arg || strlen(arg) >= sizeof cmd.text) {
+      if (!*arg || strlen(arg) >= sizeof cmd->text) {
         fprintf(stderr, "viscera-control: start-task: not a task name: '%s'\n", arg);
         return 2;
       }
-      snprintf(cmd.text, sizeof cmd.text, "%s", arg);
+      snprintf(cmd->text, sizeof cmd->text, "%s", arg);
     }
   } else {
     usage(stderr);
     return 2;
   }
 
-  vdds_t dds;
-  if (vdds_open(&dds, domain, partition, &err)) {
-    fprintf(stderr, "viscera-control: %s\n", err.msg);
-    return 2;
-  }
-  int rc = 2;
-  dds_entity_t w = vdds_writer(&dds, VT_SESSION_CONTROL, &err);
-  dds_entity_t r = vdds_reader(&dds, VT_SESSION_EVENT, &err);
-  if (w < 0 || r < 0) {
-    fprintf(stderr, "viscera-control: %s (is this identity allowed to send SessionControl in this partition?)\n",
-            err.msg);
-    goto out;
-  }
-  /* The server is there once its SceneInfo (transient-local) arrives. A
-   * matched writer alone proves nothing: a recorder's reader matches too. */
-  dds_entity_t r_scene = vdds_reader(&dds, VT_SCENE_INFO, &err);
-  if (r_scene < 0) {
-    fprintf(stderr, "viscera-control: %s\n", err.msg);
-    goto out;
-  }
-  uint64_t deadline = vtime_mono_ns() + (uint64_t)(wait_s * 1e9);
-  int have_server = 0;
-  while (!have_server && vtime_mono_ns() < deadline) {
-    void *samples[1] = {0};
-    dds_sample_info_t info;
-    int n = dds_take(r_scene, samples, &info, 1, 1);
-    if (n > 0) {
-      have_server = info.valid_data;
-      dds_return_loan(r_scene, samples, n);
-    } else {
-      dds_sleepfor(DDS_MSECS(20));
+  return 0;
+}
+
+enum { OPT_STATION = 's', OPT_TEXT = 't', OPT_WAIT = 'w' };
+
+static int on_option(void *ctx, int code, const char *arg) {
+  control_options_t *o = ctx;
+  switch (code) {
+  case OPT_STATION: {
+    char *end;
+    unsigned long station = strtoul(arg, &end, 10);
+    if (*arg == 0 || *end || station > 1000000) {
+      fprintf(stderr, "viscera-control: --station: not a station id: '%s'\n", arg);
+      return 2;
     }
+    o->cmd.source_id = (uint32_t)station;
+    return 0;
   }
-  if (!have_server) {
-    fprintf(stderr, "viscera-control: no server on domain %d partition '%s' within %.1f s\n", domain,
-            partition ? partition : VDDS_DEFAULT_PARTITION, wait_s);
-    rc = 1;
-    goto out;
-  }
-  rc = 1;
-  char mine[64];
-  snprintf(mine, sizeof mine, "[station %" PRIu32 " seq %" PRIu64 "]", cmd.source_id, cmd.seq);
-  uint64_t next_send = 0;
-  while (vtime_mono_ns() < deadline) {
-    /* Resent (same seq, the server drops copies) until answered: the
-     * server's reader may match this writer a little after its SceneInfo
-     * arrived, and a volatile write before that reaches nobody. */
-    if (vtime_mono_ns() >= next_send) {
-      if (dds_write(w, &cmd) < 0) {
-        fprintf(stderr, "viscera-control: write failed\n");
-        rc = 2;
-        break;
-      }
-      next_send = vtime_mono_ns() + 500000000ull;
+  case OPT_TEXT:
+    snprintf(o->cmd.text, sizeof o->cmd.text, "%s", arg);
+    o->has_text = *arg != 0;
+    return 0;
+  case OPT_WAIT:
+    if (parse_double(arg, &o->wait_s) || o->wait_s < 0) {
+      fprintf(stderr, "viscera-control: --wait: not a duration: '%s'\n", arg);
+      return 2;
     }
-    void *samples[8] = {0};
-    dds_sample_info_t infos[8];
-    int n = dds_take(r, samples, infos, 8, 8);
-    for (int i = 0; i < n; i++) {
-      const viscera_SessionEvent *e = samples[i];
-      if (!infos[i].valid_data || !strstr(e->text, mine)) continue;
-      if (e->kind == viscera_EVENT_CONTROL_APPLIED && rc == 1) {
-        printf("applied: %s\n", e->text);
-        rc = 0;
-      } else if (e->kind == viscera_EVENT_INPUT_REJECTED && rc == 1) {
-        printf("refused: %s\n", e->text);
-        rc = 3;
-      }
-    }
-    if (n > 0) dds_return_loan(r, samples, n);
-    if (rc != 1) break;
-    dds_sleepfor(DDS_MSECS(10));
+    return 0;
   }
-  if (rc == 1) fprintf(stderr, "viscera-control: no answer from the server within %.1f s\n", wait_s);
-  if (rc == 3) rc = 1;
-out:
-  vdds_close(&dds);
-  return rc;
+  return 0; /* not reached: cli_parse passes only the codes above */
+}
+
+int main(int argc, char **argv) {
+  vdds_set_role("control"); /* announced in the participant USER_DATA */
+  static const struct option opts[] = {{"station", required_argument, 0, OPT_STATION},
+                                       {"text", required_argument, 0, OPT_TEXT},
+                                       {"wait", required_argument, 0, OPT_WAIT},
+                                       {0, 0, 0, 0}};
+  const cli_spec_t spec = {.program = "viscera-control",
+                           .common = CLI_DOMAIN | CLI_DOMAIN_ENV | CLI_PARTITION,
+                           .shortopts = "+", /* stop at the command, so "-1" values are not options */
+                           .options = opts,
+                           .option = on_option,
+                           .usage = usage,
+                           .domain_error = "--domain: not a domain id: '%s'"};
+  control_options_t o = {.wait_s = 5};
+  memset(&o.cmd, 0, sizeof o.cmd);
+  o.cmd.source_id = 1;
+  cli_common_t common = {0};
+  int rc = cli_parse(&spec, argc, argv, &common, &o);
+  if (rc != CLI_RUN) return rc;
+  o.domain = common.domain;
+  o.partition = common.partition;
+  o.cmd.seq = vtime_mono_ns(); /* increasing across invocations of one station */
+  o.cmd.tool_id = -1;
+  o.cmd.organ_id = -1;
+  if (parse_command(argc - optind, argv + optind, o.has_text, &o.cmd)) return 2;
+  return control_run(&o);
 }

@@ -44,6 +44,7 @@
 #include "replay_pause.h"
 #include "replay_serdata.h"
 #include "dds/vdds_ident.h"
+#include "cli.h"
 #include "verr.h"
 #include "vsignal.h"
 #include "dds/vdds_ident.h"
@@ -116,85 +117,74 @@ static void usage(FILE *f) {
              "  --pause-at S    pause when the replay reaches recording time S seconds (once)\n"
              "  --loop          start over at the end until interrupted\n"
              "  --quiet         no progress lines\n"
+             "  --help          this text\n"
+             "  --version       print the version and exit\n"
              "SIGUSR1 toggles pause/resume; after a resume the original timing goes on\n"
              "(the schedule is shifted by the paused time, no burst of missed samples).\n");
 }
 
+enum { OPT_SPEED = 's', OPT_SEEK = 'k', OPT_LOOP = 'l', OPT_PAUSE_AT = 'P' };
+
+/* A number in lo..hi (lo itself allowed only when `lo_ok`), or -1 after the
+ * message "replay: --NAME 'ARG': expected WHAT". */
+static int number(const char *name, const char *arg, double lo, int lo_ok, double hi, const char *what, double *out) {
+  char *end;
+  *out = strtod(arg, &end);
+  if (*end || end == arg || !(*out > lo || (lo_ok && *out == lo)) || *out > hi) {
+    fprintf(stderr, "replay: --%s '%s': expected %s\n", name, arg, what);
+    return 1;
+  }
+  return 0;
+}
+
+static int on_option(void *ctx, int code, const char *arg) {
+  replay_t *r = ctx;
+  switch (code) {
+  case OPT_SPEED:
+    return number("speed", arg, 0.0, 0, 1e6, "a number > 0", &r->speed);
+  case OPT_PAUSE_AT:
+    return number("pause-at", arg, 0.0, 1, 1e8, "seconds >= 0", &r->pause_at);
+  case OPT_SEEK:
+    return number("seek", arg, 0.0, 1, 1e8, "seconds >= 0", &r->seek);
+  case OPT_LOOP:
+    r->loop = true;
+    return 0;
+  }
+  return 0; /* not reached: cli_parse passes only the codes above */
+}
+
+/* Returns CLI_RUN, or the exit code (0 after --help/--version, 1 on a
+ * usage error, as replay always had). */
 static int parse_args(replay_t *r, int argc, char **argv) {
-  static const struct option opts[] = {{"domain", required_argument, NULL, 'd'},
-                                       {"partition", required_argument, NULL, 'p'},
-                                       {"speed", required_argument, NULL, 's'},
-                                       {"seek", required_argument, NULL, 'k'},
-                                       {"loop", no_argument, NULL, 'l'},
-                                       {"quiet", no_argument, NULL, 'q'},
-                                       {"pause-at", required_argument, NULL, 'P'},
-                                       {"help", no_argument, NULL, 'h'},
+  static const struct option opts[] = {{"speed", required_argument, NULL, OPT_SPEED},
+                                       {"seek", required_argument, NULL, OPT_SEEK},
+                                       {"loop", no_argument, NULL, OPT_LOOP},
+                                       {"pause-at", required_argument, NULL, OPT_PAUSE_AT},
                                        {NULL, 0, NULL, 0}};
-  r->domain = -1;
+  const cli_spec_t spec = {.program = "viscera-replay",
+                           .tag = "replay",
+                           .common = CLI_DOMAIN | CLI_PARTITION | CLI_QUIET,
+                           .options = opts,
+                           .option = on_option,
+                           .usage = usage,
+                           .domain_error = "--domain '%s': expected an integer 0..230",
+                           .partition_error = "--partition: empty or too long",
+                           .partition_max = sizeof r->partition,
+                           .usage_status = 1};
   r->speed = 1.0;
   r->pause_at = -1.0;
-  int c;
-  char *end;
-  while ((c = getopt_long(argc, argv, "", opts, NULL)) != -1) {
-    switch (c) {
-    case 'd': {
-      errno = 0;
-      long v = strtol(optarg, &end, 10);
-      if (errno || *end || end == optarg || v < 0 || v > 230) {
-        fprintf(stderr, "replay: --domain '%s': expected an integer 0..230\n", optarg);
-        return -1;
-      }
-      r->domain = (int)v;
-      break;
-    }
-    case 'p':
-      if (!*optarg || strlen(optarg) >= sizeof r->partition) {
-        fprintf(stderr, "replay: --partition: empty or too long\n");
-        return -1;
-      }
-      snprintf(r->partition, sizeof r->partition, "%s", optarg);
-      break;
-    case 's':
-      r->speed = strtod(optarg, &end);
-      if (*end || end == optarg || !(r->speed > 0.0) || r->speed > 1e6) {
-        fprintf(stderr, "replay: --speed '%s': expected a number > 0\n", optarg);
-        return -1;
-      }
-      break;
-    case 'P':
-      r->pause_at = strtod(optarg, &end);
-      if (*end || end == optarg || !(r->pause_at >= 0.0) || r->pause_at > 1e8) {
-        fprintf(stderr, "replay: --pause-at '%s': expected seconds >= 0\n", optarg);
-        return -1;
-      }
-      break;
-    case 'k':
-      r->seek = strtod(optarg, &end);
-      if (*end || end == optarg || !(r->seek >= 0.0) || r->seek > 1e8) {
-        fprintf(stderr, "replay: --seek '%s': expected seconds >= 0\n", optarg);
-        return -1;
-      }
-      break;
-    case 'l':
-      r->loop = true;
-      break;
-    case 'q':
-      r->quiet = true;
-      break;
-    case 'h':
-      usage(stdout);
-      exit(0);
-    default:
-      usage(stderr);
-      return -1;
-    }
-  }
+  cli_common_t common = {.domain = -1}; /* -1: the recorded one */
+  int rc = cli_parse(&spec, argc, argv, &common, r);
+  if (rc != CLI_RUN) return rc;
+  r->domain = common.domain;
+  if (common.partition) snprintf(r->partition, sizeof r->partition, "%s", common.partition);
+  r->quiet = common.quiet;
   if (optind != argc - 1) {
     usage(stderr);
-    return -1;
+    return 1;
   }
   r->path = argv[optind];
-  return 0;
+  return CLI_RUN;
 }
 
 static dds_duration_t col_dur(sqlite3_stmt *st, int col, dds_duration_t dflt) {
@@ -610,65 +600,72 @@ static void find_time_range(replay_t *r) {
   r->t_end = last;
 }
 
-int main(int argc, char **argv) {
-  vdds_set_role("replay"); /* announced in the participant USER_DATA */
-  replay_t r;
-  memset(&r, 0, sizeof r);
-  if (parse_args(&r, argc, argv) < 0) return 1;
+/* Opens the recording (and a second read-only connection for the
+ * descriptor columns recfile does not expose) and fills in the recorded
+ * domain and partition where none was given. Returns 0, or 1 after a
+ * message. */
+static int open_recording(replay_t *r) {
   verr_t err;
-  if (recfile_open(&r.rf, r.path, &err) < 0) {
+  if (recfile_open(&r->rf, r->path, &err) < 0) {
     fprintf(stderr, "replay: %s\n", err.msg);
     return 1;
   }
-  const char *w = recfile_warnings(r.rf);
-  if (*w) fprintf(stderr, "replay: %s: %s\n", r.path, w);
-  if (recfile_damaged(r.rf)) fprintf(stderr, "replay: %s: damaged; replaying what can be read\n", r.path);
+  const char *w = recfile_warnings(r->rf);
+  if (*w) fprintf(stderr, "replay: %s: %s\n", r->path, w);
+  if (recfile_damaged(r->rf)) fprintf(stderr, "replay: %s: damaged; replaying what can be read\n", r->path);
   /* A second read-only connection for the descriptor columns recfile does
    * not expose. */
-  if (sqlite3_open_v2(r.path, &r.db, SQLITE_OPEN_READONLY, NULL) != SQLITE_OK) {
-    fprintf(stderr, "replay: %s: cannot open: %s\n", r.path, r.db ? sqlite3_errmsg(r.db) : "?");
-    sqlite3_close(r.db);
-    recfile_close(r.rf);
+  if (sqlite3_open_v2(r->path, &r->db, SQLITE_OPEN_READONLY, NULL) != SQLITE_OK) {
+    fprintf(stderr, "replay: %s: cannot open: %s\n", r->path, r->db ? sqlite3_errmsg(r->db) : "?");
+    sqlite3_close(r->db);
+    recfile_close(r->rf);
     return 1;
   }
-  sqlite3_busy_timeout(r.db, 2000);
-  if (recfile_damaged(r.rf)) sqlite3_exec(r.db, "PRAGMA writable_schema=ON", NULL, NULL, NULL);
-  const recfile_session_t *s = recfile_session(r.rf);
-  if (r.domain < 0) r.domain = s->valid ? s->domain : 0;
-  if (!r.partition[0]) {
+  sqlite3_busy_timeout(r->db, 2000);
+  if (recfile_damaged(r->rf)) sqlite3_exec(r->db, "PRAGMA writable_schema=ON", NULL, NULL, NULL);
+  const recfile_session_t *s = recfile_session(r->rf);
+  if (r->domain < 0) r->domain = s->valid ? s->domain : 0;
+  if (!r->partition[0]) {
     if (!s->valid || strpbrk(s->partition, "*?[") != NULL) {
-      fprintf(stderr, "replay: %s: recorded partition '%s' is a pattern or unknown; give --partition\n", r.path,
+      fprintf(stderr, "replay: %s: recorded partition '%s' is a pattern or unknown; give --partition\n", r->path,
               s->valid ? s->partition : "");
-      sqlite3_close(r.db);
-      recfile_close(r.rf);
+      sqlite3_close(r->db);
+      recfile_close(r->rf);
       return 1;
     }
-    snprintf(r.partition, sizeof r.partition, "%s", s->partition);
+    snprintf(r->partition, sizeof r->partition, "%s", s->partition);
   }
+  return 0;
+}
+
+/* Publishes the recording (every pass with --loop) and prints the
+ * summary. Returns the exit code. */
+static int replay_run(replay_t *r) {
+  verr_t err;
   int status = 0;
   dds_qos_t *ppq = vdds_participant_qos();
-  r.pp = dds_create_participant((dds_domainid_t)r.domain, ppq, NULL);
+  r->pp = dds_create_participant((dds_domainid_t)r->domain, ppq, NULL);
   if (ppq) dds_delete_qos(ppq);
-  if (r.pp < 0) {
-    fprintf(stderr, "replay: cannot create a participant on domain %d: %s\n", r.domain, dds_strretcode(r.pp));
+  if (r->pp < 0) {
+    fprintf(stderr, "replay: cannot create a participant on domain %d: %s\n", r->domain, dds_strretcode(r->pp));
     status = 1;
     goto out;
   }
   dds_qos_t *pq = dds_create_qos();
-  dds_qset_partition1(pq, r.partition);
-  r.pub = dds_create_publisher(r.pp, pq, NULL);
+  dds_qset_partition1(pq, r->partition);
+  r->pub = dds_create_publisher(r->pp, pq, NULL);
   dds_delete_qos(pq);
-  if (r.pub < 0) {
-    fprintf(stderr, "replay: cannot create a publisher: %s\n", dds_strretcode(r.pub));
+  if (r->pub < 0) {
+    fprintf(stderr, "replay: cannot create a publisher: %s\n", dds_strretcode(r->pub));
     status = 1;
     goto out;
   }
-  if (setup_topics(&r, &err) < 0) {
+  if (setup_topics(r, &err) < 0) {
     fprintf(stderr, "replay: %s\n", err.msg);
     status = 1;
     goto out;
   }
-  find_time_range(&r);
+  find_time_range(r);
   vsignal_on_stop(on_signal, 0);
   {
     struct sigaction sa;
@@ -678,47 +675,56 @@ int main(int argc, char **argv) {
     sigemptyset(&sa.sa_mask);
     sigaction(SIGUSR1, &sa, NULL);
   }
-  if (!r.quiet)
-    fprintf(stderr, "replay: %s: %zu topics into domain %d partition '%s' at speed %g\n", r.path, r.ntopics, r.domain,
-            r.partition, r.speed);
+  if (!r->quiet)
+    fprintf(stderr, "replay: %s: %zu topics into domain %d partition '%s' at speed %g\n", r->path, r->ntopics,
+            r->domain, r->partition, r->speed);
   /* Let already running receivers match the new writers before the first
    * sample (volatile topics would otherwise lose it). */
   /* (a SIGUSR1 during this wait pauses before the first sample) */
-  sleep_until(&r, mono_ns() + DDS_MSECS(500));
+  sleep_until(r, mono_ns() + DDS_MSECS(500));
   unsigned passes = 0;
   recfile_scan_report_t rep;
   memset(&rep, 0, sizeof rep);
   do {
-    r.start_mono = mono_ns();
-    rpause_new_pass(&r.pause, r.start_mono);
-    r.sched_ts = r.t0;
-    r.pass_rows = 0;
-    recfile_scan(r.rf, 0, true, on_row, &r, &rep);
+    r->start_mono = mono_ns();
+    rpause_new_pass(&r->pause, r->start_mono);
+    r->sched_ts = r->t0;
+    r->pass_rows = 0;
+    recfile_scan(r->rf, 0, true, on_row, r, &rep);
     passes++;
     if (rep.damaged && passes == 1)
-      fprintf(stderr, "replay: %s: damaged sample table: %s%s; %llu samples read\n", r.path, rep.first_error,
+      fprintf(stderr, "replay: %s: damaged sample table: %s%s; %llu samples read\n", r->path, rep.first_error,
               rep.gave_up ? " (gave up past it)" : "", (unsigned long long)rep.rows);
-    if (r.pass_rows == 0) break;
-  } while (r.loop && !stop_flag);
-  progress(&r, true);
+    if (r->pass_rows == 0) break;
+  } while (r->loop && !stop_flag);
+  progress(r, true);
   /* Reliable receivers get everything written before the writers go. */
-  for (size_t i = 0; i < r.ntopics; i++) dds_wait_for_acks(r.topics[i].writer, DDS_SECS(2));
-  for (size_t i = 0; i < r.ntopics; i++)
-    if (r.topics[i].bad)
-      fprintf(stderr, "replay: %s: %llu samples could not be decoded with the stored type, skipped\n", r.topics[i].name,
-              (unsigned long long)r.topics[i].bad);
+  for (size_t i = 0; i < r->ntopics; i++) dds_wait_for_acks(r->topics[i].writer, DDS_SECS(2));
+  for (size_t i = 0; i < r->ntopics; i++)
+    if (r->topics[i].bad)
+      fprintf(stderr, "replay: %s: %llu samples could not be decoded with the stored type, skipped\n",
+              r->topics[i].name, (unsigned long long)r->topics[i].bad);
   fprintf(stderr, "replay: %s %llu samples of %zu topics (%llu skipped, %llu undecodable)%s\n",
-          stop_flag ? "interrupted after" : "wrote", (unsigned long long)r.total_written, r.ntopics,
-          (unsigned long long)r.total_skipped, (unsigned long long)r.total_bad,
+          stop_flag ? "interrupted after" : "wrote", (unsigned long long)r->total_written, r->ntopics,
+          (unsigned long long)r->total_skipped, (unsigned long long)r->total_bad,
           passes > 1 ? " over several passes" : "");
-  printf("SUMMARY written=%llu topics=%zu bad=%llu skipped=%llu\n", (unsigned long long)r.total_written, r.ntopics,
-         (unsigned long long)r.total_bad, (unsigned long long)r.total_skipped);
+  printf("SUMMARY written=%llu topics=%zu bad=%llu skipped=%llu\n", (unsigned long long)r->total_written, r->ntopics,
+         (unsigned long long)r->total_bad, (unsigned long long)r->total_skipped);
 out:
-  if (r.pp > 0) dds_delete(r.pp);
-  for (size_t i = 0; i < r.ntopics; i++) topic_free(&r.topics[i]);
-  free(r.topics);
-  free(r.buf);
-  sqlite3_close(r.db);
-  recfile_close(r.rf);
+  if (r->pp > 0) dds_delete(r->pp);
+  for (size_t i = 0; i < r->ntopics; i++) topic_free(&r->topics[i]);
+  free(r->topics);
+  free(r->buf);
+  sqlite3_close(r->db);
+  recfile_close(r->rf);
   return status;
+}
+
+int main(int argc, char **argv) {
+  vdds_set_role("replay"); /* announced in the participant USER_DATA */
+  static replay_t r;
+  int rc = parse_args(&r, argc, argv);
+  if (rc != CLI_RUN) return rc;
+  if (open_recording(&r)) return 1;
+  return replay_run(&r);
 }

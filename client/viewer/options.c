@@ -42,6 +42,7 @@ void options_usage(FILE *f, const char *prog) {
           "                     closes 1 s after the last event\n"
           "  --quiet            no progress lines (the summary and errors still print)\n"
           "  --help             show this help and exit\n"
+          "  --version          print the version and exit\n"
           "\n"
           "Signals: SIGUSR1 writes a frame now (or as soon as a keyframe is here);\n"
           "SIGINT/SIGTERM stop cleanly (exit 0).\n"
@@ -105,7 +106,8 @@ int options_parse(viewer_opts_t *o, int argc, char **argv, verr_t *err) {
     O_SCRIPT,
     O_WINDOW,
     O_QUIET,
-    O_HELP
+    O_HELP,
+    O_VERSION
   };
   static const struct option longopts[] = {{"domain", required_argument, NULL, O_DOMAIN},
                                            {"partition", required_argument, NULL, O_PARTITION},
@@ -122,6 +124,7 @@ int options_parse(viewer_opts_t *o, int argc, char **argv, verr_t *err) {
                                            {"script-input", required_argument, NULL, O_SCRIPT},
                                            {"quiet", no_argument, NULL, O_QUIET},
                                            {"help", no_argument, NULL, O_HELP},
+                                           {"version", no_argument, NULL, O_VERSION},
                                            {NULL, 0, NULL, 0}};
   opterr = 0;
   optind = 1;
@@ -190,6 +193,8 @@ int options_parse(viewer_opts_t *o, int argc, char **argv, verr_t *err) {
       break;
     case O_HELP:
       return 1;
+    case O_VERSION:
+      return 2;
     default:
       if ((optopt >= O_DOMAIN && optopt <= O_DUMP) || optopt == O_DRIVE || optopt == O_SCRIPT)
         return verr_set(err, "%s: missing value", argv[optind - 1]);

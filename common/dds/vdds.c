@@ -1,5 +1,7 @@
 #include "dds/vdds.h"
 
+#include "cli.h"
+
 #include <stdlib.h>
 #include <string.h>
 
@@ -168,17 +170,7 @@ int vdds_station_of_writer(dds_entity_t reader, dds_instance_handle_t pub, char 
   return 0;
 }
 
-int vdds_parse_domain(const char *s) {
-  char *end = NULL;
-  long d = strtol(s, &end, 10);
-  if (!s[0] || *end || d < 0 || d > 230) return -1;
-  return (int)d;
-}
+/* One parser for every program: cli.h. */
+int vdds_parse_domain(const char *s) { return cli_parse_domain(s); }
 
-int vdds_env_domain(verr_t *err) {
-  const char *env = getenv("VISCERA_DOMAIN");
-  if (!env || !*env) return 0;
-  int d = vdds_parse_domain(env);
-  if (d < 0) verr_set(err, "VISCERA_DOMAIN='%s' is not a domain id 0..230", env);
-  return d;
-}
+int vdds_env_domain(verr_t *err) { return cli_env_domain(err); }

@@ -1,0 +1,90 @@
+#include "control_run.h"
+
+#include <inttypes.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "dds/vdds.h"
+#include "vtime.h"
+
+int control_run(const control_options_t *o) {
+  verr_t err;
+  vdds_t dds;
+  if (vdds_open(&dds, o->domain, o->partition, &err)) {
+    fprintf(stderr, "viscera-control: %s\n", err.msg);
+    return 2;
+  }
+  int rc = 2;
+  dds_entity_t w = vdds_writer(&dds, VT_SESSION_CONTROL, &err);
+  dds_entity_t r = vdds_reader(&dds, VT_SESSION_EVENT, &err);
+  if (w < 0 || r < 0) {
+    fprintf(stderr, "viscera-control: %s (is this identity allowed to send SessionControl in this partition?)\n",
+            err.msg);
+    goto out;
+  }
+  /* The server is there once its SceneInfo (transient-local) arrives. A
+   * matched writer alone proves nothing: a recorder's reader matches too. */
+  dds_entity_t r_scene = vdds_reader(&dds, VT_SCENE_INFO, &err);
+  if (r_scene < 0) {
+    fprintf(stderr, "viscera-control: %s\n", err.msg);
+    goto out;
+  }
+  uint64_t deadline = vtime_mono_ns() + (uint64_t)(o->wait_s * 1e9);
+  int have_server = 0;
+  while (!have_server && vtime_mono_ns() < deadline) {
+    void *samples[1] = {0};
+    dds_sample_info_t info;
+    int n = dds_take(r_scene, samples, &info, 1, 1);
+    if (n > 0) {
+      have_server = info.valid_data;
+      dds_return_loan(r_scene, samples, n);
+    } else {
+      dds_sleepfor(DDS_MSECS(20));
+    }
+  }
+  if (!have_server) {
+    fprintf(stderr, "viscera-control: no server on domain %d partition '%s' within %.1f s\n", o->domain,
+            o->partition ? o->partition : VDDS_DEFAULT_PARTITION, o->wait_s);
+    rc = 1;
+    goto out;
+  }
+  rc = 1;
+  char mine[64];
+  snprintf(mine, sizeof mine, "[station %" PRIu32 " seq %" PRIu64 "]", o->cmd.source_id, o->cmd.seq);
+  uint64_t next_send = 0;
+  while (vtime_mono_ns() < deadline) {
+    /* Resent (same seq, the server drops copies) until answered: the
+     * server's reader may match this writer a little after its SceneInfo
+     * arrived, and a volatile write before that reaches nobody. */
+    if (vtime_mono_ns() >= next_send) {
+      if (dds_write(w, &o->cmd) < 0) {
+        fprintf(stderr, "viscera-control: write failed\n");
+        rc = 2;
+        break;
+      }
+      next_send = vtime_mono_ns() + 500000000ull;
+    }
+    void *samples[8] = {0};
+    dds_sample_info_t infos[8];
+    int n = dds_take(r, samples, infos, 8, 8);
+    for (int i = 0; i < n; i++) {
+      const viscera_SessionEvent *e = samples[i];
+      if (!infos[i].valid_data || !strstr(e->text, mine)) continue;
+      if (e->kind == viscera_EVENT_CONTROL_APPLIED && rc == 1) {
+        printf("applied: %s\n", e->text);
+        rc = 0;
+      } else if (e->kind == viscera_EVENT_INPUT_REJECTED && rc == 1) {
+        printf("refused: %s\n", e->text);
+        rc = 3;
+      }
+    }
+    if (n > 0) dds_return_loan(r, samples, n);
+    if (rc != 1) break;
+    dds_sleepfor(DDS_MSECS(10));
+  }
+  if (rc == 1) fprintf(stderr, "viscera-control: no answer from the server within %.1f s\n", o->wait_s);
+  if (rc == 3) rc = 1;
+out:
+  vdds_close(&dds);
+  return rc;
+}

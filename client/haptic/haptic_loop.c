@@ -1,0 +1,166 @@
+#include "haptic_loop.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "contact_model.h"
+#include "guide_force.h"
+#include "viscera.h"
+#include "vtime.h"
+
+/* State carried from tick to tick. */
+typedef struct tick_state {
+  contact_model_t model;
+  const char *own_station;
+  double prev_pos[3];
+  uint64_t prev_pos_ns;
+  int have_prev_pos;
+  uint64_t seq;
+  int server_lost_reported;
+  uint64_t live_lost_reported_ns;
+} tick_state_t;
+
+/* The device's pose as this tick's ToolCommand. */
+static void send_command(const haptic_loop_t *l, tick_state_t *s, uint64_t now, const double pos[3],
+                         const double quat[4], uint32_t buttons) {
+  viscera_ToolCommand cmd;
+  memset(&cmd, 0, sizeof cmd);
+  cmd.tool_id = l->o->tool;
+  cmd.seq = ++s->seq;
+  cmd.client_mono_ns = now;
+  for (int k = 0; k < 3; k++) cmd.position[k] = (float)pos[k];
+  for (int k = 0; k < 4; k++) cmd.orientation[k] = (float)quat[k];
+  cmd.buttons = buttons;
+  cmd.max_force = (float)l->dev->max_force;
+  feedback_slot_sent(&l->h->slot, cmd.seq, cmd.client_mono_ns); /* before the write: the echo may beat it back */
+  dds_write(l->h->w_cmd, &cmd);
+}
+
+/* The latest contact model, cleared (and said once) when the server is lost.
+ * Returns the monotonic time of the last feedback (0: none yet). */
+static uint64_t read_feedback(const haptic_loop_t *l, tick_state_t *s, uint64_t now) {
+  uint64_t last_fb_mono = feedback_slot_read(&l->h->slot, &s->model);
+  uint64_t lost_ns = 0, lost_last = 0;
+  int lost_live = feedback_slot_server_lost(&l->h->slot, &lost_ns, &lost_last);
+  if (last_fb_mono && s->server_lost_reported && !lost_live && now - last_fb_mono < 50000000ull) {
+    fprintf(stderr, "haptic: server back\n");
+    s->server_lost_reported = 0;
+  }
+  /* The server process is gone (its feedback writer's liveliness lapsed):
+   * the listener already cleared the slot; say so once per loss, even when
+   * the feedback timeout happened to notice first on a loaded machine. */
+  if (lost_live) {
+    s->model.in_contact = 0;
+    if (lost_ns != s->live_lost_reported_ns) {
+      s->live_lost_reported_ns = lost_ns;
+      fprintf(stderr,
+              "haptic: server lost (liveliness lost, last feedback %.0f ms before, lease %d ms), force set to "
+              "zero\n",
+              lost_last ? (double)(lost_ns - lost_last) * 1e-6 : -1.0, VDDS_FEEDBACK_LEASE_MS);
+      s->server_lost_reported = 1;
+    }
+  }
+  /* No feedback for 50 ms while the server is alive (stalled, or not
+   * answering this tool): render nothing rather than a stale wall. */
+  if (last_fb_mono && now > last_fb_mono + 50000000ull) {
+    s->model.in_contact = 0;
+    if (!s->server_lost_reported) {
+      fprintf(stderr, "haptic: server lost (no feedback for 50 ms), force set to zero\n");
+      s->server_lost_reported = 1;
+    }
+  }
+  return last_fb_mono;
+}
+
+/* The force to render: guided or not, one force law (guide_force.h); a
+ * server silent for GUIDE_SERVER_TIMEOUT_S ends the coupling too. */
+static void render_force(const haptic_loop_t *l, tick_state_t *s, double t, uint64_t now, uint64_t last_fb_mono,
+                         const double pos[3], guide_output_t *gout) {
+  const haptic_options_t *o = l->o;
+  /* Device velocity by backward difference over the actual tick. */
+  double vel[3] = {0, 0, 0};
+  if (s->have_prev_pos && now > s->prev_pos_ns)
+    for (int k = 0; k < 3; k++) vel[k] = (pos[k] - s->prev_pos[k]) / ((double)(now - s->prev_pos_ns) * 1e-9);
+  memcpy(s->prev_pos, pos, sizeof s->prev_pos);
+  s->prev_pos_ns = now;
+  s->have_prev_pos = 1;
+  /* Device capability data: never render a wall stiffer than the device
+   * is rated for (its damping follows the clamped stiffness). */
+  s->model.stiffness = contact_model_device_stiffness(s->model.stiffness, l->dev->max_stiffness);
+  s->model.damping = contact_model_passive_damping(s->model.stiffness, 1.0 / o->rate);
+  guide_view_t gv;
+  guide_slot_read(&l->h->guide, s->own_station, now, &gv);
+  guide_input_t gin = {.role = &gv.role,
+                       .own_station = s->own_station,
+                       .have_peer = gv.have_peer,
+                       .peer_age_s = gv.peer_age_s,
+                       .server_silent_s = !last_fb_mono        ? -1.0
+                                          : now > last_fb_mono ? (double)(now - last_fb_mono) * 1e-9
+                                                               : 0.0,
+                       .contact = &s->model,
+                       .max_force = l->dev->max_force,
+                       .max_stiffness = l->dev->max_stiffness,
+                       .period_s = 1.0 / o->rate};
+  memcpy(gin.x, pos, sizeof gin.x);
+  memcpy(gin.v, vel, sizeof gin.v);
+  memcpy(gin.peer, gv.peer, sizeof gin.peer);
+  guide_force(&gin, gout);
+  guide_report_tick(l->guide, t, &gv.role, gv.peer_station, gv.peer_age_s, gout, o->quiet ? NULL : stderr);
+}
+
+/* The rendered force in the statistics and the CSV. */
+static void record_force(const haptic_loop_t *l, const tick_state_t *s, double t, const double pos[3],
+                         const guide_output_t *gout) {
+  haptic_stats_t *st = l->st;
+  const double *f = gout->f, mag = gout->magnitude;
+  st->ticks++;
+  /* In contact: the tissue pushes (a guiding spring in free space is not
+   * contact; unguided, mag > 0 only in contact anyway). */
+  if (mag > 0 && s->model.in_contact) {
+    st->contact_ticks++;
+    st->force_sum += mag;
+  }
+  if (mag > st->peak_force) st->peak_force = mag;
+  if (l->csv)
+    fprintf(l->csv, "%.4f,%.6f,%.6f,%.6f,%.5f,%.5f,%.5f,%d\n", t, pos[0], pos[1], pos[2], f[0], f[1], f[2],
+            s->model.in_contact);
+}
+
+void haptic_loop_run(const haptic_loop_t *l) {
+  const haptic_options_t *o = l->o;
+  haptic_stats_t *st = l->st;
+  tick_state_t s = {.own_station = o->station ? o->station : ""};
+  uint64_t period_ns = (uint64_t)(1e9 / o->rate);
+  double run_for = o->duration >= 0 ? o->duration : 1e300;
+  uint64_t start = vtime_mono_ns(), next = start, prev_tick = 0;
+  double finished_at = -1;
+  while (!*l->stop) {
+    vtime_sleep_until(next);
+    uint64_t now = vtime_mono_ns();
+    double t = (double)(now - start) * 1e-9;
+    if (prev_tick) {
+      if (st->nperiod < st->cap) st->period_us[st->nperiod++] = (double)(now - prev_tick) * 1e-3;
+      if (now > next + 1000000ull) st->late_ticks++; /* more than 1 ms late */
+    }
+    prev_tick = now;
+    double pos[3], quat[4];
+    uint32_t buttons = 0;
+    l->dev->ops->read(l->dev, t, pos, quat, &buttons);
+    send_command(l, &s, now, pos, quat, buttons);
+    uint64_t last_fb_mono = read_feedback(l, &s, now);
+    guide_output_t gout;
+    render_force(l, &s, t, now, last_fb_mono, pos, &gout);
+    l->dev->ops->write_force(l->dev, gout.f);
+    record_force(l, &s, t, pos, &gout);
+
+    if (t >= run_for) break;
+    if (o->duration < 0 && l->dev->ops->finished(l->dev, t)) {
+      if (finished_at < 0) finished_at = t;
+      if (t - finished_at > 0.5) break;
+    }
+    next += period_ns;
+    if (now > next + 100000000ull) next = now; /* resynchronise after a long stall */
+  }
+  if (l->csv) fclose(l->csv);
+  st->elapsed_s = (double)(vtime_mono_ns() - start) * 1e-9;
+}

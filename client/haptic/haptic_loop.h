@@ -1,0 +1,39 @@
+/* haptic_loop: viscera-haptic's fixed-rate loop. Each tick reads the
+ * device, writes a ToolCommand, reads the latest contact model and renders
+ * the one force law of guide_force.h on the device. */
+#ifndef VISCERA_HAPTIC_LOOP_H
+#define VISCERA_HAPTIC_LOOP_H
+
+#include <signal.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#include "device.h"
+#include "guide_report.h"
+#include "haptic_dds.h"
+#include "haptic_options.h"
+
+/* What the loop measured, for the summary (haptic_summary.h). */
+typedef struct haptic_stats {
+  double *period_us; /* tick periods (us), cap entries */
+  size_t nperiod, cap;
+  double peak_force, force_sum; /* N; the sum over ticks in contact */
+  uint64_t ticks, contact_ticks, late_ticks;
+  double elapsed_s; /* wall time of the loop */
+} haptic_stats_t;
+
+typedef struct haptic_loop {
+  const haptic_options_t *o;
+  device_t *dev;
+  haptic_dds_t *h;
+  FILE *csv;             /* t,x,y,z,fx,fy,fz,in_contact per tick, or NULL */
+  guide_report_t *guide; /* guiding events and ages */
+  haptic_stats_t *st;    /* period_us allocated by the caller */
+  volatile sig_atomic_t *stop;
+} haptic_loop_t;
+
+/* Runs until *stop, --duration, or the end of a scripted trajectory + 0.5 s.
+ * Fills st (elapsed_s from the first tick to the return). */
+void haptic_loop_run(const haptic_loop_t *l);
+
+#endif

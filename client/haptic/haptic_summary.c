@@ -1,0 +1,50 @@
+#include "haptic_summary.h"
+
+#include <inttypes.h>
+#include <math.h>
+#include <pthread.h>
+#include <stdio.h>
+
+#include "vstats.h"
+
+void haptic_summary_print(const haptic_options_t *o, haptic_stats_t *st, haptic_dds_t *h, const guide_report_t *guide) {
+  vstats_summary_t per = vstats_summarise(st->period_us, st->nperiod);
+  pthread_mutex_lock(&h->slot.lock);
+  vstats_summary_t lat = vstats_summarise(h->slot.latency_us, h->slot.nlatency);
+  uint64_t feedback = h->slot.received, live_lost = h->slot.lost_events, live_back = h->slot.regained_events;
+  uint64_t foreign = h->slot.foreign_echoes;
+  pthread_mutex_unlock(&h->slot.lock);
+  /* Jitter: the p99 of |period - nominal| (early and late ticks alike). */
+  for (size_t i = 0; i < st->nperiod; i++) st->period_us[i] = fabs(st->period_us[i] - 1e6 / o->rate);
+  vstats_summary_t jit = vstats_summarise(st->period_us, st->nperiod);
+  double jitter_p99 = jit.p99;
+  fprintf(stderr,
+          "haptic: %" PRIu64 " ticks in %.2f s (%.1f Hz); period median %.1f us, p99 %.1f us, max %.1f us; "
+          "%" PRIu64 " ticks over 1 ms late; jitter p99 %.1f us\n",
+          st->ticks, st->elapsed_s, (double)st->ticks / st->elapsed_s, per.median, per.p99, per.max, st->late_ticks,
+          jitter_p99);
+  fprintf(
+      stderr,
+      "haptic: force peak %.3f N, mean in contact %.3f N, %" PRIu64 " ticks in contact, %" PRIu64 " feedback samples\n",
+      st->peak_force, st->contact_ticks ? st->force_sum / (double)st->contact_ticks : 0.0, st->contact_ticks, feedback);
+  if (live_lost || live_back)
+    fprintf(stderr, "haptic: server liveliness lost %" PRIu64 " time(s), regained %" PRIu64 " time(s)\n", live_lost,
+            live_back);
+  fprintf(stderr, "haptic: command->feedback latency median %.1f us, p99 %.1f us (%zu samples)\n", lat.median, lat.p99,
+          lat.n);
+  if (foreign)
+    fprintf(stderr, "haptic: %" PRIu64 " feedback samples answered another station's commands (not in the latency)\n",
+            foreign);
+  guide_report_summary(guide, 1.0 / o->rate, stderr);
+  pthread_mutex_lock(&h->guide.lock);
+  fprintf(stderr,
+          "haptic: guide: %" PRIu64 " ToolRole samples (%" PRIu64 " refused), %" PRIu64
+          " commands from other stations (%" PRIu64 " not finite), %" PRIu64 " of ours skipped\n",
+          h->guide.roles_received, h->guide.roles_rejected, h->guide.peer_samples, h->guide.bad_samples,
+          h->guide.own_samples_skipped);
+  pthread_mutex_unlock(&h->guide.lock);
+  printf("SUMMARY ticks=%" PRIu64 " rate_hz=%.1f peak_force=%.4f contact_ticks=%" PRIu64 " latency_us_median=%.1f "
+         "latency_us_p99=%.1f period_us_p99=%.1f jitter_us_p99=%.1f late_ticks=%" PRIu64 " guide_coupled_s=%.2f\n",
+         st->ticks, (double)st->ticks / st->elapsed_s, st->peak_force, st->contact_ticks, lat.median, lat.p99, per.p99,
+         jitter_p99, st->late_ticks, guide_report_coupled_s(guide, 1.0 / o->rate));
+}

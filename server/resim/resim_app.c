@@ -1,0 +1,172 @@
+/* viscera-resim after its options (resim.c): load the scene and the
+ * recording, re-simulate, compare and print the SCHEDULE, ORGAN, STREAM and
+ * RESIM lines. */
+#include "resim/resim_app.h"
+
+#include <inttypes.h>
+#include <math.h>
+#include <stdio.h>
+
+#include "resim/resim_recording.h"
+#include "resim/resim_run.h"
+#include "runtime/scene_runtime.h"
+#include "scene.h"
+#include "vtime.h"
+
+/* Float rounding of a recorded position (keyframe float plus quantized
+ * delta, |x| < 1 m): a few 1e-9 m. The default tolerance adds this to the
+ * quantization bound quant_step / 2. */
+#define RESIM_FLOAT_SLACK 5e-8
+
+typedef struct progress_ctx {
+  FILE *csv;
+  double dt;
+  int quiet;
+  uint64_t t0, last_print;
+} progress_ctx_t;
+
+static void on_frame(void *arg, uint64_t step, uint32_t organ, int keyframe, double max_err, double rms, int exact) {
+  progress_ctx_t *c = arg;
+  if (c->csv)
+    fprintf(c->csv, "%" PRIu64 ",%.6f,%u,%s,%.9g,%.9g,%d\n", step, (double)step * c->dt, organ,
+            keyframe ? "keyframe" : "delta", max_err, rms, exact);
+}
+
+static void on_progress(void *arg, uint64_t step, uint64_t total) {
+  progress_ctx_t *c = arg;
+  uint64_t now = vtime_mono_ns();
+  /* A line every 2 s of wall time, so long recordings show they move. */
+  if (c->quiet || now - c->last_print < 2000000000ull || step == 0) return;
+  c->last_print = now;
+  double el = (double)(now - c->t0) * 1e-9;
+  fprintf(stderr, "resim: step %" PRIu64 " / %" PRIu64 " (%.0f %%), %.1f s elapsed, %.1f s left\n", step, total,
+          100.0 * (double)step / (double)total, el, el * (double)(total - step) / (double)step);
+}
+
+/* SCHEDULE lines: how each tool's command stream was rebuilt. */
+static void print_schedules(const runtime_t *rt, const resim_recording_t *rec, const resim_result_t *res) {
+  for (size_t t = 0; t < rt->ntools; t++) {
+    const resim_schedule_stats_t *s = &res->sched[t];
+    /* The recorded command stream itself (sorted by seq by now): a client
+     * numbers its commands 1, 2, ..., so seqs missing between the first and
+     * the last recorded are samples the recorder lost mid-session, and
+     * first - 1 those sent before it (or the server) matched the writer. */
+    const resim_tool_input_t *in = &rec->tools[t];
+    uint64_t distinct = 0, first = in->ncmd ? in->cmd[0].seq : 0, last = in->ncmd ? in->cmd[in->ncmd - 1].seq : 0;
+    for (size_t i = 0; i < in->ncmd; i++) distinct += i == 0 || in->cmd[i].seq != in->cmd[i - 1].seq;
+    printf("SCHEDULE tool=%s feedback_steps=%" PRIu64 " gaps=%" PRIu64 " bridged_steps=%" PRIu64
+           " ambiguous_steps=%" PRIu64 " missing_commands=%" PRIu64 " conflicts=%" PRIu64 " releases=%" PRIu64
+           " cmd_first_seq=%" PRIu64 " cmd_last_seq=%" PRIu64 " cmd_seq_gaps=%" PRIu64 "\n",
+           rt->tools[t].cfg->name, s->feedback_steps, s->gaps, s->bridged_steps, s->ambiguous_steps,
+           s->missing_commands, s->conflicts, s->releases, first, last, in->ncmd ? last - first + 1 - distinct : 0);
+  }
+}
+
+/* ORGAN and STREAM lines; returns whether an organ is beyond the
+ * tolerance, *compared whether any frame was compared. */
+static int print_organs(const runtime_t *rt, const resim_recording_t *rec, const resim_result_t *res,
+                        const scene_t *scene, double tolerance, int *compared) {
+  int beyond = 0;
+  for (size_t i = 0; i < rt->norgans; i++) {
+    const resim_organ_result_t *r = &res->organs[i];
+    double rms = r->nsq ? sqrt(r->sum_sq / (double)r->nsq) : 0;
+    printf("ORGAN %s frames=%" PRIu64 " keyframes=%" PRIu64 " exact=%" PRIu64 " unmatched=%" PRIu64
+           " max_err_m=%.3g rms_err_m=%.3g worst_step=%" PRIu64 "\n",
+           rt->organs[i].cfg->name, r->frames, r->keyframes, r->exact, r->unmatched, r->max_err, rms, r->worst_step);
+    /* MeshDelta frame_seq counts every published frame of the organ. */
+    uint64_t dfirst = 0, dlast = 0, ddistinct = 0, dprev = 0;
+    for (size_t j = 0; j < rec->ndeltas; j++) {
+      const resim_delta_t *d = &rec->deltas[j];
+      if (d->organ != i) continue;
+      if (!ddistinct || d->frame_seq < dfirst) dfirst = d->frame_seq;
+      if (!ddistinct || d->frame_seq > dlast) dlast = d->frame_seq;
+      if (!ddistinct || d->frame_seq != dprev) ddistinct++;
+      dprev = d->frame_seq;
+    }
+    printf("STREAM organ=%s delta_first_seq=%" PRIu64 " delta_last_seq=%" PRIu64 " delta_seq_gaps=%" PRIu64 "\n",
+           rt->organs[i].cfg->name, dfirst, dlast, ddistinct ? dlast - dfirst + 1 - ddistinct : 0);
+    if (r->frames) *compared = 1;
+    if (r->max_err > tolerance) {
+      beyond = 1;
+      fprintf(stderr,
+              "viscera-resim: organ '%s' differs from the recording by %.3g m (at step %" PRIu64
+              ", t = %.3f s), beyond the tolerance %.3g m: the re-simulation does not reproduce the session\n",
+              rt->organs[i].cfg->name, r->max_err, r->worst_step, (double)r->worst_step * scene->dt, tolerance);
+    }
+  }
+  return beyond;
+}
+
+int resim_app_run(const resim_options_t *o) {
+  verr_t err;
+  static scene_t scene; /* large; static keeps it off the stack */
+  if (scene_load(o->scene_path, &scene, &err)) {
+    fprintf(stderr, "viscera-resim: %s\n", err.msg);
+    return 2;
+  }
+  static resim_recording_t rec;
+  if (resim_recording_load(&rec, o->rec_path, &err)) {
+    fprintf(stderr, "viscera-resim: %s\n", err.msg);
+    return 2;
+  }
+  if (rec.warnings[0]) fprintf(stderr, "viscera-resim: warning: %s\n", rec.warnings);
+  if (rec.skipped)
+    fprintf(stderr, "viscera-resim: warning: %" PRIu64 " sample(s) skipped; first: %s\n", rec.skipped, rec.first_skip);
+  static runtime_t rt;
+  if (runtime_init(&rt, &scene, &err)) {
+    fprintf(stderr, "viscera-resim: %s\n", err.msg);
+    resim_recording_free(&rec);
+    return 2;
+  }
+  int rc = 2;
+  FILE *csv = NULL;
+  if (resim_check_scene(&rt, &rec, &err)) {
+    fprintf(stderr, "viscera-resim: %s: refusing to re-simulate: %s\n", o->rec_path, err.msg);
+    goto out;
+  }
+  if (o->csv_path) {
+    csv = fopen(o->csv_path, "w");
+    if (!csv) {
+      fprintf(stderr, "viscera-resim: %s: cannot open for writing\n", o->csv_path);
+      goto out;
+    }
+    fprintf(csv, "step,sim_time_s,organ,kind,max_err_m,rms_err_m,exact\n");
+  }
+  double tolerance = o->tolerance;
+  if (tolerance < 0) tolerance = 0.5 * (double)rec.quant_step + RESIM_FLOAT_SLACK;
+  if (!o->quiet)
+    fprintf(stderr,
+            "resim: scene '%s', %zu organ(s), %zu tool(s); recording %s: %" PRIu64 " commands, %" PRIu64
+            " feedback, %" PRIu64 " keyframes, %" PRIu64 " deltas, last frame at step %" PRIu64 " (%.3f s)\n",
+            scene.name, rt.norgans, rt.ntools, o->rec_path, rec.n_commands, rec.n_feedback, rec.n_states, rec.n_deltas,
+            rec.last_step, (double)rec.last_step * scene.dt);
+  progress_ctx_t ctx = {.csv = csv, .dt = scene.dt, .quiet = o->quiet, .t0 = vtime_mono_ns()};
+  ctx.last_print = ctx.t0;
+  resim_hooks_t hooks = {.frame = on_frame, .progress = on_progress, .arg = &ctx};
+  static resim_result_t res;
+  if (resim_run(&rt, &rec, &hooks, &res, &err)) {
+    fprintf(stderr, "viscera-resim: %s: %s\n", o->rec_path, err.msg);
+    goto out;
+  }
+  double wall = (double)(vtime_mono_ns() - ctx.t0) * 1e-9;
+
+  print_schedules(&rt, &rec, &res);
+  int compared = 0, beyond = print_organs(&rt, &rec, &res, &scene, tolerance, &compared);
+  if (res.first_unmatched[0])
+    fprintf(stderr, "viscera-resim: warning: frames not compared; first: %s\n", res.first_unmatched);
+  if (!compared) {
+    fprintf(stderr, "viscera-resim: %s: no mesh frame recorded: nothing to compare\n", o->rec_path);
+    goto out;
+  }
+  printf("RESIM %s steps=%" PRIu64 " rollbacks=%" PRIu64 " tolerance_m=%.3g wall_s=%.2f\n", beyond ? "FAIL" : "PASS",
+         res.steps, res.rollbacks, tolerance, wall);
+  rc = beyond ? 1 : 0;
+out:
+  if (csv && fclose(csv) != 0) {
+    fprintf(stderr, "viscera-resim: %s: write failed\n", o->csv_path);
+    rc = 2;
+  }
+  runtime_destroy(&rt);
+  resim_recording_free(&rec);
+  return rc;
+}

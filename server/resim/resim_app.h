@@ -1,0 +1,16 @@
+/* resim_app: what viscera-resim does once its command line is parsed. */
+#ifndef VISCERA_RESIM_APP_H
+#define VISCERA_RESIM_APP_H
+
+typedef struct resim_options {
+  const char *scene_path; /* --scene FILE */
+  const char *csv_path;   /* --csv FILE, or NULL */
+  const char *rec_path;   /* the recording */
+  double tolerance;       /* --tolerance, m; < 0: quant_step/2 + float slack */
+  int quiet;              /* --quiet */
+} resim_options_t;
+
+/* Exit code: 0 within tolerance, 1 beyond, 2 on an error. */
+int resim_app_run(const resim_options_t *o);
+
+#endif

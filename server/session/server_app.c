@@ -1,0 +1,132 @@
+/* viscera-server after its options: scene check or session run, then the
+ * summary lines on stderr and stdout (SUMMARY, PUBLISHED, PALPATION, TOOL,
+ * TASK, OBJECT) that scripts read. */
+#include "session/server_app.h"
+
+#include <inttypes.h>
+#include <signal.h>
+#include <stdio.h>
+
+#include "dds/vdds.h"
+#include "scene.h"
+#include "vsignal.h"
+
+static volatile sig_atomic_t g_stop = 0;
+static void on_signal(int sig) {
+  (void)sig;
+  g_stop = 1;
+}
+
+/* --check: build the models and print what each organ runs. */
+static int check_scene(const scene_t *scene) {
+  verr_t err;
+  static runtime_t rt;
+  if (runtime_init(&rt, scene, &err)) {
+    fprintf(stderr, "viscera-server: %s\n", err.msg);
+    return 1;
+  }
+  printf("scene '%s': %zu organ(s), %zu tool(s), dt %.3g s\n", scene->name, scene->norgans, scene->ntools, scene->dt);
+  for (size_t i = 0; i < rt.norgans; i++) {
+    const organ_rt_t *o = &rt.organs[i];
+    const model_t *m = o->model;
+    /* "stable dt inf": the scheme is unconditionally stable (implicit). */
+    printf("  organ '%s': model %s, integrator %s, %zu nodes, %zu tets, surface %zu vertices / %zu triangles, "
+           "%d sub-step(s), stable dt %.3g ms\n",
+           o->cfg->name, m->ops->name, o->cfg->integrator, m->nnodes, m->ntets, m->nsurf, m->nsurf_tris, m->substeps,
+           m->stable_dt * 1e3);
+  }
+  runtime_destroy(&rt);
+  return 0;
+}
+
+/* The run's figures on stderr, for a person. */
+static void print_stats(const scene_t *scene, const server_opts_t *opts, const server_stats_t *s) {
+  fprintf(stderr,
+          "server: %" PRIu64 " steps, step time median %.1f us p99 %.1f us max %.1f us, %" PRIu64 " overruns, %" PRIu64
+          " rollbacks\n",
+          s->steps, s->step_us_median, s->step_us_p99, s->step_us_max, s->overruns, s->rollbacks);
+  fprintf(stderr, "server: step CPU time median %.1f us p99 %.1f us; %.3f simulated s per wall s\n",
+          s->step_cpu_us_median, s->step_cpu_us_p99, s->realtime_ratio);
+  if (scene->sleep_speed > 0)
+    fprintf(stderr,
+            "server: organs slept %" PRIu64 " times, woke %" PRIu64 " times; every organ asleep in %" PRIu64
+            " of %" PRIu64 " steps (%.1f %%); steps with an organ awake (%zu recent): wall median %.1f us p99 %.1f "
+            "us, CPU median %.1f us p99 %.1f us\n",
+            s->organ_sleeps, s->organ_wakes, s->steps_all_asleep, s->steps,
+            s->steps ? 100.0 * (double)s->steps_all_asleep / (double)s->steps : 0.0, s->awake_samples,
+            s->awake_step_us_median, s->awake_step_us_p99, s->awake_step_cpu_us_median, s->awake_step_cpu_us_p99);
+  fprintf(stderr, "server: %" PRIu64 " tool commands applied, %" PRIu64 " rejected (", s->commands, s->rejected_total);
+  for (int v = 1; v < TOOLCMD_VERDICT_COUNT; v++)
+    fprintf(stderr, "%s%s: %" PRIu64, v > 1 ? ", " : "", tool_command_verdict_str((tool_cmd_verdict_t)v),
+            s->rejected[v]);
+  fprintf(stderr, ")\n");
+  if (opts->checkpoint)
+    fprintf(stderr, "server: %" PRIu64 " checkpoint(s) written to %s%s\n", s->checkpoints_written, opts->checkpoint,
+            s->resumed ? " (this run resumed from it)" : "");
+  if (s->liveliness_blips)
+    fprintf(stderr,
+            "server: %" PRIu64 " client liveliness lapse(s) while still sending (kept, see liveliness_watch.h)\n",
+            s->liveliness_blips);
+  if (s->deltas_skipped)
+    fprintf(stderr, "server: %" PRIu64 " MeshDelta frames written, %" PRIu64 " skipped (unchanged mesh)\n",
+            s->published[VT_MESH_DELTA], s->deltas_skipped);
+}
+
+/* The run's figures on stdout, one line per kind, for scripts. */
+static void print_summary(const scene_t *scene, const server_stats_t *s) {
+  printf("SUMMARY steps=%" PRIu64 " peak_force=%.3f rejected=%" PRIu64 " rollbacks=%" PRIu64 " step_us_median=%.1f\n",
+         s->steps, s->peak_force, s->rejected_total, s->rollbacks, s->step_us_median);
+  /* What went on the wire, per topic, so a recording can be checked for drops. */
+  printf("PUBLISHED");
+  for (int t = 0; t < VT_COUNT; t++)
+    if (t != VT_TOOL_COMMAND) printf(" %s=%" PRIu64, vdds_topic_name((vdds_topic_id_t)t), s->published[t]);
+  printf("\n");
+  /* Trainee measures per tool (seed 002 ch. 6); levels of 0 are unset. */
+  for (size_t t = 0; t < s->ntools; t++) {
+    const thr_tracker_t *tr = &s->thr[t];
+    printf("PALPATION tool=%s contact_time=%.3f mean_contact_force=%.4f peak_force=%.4f path_length=%.4f",
+           scene->tools[t].name, tr->contact_time, thr_mean_contact_force(tr), tr->peak_force, tr->path_length);
+    for (int k = 0; k < THR_COUNT; k++)
+      printf(" %s=%.3f time_above_%s=%.3f crossings_%s=%u", thr_name((thr_id_t)k), tr->level[k], thr_name((thr_id_t)k),
+             tr->time_above[k], thr_name((thr_id_t)k), tr->crossings[k]);
+    printf("\n");
+  }
+  /* Per tool and per task (issue 4; seed 000 Table 2 operation times). */
+  for (size_t t = 0; t < s->ntools; t++) {
+    const viscera_ToolMetrics *m = &s->tools[t];
+    printf("TOOL tool=%s kind=%s peak_force=%.4f contact_time=%.3f path_length=%.4f exploration_time=%.3f grasps=%u "
+           "grasp_time=%.3f tasks=%u/%u operation_time=%.3f\n",
+           scene->tools[t].name, scene->tools[t].kind, m->peak_force, m->contact_time, m->path_length,
+           m->exploration_time, m->grasps, m->grasp_time, m->tasks_completed, m->tasks_total, m->operation_time);
+  }
+  for (size_t i = 0; i < s->ntasks; i++) {
+    const task_rt_t *k = &s->tasks[i];
+    printf("TASK task=%s kind=%s tool=%s state=%s operation_time=%.3f\n", scene->tasks[i].name, scene->tasks[i].kind,
+           scene->tools[scene->tasks[i].tool].name,
+           k->completed ? "completed"
+           : k->started ? "started"
+                        : "not_started",
+           task_operation_time(k, s->sim_time));
+  }
+  for (size_t i = 0; i < scene->nobjects; i++)
+    printf("OBJECT object=%s removed=%d\n", scene->objects[i].name, s->stone_removed[i]);
+}
+
+int server_app_run(const server_app_options_t *o) {
+  static scene_t scene;
+  verr_t err;
+  if (scene_load(o->scene_path, &scene, &err)) {
+    fprintf(stderr, "viscera-server: %s\n", err.msg);
+    return 1;
+  }
+  if (o->check_only) return check_scene(&scene);
+  vsignal_on_stop(on_signal, 0);
+  server_stats_t st;
+  if (server_run(&scene, &o->opts, &g_stop, &st, &err)) {
+    fprintf(stderr, "viscera-server: %s\n", err.msg);
+    return 1;
+  }
+  print_stats(&scene, &o->opts, &st);
+  print_summary(&scene, &st);
+  return 0;
+}
