@@ -31,3 +31,12 @@ const char *tool_command_verdict_str(tool_cmd_verdict_t v) {
   default: return "?";
   }
 }
+
+void tool_input_from_cmd(const tool_cmd_t *c, tool_input_t *out) {
+  for (int k = 0; k < 3; k++) out->pos[k] = c->position[k];
+  for (int k = 0; k < 4; k++) out->q[k] = c->orientation[k];
+  out->buttons = c->buttons;
+  out->max_force = c->max_force;
+  out->seq = c->seq;
+  out->echo = c->echo;
+}
