@@ -33,10 +33,10 @@ const char *tool_command_verdict_str(tool_cmd_verdict_t v) {
 }
 
 void tool_input_from_cmd(const tool_cmd_t *c, tool_input_t *out) {
-  for (int k = 0; k < 3; k++) out->pos[k] = c->position[k];
-  for (int k = 0; k < 4; k++) out->q[k] = c->orientation[k];
-  out->buttons = c->buttons;
-  out->max_force = c->max_force;
-  out->seq = c->seq;
-  out->echo = c->echo;
+  *out = (tool_input_t){.pos = {c->position[0], c->position[1], c->position[2]},
+                        .q = {c->orientation[0], c->orientation[1], c->orientation[2], c->orientation[3]},
+                        .buttons = c->buttons,
+                        .max_force = c->max_force,
+                        .seq = c->seq,
+                        .echo = c->echo};
 }
