@@ -66,10 +66,11 @@ void runtime_release_tool(runtime_t *rt, size_t t);
 void runtime_topology_restored(runtime_t *rt, size_t organ);
 
 /* One scene step of scene.dt in named phases (scene_runtime.c: inputs,
- * tools, contact, models with cut and topology, contact settle, outputs). Returns the number of
- * organs whose step was rolled back because it produced NaN/Inf. With the
- * scene's sleep_speed > 0 an organ at rest with nothing within reach is
- * skipped (organ_sleep.h; organs_stepped tells how many were stepped). */
+ * tools, contact, models with cut and topology, contact settle, outputs).
+ * Returns the number of organs whose step was rolled back because it
+ * produced NaN/Inf. With the scene's sleep_speed > 0 an organ at rest with
+ * nothing within reach is skipped (organ_sleep.h; organs_stepped tells how
+ * many were stepped). */
 int runtime_step(runtime_t *rt);
 
 #endif
