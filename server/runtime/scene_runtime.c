@@ -134,30 +134,44 @@ void runtime_destroy(runtime_t *rt) {
   rt->norgans = 0;
 }
 
-void runtime_set_tool(runtime_t *rt, size_t t, const double pos[3], double device_max_force) {
-  if (t >= rt->ntools) return;
-  tool_rt_t *tool = &rt->tools[t];
-  v3_copy(tool->device, pos);
-  tool->max_force = fmin(tool->cfg->max_force, device_max_force);
+/* The tip and force limit of the tool's accepted command (tool->cmd). */
+static void take_pose(runtime_t *rt, tool_rt_t *tool) {
+  v3_copy(tool->device, tool->cmd.pos);
+  tool->max_force = fmin(tool->cfg->max_force, tool->cmd.max_force);
   tool->active = 1;
   if (tool->first_cmd_time < 0) tool->first_cmd_time = rt->sim_time;
 }
 
+void runtime_command_tool(runtime_t *rt, size_t t, const tool_input_t *in) {
+  if (t >= rt->ntools) return;
+  tool_rt_t *tool = &rt->tools[t];
+  tool->cmd = *in;
+  take_pose(rt, tool);
+  tool->buttons = in->buttons;
+  shaft_axis(in->q, tool->axis);
+}
+
+void runtime_set_tool(runtime_t *rt, size_t t, const double pos[3], double device_max_force) {
+  if (t >= rt->ntools) return;
+  tool_rt_t *tool = &rt->tools[t];
+  v3_copy(tool->cmd.pos, pos);
+  tool->cmd.max_force = device_max_force;
+  take_pose(rt, tool);
+}
+
 void runtime_set_buttons(runtime_t *rt, size_t t, uint32_t buttons) {
-  if (t < rt->ntools) rt->tools[t].buttons = buttons;
+  if (t >= rt->ntools) return;
+  rt->tools[t].cmd.buttons = buttons;
+  rt->tools[t].buttons = buttons;
 }
 
 void runtime_set_orientation(runtime_t *rt, size_t t, const double q[4]) {
-  if (t < rt->ntools) shaft_axis(q, rt->tools[t].axis);
+  if (t >= rt->ntools) return;
+  memcpy(rt->tools[t].cmd.q, q, sizeof rt->tools[t].cmd.q);
+  shaft_axis(q, rt->tools[t].axis);
 }
 
-void runtime_release_tool(runtime_t *rt, size_t t) {
-  if (t >= rt->ntools) return;
-  interact_release_tool(rt, t);
-  rt->tools[t].active = 0;
-  proxy_reset(&rt->tools[t].proxy);
-  v3_set(rt->tools[t].force, 0, 0, 0);
-}
+void runtime_release_tool(runtime_t *rt, size_t t) { interact_release_tool(rt, t); }
 
 /* The model's hook, before every sub-step: re-evaluates every proxy spring
  * attached to this organ at the sub-step's surface positions and spreads
@@ -270,20 +284,43 @@ static int organ_disturbed(const runtime_t *rt, size_t i) {
   return 0;
 }
 
-int runtime_step(runtime_t *rt) {
-  double dt = rt->scene.dt;
-  /* Stillness over sleep_after, in whole steps (at least 2, scene.c); only
-   * worked out when organs may sleep. */
-  uint32_t need = rt->scene.sleep_speed > 0 ? (uint32_t)fmin(4e9, ceil(rt->scene.sleep_after / dt - 1e-9)) : 0;
-  rt->organs_stepped = 0;
-  interact_before_step(rt);
+/* Phase contact, before the models: every driven tool that meets tissue
+ * moves its god-object toward its tip over the surfaces as they are
+ * (friction), and gathers the patch that takes its reaction in the models'
+ * hook (apply_contacts). */
+static void step_contact(runtime_t *rt) {
   for (size_t t = 0; t < rt->ntools; t++) {
     tool_rt_t *tool = &rt->tools[t];
     if (!tool->active || !interact_uses_proxy(rt, t)) continue;
     proxy_update_friction(&tool->proxy, tool->device, rt->surfaces, rt->norgans, tool->cfg->stiffness, tool->max_force,
-                          tool->cfg->friction, tool->force);
+                          tool->cfg->friction, tool->from.proxy);
     build_patch(rt, tool);
   }
+}
+
+/* Phase topology of organ i: after a cut (or a refinement) changed the
+ * model's topology, everything built on its surface follows at once,
+ * before anything reads the surface again; otherwise the tree is refit
+ * (every step, rolled back or not: the proxy trusts the boxes). */
+static void organ_topology(runtime_t *rt, size_t i, const topo_anchor_t anchors[SCENE_MAX_TOOLS]) {
+  organ_rt_t *o = &rt->organs[i];
+  if (o->model->topology_version != o->topology_version)
+    follow_organ(rt, i, anchors);
+  else if (o->tree.ntris)
+    aabb_tree_refit(&o->tree, o->model->surf_x);
+}
+
+/* Phase models: each organ that is not asleep steps its model (the hook
+ * applies the tools' contact, grasp, shaft and stone forces every
+ * sub-step), then, organ by organ, its cut and the topology follow-up run
+ * (phases cut and topology, inside this loop: the next organ's step reads
+ * the tools as this organ's follow-up left them). Returns the organs whose
+ * step was rolled back. */
+static int step_models(runtime_t *rt) {
+  double dt = rt->scene.dt;
+  /* Stillness over sleep_after, in whole steps (at least 2, scene.c); only
+   * worked out when organs may sleep. */
+  uint32_t need = rt->scene.sleep_speed > 0 ? (uint32_t)fmin(4e9, ceil(rt->scene.sleep_after / dt - 1e-9)) : 0;
   int rolled = 0;
   for (size_t i = 0; i < rt->norgans; i++) {
     organ_rt_t *o = &rt->organs[i];
@@ -307,31 +344,43 @@ int runtime_step(runtime_t *rt) {
       o->rollbacks++;
       rolled++;
     }
-    /* Between model steps: a cut changes the topology here, and the
-     * follow-up below runs before anything reads the surface again. */
-    scalpel_after_organ_step(rt, i);
-    if (o->model->topology_version != o->topology_version) {
-      follow_organ(rt, i, anchors);
-    } else if (o->tree.ntris) {
-      /* Every step, rolled back or not: the proxy trusts the boxes. */
-      aabb_tree_refit(&o->tree, o->model->surf_x);
-    }
+    scalpel_after_organ_step(rt, i); /* phase cut: may change the topology */
+    organ_topology(rt, i, anchors);  /* phase topology */
     /* A rolled-back or re-meshed step is no evidence of rest. */
     if (sleeping)
       organ_sleep_observe(&o->sleep, o->model->surf_x, o->model->nsurf, rt->scene.sleep_speed * dt, need,
                           disturbed || bad || o->topology_version != topo);
   }
-  /* Report the force at the end of the step, with the proxy on the moved surface. */
+  return rolled;
+}
+
+/* Phase contact, after the models: the god-objects settle on the moved
+ * surfaces; their spring is the proxy's contribution to the hand force
+ * (tool->from.proxy). */
+static void settle_contact(runtime_t *rt) {
   for (size_t t = 0; t < rt->ntools; t++) {
     tool_rt_t *tool = &rt->tools[t];
     if (!tool->active) continue;
-    proxy_settle(&tool->proxy, dt);
+    proxy_settle(&tool->proxy, rt->scene.dt);
     proxy_follow_surface(&tool->proxy, rt->surfaces, rt->norgans);
-    double mag = proxy_spring_force(&tool->proxy, tool->device, tool->cfg->stiffness, tool->max_force, tool->force);
-    if (mag > tool->peak_force) tool->peak_force = mag;
+    tool->from.proxy_mag =
+        proxy_spring_force(&tool->proxy, tool->device, tool->cfg->stiffness, tool->max_force, tool->from.proxy);
   }
+}
+
+/* The phases in order: inputs (the accepted commands' jaws), tools (grasp,
+ * release, carry), contact (god-objects onto the surfaces), models (organ
+ * steps, each followed by its cut and topology follow-up), contact again
+ * (settle, proxy spring), outputs (hand force, feedback, events, tasks). */
+int runtime_step(runtime_t *rt) {
+  rt->organs_stepped = 0;
+  interact_inputs(rt);
+  interact_tools(rt);
+  step_contact(rt);
+  int rolled = step_models(rt);
+  settle_contact(rt);
   rt->steps++;
-  rt->sim_time = (double)rt->steps * dt;
-  interact_after_step(rt);
+  rt->sim_time = (double)rt->steps * rt->scene.dt;
+  interact_outputs(rt);
   return rolled;
 }

@@ -46,7 +46,12 @@ typedef struct runtime {
 int runtime_init(runtime_t *rt, const scene_t *scene, verr_t *err);
 void runtime_destroy(runtime_t *rt);
 
-/* Applies a validated command for tool `t`. */
+/* Applies a validated command to tool `t` (runtime/tool_command.h: a
+ * checked tool_cmd_t as tool_input_t): it becomes the tool's cmd, drives its
+ * tip, jaws and shaft from the next step on. */
+void runtime_command_tool(runtime_t *rt, size_t t, const tool_input_t *in);
+/* Parts of a command (re-simulation and tests drive tools this way): */
+/* The tip and the device's force capability; makes the tool active. */
 void runtime_set_tool(runtime_t *rt, size_t t, const double pos[3], double device_max_force);
 /* The command's buttons (bit 0: close the jaws), applied at the next step. */
 void runtime_set_buttons(runtime_t *rt, size_t t, uint32_t buttons);
@@ -60,10 +65,12 @@ void runtime_release_tool(runtime_t *rt, size_t t);
  * proxies, normals; grasps of it released). */
 void runtime_topology_restored(runtime_t *rt, size_t organ);
 
-/* One scene step of scene.dt: contact, then physics. Returns the number of
- * organs whose step was rolled back because it produced NaN/Inf. With the
- * scene's sleep_speed > 0 an organ at rest with nothing within reach is
- * skipped (organ_sleep.h; organs_stepped tells how many were stepped). */
+/* One scene step of scene.dt in named phases (scene_runtime.c: inputs,
+ * tools, contact, models with cut and topology, contact settle, outputs).
+ * Returns the number of organs whose step was rolled back because it
+ * produced NaN/Inf. With the scene's sleep_speed > 0 an organ at rest with
+ * nothing within reach is skipped (organ_sleep.h; organs_stepped tells how
+ * many were stepped). */
 int runtime_step(runtime_t *rt);
 
 #endif

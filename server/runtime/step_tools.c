@@ -113,21 +113,34 @@ static void release_held(runtime_t *rt, size_t t) {
 
 void interact_release_tool(runtime_t *rt, size_t t) {
   if (t >= rt->ntools) return;
+  tool_rt_t *tool = &rt->tools[t];
   release_held(rt, t);
-  rt->tools[t].buttons = rt->tools[t].prev_buttons = 0;
-  rt->tools[t].fb_contact = 0;
+  tool->buttons = tool->prev_buttons = 0;
+  tool->fb_contact = 0;
+  tool->active = 0;
+  proxy_reset(&tool->proxy);
+  interact_hand_force(rt, t);
 }
 
-void interact_before_step(runtime_t *rt) {
+void interact_inputs(runtime_t *rt) {
   for (size_t t = 0; t < rt->ntools; t++) {
     tool_rt_t *tool = &rt->tools[t];
     if (!tool->active) continue;
     int closed = (tool->buttons & 1u) != 0, was = (tool->prev_buttons & 1u) != 0;
     tool->prev_buttons = tool->buttons;
-    if (closed && !was) {
+    tool->closing = closed && !was;
+    tool->opening = !closed && was;
+  }
+}
+
+void interact_tools(runtime_t *rt) {
+  for (size_t t = 0; t < rt->ntools; t++) {
+    tool_rt_t *tool = &rt->tools[t];
+    if (!tool->active) continue;
+    if (tool->closing) {
       if (is_kind(tool, "grasper")) try_grasp_tissue(rt, t);
       if (is_kind(tool, "extractor")) try_grasp_stone(rt, t);
-    } else if (!closed && was) {
+    } else if (tool->opening) {
       release_held(rt, t);
     }
     if (tool->stone >= 0) stone_follow(&rt->stones[tool->stone], tool->device);
@@ -205,14 +218,17 @@ void interact_apply(runtime_t *rt, organ_rt_t *o, model_t *m) {
   }
 }
 
-/* Force f on the tool, clamped; the client is told a contact plane through
- * device + f / k with normal f / |f|, which renders f at the device. */
-static void set_pulled(tool_rt_t *tool, const double f_in[3], int organ) {
-  double f[3];
-  v3_copy(f, f_in);
+/* f clamped to the tool's force limit. */
+static void clamp_force(const tool_rt_t *tool, const double in[3], double f[3]) {
+  v3_copy(f, in);
   double mag = v3_norm(f);
   if (mag > tool->max_force && mag > 0) v3_scale(f, f, tool->max_force / mag);
-  v3_copy(tool->force, f);
+}
+
+/* A pull f (already clamped) on the tool: the client is told a contact
+ * plane through device + f / k with normal f / |f|, which renders f at the
+ * device. */
+static void tell_pulled(tool_rt_t *tool, const double f[3], int organ) {
   tool->fb_contact = 1;
   tool->fb_organ = organ;
   v3_copy(tool->fb_normal, f);
@@ -227,14 +243,15 @@ static void add_nothing(void *ctx, uint32_t i, const double f[3]) {
   (void)f;
 }
 
-/* The shaft's reaction at the end of the step: added to what the tip
- * feels; a shaft touching while the tip is free is a contact of its own. */
-static void shaft_feedback(runtime_t *rt, size_t t) {
+/* The shaft's reaction at the end of the step (from->shaft): added to
+ * what the tip feels; a shaft touching while the tip is free is a contact
+ * of its own. */
+static void shaft_contribution(runtime_t *rt, size_t t) {
   tool_rt_t *tool = &rt->tools[t];
-  double p0[3], p1[3], ft[3] = {0, 0, 0};
+  tool_forces_t *from = &tool->from;
+  double p0[3], p1[3];
+  v3_set(from->shaft, 0, 0, 0);
   if (!shaft_of(rt, t, p0, p1)) return;
-  size_t hits = 0;
-  int organ = -1;
   for (size_t i = 0; i < rt->norgans; i++) {
     const organ_rt_t *o = &rt->organs[i];
     const model_t *m = o->model;
@@ -245,57 +262,119 @@ static void shaft_feedback(runtime_t *rt, size_t t) {
                             m->nsurf_tris,
                             o->tree.ntris && m->topology_version == o->topology_version ? &o->tree : NULL,
                             0};
-    size_t h = tip_on(tool, i)
-                   ? shaft_push(p0, p1, SHAFT_RADIUS_FRACTION * tool->cfg->radius, tool->cfg->stiffness, m->surf_x,
-                                m->nsurf, add_nothing, NULL, ft)
-                   : shaft_contact(p0, p1, SHAFT_RADIUS_FRACTION * tool->cfg->radius, tool->cfg->stiffness, &surf,
-                                   add_nothing, NULL, ft, NULL);
-    if (h && organ < 0) organ = (int)i;
-    hits += h;
-  }
-  if (!hits) return;
-  double f[3];
-  v3_add(f, tool->force, ft);
-  if (tool->fb_contact) {
-    double mag = v3_norm(f);
-    if (mag > tool->max_force && mag > 0) v3_scale(f, f, tool->max_force / mag);
-    v3_copy(tool->force, f);
-  } else {
-    set_pulled(tool, f, organ);
+    size_t h = tip_on(tool, i) ? shaft_push(p0, p1, SHAFT_RADIUS_FRACTION * tool->cfg->radius, tool->cfg->stiffness,
+                                            m->surf_x, m->nsurf, add_nothing, NULL, from->shaft)
+                               : shaft_contact(p0, p1, SHAFT_RADIUS_FRACTION * tool->cfg->radius, tool->cfg->stiffness,
+                                               &surf, add_nothing, NULL, from->shaft, NULL);
+    if (h && from->shaft_organ < 0) from->shaft_organ = (int)i;
+    from->shaft_hits += h;
   }
 }
 
 /* The extractor's tip against a stone it does not hold: a god-object on
- * the sphere of radius stone + tip. */
+ * the sphere of radius stone + tip (from->touch). */
 static void stone_touch(runtime_t *rt, tool_rt_t *tool) {
+  tool_forces_t *from = &tool->from;
   for (size_t i = 0; i < rt->nstones; i++) {
     const stone_t *s = &rt->stones[i];
     double d[3], reach = s->radius + tool->cfg->radius;
     v3_sub(d, tool->device, s->pos);
     double len = v3_norm(d);
     if (!(len < reach) || len < 1e-12) continue;
-    double p[3], f[3];
-    v3_copy(p, s->pos);
-    v3_axpy(p, d, reach / len);
-    v3_sub(f, p, tool->device);
-    v3_scale(f, f, tool->cfg->stiffness);
-    double mag = v3_norm(f);
-    if (mag > tool->max_force) v3_scale(f, f, tool->max_force / mag);
-    v3_copy(tool->force, f);
-    tool->fb_contact = 1;
-    tool->fb_organ = -1;
-    v3_copy(tool->fb_pos, p);
-    v3_scale(tool->fb_normal, d, 1 / len);
+    v3_copy(from->touch_p, s->pos);
+    v3_axpy(from->touch_p, d, reach / len);
+    v3_sub(from->touch_f, from->touch_p, tool->device);
+    v3_scale(from->touch_f, from->touch_f, tool->cfg->stiffness);
+    v3_scale(from->touch_n, d, 1 / len);
+    from->touch = 1;
     return;
+  }
+}
+
+/* What the outputs phase adds to tool t's contributions: the grasp's pull
+ * or the held stone's reaction, an extractor's touch of a free stone, the
+ * shaft's reaction. */
+static void contributions(runtime_t *rt, size_t t) {
+  tool_rt_t *tool = &rt->tools[t];
+  tool_forces_t *from = &tool->from;
+  from->pull = from->touch = from->tool_tool = 0;
+  from->pull_organ = from->shaft_organ = -1;
+  from->shaft_hits = 0;
+  if (!tool->active) return;
+  if (tool->grasp.active) {
+    const model_t *m = rt->organs[tool->grasp.organ].model;
+    double fv[GRASP_MAX_VERTS][3];
+    grasp_force(&tool->grasp, m->surf_x, tool->device, tool->cfg->stiffness, tool->max_force, fv, from->pull_f);
+    from->pull = 1;
+    from->pull_organ = tool->grasp.organ;
+  } else if (tool->stone >= 0) {
+    v3_copy(from->pull_f, rt->stones[tool->stone].force);
+    from->pull = 1;
+  } else if (is_kind(tool, "extractor")) {
+    stone_touch(rt, tool);
+  }
+  shaft_contribution(rt, t);
+}
+
+/* The tip's force before other tools push it: the grasp pull or held
+ * stone (clamped), an extractor's stone touch (clamped) or the proxy
+ * spring, plus the shaft's reaction (the sum clamped). */
+static void tip_force(const tool_rt_t *tool, double f[3]) {
+  const tool_forces_t *from = &tool->from;
+  if (from->pull)
+    clamp_force(tool, from->pull_f, f);
+  else if (is_kind(tool, "extractor") && from->touch)
+    clamp_force(tool, from->touch_f, f);
+  else if (is_kind(tool, "extractor"))
+    v3_set(f, 0, 0, 0);
+  else
+    v3_copy(f, from->proxy);
+  if (from->shaft_hits) {
+    double sum[3];
+    v3_add(sum, f, from->shaft);
+    clamp_force(tool, sum, f);
+  }
+}
+
+/* What tool t's client is told about its tip: a pull's plane, the stone
+ * the extractor touches, or the god-object; a shaft touching while the tip
+ * is free is told as a pull of its own. */
+static void tip_feedback(runtime_t *rt, size_t t) {
+  tool_rt_t *tool = &rt->tools[t];
+  const tool_forces_t *from = &tool->from;
+  tool->fb_contact = 0;
+  tool->fb_organ = -1;
+  if (!tool->active) return;
+  if (from->pull) {
+    double f[3];
+    clamp_force(tool, from->pull_f, f);
+    tell_pulled(tool, f, from->pull_organ);
+  } else if (is_kind(tool, "extractor")) {
+    v3_copy(tool->fb_pos, tool->device);
+    v3_set(tool->fb_normal, 0, 0, 1);
+    if (from->touch) {
+      tool->fb_contact = 1;
+      v3_copy(tool->fb_pos, from->touch_p);
+      v3_copy(tool->fb_normal, from->touch_n);
+    }
+  } else {
+    tool->fb_contact = tool->proxy.in_contact;
+    tool->fb_organ = tool->proxy.in_contact ? tool->proxy.surface : -1;
+    v3_copy(tool->fb_pos, tool->proxy.pos);
+    v3_copy(tool->fb_normal, tool->proxy.normal);
+  }
+  if (from->shaft_hits && !tool->fb_contact) {
+    double f[3];
+    tip_force(tool, f);
+    tell_pulled(tool, f, from->shaft_organ);
   }
 }
 
 /* Keeps every pair of tips at least r_i + r_j apart: each of the two moves
  * half the overlap along the line between them (a few Gauss-Seidel passes
- * for three or more tools in a cluster). A moved tip is a contact: the tool
- * feels K (tip - device), clamped. */
+ * for three or more tools in a cluster). A moved tip is a contact
+ * (from->tool_tool): the tool feels K (tip - device), clamped. */
 static void tool_tool_contact(runtime_t *rt) {
-  int moved[SCENE_MAX_TOOLS] = {0};
   for (int pass = 0; pass < 4; pass++) {
     int any = 0;
     for (size_t a = 0; a < rt->ntools; a++)
@@ -311,60 +390,55 @@ static void tool_tool_contact(runtime_t *rt) {
         v3_scale(n, d, 1 / len);
         v3_axpy(ta->fb_pos, n, push);
         v3_axpy(tb->fb_pos, n, -push);
-        moved[a] = moved[b] = 1;
+        ta->from.tool_tool = tb->from.tool_tool = 1;
         any = 1;
       }
     if (!any) break;
   }
-  for (size_t t = 0; t < rt->ntools; t++) {
-    if (!moved[t]) continue;
-    tool_rt_t *tool = &rt->tools[t];
-    double f[3];
+}
+
+void interact_hand_force(runtime_t *rt, size_t t) {
+  tool_rt_t *tool = &rt->tools[t];
+  const tool_forces_t *from = &tool->from;
+  if (!tool->active) {
+    v3_set(tool->force, 0, 0, 0);
+    return;
+  }
+  double f[3];
+  if (from->tool_tool) {
     v3_sub(f, tool->fb_pos, tool->device);
     v3_scale(f, f, tool->cfg->stiffness);
     double mag = v3_norm(f);
     if (mag > tool->max_force) v3_scale(f, f, tool->max_force / mag);
-    v3_copy(tool->force, f);
-    tool->fb_contact = 1;
-    if (tool->fb_organ < 0 || !tool->proxy.in_contact) {
-      tool->fb_organ = -1;
-      v3_copy(tool->fb_normal, f);
-      if (v3_normalize(tool->fb_normal) <= 0) v3_set(tool->fb_normal, 0, 0, 1);
-    }
+  } else {
+    tip_force(tool, f);
+  }
+  v3_copy(tool->force, f);
+  if (from->proxy_mag > tool->peak_force) tool->peak_force = from->proxy_mag;
+  double mag = v3_norm(tool->force);
+  if (mag > tool->peak_force) tool->peak_force = mag;
+}
+
+/* A tip another tool moved is a contact: with another tool (organ -1, the
+ * force's direction) unless the god-object still touches an organ. */
+static void tool_tool_feedback(tool_rt_t *tool) {
+  tool->fb_contact = 1;
+  if (tool->fb_organ < 0 || !tool->proxy.in_contact) {
+    tool->fb_organ = -1;
+    v3_copy(tool->fb_normal, tool->force);
+    if (v3_normalize(tool->fb_normal) <= 0) v3_set(tool->fb_normal, 0, 0, 1);
   }
 }
 
-void interact_after_step(runtime_t *rt) {
+void interact_outputs(runtime_t *rt) {
   for (size_t t = 0; t < rt->ntools; t++) {
-    tool_rt_t *tool = &rt->tools[t];
-    tool->fb_contact = 0;
-    tool->fb_organ = -1;
-    if (!tool->active) continue;
-    if (tool->grasp.active) {
-      const model_t *m = rt->organs[tool->grasp.organ].model;
-      double fv[GRASP_MAX_VERTS][3], ft[3];
-      grasp_force(&tool->grasp, m->surf_x, tool->device, tool->cfg->stiffness, tool->max_force, fv, ft);
-      set_pulled(tool, ft, tool->grasp.organ);
-    } else if (tool->stone >= 0) {
-      set_pulled(tool, rt->stones[tool->stone].force, -1);
-    } else if (is_kind(tool, "extractor")) {
-      v3_set(tool->force, 0, 0, 0);
-      v3_copy(tool->fb_pos, tool->device);
-      v3_set(tool->fb_normal, 0, 0, 1);
-      stone_touch(rt, tool);
-    } else {
-      tool->fb_contact = tool->proxy.in_contact;
-      tool->fb_organ = tool->proxy.in_contact ? tool->proxy.surface : -1;
-      v3_copy(tool->fb_pos, tool->proxy.pos);
-      v3_copy(tool->fb_normal, tool->proxy.normal);
-    }
-    shaft_feedback(rt, t);
+    contributions(rt, t);
+    tip_feedback(rt, t);
   }
   tool_tool_contact(rt);
   for (size_t t = 0; t < rt->ntools; t++) {
-    tool_rt_t *tool = &rt->tools[t];
-    double mag = tool->active ? v3_norm(tool->force) : 0;
-    if (mag > tool->peak_force) tool->peak_force = mag;
+    interact_hand_force(rt, t);
+    if (rt->tools[t].active && rt->tools[t].from.tool_tool) tool_tool_feedback(&rt->tools[t]);
   }
   for (size_t i = 0; i < rt->nstones; i++) {
     stone_t *s = &rt->stones[i];

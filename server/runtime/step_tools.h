@@ -1,24 +1,25 @@
 /* step_tools: the runtime's tool phases (interact_*): what tools do
- * besides the god-object contact (issue 4). Graspers grasp, hold, pull and
- * release tissue (interaction/grasp.h), extractors take and carry stones
+ * besides the god-object contact. Graspers grasp, hold, pull and release
+ * tissue (interaction/grasp.h), extractors take and carry stones
  * (interaction/stone.h), tools touch each other, tasks progress
- * (interaction/tasks.h). scene_runtime.c calls these at fixed points of its
- * step:
+ * (interaction/tasks.h). runtime_step (scene_runtime.c) calls these in its
+ * phases:
  *
- *   interact_before_step  jaws closing/opening (button bit 0 edges): grab
- *                         or release; held stones follow their tool; tools
- *                         that hold something or have no tissue contact
- *                         (extractor) leave the god-object proxy
- *   interact_apply        in the model hook, every sub-step: grasp springs,
- *                         shaft contact (shaft.h; node test and
- *                         segment-triangle crossings via the organ's tree)
- *                         and stone penalty forces on the organ's surface
- *   interact_after_step   the force each tool feels and what its client is
- *                         told (tool_rt_t.fb_*), tool-tool contact (tips are
- *                         kept at least the sum of their radii apart by
- *                         moving both along the line between them; the
- *                         tools feel K (tip - device)), stone removal,
- *                         tasks
+ *   inputs   interact_inputs: the accepted commands' jaws (button bit 0)
+ *            closing or opening since the last step
+ *   tools    interact_tools: closing grabs, opening releases; held stones
+ *            follow their tool; tools that hold something or have no
+ *            tissue contact (extractor) leave the god-object proxy
+ *   models   interact_apply, in the model hook, every sub-step: grasp
+ *            springs, shaft contact (shaft.h; node test and
+ *            segment-triangle crossings via the organ's tree) and stone
+ *            penalty forces on the organ's surface
+ *   outputs  interact_outputs: each tool's contributions to the force the
+ *            hand feels (grasp pull, held stone, stone touch, shaft), what
+ *            its client is told (tool_rt_t.fb_*), tool-tool contact (tips
+ *            are kept at least the sum of their radii apart by moving both
+ *            along the line between them; the tools feel K (tip - device)),
+ *            the hand force (interact_hand_force), stone removal, tasks
  *
  * Events (grasp begin/end, task started/completed) go to rt->events. */
 #ifndef VISCERA_STEP_TOOLS_H
@@ -29,12 +30,19 @@
 /* Stones from the scene's objects; refuses a stone whose centre is not
  * inside its organ's surface (message names the scene line). */
 int interact_init(runtime_t *rt, verr_t *err);
-void interact_before_step(runtime_t *rt);
+void interact_inputs(runtime_t *rt);
+void interact_tools(runtime_t *rt);
 /* Whether tool t's god-object proxy meets tissue this step. */
 int interact_uses_proxy(const runtime_t *rt, size_t t);
 void interact_apply(runtime_t *rt, organ_rt_t *o, model_t *m);
-void interact_after_step(runtime_t *rt);
-/* The tool's client is gone: drop whatever it holds. */
+void interact_outputs(runtime_t *rt);
+/* The tool's client is gone: drop whatever it holds, leave the contact,
+ * stop acting (tool inactive, no force). */
 void interact_release_tool(runtime_t *rt, size_t t);
+
+/* The force the hand feels on tool t (tool->force, N) from this step's
+ * contributions (tool->from): the only writer of tool->force. Zero for an
+ * inactive tool. Also raises the tool's peak force. */
+void interact_hand_force(runtime_t *rt, size_t t);
 
 #endif

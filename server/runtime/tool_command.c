@@ -31,3 +31,12 @@ const char *tool_command_verdict_str(tool_cmd_verdict_t v) {
   default: return "?";
   }
 }
+
+void tool_input_from_cmd(const tool_cmd_t *c, tool_input_t *out) {
+  *out = (tool_input_t){.pos = {c->position[0], c->position[1], c->position[2]},
+                        .q = {c->orientation[0], c->orientation[1], c->orientation[2], c->orientation[3]},
+                        .buttons = c->buttons,
+                        .max_force = c->max_force,
+                        .seq = c->seq,
+                        .echo = c->echo};
+}

@@ -19,7 +19,21 @@ typedef struct tool_cmd {
   float orientation[4]; /* unit quaternion w, x, y, z */
   uint32_t buttons;     /* bit 0: primary (grasp/cut) */
   float max_force;      /* N, device capability */
+  uint64_t seq, echo;   /* the sender's sequence number and clock (ToolCommand seq, client_mono_ns): not
+                           checked, carried to the ContactFeedback that answers the command */
 } tool_cmd_t;
+
+/* A command as a tool takes it (runtime_command_tool, scene_runtime.h): a
+ * checked tool_cmd_t in the core's precision, or the mix of two stations'
+ * commands for a guided tool (session/tool_roles.h). The same record from
+ * the side that sent it to the tool's record (tool_rt.h: cmd). */
+typedef struct tool_input {
+  double pos[3];    /* m, tool tip in scene frame */
+  double q[4];      /* unit quaternion w, x, y, z */
+  uint32_t buttons; /* bit 0: primary (grasp/cut) */
+  double max_force; /* N, device capability */
+  uint64_t seq, echo;
+} tool_input_t;
 
 typedef enum tool_cmd_verdict {
   TOOLCMD_OK = 0,
@@ -38,5 +52,8 @@ typedef struct tool_workspace {
 
 tool_cmd_verdict_t tool_command_check(const tool_cmd_t *c, size_t ntools, const tool_workspace_t *ws);
 const char *tool_command_verdict_str(tool_cmd_verdict_t v);
+
+/* The checked command in the core's precision (every float widened exactly). */
+void tool_input_from_cmd(const tool_cmd_t *c, tool_input_t *out);
 
 #endif

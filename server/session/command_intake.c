@@ -6,4 +6,6 @@ void command_from_dds(const viscera_ToolCommand *in, tool_cmd_t *out) {
   for (int k = 0; k < 4; k++) out->orientation[k] = in->orientation[k];
   out->buttons = in->buttons;
   out->max_force = in->max_force;
+  out->seq = in->seq;
+  out->echo = in->client_mono_ns;
 }

@@ -23,6 +23,18 @@
 
 #define STEP_RING 65536
 
+/* What the session adds to a tool, by the tool's index in the core's
+ * s->rt.tools (runtime/tool_rt.h: the tool's one record, with the command
+ * as last accepted, its mechanics, contact, hand force and feedback). The
+ * writers and stations that drive it, and when each was last heard, are
+ * the tool's role (roles.tool[t], tool_roles.h); its training measures
+ * are thr[t] and tally[t]. */
+typedef struct session_tool {
+  uint64_t last_cmd_mono; /* monotonic ns when its last command was accepted (the command timeout) */
+  int lost;               /* released for a lost client (to report its return) */
+  int was_contact;        /* the contact last written in ContactFeedback (CONTACT_BEGIN/END) */
+} session_tool_t;
+
 typedef struct server {
   const server_opts_t *opts;
   runtime_t rt;
@@ -31,12 +43,9 @@ typedef struct server {
   dds_entity_t w_objects, w_tool_metrics, w_role;
   tool_tally_t tally[SCENE_MAX_TOOLS];
   mesh_publisher_t pubs[SCENE_MAX_ORGANS];
-  uint64_t cmd_seq[SCENE_MAX_TOOLS], cmd_echo[SCENE_MAX_TOOLS], last_cmd_mono[SCENE_MAX_TOOLS];
-  int was_contact[SCENE_MAX_TOOLS];
-  /* Loss detection: the writers driving each tool are in roles (per side),
-   * and whether the tool was released for a lost client (to report its return). */
+  session_tool_t tool[SCENE_MAX_TOOLS];
+  /* Loss detection: the writers driving each tool are in roles (per side). */
   liveliness_watch_t lw;
-  int tool_lost[SCENE_MAX_TOOLS];
   /* Who drives each tool and each side's latest command (tool_roles.h);
    * the station of each command writer (writer_stations.h). */
   tool_roles_t roles;
@@ -48,6 +57,7 @@ typedef struct server {
   double *step_cpu_us;       /* the same steps' thread CPU times */
   unsigned char *step_awake; /* the same steps: 1 when an organ was stepped (not all asleep, not paused) */
   size_t nstep_us;
+  uint64_t publish_every, metrics_every; /* steps between frames, between metrics */
   server_stats_t *stats;
 } server_t;
 
@@ -210,7 +220,7 @@ static void release_lost_writers(server_t *s, uint64_t now) {
         continue;
       }
       runtime_release_tool(&s->rt, t);
-      s->tool_lost[t] = 1;
+      s->tool[t].lost = 1;
       /* From the last command taken to the listener's report, and to this
        * release (which adds the confirmation delay and the step). */
       double heard_ms = e.mono_ns > last ? (double)(e.mono_ns - last) * 1e-6 : 0;
@@ -234,15 +244,11 @@ static void release_lost_writers(server_t *s, uint64_t now) {
 static void drive_tool(server_t *s, size_t t, uint64_t now) {
   tool_effective_t eff;
   if (!tool_roles_effective(&s->roles, t, now, &eff)) return;
-  if (s->tool_lost[t]) {
-    s->tool_lost[t] = 0;
+  if (s->tool[t].lost) {
+    s->tool[t].lost = 0;
     if (!s->opts->quiet) fprintf(stderr, "server: tool %zu: haptic client back\n", t);
   }
-  runtime_set_tool(&s->rt, t, eff.pos, eff.max_force);
-  runtime_set_buttons(&s->rt, t, eff.buttons);
-  runtime_set_orientation(&s->rt, t, eff.q);
-  s->cmd_seq[t] = eff.seq;
-  s->cmd_echo[t] = eff.echo;
+  runtime_command_tool(&s->rt, t, &eff.cmd);
 }
 
 /* Publishes the ToolRole of every tool whose role changed (or all, after
@@ -258,8 +264,12 @@ static void publish_roles(server_t *s) {
   }
 }
 
-/* Takes every pending ToolCommand; applies valid ones, counts and reports the rest. */
-static void read_commands(server_t *s, uint64_t now) {
+/* Takes every pending ToolCommand from DDS as the core's command
+ * (command_intake.h), checks it (tool_command_check) and its station
+ * (tool_roles_classify), and keeps a valid one as its side's latest
+ * (tool_roles_note); counts and reports the rest. Returns the tools with a
+ * new command (bit t). */
+static uint32_t take_commands(server_t *s, uint64_t now) {
   enum { MAXS = 16 };
   void *samples[MAXS] = {0};
   dds_sample_info_t infos[MAXS];
@@ -302,22 +312,25 @@ static void read_commands(server_t *s, uint64_t now) {
         }
         continue;
       }
-      tool_roles_note(&s->roles, c->tool_id, side, station, infos[i].publication_handle, c, now);
+      tool_roles_note(&s->roles, c->tool_id, side, station, infos[i].publication_handle, &cmd, now);
       fresh |= 1u << c->tool_id;
-      s->last_cmd_mono[c->tool_id] = now;
+      s->tool[c->tool_id].last_cmd_mono = now;
       s->stats->commands++;
     }
     dds_return_loan(s->r_cmd, samples, n);
     if (n < MAXS) break;
   }
-  /* Once per step, after every side's latest command is in. */
-  for (size_t t = 0; t < s->rt.ntools; t++)
-    if (fresh & (1u << t)) drive_tool(s, t, now);
+  return fresh;
+}
+
+/* Releases every driven tool whose client is gone: its writer lost its
+ * liveliness (release_lost_writers) or it sent nothing for tool_timeout. */
+static void release_lost_tools(server_t *s, uint64_t now) {
   release_lost_writers(s, now);
   for (size_t t = 0; t < s->rt.ntools; t++) {
-    if (s->rt.tools[t].active && now - s->last_cmd_mono[t] > (uint64_t)(s->opts->tool_timeout * 1e9)) {
+    if (s->rt.tools[t].active && now - s->tool[t].last_cmd_mono > (uint64_t)(s->opts->tool_timeout * 1e9)) {
       runtime_release_tool(&s->rt, t);
-      s->tool_lost[t] = 1;
+      s->tool[t].lost = 1;
       if (!s->opts->quiet)
         fprintf(stderr, "server: tool %zu: no commands for %.1f s, released\n", t, s->opts->tool_timeout);
       publish_event(s, viscera_EVENT_CLIENT_LOST, -1, (int)t, s->opts->tool_timeout,
@@ -351,7 +364,7 @@ static int rebuild_runtime(server_t *s, const scene_t *sc, const scene_t *old, v
     const scene_tool_t *c = s->rt.tools[t].cfg;
     thr_init(&s->thr[t], c->st, c->mpf, c->sft);
     memset(&s->tally[t], 0, sizeof s->tally[t]);
-    s->was_contact[t] = 0;
+    s->tool[t].was_contact = 0;
   }
   tool_roles_forget_all(&s->roles); /* tools released; roles kept and published again */
   for (size_t i = 0; i < s->rt.norgans; i++) {
@@ -445,8 +458,8 @@ static void publish_feedback(server_t *s) {
     viscera_ContactFeedback fb;
     memset(&fb, 0, sizeof fb);
     fb.tool_id = (uint32_t)t;
-    fb.cmd_seq = s->cmd_seq[t];
-    fb.cmd_client_mono_ns = s->cmd_echo[t];
+    fb.cmd_seq = tool->cmd.seq;
+    fb.cmd_client_mono_ns = tool->cmd.echo;
     fb.sim_time_ns = sim_ns(s);
     /* fb_*: the god-object, or what a grasp, a stone or another tool
      * makes the hand feel (runtime/step_tools.c). */
@@ -460,10 +473,10 @@ static void publish_feedback(server_t *s) {
     }
     if (dds_write(s->w_feedback, &fb) >= 0) s->stats->published[VT_CONTACT_FEEDBACK]++;
     int c = tool->fb_contact != 0;
-    if (c != s->was_contact[t]) {
+    if (c != s->tool[t].was_contact) {
       publish_event(s, c ? viscera_EVENT_CONTACT_BEGIN : viscera_EVENT_CONTACT_END, fb.organ_id, (int)t, 0,
                     c ? "contact begins" : "contact ends");
-      s->was_contact[t] = c;
+      s->tool[t].was_contact = c;
     }
   }
 }
@@ -686,6 +699,58 @@ static void write_final_mesh(server_t *s) {
   }
 }
 
+/* The step's wall and CPU time since t0, c0 (the step-time rings). */
+static void record_step_time(server_t *s, uint64_t t0, uint64_t c0, uint64_t t1) {
+  s->step_cpu_us[s->nstep_us % STEP_RING] = (double)(vtime_thread_cpu_ns() - c0) * 1e-3;
+  int awake = !s->control.paused && s->rt.organs_stepped > 0;
+  s->step_awake[s->nstep_us % STEP_RING] = (unsigned char)awake;
+  if (!s->control.paused && !awake) s->stats->steps_all_asleep++;
+  s->step_us[s->nstep_us++ % STEP_RING] = (double)(t1 - t0) * 1e-3;
+}
+
+/* One step of the session, started at t0 (monotonic ns; c0 the thread's
+ * CPU time then): the walk of a ToolCommand from the DDS take to the
+ * ContactFeedback write. t1 is when the step's work was done (before the
+ * metrics). -1 when the scene could not be rebuilt after a control. */
+static int session_step(server_t *s, uint64_t t0, uint64_t c0, uint64_t *t1) {
+  /* In: take and convert the commands, check them, note each side's latest. */
+  uint32_t fresh = take_commands(s, t0);
+  /* Once per step, after every side's latest command is in: each tool with
+   * a new one takes its effective command (owner, guide or their mix) into
+   * its core record. */
+  for (size_t t = 0; t < s->rt.ntools; t++)
+    if (fresh & (1u << t)) drive_tool(s, t, t0);
+  release_lost_tools(s, t0);
+  if (read_controls(s)) return -1;
+  if (s->roles.changed) publish_roles(s);
+  /* Step: paused, the organs and the measures freeze; commands are still
+   * read (so nothing queues up) and the last contact model keeps going out. */
+  int rolled = s->control.paused ? 0 : runtime_step(&s->rt);
+  if (rolled) {
+    s->stats->rollbacks += (uint64_t)rolled;
+    publish_event(s, viscera_EVENT_STEP_ROLLED_BACK, -1, -1, rolled, "non-finite state: step rolled back");
+    if (!s->opts->quiet) fprintf(stderr, "server: step %" PRIu64 ": non-finite state, rolled back\n", s->rt.steps);
+  }
+  /* Out: keyframes after a topology change, the ContactFeedback of every
+   * driven tool (its force, tip and normal from the core record), the
+   * trainee measures, the step's events, frames and metrics. */
+  follow_topology(s);
+  publish_feedback(s);
+  if (!s->control.paused) {
+    track_thresholds(s);
+    for (size_t t = 0; t < s->rt.ntools; t++) tool_tally_update(&s->tally[t], &s->rt.tools[t], s->rt.scene.dt);
+    publish_interactions(s); /* the events of the step just taken */
+  }
+  if (s->rt.steps % s->publish_every == 0) publish_frames(s);
+  *t1 = vtime_mono_ns();
+  record_step_time(s, t0, c0, *t1);
+  if (s->rt.steps % s->metrics_every == 0) {
+    publish_metrics(s, s->metrics_every);
+    publish_tool_metrics(s);
+  }
+  return 0;
+}
+
 int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_atomic_t *stop, server_stats_t *stats,
                verr_t *err) {
   server_t s;
@@ -759,8 +824,8 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
   publish_event(&s, viscera_EVENT_SESSION_STARTED, -1, -1, stats->resumed, resumed[0] ? resumed : scene->name);
 
   uint64_t dt_ns = (uint64_t)(scene->dt * 1e9);
-  uint64_t publish_every = (uint64_t)fmax(1.0, floor(1.0 / (scene->publish_hz * scene->dt) + 0.5));
-  uint64_t metrics_every = (uint64_t)fmax(1.0, floor(1.0 / scene->dt + 0.5));
+  s.publish_every = (uint64_t)fmax(1.0, floor(1.0 / (scene->publish_hz * scene->dt) + 0.5));
+  s.metrics_every = (uint64_t)fmax(1.0, floor(1.0 / scene->dt + 0.5));
   /* Real time for this thread only, after every other thread (DDS, the
    * checkpoint writer) has started, so they stay SCHED_OTHER. The loop sleeps
    * to each tick in vtime_sleep_until, so FIFO costs the machine no more CPU
@@ -774,37 +839,10 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
   double sim0 = s.rt.sim_time; /* a resumed run starts where its checkpoint was */
   while (!*stop && (opts->duration <= 0 || (double)(vtime_mono_ns() - start) * 1e-9 < opts->duration)) {
     uint64_t t0 = vtime_mono_ns(), c0 = vtime_thread_cpu_ns();
-    read_commands(&s, t0);
-    if (read_controls(&s)) {
+    uint64_t t1;
+    if (session_step(&s, t0, c0, &t1)) {
       stats->overruns++;
       break; /* the scene could not be rebuilt: nothing left to simulate */
-    }
-    if (s.roles.changed) publish_roles(&s);
-    /* Paused: the organs and the measures freeze; commands are still read
-     * (so nothing queues up) and the last contact model keeps going out. */
-    int rolled = s.control.paused ? 0 : runtime_step(&s.rt);
-    if (rolled) {
-      stats->rollbacks += (uint64_t)rolled;
-      publish_event(&s, viscera_EVENT_STEP_ROLLED_BACK, -1, -1, rolled, "non-finite state: step rolled back");
-      if (!opts->quiet) fprintf(stderr, "server: step %" PRIu64 ": non-finite state, rolled back\n", s.rt.steps);
-    }
-    follow_topology(&s);
-    publish_feedback(&s);
-    if (!s.control.paused) {
-      track_thresholds(&s);
-      for (size_t t = 0; t < s.rt.ntools; t++) tool_tally_update(&s.tally[t], &s.rt.tools[t], scene->dt);
-      publish_interactions(&s); /* the events of the step just taken */
-    }
-    if (s.rt.steps % publish_every == 0) publish_frames(&s);
-    uint64_t t1 = vtime_mono_ns();
-    s.step_cpu_us[s.nstep_us % STEP_RING] = (double)(vtime_thread_cpu_ns() - c0) * 1e-3;
-    int awake = !s.control.paused && s.rt.organs_stepped > 0;
-    s.step_awake[s.nstep_us % STEP_RING] = (unsigned char)awake;
-    if (!s.control.paused && !awake) stats->steps_all_asleep++;
-    s.step_us[s.nstep_us++ % STEP_RING] = (double)(t1 - t0) * 1e-3;
-    if (s.rt.steps % metrics_every == 0) {
-      publish_metrics(&s, metrics_every);
-      publish_tool_metrics(&s);
     }
     if (ckpt && s.rt.steps % ckpt_every == 0) checkpointer_submit(ckpt, &s.rt, s.thr, s.tally, &s.roles);
     next += dt_ns;
@@ -815,7 +853,7 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
     vtime_sleep_until(next);
   }
   publish_frames(&s);
-  publish_metrics(&s, metrics_every);
+  publish_metrics(&s, s.metrics_every);
   publish_tool_metrics(&s);
   if (ckpt) {
     checkpointer_submit(ckpt, &s.rt, s.thr, s.tally, &s.roles);

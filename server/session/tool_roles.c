@@ -37,33 +37,19 @@ tool_side_t tool_roles_classify(const tool_roles_t *r, size_t t, const char *sta
 }
 
 void tool_roles_note(tool_roles_t *r, size_t t, tool_side_t side, const char *station, uint64_t writer,
-                     const viscera_ToolCommand *c, uint64_t now_ns) {
+                     const tool_cmd_t *c, uint64_t now_ns) {
   if (t >= r->ntools || side == TOOL_SIDE_REJECTED) return;
   tool_pose_t *p = &r->tool[t].side[side];
   p->has = 1;
   copy_station(p->station, station);
   p->writer = writer;
-  for (int k = 0; k < 3; k++) p->pos[k] = c->position[k];
-  for (int k = 0; k < 4; k++) p->q[k] = c->orientation[k];
-  p->buttons = c->buttons;
-  p->max_force = c->max_force;
-  p->seq = c->seq;
-  p->echo = c->client_mono_ns;
+  tool_input_from_cmd(c, &p->cmd);
   p->mono_ns = now_ns;
 }
 
 static int present(const tool_pose_t *p, uint64_t now_ns) {
   /* A command stamped after now (taken later in the same step) is fresh. */
   return p->has && (now_ns <= p->mono_ns || now_ns - p->mono_ns <= TOOL_ROLE_ABSENT_NS);
-}
-
-static void take_side(const tool_pose_t *p, tool_effective_t *out) {
-  memcpy(out->pos, p->pos, sizeof out->pos);
-  memcpy(out->q, p->q, sizeof out->q);
-  out->buttons = p->buttons;
-  out->max_force = p->max_force;
-  out->seq = p->seq;
-  out->echo = p->echo;
 }
 
 int tool_roles_effective(const tool_roles_t *r, size_t t, uint64_t now_ns, tool_effective_t *out) {
@@ -75,22 +61,22 @@ int tool_roles_effective(const tool_roles_t *r, size_t t, uint64_t now_ns, tool_
   out->guide_present = tr->guide[0] && present(g, now_ns);
   if (!out->owner_present && !out->guide_present) return 0;
   if (!out->guide_present) {
-    take_side(o, out);
+    out->cmd = o->cmd;
     return 1;
   }
   if (!out->owner_present) {
-    take_side(g, out);
+    out->cmd = g->cmd;
     return 1;
   }
   double a = tr->authority;
   /* The dominant side gives what cannot be averaged (buttons, the shaft's
    * orientation: a mean of two quaternions is not the pose of either). */
-  take_side(a >= 0.5 ? g : o, out);
-  for (int k = 0; k < 3; k++) out->pos[k] = a * g->pos[k] + (1 - a) * o->pos[k];
-  out->max_force = fmin(o->max_force, g->max_force);
+  out->cmd = a >= 0.5 ? g->cmd : o->cmd;
+  for (int k = 0; k < 3; k++) out->cmd.pos[k] = a * g->cmd.pos[k] + (1 - a) * o->cmd.pos[k];
+  out->cmd.max_force = fmin(o->cmd.max_force, g->cmd.max_force);
   /* The trainee's client measures its latency from this echo. */
-  out->seq = o->seq;
-  out->echo = o->echo;
+  out->cmd.seq = o->cmd.seq;
+  out->cmd.echo = o->cmd.echo;
   return 1;
 }
 

@@ -31,6 +31,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "runtime/tool_command.h"
 #include "scene.h"
 #include "viscera.h"
 
@@ -45,11 +46,8 @@ typedef struct tool_pose {
   int has;                             /* a command was taken since the side was (re)set */
   char station[TOOL_ROLE_STATION_MAX]; /* who sent it ("" anonymous) */
   uint64_t writer;                     /* its writer's publication handle (liveliness) */
-  double pos[3], q[4];
-  uint32_t buttons;
-  double max_force;
-  uint64_t seq, echo; /* ToolCommand seq and client_mono_ns, echoed in ContactFeedback */
-  uint64_t mono_ns;   /* when it was taken (server monotonic clock) */
+  uint64_t mono_ns;                    /* when it was taken (server monotonic clock) */
+  tool_input_t cmd;                    /* the command (its seq and echo go back in ContactFeedback) */
 } tool_pose_t;
 
 typedef struct tool_role {
@@ -67,12 +65,10 @@ typedef struct tool_roles {
   uint32_t changed; /* bit t: tool t's role changed and is not yet published */
 } tool_roles_t;
 
-/* The pose the tool takes now (tool_roles_effective). */
+/* The command the tool takes now (tool_roles_effective), for
+ * runtime_command_tool. */
 typedef struct tool_effective {
-  double pos[3], q[4];
-  uint32_t buttons;
-  double max_force;
-  uint64_t seq, echo;
+  tool_input_t cmd;
   int owner_present, guide_present;
 } tool_effective_t;
 
@@ -88,7 +84,7 @@ tool_side_t tool_roles_classify(const tool_roles_t *r, size_t t, const char *sta
 
 /* Keeps command c (already validated by tool_command_check, runtime/tool_command.h) as side's latest. */
 void tool_roles_note(tool_roles_t *r, size_t t, tool_side_t side, const char *station, uint64_t writer,
-                     const viscera_ToolCommand *c, uint64_t now_ns);
+                     const tool_cmd_t *c, uint64_t now_ns);
 
 /* The mixed pose of tool t at now_ns; returns 0 when neither side is
  * present (nothing to apply), 1 otherwise. */

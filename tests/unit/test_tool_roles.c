@@ -27,8 +27,8 @@ static void load_scene(void) {
   CHECK(scene_loads(&scene, &err, yaml, "/base"));
 }
 
-static viscera_ToolCommand command(double x, double y, double z, uint32_t buttons, float max_force, uint64_t seq) {
-  viscera_ToolCommand c;
+static tool_cmd_t command(double x, double y, double z, uint32_t buttons, float max_force, uint64_t seq) {
+  tool_cmd_t c;
   memset(&c, 0, sizeof c);
   c.position[0] = (float)x;
   c.position[1] = (float)y;
@@ -37,7 +37,7 @@ static viscera_ToolCommand command(double x, double y, double z, uint32_t button
   c.buttons = buttons;
   c.max_force = max_force;
   c.seq = seq;
-  c.client_mono_ns = seq * 1000;
+  c.echo = seq * 1000;
   return c;
 }
 
@@ -102,41 +102,41 @@ static void test_mix(void) {
   uint64_t t0 = 1000 * MS;
   tool_effective_t e;
   CHECK(tool_roles_effective(&r, 0, t0, &e) == 0); /* nobody sent anything yet */
-  viscera_ToolCommand ca = command(0.0, 0.0, 0.04, 0, 4.0f, 7), cb = command(0.02, 0.0, 0.06, 1, 3.0f, 9);
+  tool_cmd_t ca = command(0.0, 0.0, 0.04, 0, 4.0f, 7), cb = command(0.02, 0.0, 0.06, 1, 3.0f, 9);
   cb.orientation[0] = 0;
   cb.orientation[1] = 1; /* the guide holds its shaft another way */
   tool_roles_note(&r, 0, TOOL_SIDE_OWNER, "alice", 11, &ca, t0);
   tool_roles_note(&r, 0, TOOL_SIDE_GUIDE, "bob", 22, &cb, t0 + 1 * MS);
   CHECK(tool_roles_effective(&r, 0, t0 + 2 * MS, &e) == 1);
   CHECK(e.owner_present && e.guide_present);
-  CHECK_NEAR(e.pos[0], 0.25 * 0.02, 1e-7);
-  CHECK_NEAR(e.pos[2], 0.75 * 0.04 + 0.25 * 0.06, 1e-7);
-  CHECK(e.buttons == 0);               /* authority < 0.5: the owner's */
-  CHECK_NEAR(e.q[0], 1, 0);            /* and the owner's orientation */
-  CHECK_NEAR(e.max_force, 3.0, 0);     /* the weaker device */
-  CHECK(e.seq == 7 && e.echo == 7000); /* the owner's echo */
+  CHECK_NEAR(e.cmd.pos[0], 0.25 * 0.02, 1e-7);
+  CHECK_NEAR(e.cmd.pos[2], 0.75 * 0.04 + 0.25 * 0.06, 1e-7);
+  CHECK(e.cmd.buttons == 0);                   /* authority < 0.5: the owner's */
+  CHECK_NEAR(e.cmd.q[0], 1, 0);                /* and the owner's orientation */
+  CHECK_NEAR(e.cmd.max_force, 3.0, 0);         /* the weaker device */
+  CHECK(e.cmd.seq == 7 && e.cmd.echo == 7000); /* the owner's echo */
 
   /* Authority 0.5: halfway; the guide's buttons and orientation. */
   CHECK(apply(&r, viscera_CONTROL_GUIDE, 0, "bob", 0.5, 100, text, sizeof text) == 0);
   CHECK(r.tool[0].side[TOOL_SIDE_OWNER].has && r.tool[0].side[TOOL_SIDE_GUIDE].has); /* same stations: kept */
   CHECK(tool_roles_effective(&r, 0, t0 + 2 * MS, &e) == 1);
-  CHECK_NEAR(e.pos[0], 0.01, 1e-7);
-  CHECK_NEAR(e.pos[2], 0.05, 1e-7);
-  CHECK(e.buttons == 1);
-  CHECK_NEAR(e.q[1], 1, 0);
-  CHECK(e.seq == 7);
+  CHECK_NEAR(e.cmd.pos[0], 0.01, 1e-7);
+  CHECK_NEAR(e.cmd.pos[2], 0.05, 1e-7);
+  CHECK(e.cmd.buttons == 1);
+  CHECK_NEAR(e.cmd.q[1], 1, 0);
+  CHECK(e.cmd.seq == 7);
 
   /* Take-over: the guide's pose. */
   CHECK(apply(&r, viscera_CONTROL_GUIDE, 0, "bob", 1, 0, text, sizeof text) == 0);
   CHECK(strstr(text, "taken over by station 'bob'") != NULL);
   CHECK(tool_roles_effective(&r, 0, t0 + 2 * MS, &e) == 1);
-  CHECK_NEAR(e.pos[0], 0.02, 1e-7);
-  CHECK_NEAR(e.pos[2], 0.06, 1e-7);
+  CHECK_NEAR(e.cmd.pos[0], 0.02, 1e-7);
+  CHECK_NEAR(e.cmd.pos[2], 0.06, 1e-7);
 
   /* Authority 0: the owner's pose although the guide is there. */
   CHECK(apply(&r, viscera_CONTROL_GUIDE, 0, "bob", 0, 0, text, sizeof text) == 0);
   CHECK(tool_roles_effective(&r, 0, t0 + 2 * MS, &e) == 1);
-  CHECK_NEAR(e.pos[0], 0.0, 1e-7);
+  CHECK_NEAR(e.cmd.pos[0], 0.0, 1e-7);
   CHECK(e.guide_present);
 }
 
@@ -147,19 +147,19 @@ static void test_absent_side(void) {
   CHECK(apply(&r, viscera_CONTROL_GUIDE, 1, "bob", 0.5, 0, text, sizeof text) == 0);
   CHECK_NEAR(r.tool[1].coupling, 150, 0); /* default capped by the tool's stiffness */
   uint64_t t0 = 5000 * MS;
-  viscera_ToolCommand ca = command(0.0, 0.0, 0.04, 0, 4.0f, 1), cb = command(0.02, 0.0, 0.04, 1, 4.0f, 2);
+  tool_cmd_t ca = command(0.0, 0.0, 0.04, 0, 4.0f, 1), cb = command(0.02, 0.0, 0.04, 1, 4.0f, 2);
   tool_roles_note(&r, 1, TOOL_SIDE_OWNER, "alice", 11, &ca, t0);
   tool_roles_note(&r, 1, TOOL_SIDE_GUIDE, "bob", 22, &cb, t0 + 60 * MS);
   tool_effective_t e;
   /* At +100 ms both are there (the owner exactly at its limit). */
   CHECK(tool_roles_effective(&r, 1, t0 + 100 * MS, &e) == 1);
-  CHECK_NEAR(e.pos[0], 0.01, 1e-7);
+  CHECK_NEAR(e.cmd.pos[0], 0.01, 1e-7);
   /* At +101 ms the owner has been silent for more than 100 ms: the guide alone,
    * with the guide's echo (the owner's is stale). */
   CHECK(tool_roles_effective(&r, 1, t0 + 101 * MS, &e) == 1);
   CHECK(!e.owner_present && e.guide_present);
-  CHECK_NEAR(e.pos[0], 0.02, 1e-7);
-  CHECK(e.buttons == 1 && e.seq == 2);
+  CHECK_NEAR(e.cmd.pos[0], 0.02, 1e-7);
+  CHECK(e.cmd.buttons == 1 && e.cmd.seq == 2);
   /* Both silent: nothing to apply. */
   CHECK(tool_roles_effective(&r, 1, t0 + 161 * MS, &e) == 0);
   /* The guide's writer lost: the owner alone at once. */
@@ -170,7 +170,7 @@ static void test_absent_side(void) {
   CHECK(tool_roles_side_of_writer(&r, 1, 33) == -1);
   tool_roles_forget(&r, 1, TOOL_SIDE_GUIDE);
   CHECK(tool_roles_effective(&r, 1, t0 + 201 * MS, &e) == 1);
-  CHECK_NEAR(e.pos[0], 0.0, 1e-7);
+  CHECK_NEAR(e.cmd.pos[0], 0.0, 1e-7);
   CHECK(tool_roles_side_of_writer(&r, 1, 22) == -1);
   /* A reset forgets every command and republishes every role. */
   r.changed = 0;
@@ -185,7 +185,7 @@ static void test_role_changes_drop_stale_sides(void) {
   char text[200];
   tool_roles_init(&r, &scene);
   uint64_t t0 = 100 * MS;
-  viscera_ToolCommand cb = command(0.02, 0.0, 0.04, 0, 4.0f, 2);
+  tool_cmd_t cb = command(0.02, 0.0, 0.04, 0, 4.0f, 2);
   /* Tool 0 is anyone's: bob's command is an owner-side one... */
   tool_roles_note(&r, 0, TOOL_SIDE_OWNER, "bob", 22, &cb, t0);
   /* ...until bob becomes the guide: then it must not keep counting as the owner. */
