@@ -3,7 +3,7 @@
 # time above the crossed thresholds, in the recording and the server summary.
 # Domain 70.
 if(TARGET viscera-recorder)
-  add_executable(rec_palpation ${CMAKE_CURRENT_LIST_DIR}/rec_palpation.c ${CMAKE_CURRENT_LIST_DIR}/rec_read.c)
-  target_link_libraries(rec_palpation PRIVATE viscera_recording)
+  add_executable(rec_palpation ${CMAKE_CURRENT_LIST_DIR}/rec_palpation.c)
+  target_link_libraries(rec_palpation PRIVATE viscera_test_recording viscera_recording)
   viscera_integration_test(palpation_thresholds 70 palpation_test.sh)
 endif()
