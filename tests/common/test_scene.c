@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include "check.h"
+#include "test_assets.h"
 #include "scene.h"
 #include "scene_expect.h"
 
@@ -228,8 +229,10 @@ static void test_wrong_types(void) {
   CHECK(fails_with(HEAD "    integrator: leapfrog\n", "t.yaml:5:",
                    "organs[0].integrator': must be one of: symplectic_euler, explicit_euler, verlet, rk4, "
                    "implicit_euler (got 'leapfrog')"));
-  CHECK(fails_with(HEAD "    model: fem\n", "mass_spring_surface, mass_spring_tet, molecular, pbd, xpbd, vertex_based, "
-                   "adaptive_mass_spring (got 'fem')", NULL));
+  CHECK(fails_with(HEAD "    model: fem\n",
+                   "mass_spring_surface, mass_spring_tet, molecular, pbd, xpbd, vertex_based, "
+                   "adaptive_mass_spring (got 'fem')",
+                   NULL));
   CHECK(fails_with(HEAD "    solver: 4\n", "t.yaml:5: field 'organs[0].solver': must be a mapping", NULL));
   CHECK(fails_with(HEAD "    solver: {substeps: two}\n", "organs[0].solver.substeps': must be a number (got 'two')",
                    NULL));
@@ -279,7 +282,6 @@ static void test_out_of_range(void) {
   CHECK(fails_with(HEAD "tools: [{name: p, max_force: 0}]\n", "tools[0].max_force'", NULL));
   CHECK(fails_with(HEAD "tools: [{name: p, max_force: 101}]\n", "tools[0].max_force'", NULL));
 }
-
 
 /* The model-specific fields: solver settings and the extra material keys,
  * with their defaults (scene.h) and every range. */
@@ -332,8 +334,8 @@ static void test_model_fields(void) {
   CHECK_NEAR(m->refine_area, 1e-5, 1e-20);
   CHECK(m->refine_levels == 4);
   /* Defaults: every model and integrator name is accepted; the rest as in scene.h. */
-  static const char *const models[] = {"mass_spring_surface", "mass_spring_tet", "molecular", "pbd", "xpbd",
-                                       "vertex_based", "adaptive_mass_spring"};
+  static const char *const models[] = {"mass_spring_surface", "mass_spring_tet",     "molecular", "pbd", "xpbd",
+                                       "vertex_based",        "adaptive_mass_spring"};
   static const char *const integrators[] = {"explicit_euler", "symplectic_euler", "verlet", "rk4", "implicit_euler"};
   char yaml[256];
   for (size_t i = 0; i < sizeof models / sizeof models[0]; i++) {
@@ -364,9 +366,11 @@ static void test_model_fields(void) {
   CHECK(m->refine_levels == 2);
   /* Limits themselves load. */
   CHECK(loads(HEAD "    solver: {substeps: 256, iterations: 1000, cg_tolerance: 0.1, cg_max_iterations: 10000, "
-                   "tet_size: 0.1}\n", NULL));
+                   "tet_size: 0.1}\n",
+              NULL));
   CHECK(loads(HEAD "    solver: {substeps: 0, iterations: 1, cg_tolerance: 1e-12, cg_max_iterations: 1, "
-                   "tet_size: 1e-4}\n", NULL));
+                   "tet_size: 1e-4}\n",
+              NULL));
   CHECK(loads(HEAD "    material: {distance_stiffness: 1, volume_stiffness: 1, refine_levels: 1}\n", NULL));
 }
 
@@ -376,8 +380,8 @@ static void test_model_field_ranges(void) {
   CHECK(fails_with(HEAD "    solver: {substeps: -1}\n", "organs[0].solver.substeps': must be >= 0", NULL));
   CHECK(fails_with(HEAD "    solver: {substeps: 2.5}\n",
                    "t.yaml:5: field 'organs[0].solver.substeps': must be a whole number (got 2.5)", NULL));
-  CHECK(fails_with(HEAD "    solver: {iterations: 0}\n", "organs[0].solver.iterations': must be >= 1 and <= 1000",
-                   NULL));
+  CHECK(
+      fails_with(HEAD "    solver: {iterations: 0}\n", "organs[0].solver.iterations': must be >= 1 and <= 1000", NULL));
   CHECK(fails_with(HEAD "    solver: {iterations: 1001}\n", "organs[0].solver.iterations'", "(got 1001)"));
   CHECK(fails_with(HEAD "    solver: {cg_tolerance: 1e-13}\n",
                    "organs[0].solver.cg_tolerance': must be >= 1e-12 and <= 0.1 (got 1e-13)", NULL));
@@ -388,7 +392,8 @@ static void test_model_field_ranges(void) {
   CHECK(fails_with(HEAD "    solver: {cg_max_iterations: 1e3x}\n", "must be a number", NULL));
   CHECK(fails_with(HEAD "    solver:\n      tet_size: 5e-5\n",
                    "t.yaml:6: field 'organs[0].solver.tet_size': must be 0 (automatic) or >= 0.0001 and <= 0.1 "
-                   "(got 5e-5)", NULL));
+                   "(got 5e-5)",
+                   NULL));
   CHECK(fails_with(HEAD "    solver: {tet_size: 0.2}\n", "organs[0].solver.tet_size': must be >= 0 and <= 0.1", NULL));
   CHECK(fails_with(HEAD "    solver: {tet_size: -0.01}\n", "organs[0].solver.tet_size'", NULL));
   CHECK(fails_with(HEAD "    material: {bond_k: -1}\n", "organs[0].material.bond_k': must be >= 0", NULL));
@@ -418,7 +423,8 @@ static void test_model_consistency(void) {
   /* k_r k_theta = 30 * 0.001 = 0.03 <= 2 k_sb^2 = 0.08: refused at the
    * coupling's line, with the numbers. */
   CHECK(fails_with(HEAD "    model: molecular\n    material:\n      bond_k: 30\n      angle_k: 0.001\n"
-                        "      stretch_bend_k: 0.2\n", "", NULL));
+                        "      stretch_bend_k: 0.2\n",
+                   "", NULL));
   CHECK(!strcmp(e.msg, "t.yaml:9: field 'organs[0].material.stretch_bend_k': the molecular model needs bond_k * "
                        "angle_k > 2 * stretch_bend_k^2 for a positive-definite energy (got 30 * 0.001 = 0.03 <= "
                        "2 * 0.2^2 = 0.08)"));
@@ -439,11 +445,12 @@ static void test_model_consistency(void) {
 
   CHECK(fails_with(HEAD "    model: vertex_based\n    material:\n      slope_m1: 0.5\n",
                    "t.yaml:7: field 'organs[0].material.slope_m1': the vertex_based model needs slope_m1 > slope_m2 > "
-                   "slope_m3 (got 0.5, 0.6, 0.3)", NULL));
+                   "slope_m3 (got 0.5, 0.6, 0.3)",
+                   NULL));
   CHECK(fails_with(HEAD "    model: vertex_based\n    material: {slope_m1: 1, slope_m2: 0.5, slope_m3: 0.5}\n",
                    "t.yaml:6: field 'organs[0].material.slope_m3'", "(got 1, 0.5, 0.5)"));
-  CHECK(fails_with(HEAD "    model: vertex_based\n    material: {slope_m2: 2}\n",
-                   "organs[0].material.slope_m2'", "(got 1, 2, 0.3)"));
+  CHECK(fails_with(HEAD "    model: vertex_based\n    material: {slope_m2: 2}\n", "organs[0].material.slope_m2'",
+                   "(got 1, 2, 0.3)"));
   CHECK(loads(HEAD "    model: vertex_based\n    material: {slope_m1: 2, slope_m2: 1, slope_m3: 0.5}\n", NULL));
   CHECK(loads(HEAD "    model: vertex_based\n", NULL));
 }
@@ -624,7 +631,7 @@ static void test_default_asset(void) {
   CHECK(src != NULL); /* set by ctest */
   if (!src) return;
   char path[1024], want[1100];
-  snprintf(path, sizeof path, "%s/assets/scenes/default.yaml", src);
+  snprintf(path, sizeof path, "%s", test_asset("scenes/default.yaml"));
   if (scene_load(path, &s, &e) != 0) {
     fprintf(stderr, "  %s\n", e.msg);
     CHECK(!"default.yaml loads");

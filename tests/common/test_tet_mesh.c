@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "test_assets.h"
 #include "mesh.h"
 #include "mesh_import.h"
 #include "tet_mesh.h"
@@ -551,9 +552,7 @@ int main(void) {
   test_build_errors();
 
   /* The generated organs: snapping keeps every tetrahedron at radius ratio >= 0.25. */
-  const char *src = getenv("VISCERA_SOURCE_DIR");
-  char dir[4096];
-  snprintf(dir, sizeof dir, "%s/assets/meshes", src ? src : ".");
+  const char *dir = test_asset("meshes");
   const build_expect_t organs = {0.25, 0.05, 1e-12, 1};
   int n = build_dir(dir, "tissue_block.obj", &organs);
   CHECK(n >= 5);

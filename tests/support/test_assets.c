@@ -31,3 +31,9 @@ int test_mesh_load(const char *name, mesh_t *m) {
   }
   return 0;
 }
+
+int test_organ_load(const char *organ, mesh_t *m) {
+  char name[256];
+  snprintf(name, sizeof name, "%s.obj", organ);
+  return test_mesh_load(name, m);
+}

@@ -20,4 +20,7 @@ const char *test_asset(const char *sub);
 /* Loads assets/meshes/<name> into *m: 0, or -1 after printing why. */
 int test_mesh_load(const char *name, mesh_t *m);
 
+/* The same for an organ by name: assets/meshes/<organ>.obj. */
+int test_organ_load(const char *organ, mesh_t *m);
+
 #endif

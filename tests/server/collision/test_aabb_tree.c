@@ -12,19 +12,15 @@
 #include <string.h>
 
 #include "check.h"
+#include "test_rng.h"
+#include "test_assets.h"
 #include "collision/aabb_tree.h"
 #include "mesh.h"
 #include "mesh_import.h"
 #include "vmath.h"
 
 static uint64_t rng_state = 0x9e3779b97f4a7c15ull;
-static double urand(void) { /* splitmix64 -> [0, 1) */
-  uint64_t z = (rng_state += 0x9e3779b97f4a7c15ull);
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-  z ^= z >> 31;
-  return (double)(z >> 11) * (1.0 / 9007199254740992.0);
-}
+static double urand(void) { return test_rng_uniform(&rng_state); } /* splitmix64 -> [0, 1) */
 static double srand1(void) { return 2 * urand() - 1; }
 
 /* ---- brute-force references ---- */
@@ -48,7 +44,8 @@ static int brute_nearest(const double *x, const uint32_t *tris, size_t ntris, co
     }
   }
   if (found) {
-    const double *a = x + 3 * tris[3 * out->tri], *b = x + 3 * tris[3 * out->tri + 1], *c = x + 3 * tris[3 * out->tri + 2];
+    const double *a = x + 3 * tris[3 * out->tri], *b = x + 3 * tris[3 * out->tri + 1],
+                 *c = x + 3 * tris[3 * out->tri + 2];
     double e1[3], e2[3], n[3], o[3];
     v3_sub(e1, b, a);
     v3_sub(e2, c, a);
@@ -234,8 +231,8 @@ static void compare_queries(const char *what, const aabb_tree_t *t, const double
     if (fa != fb || (fa && (a.tri != b.tri || a.dist2 != b.dist2 || memcmp(a.bary, b.bary, sizeof a.bary) ||
                             memcmp(a.point, b.point, sizeof a.point) || a.behind != b.behind))) {
       if (fail_near++ < 3)
-        fprintf(stderr, "%s nearest %d: tree %d tri %u d2 %.17g, scan %d tri %u d2 %.17g\n", what, i, fa, a.tri, a.dist2,
-                fb, b.tri, b.dist2);
+        fprintf(stderr, "%s nearest %d: tree %d tri %u d2 %.17g, scan %d tri %u d2 %.17g\n", what, i, fa, a.tri,
+                a.dist2, fb, b.tri, b.dist2);
     }
     st->nearest++;
     /* The limit is strict: the best distance itself excludes everything. */
@@ -273,8 +270,10 @@ static void compare_queries(const char *what, const aabb_tree_t *t, const double
           }
         }
         bad |= ha.vertex != vmin;
-        if (entering) st->seg_enter_hits++;
-        else st->seg_hits++;
+        if (entering)
+          st->seg_enter_hits++;
+        else
+          st->seg_hits++;
         /* Limit strict: nothing before t_max == the first hit's t. */
         aabb_hit_t hc;
         bad |= aabb_tree_segment_first(t, p0, p1, entering, hb.t, &hc);
@@ -321,12 +320,10 @@ static void deform(const double *rest, double *x, size_t n, double amp, double p
 }
 
 static int organ(const char *dir, const char *name, int nq) {
-  char path[1024];
-  snprintf(path, sizeof path, "%s/assets/meshes/%s.obj", dir, name);
+  (void)dir; /* the support library finds the assets */
   mesh_t m;
   verr_t err;
-  if (mesh_import(path, &m, &err)) {
-    fprintf(stderr, "%s\n", err.msg);
+  if (test_organ_load(name, &m)) {
     CHECK(0);
     return -1;
   }
@@ -428,7 +425,8 @@ static void small_cases(void) {
   CHECK(h.vertex == 0);
   CHECK(aabb_tree_segment_first(&t, (double[]){0.1, 0.1, -1}, (double[]){0.1, 0.1, 1}, AABB_SEG_ENTERING, INFINITY,
                                 &h) == 0);
-  CHECK(aabb_tree_segment_first(&t, (double[]){0.1, 0.1, -1}, (double[]){0.1, 0.1, 1}, AABB_SEG_ANY, INFINITY, &h) == 1);
+  CHECK(aabb_tree_segment_first(&t, (double[]){0.1, 0.1, -1}, (double[]){0.1, 0.1, 1}, AABB_SEG_ANY, INFINITY, &h) ==
+        1);
   aabb_tree_destroy(&t);
   /* A 6 x 6 grid of unit squares, two triangles each, listed in shuffled
    * order; queries straight above shared vertices and edges tie exactly. */

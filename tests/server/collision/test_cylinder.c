@@ -9,19 +9,15 @@
 #include <string.h>
 
 #include "check.h"
+#include "test_rng.h"
+#include "test_assets.h"
 #include "collision/cylinder.h"
 #include "mesh.h"
 #include "mesh_import.h"
 #include "vmath.h"
 
 static uint64_t rng_state = 0x5851f42d4c957f2dull;
-static double urand(void) {
-  uint64_t z = (rng_state += 0x9e3779b97f4a7c15ull);
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-  z ^= z >> 31;
-  return (double)(z >> 11) * (1.0 / 9007199254740992.0);
-}
+static double urand(void) { return test_rng_uniform(&rng_state); }
 
 static int inside(const cylinder_t *c, double x, double y, double z) {
   cylinder_hit_t h;
@@ -112,8 +108,7 @@ static void grid_vs_scan(const char *what, const double *x, size_t n, double siz
     size_t na = cylinder_nodes_grid(&c, &g, a, n), nb = cylinder_nodes_scan(&c, x, n, b, n);
     qsort(a, na, sizeof *a, cmp_hit);
     int bad = na != nb;
-    for (size_t j = 0; !bad && j < na; j++)
-      bad = a[j].node != b[j].node || a[j].t != b[j].t || a[j].dist != b[j].dist;
+    for (size_t j = 0; !bad && j < na; j++) bad = a[j].node != b[j].node || a[j].t != b[j].t || a[j].dist != b[j].dist;
     /* Every reported node really is within r of the segment, and every
      * other node is not (independent of the angle formulation: the
      * distance to the segment, clamped projection). */
@@ -157,12 +152,8 @@ int main(void) {
     check_report("test_cylinder");
     return 77;
   }
-  char path[1024];
-  snprintf(path, sizeof path, "%s/assets/meshes/kidney.obj", dir);
   mesh_t m;
-  verr_t err;
-  if (mesh_import(path, &m, &err)) {
-    fprintf(stderr, "%s\n", err.msg);
+  if (test_mesh_load("kidney.obj", &m)) {
     CHECK(0);
   } else {
     grid_vs_scan("kidney", m.pos, m.nverts, 0.06, 300);

@@ -11,19 +11,15 @@
 #include <string.h>
 
 #include "check.h"
+#include "test_rng.h"
+#include "test_assets.h"
 #include "collision/node_grid.h"
 #include "mesh.h"
 #include "mesh_import.h"
 #include "vmath.h"
 
 static uint64_t rng_state = 0x2545f4914f6cdd1dull;
-static double urand(void) {
-  uint64_t z = (rng_state += 0x9e3779b97f4a7c15ull);
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-  z ^= z >> 31;
-  return (double)(z >> 11) * (1.0 / 9007199254740992.0);
-}
+static double urand(void) { return test_rng_uniform(&rng_state); }
 static double srand1(void) { return 2 * urand() - 1; }
 
 static uint32_t scan_nearest(const double *x, size_t n, const double q[3], double *d2out) {
@@ -108,12 +104,10 @@ static void compare(const char *what, const node_grid_t *g, const double *x, siz
 }
 
 static void organ(const char *dir, const char *name, int nq) {
-  char path[1024];
-  snprintf(path, sizeof path, "%s/assets/meshes/%s.obj", dir, name);
+  (void)dir; /* the support library finds the assets */
   mesh_t m;
   verr_t err;
-  if (mesh_import(path, &m, &err)) {
-    fprintf(stderr, "%s\n", err.msg);
+  if (test_organ_load(name, &m)) {
     CHECK(0);
     return;
   }

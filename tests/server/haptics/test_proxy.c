@@ -15,6 +15,8 @@
 #include <string.h>
 
 #include "check.h"
+#include "test_rng.h"
+#include "test_assets.h"
 #include "collision/aabb_tree.h"
 #include "haptics/proxy.h"
 #include "mesh.h"
@@ -22,13 +24,7 @@
 #include "vmath.h"
 
 static uint64_t rng_state = 0x853c49e6748fea9bull;
-static double urand(void) {
-  uint64_t z = (rng_state += 0x9e3779b97f4a7c15ull);
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-  z ^= z >> 31;
-  return (double)(z >> 11) * (1.0 / 9007199254740992.0);
-}
+static double urand(void) { return test_rng_uniform(&rng_state); }
 
 typedef struct organ {
   mesh_t m;
@@ -39,13 +35,8 @@ typedef struct organ {
 } organ_t;
 
 static int organ_load(organ_t *o, const char *dir, const char *name, const double offset[3]) {
-  char path[1024];
-  verr_t err;
-  snprintf(path, sizeof path, "%s/assets/meshes/%s.obj", dir, name);
-  if (mesh_import(path, &o->m, &err)) {
-    fprintf(stderr, "%s\n", err.msg);
-    return -1;
-  }
+  (void)dir; /* the support library finds the assets */
+  if (test_organ_load(name, &o->m)) return -1;
   size_t n = o->m.nverts;
   for (size_t i = 0; i < n; i++)
     for (int k = 0; k < 3; k++) o->m.pos[3 * i + (size_t)k] += offset[k];
@@ -65,6 +56,7 @@ static int organ_load(organ_t *o, const char *dir, const char *name, const doubl
     }
   }
   for (size_t i = 0; i < n; i++) v3_normalize(o->normal + 3 * i);
+  verr_t err;
   return aabb_tree_build(&o->tree, o->x, n, o->m.tris, o->m.ntris, &err);
 }
 
@@ -91,7 +83,8 @@ static int same_proxy(const proxy_t *a, const proxy_t *b) {
   if (a->in_contact != b->in_contact || a->surface != b->surface) return 0;
   if (memcmp(a->pos, b->pos, sizeof a->pos) || memcmp(a->device_prev, b->device_prev, sizeof a->pos)) return 0;
   if (!a->in_contact) return 1;
-  return a->tri == b->tri && !memcmp(a->bary, b->bary, sizeof a->bary) && !memcmp(a->normal, b->normal, sizeof a->normal);
+  return a->tri == b->tri && !memcmp(a->bary, b->bary, sizeof a->bary) &&
+         !memcmp(a->normal, b->normal, sizeof a->normal);
 }
 
 static void tree_vs_scan(const char *dir) {
@@ -106,8 +99,11 @@ static void tree_vs_scan(const char *dir) {
   }
   proxy_surface_t scan[2], tree[2], stale[2];
   for (int i = 0; i < 2; i++) {
-    scan[i] = (proxy_surface_t){.x = org[i].x, .tris = org[i].m.tris, .ntris = org[i].m.ntris,
-                                .max_edge = 3 * org[i].max_edge, .x_rest = org[i].m.pos};
+    scan[i] = (proxy_surface_t){.x = org[i].x,
+                                .tris = org[i].m.tris,
+                                .ntris = org[i].m.ntris,
+                                .max_edge = 3 * org[i].max_edge,
+                                .x_rest = org[i].m.pos};
     tree[i] = scan[i];
     tree[i].tree = &org[i].tree;
   }
@@ -138,7 +134,9 @@ static void tree_vs_scan(const char *dir) {
     v3_normalize(side);
     double depth = target < 12 ? 0.01 : 0.03;
     for (int s = 0; s < 60; s++, steps++) {
-      double out = s < 20 ? 0.02 - (0.02 + depth) * s / 19.0 : s < 45 ? -depth : -depth + (0.02 + depth) * (s - 44) / 15.0;
+      double out = s < 20   ? 0.02 - (0.02 + depth) * s / 19.0
+                   : s < 45 ? -depth
+                            : -depth + (0.02 + depth) * (s - 44) / 15.0;
       double slide = s < 20 ? 0 : s < 45 ? 0.02 * (s - 20) / 24.0 : 0.02;
       for (int c = 0; c < 3; c++) device[c] = p[c] + out * n[c] + slide * side[c];
       for (int i = 0; i < 2; i++) {
@@ -155,8 +153,8 @@ static void tree_vs_scan(const char *dir) {
       int rs = proxy_update(&ps, device, scan, 2, 300, 4, fs);
       int rt = proxy_update(&pt, device, tree, 2, 300, 4, ft);
       int rz = proxy_update(&pz, device, stale, 2, 300, 4, fz);
-      int ok = rs == rt && rs == rz && same_proxy(&ps, &pt) && same_proxy(&ps, &pz) &&
-               !memcmp(fs, ft, sizeof fs) && !memcmp(fs, fz, sizeof fs);
+      int ok = rs == rt && rs == rz && same_proxy(&ps, &pt) && same_proxy(&ps, &pz) && !memcmp(fs, ft, sizeof fs) &&
+               !memcmp(fs, fz, sizeof fs);
       if (!ok && mismatch++ < 3)
         fprintf(stderr, "tree_vs_scan step %d: scan %d surface %d tri %u, tree %d surface %d tri %u, stale %d tri %u\n",
                 steps, rs, ps.surface, ps.tri, rt, pt.surface, pt.tri, rz, pz.tri);

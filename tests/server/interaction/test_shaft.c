@@ -18,6 +18,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "test_assets.h"
 #include "collision/aabb_tree.h"
 #include "interaction/shaft.h"
 #include "mesh.h"
@@ -42,16 +43,7 @@ static void record(void *ctx, uint32_t i, const double f[3]) {
   r->n++;
 }
 
-static int load(const char *name, mesh_t *m) {
-  char path[1024];
-  snprintf(path, sizeof path, "%s/assets/meshes/%s", getenv("VISCERA_SOURCE_DIR"), name);
-  verr_t e;
-  if (mesh_import(path, m, &e)) {
-    fprintf(stderr, "  %s\n", e.msg);
-    return 0;
-  }
-  return 1;
-}
+static int load(const char *name, mesh_t *m) { return test_mesh_load(name, m) == 0; }
 
 static void test_coarse_triangle(void) {
   mesh_t m;

@@ -18,6 +18,8 @@
 #include <string.h>
 
 #include "check.h"
+#include "test_assets.h"
+#include "test_runtime.h"
 #include "interaction/grasp.h"
 #include "interaction/stone.h"
 #include "runtime/scene_runtime.h"
@@ -26,17 +28,7 @@
 static runtime_t rt; /* large */
 static scene_t sc;
 
-static int load(const char *yaml) {
-  const char *src = getenv("VISCERA_SOURCE_DIR");
-  char dir[1024];
-  snprintf(dir, sizeof dir, "%s/assets/scenes", src ? src : ".");
-  verr_t e;
-  if (scene_load_string(yaml, "t.yaml", dir, &sc, &e) || runtime_init(&rt, &sc, &e)) {
-    fprintf(stderr, "  %s\n", e.msg);
-    return 0;
-  }
-  return 1;
-}
+static int load(const char *yaml) { return test_runtime_load(&rt, &sc, yaml, NULL); }
 
 static int count_events(iev_kind_t kind) {
   int n = 0;
@@ -95,10 +87,8 @@ static void test_winding(void) {
   verr_t e;
   CHECK(scene_load_string(KIDNEY "objects:\n  - {name: s, radius: 0.004, position: [0, 0, 0.06], organ: kidney}\n",
                           "t.yaml", getenv("VISCERA_SOURCE_DIR") ? "" : ".", &sc, &e) == 0);
-  char dir[1024];
-  snprintf(dir, sizeof dir, "%s/assets/scenes", getenv("VISCERA_SOURCE_DIR"));
   CHECK(scene_load_string(KIDNEY "objects:\n  - {name: s, radius: 0.004, position: [0, 0, 0.06], organ: kidney}\n",
-                          "t.yaml", dir, &sc, &e) == 0);
+                          "t.yaml", test_asset("scenes"), &sc, &e) == 0);
   CHECK(runtime_init(&rt, &sc, &e) != 0 && strstr(e.msg, "t.yaml:5: object 's'") && strstr(e.msg, "not inside"));
 }
 

@@ -11,6 +11,7 @@
 #include <time.h>
 
 #include "check.h"
+#include "test_assets.h"
 #include "mesh_import.h"
 #include "physics/integrator.h"
 #include "physics/model.h"
@@ -774,12 +775,10 @@ static void time_gallbladder(void) {
     printf("  gallbladder timing skipped (VISCERA_SOURCE_DIR not set)\n");
     return;
   }
-  char path[1024];
-  snprintf(path, sizeof path, "%s/assets/meshes/gallbladder.obj", src);
   mesh_t g;
   verr_t err;
-  if (mesh_import(path, &g, &err)) {
-    printf("  gallbladder timing skipped: %s\n", err.msg);
+  if (test_mesh_load("gallbladder.obj", &g)) {
+    printf("  gallbladder timing skipped\n");
     return;
   }
   scene_organ_t o = default_organ("gallbladder");

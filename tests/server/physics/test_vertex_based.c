@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "test_assets.h"
 #include "mesh.h"
 #include "mesh_import.h"
 #include "physics/model.h"
@@ -388,14 +389,11 @@ static int cmp_double(const void *a, const void *b) {
  * step equal the touched node's rings (times sub-steps) on both, and the
  * time does not grow with the vertex count. */
 static void bench_mesh(const char *name, size_t *verts, double *us_step, double *us_sub, size_t *updates, int *subs) {
-  const char *src = getenv("VISCERA_SOURCE_DIR");
-  char path[4096];
-  snprintf(path, sizeof path, "%s/assets/meshes/%s", src ? src : "../..", name);
   mesh_t m;
   verr_t err;
   *verts = 0;
-  if (mesh_import(path, &m, &err)) {
-    printf("skipping %s: %s\n", name, err.msg);
+  if (test_mesh_load(name, &m)) {
+    printf("skipping %s\n", name);
     return;
   }
   *verts = m.nverts;

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "test_runtime.h"
 #include "resim/resim_run.h"
 #include "session/mesh_publisher.h"
 
@@ -127,14 +128,9 @@ int main(void) {
     fprintf(stderr, "test_resim_run: VISCERA_SOURCE_DIR not set\n");
     return 77;
   }
-  char path[1024];
-  snprintf(path, sizeof path, "%s/assets/scenes/default.yaml", src);
   static scene_t sc;
   verr_t e;
-  if (scene_load(path, &sc, &e)) {
-    fprintf(stderr, "%s\n", e.msg);
-    return 1;
-  }
+  if (!test_runtime_load_scene(NULL, &sc, "default.yaml", &e)) return 1;
   static resim_recording_t rec;
   CHECK(record(&sc, &rec) == 0);
   size_t frames = rec.ndeltas + rec.nkeys;

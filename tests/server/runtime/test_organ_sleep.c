@@ -19,6 +19,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "test_runtime.h"
 #include "runtime/organ_sleep.h"
 #include "runtime/scene_runtime.h"
 
@@ -87,16 +88,7 @@ static void test_reach(void) {
   "home_stiffness: 30, home_damping: 0.005}}\n"                                                                        \
   "tools:\n  - {name: probe, radius: 0.003, stiffness: 400, max_force: 4}\n"
 
-static int load(const char *yaml, scene_t *s, runtime_t *r) {
-  const char *src = getenv("VISCERA_SOURCE_DIR");
-  char dir[1024];
-  snprintf(dir, sizeof dir, "%s/assets/scenes", src ? src : ".");
-  if (scene_load_string(yaml, "t.yaml", dir, s, &e) || (r && runtime_init(r, s, &e))) {
-    fprintf(stderr, "  %s\n", e.msg);
-    return 0;
-  }
-  return 1;
-}
+static int load(const char *yaml, scene_t *s, runtime_t *r) { return test_runtime_load(r, s, yaml, &e); }
 
 static void test_keys(void) {
   CHECK(load(KIDNEY("dt: 0.001"), &sc, NULL));

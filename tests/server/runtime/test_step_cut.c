@@ -16,6 +16,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "test_runtime.h"
 #include "physics/pbd.h"
 #include "runtime/scene_runtime.h"
 #include "runtime/step_cut.h"
@@ -40,17 +41,7 @@ static const char *KIDNEY_VB = "  - name: kidney\n"
                                "    model: vertex_based\n"
                                "    position: [0, 0.2, 0]\n";
 
-static int load(const char *yaml) {
-  const char *src = getenv("VISCERA_SOURCE_DIR");
-  char dir[1024];
-  snprintf(dir, sizeof dir, "%s/assets/scenes", src ? src : ".");
-  verr_t e;
-  if (scene_load_string(yaml, "t.yaml", dir, &sc, &e) || runtime_init(&rt, &sc, &e)) {
-    fprintf(stderr, "  %s\n", e.msg);
-    return 0;
-  }
-  return 1;
-}
+static int load(const char *yaml) { return test_runtime_load(&rt, &sc, yaml, NULL); }
 
 static int count_events(iev_kind_t kind) {
   int n = 0;

@@ -11,6 +11,8 @@
 #include <string.h>
 
 #include "check.h"
+#include "test_assets.h"
+#include "test_runtime.h"
 #include "physics/adaptive.h"
 #include "runtime/scene_runtime.h"
 #include "runtime/topology_follow.h"
@@ -180,11 +182,7 @@ int main(void) {
     CHECK(!"VISCERA_SOURCE_DIR set");
     return check_report("test_topology_runtime");
   }
-  char path[1024];
-  snprintf(path, sizeof path, "%s/assets/scenes/kidney_adaptive.yaml", src);
-  verr_t err;
-  if (scene_load(path, &sc, &err) || runtime_init(&rt, &sc, &err)) {
-    fprintf(stderr, "%s\n", err.msg);
+  if (!test_runtime_load_scene(&rt, &sc, "kidney_adaptive.yaml", NULL)) {
     CHECK(!"adaptive scene loads into the runtime");
     return check_report("test_topology_runtime");
   }
@@ -251,6 +249,6 @@ int main(void) {
          changes_seen, f_refined, f_simplified, worst_jump, worst_jump_force, worst_step, worst_step_at, JUMP_BOUND,
          DYNAMICS_BOUND);
   runtime_destroy(&rt);
-  test_generic_reattach(path);
+  test_generic_reattach(test_asset("scenes/kidney_adaptive.yaml"));
   return check_report("test_topology_runtime");
 }

@@ -8,21 +8,13 @@
 #include <unistd.h>
 
 #include "check.h"
+#include "test_runtime.h"
 #include "session/checkpoint.h"
 
 static int make(runtime_t *rt, const char *src, const char *name, const char *mesh) {
-  char yaml[1024];
-  snprintf(yaml, sizeof yaml,
-           "scene: %s\norgans:\n  - name: organ\n    mesh: %s/assets/meshes/%s\ntools:\n  - {name: probe, "
-           "stiffness: 400}\n",
-           name, src, mesh);
+  (void)src; /* the support library finds the assets */
   static scene_t sc;
-  verr_t err;
-  if (scene_load_string(yaml, "ck.yaml", NULL, &sc, &err) || runtime_init(rt, &sc, &err)) {
-    fprintf(stderr, "  %s\n", err.msg);
-    return -1;
-  }
-  return 0;
+  return test_runtime_one_organ(rt, &sc, name, mesh, "", "stiffness: 400", NULL) ? 0 : -1;
 }
 
 /* Presses the probe 6 mm into the top of the organ for `steps` steps. */

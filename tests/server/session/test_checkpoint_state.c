@@ -27,6 +27,7 @@
 #include <unistd.h>
 
 #include "check.h"
+#include "test_runtime.h"
 #include "physics/pbd.h"
 #include "session/checkpoint.h"
 #include "vtime.h"
@@ -40,13 +41,7 @@ static char path[200], bad[240];
 static verr_t err;
 
 static int load(runtime_t *rt, const char *yaml) {
-  const char *src = getenv("VISCERA_SOURCE_DIR");
-  char dir[1024];
-  snprintf(dir, sizeof dir, "%s/assets/scenes", src ? src : ".");
-  if (scene_load_string(yaml, "t.yaml", dir, &sc, &err) || runtime_init(rt, &sc, &err)) {
-    fprintf(stderr, "  %s\n", err.msg);
-    return 0;
-  }
+  if (!test_runtime_load(rt, &sc, yaml, &err)) return 0;
   for (size_t t = 0; t < rt->ntools; t++) thr_init(rt == &a ? &ta[t] : &tb[t], 0.5, 0.8, 1.5);
   memset(rt == &a ? la : lb, 0, sizeof la);
   return 1;
@@ -401,13 +396,7 @@ static void test_cut_ms(void) {
  * released: the refinement is kept for release_time, then simplified). A
  * crafted refinement centre is refused. */
 static int load_adaptive(runtime_t *rt) {
-  const char *src = getenv("VISCERA_SOURCE_DIR");
-  char p[1024];
-  snprintf(p, sizeof p, "%s/assets/scenes/kidney_adaptive.yaml", src ? src : ".");
-  if (scene_load(p, &sc, &err) || runtime_init(rt, &sc, &err)) {
-    fprintf(stderr, "  %s\n", err.msg);
-    return 0;
-  }
+  if (!test_runtime_load_scene(rt, &sc, "kidney_adaptive.yaml", &err)) return 0;
   for (size_t t = 0; t < rt->ntools; t++) thr_init(rt == &a ? &ta[t] : &tb[t], 0, 0, 0);
   return 1;
 }

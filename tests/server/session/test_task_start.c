@@ -17,6 +17,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "test_runtime.h"
 #include "runtime/scene_runtime.h"
 #include "scene_expect.h"
 #include "session/session_control.h"
@@ -33,16 +34,7 @@ static verr_t e;
          "tasks:\n  - {name: a, kind: palpate_target, tool: p, target: [0, 0, 0.035], target_radius: 0.006}\n"         \
          "  - {name: b, kind: palpate_target, tool: p, target: [0, 0, 0.035], target_radius: 0.006" start_b "}\n"
 
-static int load(const char *yaml) {
-  const char *src = getenv("VISCERA_SOURCE_DIR");
-  char dir[1024];
-  snprintf(dir, sizeof dir, "%s/assets/scenes", src ? src : ".");
-  if (scene_load_string(yaml, "t.yaml", dir, &sc, &e) || runtime_init(&rt, &sc, &e)) {
-    fprintf(stderr, "  %s\n", e.msg);
-    return 0;
-  }
-  return 1;
-}
+static int load(const char *yaml) { return test_runtime_load(&rt, &sc, yaml, &e); }
 
 static int count_events(iev_kind_t kind, int task) {
   int n = 0;
