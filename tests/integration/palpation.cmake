@@ -1,6 +1,7 @@
 # Palpation thresholds end to end (issue 4): the scripted palpation of the
 # default scene must raise threshold-crossing SessionEvents and Metrics with
-# time above the crossed thresholds, in the recording and the server summary.
+# time above the crossed thresholds, asserted in C over the recording
+# (rec_palpation.c: SessionEvents, Metrics, the server's ToolMetrics).
 # Domain 70.
 if(TARGET viscera-recorder)
   add_executable(rec_palpation ${CMAKE_CURRENT_LIST_DIR}/rec_palpation.c)
