@@ -1,7 +1,7 @@
 # bench_ms_cut: three-stage mass-spring cutting: incision width over time
 # (seed 004 Fig. 6), cost per cut and per step; CSV and cairo plots.
 add_executable(bench_ms_cut ${CMAKE_CURRENT_LIST_DIR}/bench_ms_cut.c)
-target_include_directories(bench_ms_cut PRIVATE ${PROJECT_SOURCE_DIR}/tests/unit)
+target_link_libraries(bench_ms_cut PRIVATE viscera_test_support)
 target_link_libraries(bench_ms_cut PRIVATE viscera_sim viscera_plot)
 # Meshes come from VISCERA_SOURCE_DIR/assets/meshes, defaulting to this source tree.
 target_compile_definitions(bench_ms_cut PRIVATE MSCUT_SOURCE_DIR="${PROJECT_SOURCE_DIR}")

@@ -8,7 +8,7 @@ if(TARGET viscera-recorder AND TARGET viscera-recinfo)
   target_link_libraries(rec_pub PRIVATE viscera_dds)
 
   add_executable(rec_check ${CMAKE_CURRENT_LIST_DIR}/rec_check.c)
-  target_include_directories(rec_check PRIVATE ${PROJECT_SOURCE_DIR}/tests/unit)
+  target_link_libraries(rec_check PRIVATE viscera_test_support)
   target_link_libraries(rec_check PRIVATE viscera_recording PkgConfig::SQLITE3)
   # ddsi_cdrstream.h pulls in GNU `asm` (see common/recording/CMakeLists.txt)
   set_target_properties(rec_check PROPERTIES C_EXTENSIONS ON)

@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "test_runtime.h"
 #include "contact_model.h"
 #include "runtime/scene_runtime.h"
 #include "vmath.h"
@@ -49,13 +50,9 @@ static void case9(void) {
     CHECK(!"VISCERA_SOURCE_DIR set");
     return;
   }
-  char path[1024];
-  snprintf(path, sizeof path, "%s/assets/scenes/default.yaml", src);
   static scene_t sc;
   static runtime_t rt;
-  verr_t err;
-  if (scene_load(path, &sc, &err) || runtime_init(&rt, &sc, &err)) {
-    fprintf(stderr, "%s\n", err.msg);
+  if (!test_runtime_load_scene(&rt, &sc, "default.yaml", NULL)) {
     CHECK(!"default scene loads");
     return;
   }

@@ -18,6 +18,7 @@
 
 #include "runtime/scene_runtime.h"
 #include "stab_util.h"
+#include "test_runtime.h"
 
 static const char *const INTEGRATORS[] = {"explicit_euler", "symplectic_euler", "verlet", "rk4", "implicit_euler"};
 
@@ -107,17 +108,13 @@ static void runtime_case(void) {
   const char *src = getenv("VISCERA_SOURCE_DIR");
   CHECK(src != NULL); /* set by ctest */
   if (!src) return;
-  char yaml[2048];
-  snprintf(yaml, sizeof yaml,
-           "scene: nan\norgans:\n"
-           "  - {name: a, mesh: %s/assets/meshes/spleen.obj}\n"
-           "  - {name: b, mesh: %s/assets/meshes/spleen.obj, model: mass_spring_tet, position: [0.2, 0, 0]}\n",
-           src, src);
   static scene_t sc;
   static runtime_t rt;
-  verr_t err;
-  if (scene_load_string(yaml, "nan.yaml", NULL, &sc, &err) || runtime_init(&rt, &sc, &err)) {
-    fprintf(stderr, "%s\n", err.msg);
+  if (!test_runtime_load(&rt, &sc,
+                         "scene: nan\norgans:\n"
+                         "  - {name: a, mesh: ../meshes/spleen.obj}\n"
+                         "  - {name: b, mesh: ../meshes/spleen.obj, model: mass_spring_tet, position: [0.2, 0, 0]}\n",
+                         NULL)) {
     CHECK(!"two-organ scene loads");
     return;
   }
