@@ -17,19 +17,7 @@
 int main(int argc, char **argv) {
   vdds_set_role("viewer"); /* announced in the participant USER_DATA */
   viewer_opts_t o;
-  verr_t err = {{0}};
-  int rc = options_parse(&o, argc, argv, &err);
-  if (rc == 1) {
-    options_usage(stdout, argv[0]);
-    return 0;
-  }
-  if (rc == 2) {
-    printf("viscera-viewer %s\n", cli_version());
-    return 0;
-  }
-  if (rc < 0) {
-    fprintf(stderr, "viscera-viewer: %s\nTry '%s --help'.\n", err.msg, argv[0]);
-    return 2;
-  }
+  int rc = options_parse(&o, argc, argv);
+  if (rc != CLI_RUN) return rc;
   return viewer_run(&o);
 }

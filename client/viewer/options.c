@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cli.h"
 #include "dds/vdds.h"
 #include "view/camera.h"
 #include "view/render.h"
@@ -81,7 +82,87 @@ static int parse_long(const char *s, long lo, long hi, long *out) {
   return 0;
 }
 
-int options_parse(viewer_opts_t *o, int argc, char **argv, verr_t *err) {
+/* Refuses a value: the message, the hint, and the usage exit code 2. */
+static int refuse(const char *fmt, const char *arg, int n) {
+  fprintf(stderr, "viscera-viewer: ");
+  fprintf(stderr, fmt, arg, n);
+  fprintf(stderr, "\nTry 'viscera-viewer --help'.\n");
+  return 2;
+}
+
+enum {
+  O_OUT = 256,
+  O_INTERVAL,
+  O_WIDTH,
+  O_HEIGHT,
+  O_TOOLS,
+  O_DURATION,
+  O_MAX,
+  O_DUMP,
+  O_DRIVE,
+  O_SCRIPT,
+  O_WINDOW,
+};
+
+/* The viewer's own options (cli_option_fn); the common ones are cli.c's. */
+static int viewer_option(void *ctx, int code, const char *arg) {
+  viewer_opts_t *o = ctx;
+  long v;
+  char *end = NULL;
+  switch (code) {
+  case O_OUT:
+    if (!*arg) return refuse("--out: empty directory name%.0s", arg, 0);
+    o->out_dir = arg;
+    o->out_set = 1;
+    return 0;
+  case O_INTERVAL:
+    if (parse_long(arg, 0, 3600000, &v)) return refuse("--interval-ms '%s': expected 0..3600000", arg, 0);
+    o->interval_ms = (int)v;
+    return 0;
+  case O_WIDTH:
+  case O_HEIGHT:
+    if (parse_long(arg, 16, RENDER_MAX_SIZE, &v))
+      return refuse(code == O_WIDTH ? "--width '%s': expected 16..%d" : "--height '%s': expected 16..%d", arg,
+                    RENDER_MAX_SIZE);
+    *(code == O_WIDTH ? &o->width : &o->height) = (int)v;
+    return 0;
+  case O_TOOLS:
+    if (strcmp(arg, "on") != 0 && strcmp(arg, "off") != 0) return refuse("--tools '%s': expected on or off", arg, 0);
+    o->tools = strcmp(arg, "on") == 0;
+    return 0;
+  case O_DURATION:
+    errno = 0;
+    o->duration_s = strtod(arg, &end);
+    /* The cap keeps the nanosecond count far inside uint64_t. */
+    if (!*arg || *end || errno || !(o->duration_s > 0 && o->duration_s <= 1e8))
+      return refuse("--duration '%s': expected seconds, > 0 and <= 1e8", arg, 0);
+    return 0;
+  case O_MAX:
+    if (parse_long(arg, 1, 100000000, &v)) return refuse("--max-frames '%s': expected 1..100000000", arg, 0);
+    o->max_frames = v;
+    return 0;
+  case O_DUMP:
+    if (!*arg) return refuse("--dump-mesh: empty path%.0s", arg, 0);
+    o->dump_mesh = arg;
+    return 0;
+  case O_WINDOW:
+    o->window = 1;
+    return 0;
+  case O_DRIVE:
+    if (parse_long(arg, 0, 7, &v)) return refuse("--drive '%s': expected a tool id 0..7", arg, 0);
+    o->drive_tool = (int)v;
+    return 0;
+  case O_SCRIPT:
+    if (!*arg) return refuse("--script-input: empty path%.0s", arg, 0);
+    o->script_input = arg;
+    return 0;
+  }
+  return 2;
+}
+
+static void usage_text(FILE *f) { options_usage(f, "viscera-viewer"); }
+
+int options_parse(viewer_opts_t *o, int argc, char **argv) {
   *o = (viewer_opts_t){.domain = 0,
                        .partition = VDDS_DEFAULT_PARTITION,
                        .out_dir = "./frames",
@@ -90,28 +171,7 @@ int options_parse(viewer_opts_t *o, int argc, char **argv, verr_t *err) {
                        .height = 480,
                        .tools = 1,
                        .drive_tool = -1};
-  if ((o->domain = vdds_env_domain(err)) < 0) return -1;
-  enum {
-    O_DOMAIN = 256,
-    O_PARTITION,
-    O_OUT,
-    O_INTERVAL,
-    O_WIDTH,
-    O_HEIGHT,
-    O_TOOLS,
-    O_DURATION,
-    O_MAX,
-    O_DUMP,
-    O_DRIVE,
-    O_SCRIPT,
-    O_WINDOW,
-    O_QUIET,
-    O_HELP,
-    O_VERSION
-  };
-  static const struct option longopts[] = {{"domain", required_argument, NULL, O_DOMAIN},
-                                           {"partition", required_argument, NULL, O_PARTITION},
-                                           {"out", required_argument, NULL, O_OUT},
+  static const struct option longopts[] = {{"out", required_argument, NULL, O_OUT},
                                            {"interval-ms", required_argument, NULL, O_INTERVAL},
                                            {"width", required_argument, NULL, O_WIDTH},
                                            {"height", required_argument, NULL, O_HEIGHT},
@@ -122,92 +182,33 @@ int options_parse(viewer_opts_t *o, int argc, char **argv, verr_t *err) {
                                            {"window", no_argument, NULL, O_WINDOW},
                                            {"drive", required_argument, NULL, O_DRIVE},
                                            {"script-input", required_argument, NULL, O_SCRIPT},
-                                           {"quiet", no_argument, NULL, O_QUIET},
-                                           {"help", no_argument, NULL, O_HELP},
-                                           {"version", no_argument, NULL, O_VERSION},
                                            {NULL, 0, NULL, 0}};
-  opterr = 0;
+  const cli_spec_t spec = {.program = "viscera-viewer",
+                           .common = CLI_DOMAIN | CLI_DOMAIN_ENV | CLI_PARTITION | CLI_QUIET,
+                           .options = longopts,
+                           .option = viewer_option,
+                           .usage = usage_text,
+                           .domain_error = "--domain '%s': expected an integer 0..230",
+                           .partition_error = "--partition: empty partition name"};
+  cli_common_t common = {.domain = 0};
   optind = 1;
-  int c;
-  while ((c = getopt_long(argc, argv, "", longopts, NULL)) != -1) {
-    long v;
-    char *end = NULL;
-    switch (c) {
-    case O_DOMAIN:
-      o->domain = vdds_parse_domain(optarg);
-      if (o->domain < 0) return verr_set(err, "--domain '%s': expected an integer 0..230", optarg);
-      break;
-    case O_PARTITION:
-      if (!*optarg) return verr_set(err, "--partition: empty partition name");
-      o->partition = optarg;
-      break;
-    case O_OUT:
-      if (!*optarg) return verr_set(err, "--out: empty directory name");
-      o->out_dir = optarg;
-      o->out_set = 1;
-      break;
-    case O_INTERVAL:
-      if (parse_long(optarg, 0, 3600000, &v)) return verr_set(err, "--interval-ms '%s': expected 0..3600000", optarg);
-      o->interval_ms = (int)v;
-      break;
-    case O_WIDTH:
-    case O_HEIGHT:
-      if (parse_long(optarg, 16, RENDER_MAX_SIZE, &v))
-        return verr_set(err, "--%s '%s': expected 16..%d", c == O_WIDTH ? "width" : "height", optarg, RENDER_MAX_SIZE);
-      *(c == O_WIDTH ? &o->width : &o->height) = (int)v;
-      break;
-    case O_TOOLS:
-      if (strcmp(optarg, "on") != 0 && strcmp(optarg, "off") != 0)
-        return verr_set(err, "--tools '%s': expected on or off", optarg);
-      o->tools = strcmp(optarg, "on") == 0;
-      break;
-    case O_DURATION:
-      errno = 0;
-      o->duration_s = strtod(optarg, &end);
-      /* The cap keeps the nanosecond count far inside uint64_t. */
-      if (!*optarg || *end || errno || !(o->duration_s > 0 && o->duration_s <= 1e8))
-        return verr_set(err, "--duration '%s': expected seconds, > 0 and <= 1e8", optarg);
-      break;
-    case O_MAX:
-      if (parse_long(optarg, 1, 100000000, &v))
-        return verr_set(err, "--max-frames '%s': expected 1..100000000", optarg);
-      o->max_frames = v;
-      break;
-    case O_DUMP:
-      if (!*optarg) return verr_set(err, "--dump-mesh: empty path");
-      o->dump_mesh = optarg;
-      break;
-    case O_WINDOW:
-      o->window = 1;
-      break;
-    case O_DRIVE:
-      if (parse_long(optarg, 0, 7, &v)) return verr_set(err, "--drive '%s': expected a tool id 0..7", optarg);
-      o->drive_tool = (int)v;
-      break;
-    case O_SCRIPT:
-      if (!*optarg) return verr_set(err, "--script-input: empty path");
-      o->script_input = optarg;
-      break;
-    case O_QUIET:
-      o->quiet = 1;
-      break;
-    case O_HELP:
-      return 1;
-    case O_VERSION:
-      return 2;
-    default:
-      if ((optopt >= O_DOMAIN && optopt <= O_DUMP) || optopt == O_DRIVE || optopt == O_SCRIPT)
-        return verr_set(err, "%s: missing value", argv[optind - 1]);
-      return verr_set(err, "unknown option '%s'", argv[optind - 1]);
-    }
-  }
-  if (optind < argc) return verr_set(err, "unexpected argument '%s'", argv[optind]);
-  if (o->drive_tool >= 0 && !o->window) return verr_set(err, "--drive needs --window (input comes from the window)");
-  if (o->script_input && o->drive_tool < 0) return verr_set(err, "--script-input needs --drive N");
+  int rc = cli_parse(&spec, argc, argv, &common, o);
+  if (rc != CLI_RUN) return rc;
+  o->domain = common.domain;
+  if (common.partition) o->partition = common.partition;
+  o->quiet = common.quiet;
+  const char *why = NULL;
+  if (optind < argc)
+    return refuse("unexpected argument '%s'", argv[optind], 0);
+  else if (o->drive_tool >= 0 && !o->window)
+    why = "--drive needs --window (input comes from the window)";
+  else if (o->script_input && o->drive_tool < 0)
+    why = "--script-input needs --drive N";
 #ifndef VISCERA_HAVE_WINDOW
-  if (o->window)
-    return verr_set(err, "--window: this viewer was built without SDL2 (install libsdl2-dev and rebuild with "
-                         "VISCERA_BUILD_WINDOW=ON)");
+  else if (o->window)
+    why = "--window: this viewer was built without SDL2 (install libsdl2-dev and rebuild with "
+          "VISCERA_BUILD_WINDOW=ON)";
 #endif
-  return 0;
+  if (why) return refuse("%s", why, 0);
+  return CLI_RUN;
 }

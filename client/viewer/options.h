@@ -23,10 +23,12 @@ typedef struct viewer_opts {
   const char *script_input; /* --script-input FILE: timed input events (input_script.h) */
 } viewer_opts_t;
 
-/* Defaults, then the environment (VISCERA_DOMAIN), then argv. Returns 0 to
- * run, 1 on --help, 2 on --version (print it, exit 0), -1 with err set on bad usage.
+/* Defaults, then the environment (VISCERA_DOMAIN), then argv, through the
+ * shared parser (common/cli.h: --domain, --partition, --quiet, --help,
+ * --version). Returns CLI_RUN to run, else the exit code: 0 after --help or
+ * --version (printed), 2 after a usage error (printed on stderr).
  * Strings point into argv or static storage. */
-int options_parse(viewer_opts_t *o, int argc, char **argv, verr_t *err);
+int options_parse(viewer_opts_t *o, int argc, char **argv);
 void options_usage(FILE *f, const char *prog);
 
 #endif
