@@ -67,7 +67,7 @@ typedef struct ms_model {
   double dt, tool_stiffness;
   int requested_substeps;
   size_t tri_cap; /* capacity of tris */
-  /* Cutting only (model_mass_spring_prepare): the dominant vector of M^-1 K
+  /* Cutting only (ms_prepare): the dominant vector of M^-1 K
    * at rest and a scratch vector (3 cap each, NULL otherwise), the bound the
    * sub-steps follow, and the state of a re-estimate spread over steps. */
   double *eig_k, *eig_y;
@@ -218,6 +218,8 @@ static int surface_save_topology(const model_t *m, state_blob_t *b);
 static int surface_restore_topology(model_t *m, state_blob_t *b, size_t nnodes, const double *x, const double *v,
                                     verr_t *err);
 
+static const model_edit_ops_t SURFACE_EDIT;
+
 static const model_ops_t SURFACE_OPS = {.name = "mass_spring_surface",
                                         .step = ms_step,
                                         .destroy = ms_destroy,
@@ -225,7 +227,8 @@ static const model_ops_t SURFACE_OPS = {.name = "mass_spring_surface",
                                         .error_estimate = surface_error,
                                         .add_surface_force = surface_add_force,
                                         .save_topology = surface_save_topology,
-                                        .restore_topology = surface_restore_topology};
+                                        .restore_topology = surface_restore_topology,
+                                        .edit = &SURFACE_EDIT};
 static const model_ops_t TET_OPS = {.name = "mass_spring_tet",
                                     .step = ms_step,
                                     .destroy = ms_destroy,
@@ -372,7 +375,7 @@ static int grow_buf(double **p, size_t count) {
   return 0;
 }
 
-int model_mass_spring_reserve(model_t *m, size_t cap, int with_f_res, verr_t *err) {
+static int ms_reserve(model_t *m, size_t cap, int with_f_res, verr_t *err) {
   ms_model_t *mm = (ms_model_t *)m;
   if (m->ops != &SURFACE_OPS) return verr_set(err, "topology changes need a mass_spring_surface model");
   size_t old = mm->ms.cap;
@@ -396,7 +399,7 @@ int model_mass_spring_reserve(model_t *m, size_t cap, int with_f_res, verr_t *er
   return 0;
 }
 
-int model_mass_spring_prepare(model_t *m, verr_t *err) {
+static int ms_prepare(model_t *m, verr_t *err) {
   ms_model_t *mm = (ms_model_t *)m;
   if (m->ops != &SURFACE_OPS) return verr_set(err, "topology changes need a mass_spring_surface model");
   if (mm->eig_k) return 0;
@@ -447,8 +450,8 @@ static int substeps_from_k(ms_model_t *mm, double lk, verr_t *err) {
   return substeps_from(mm, mm->it.kind, lk, lc, err);
 }
 
-int model_mass_spring_commit(model_t *m, size_t n, const uint32_t *old_to_new, size_t old_n, const uint32_t *tris,
-                             size_t ntris, verr_t *err) {
+static int ms_commit_nodes(model_t *m, size_t n, const uint32_t *old_to_new, size_t old_n, const uint32_t *tris,
+                           size_t ntris, verr_t *err) {
   ms_model_t *mm = (ms_model_t *)m;
   if (m->ops != &SURFACE_OPS) return verr_set(err, "topology changes need a mass_spring_surface model");
   if (ntris > mm->tri_cap) {
@@ -500,7 +503,7 @@ int model_mass_spring_commit(model_t *m, size_t n, const uint32_t *old_to_new, s
   return substeps_from(mm, mm->it.kind, lk, lc, err);
 }
 
-int model_mass_spring_refine(model_t *m, int iterations, verr_t *err) {
+static int ms_refine(model_t *m, int iterations, verr_t *err) {
   ms_model_t *mm = (ms_model_t *)m;
   if (m->ops != &SURFACE_OPS || !mm->refining || !mm->eig_k) return 0;
   if (!mass_spring_power_steps(&mm->ms, mm->tool_stiffness, mm->eig_k, mm->eig_y, iterations, &mm->refine_count,
@@ -518,7 +521,7 @@ int model_mass_spring_refine(model_t *m, int iterations, verr_t *err) {
 
 /* A cut surface model is its nodes (rest positions, masses, residual
  * forces), its triangles (the springs are their unique edges, rest lengths
- * from the rest positions: model_mass_spring_commit, as after a cut) and
+ * from the rest positions: ms_commit_nodes, as after a cut) and
  * the sub-steps it had chosen. */
 static int surface_save_topology(const model_t *m, state_blob_t *b) {
   const ms_model_t *mm = (const ms_model_t *)m;
@@ -597,7 +600,7 @@ static int surface_restore_topology(model_t *m, state_blob_t *b, size_t nnodes, 
    * if anything below fails). A prepared model (one a scalpel may cut)
    * gets its dominant vector anew for the new topology. */
   int prepared = mm->eig_k != NULL;
-  if (model_mass_spring_reserve(m, n, fres != NULL, err)) goto out;
+  if (ms_reserve(m, n, fres != NULL, err)) goto out;
   memcpy(mm->ms.x, x, 3 * n * sizeof(double));
   memcpy(mm->ms.v, v, 3 * n * sizeof(double));
   memcpy(mm->ms.x_rest, xr, 3 * n * sizeof(double));
@@ -611,8 +614,8 @@ static int surface_restore_topology(model_t *m, state_blob_t *b, size_t nnodes, 
   free(mm->eig_y);
   mm->eig_k = mm->eig_y = NULL;
   mm->refining = 0;
-  if (model_mass_spring_commit(m, n, NULL, 0, tris, nt, err)) goto out;
-  if (prepared && model_mass_spring_prepare(m, err)) goto out;
+  if (ms_commit_nodes(m, n, NULL, 0, tris, nt, err)) goto out;
+  if (prepared && ms_prepare(m, err)) goto out;
   m->substeps = (int)substeps; /* as the running model had them (its re-estimates are not saved) */
   m->topology_version = (uint32_t)version;
   rc = 0;
@@ -624,3 +627,44 @@ out:
   free(tris);
   return rc;
 }
+
+/* ---- topology edits (model.h edit, MODEL_EDIT_SURFACE; model_mass_spring.h) -- */
+
+static void ms_nodes(model_t *m, model_nodes_t *out) {
+  mass_spring_t *ms = &((ms_model_t *)m)->ms;
+  *out = (model_nodes_t){.n = ms->n,
+                         .cap = ms->cap,
+                         .x = ms->x,
+                         .v = ms->v,
+                         .x_rest = ms->x_rest,
+                         .mass = ms->mass,
+                         .inv_mass = ms->inv_mass,
+                         .f_res = ms->f_res,
+                         .f_ext = ms->f_ext,
+                         .mass_total = ms->p.mass,
+                         .edge_stiffness = ms->p.stiffness};
+}
+
+static size_t ms_rest_edges(const model_t *m, double *mean, double *max) {
+  const mass_spring_t *ms = &((const ms_model_t *)m)->ms;
+  double sum = 0, mx = 0;
+  for (size_t s = 0; s < ms->nsprings; s++) {
+    sum += ms->springs[s].rest;
+    mx = fmax(mx, ms->springs[s].rest);
+  }
+  *mean = ms->nsprings ? sum / (double)ms->nsprings : 0;
+  *max = mx;
+  return ms->nsprings;
+}
+
+static int ms_commit(model_t *m, const model_topology_t *t, verr_t *err) {
+  return ms_commit_nodes(m, t->n, t->old_to_new, t->old_n, t->tris, t->ntris, err);
+}
+
+static const model_edit_ops_t SURFACE_EDIT = {.kind = MODEL_EDIT_SURFACE,
+                                              .nodes = ms_nodes,
+                                              .rest_edges = ms_rest_edges,
+                                              .reserve = ms_reserve,
+                                              .commit = ms_commit,
+                                              .prepare = ms_prepare,
+                                              .refine = ms_refine};
