@@ -41,6 +41,7 @@
 #include <stdint.h>
 
 #include "physics/model.h"
+#include "physics/model_guard.h"
 #include "verr.h"
 
 /* Constraints are ordered by colour, at most this many (see pbd.c). */
@@ -68,7 +69,7 @@ typedef struct pbd {
   size_t n, nedges, ntets;
   double *x, *v, *x_rest;  /* 3n */
   double *x_old;           /* 3n, positions at the start of the sub-step */
-  double *x_save, *v_save; /* 3n, state before the step, for rollback */
+  model_guard_t guard;     /* state before the step, for rollback (physics/model_guard.h) */
   double *f_ext;           /* 3n, external forces for the current sub-step */
   double *inv_mass, *mass; /* n */
   uint32_t *edge;          /* 2 nedges, i < j, in colour order */
