@@ -172,20 +172,14 @@ static double damped_bound(double lk, double lc) {
 /* ----------------------------------------------------------------- create */
 
 void adaptive_destroy(adaptive_t *ad) {
-  void *ptrs[] = {ad->tris0,     ad->fadj0,      ad->fspr0,
-                  ad->area0,     ad->varea0,     ad->vf_off,
-                  ad->vf_idx,    ad->x,          ad->v,
-                  ad->x_rest,    ad->f,          ad->f_ext,
-                  ad->mass,      ad->inv_mass,   ad->kh,
-                  ad->ch,        ad->fixed,      ad->vlevel,
-                  ad->anchor,    ad->tris,       ad->tri_face,
-                  ad->springs,   ad->spring_off, ad->root_face,
-                  ad->root_node, ad->root_first, ad->root_count,
-                  ad->face_root, ad->nodes,      ad->disabled,
-                  ad->modv,      ad->vflag,      ad->stamp,
-                  ad->ksum,      ad->csum,       ad->vmark,
-                  ad->fine,      ad->fine_nodes, ad->fine_springs,
-                  ad->ffine,     ad->forced,     ad->is_forced};
+  void *ptrs[] = {
+      ad->tris0,      ad->fadj0,     ad->fspr0,   ad->area0,      ad->varea0,     ad->vf_off,       ad->vf_idx,
+      ad->x,          ad->v,         ad->x_rest,  ad->f,          ad->f_ext,      ad->ffine,        ad->forced,
+      ad->mass,       ad->inv_mass,  ad->kh,      ad->ch,         ad->fixed,      ad->vlevel,       ad->anchor,
+      ad->tris,       ad->tri_face,  ad->springs, ad->spring_off, ad->root_face,  ad->root_node,    ad->root_first,
+      ad->root_count, ad->face_root, ad->nodes,   ad->disabled,   ad->modv,       ad->vflag,        ad->stamp,
+      ad->ksum,       ad->csum,      ad->vmark,   ad->fine,       ad->fine_nodes, ad->fine_springs, ad->is_forced,
+  };
   for (size_t k = 0; k < sizeof ptrs / sizeof ptrs[0]; k++) free(ptrs[k]);
   model_guard_free(&ad->guard);
   hash_free(&ad->mid);

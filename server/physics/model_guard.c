@@ -6,29 +6,23 @@
 
 int model_guard_reserve(model_guard_t *g, size_t cap) {
   if (g->x && cap <= g->cap) return 0;
-  size_t bytes = 3 * (cap ? cap : 1) * sizeof(double);
-  double *x = calloc(1, bytes), *v = calloc(1, bytes);
-  if (!x || !v) {
-    free(x);
-    free(v);
-    return -1;
-  }
+  /* One block: the positions in its first half, the velocities in its second. */
+  size_t half = 3 * (cap ? cap : 1);
+  double *x = calloc(2 * half, sizeof(double));
+  if (!x) return -1;
+  double *v = x + half;
   if (g->x) {
     memcpy(x, g->x, 3 * g->cap * sizeof(double));
     memcpy(v, g->v, 3 * g->cap * sizeof(double));
   }
   free(g->x);
-  free(g->v);
-  g->x = x;
-  g->v = v;
-  g->cap = cap;
+  *g = (model_guard_t){.x = x, .v = v, .cap = cap, .n = g->n, .idx = g->idx};
   return 0;
 }
 
 void model_guard_free(model_guard_t *g) {
-  free(g->x);
-  free(g->v);
-  memset(g, 0, sizeof *g);
+  free(g->x); /* v lives in the same block */
+  *g = (model_guard_t){0};
 }
 
 int model_state_finite(const double *x, const double *v, size_t n, const uint32_t *idx) {

@@ -26,7 +26,7 @@
 #include <stdint.h>
 
 typedef struct model_guard {
-  double *x, *v;       /* 3 cap each: the saved positions and velocities, in save order */
+  double *x, *v;       /* 3 cap each (one block): the saved positions and velocities, in save order */
   size_t cap;          /* nodes the buffers hold */
   size_t n;            /* nodes saved by the last save */
   const uint32_t *idx; /* the saved nodes, or NULL: nodes 0..n-1 */
