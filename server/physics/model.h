@@ -104,7 +104,8 @@ typedef struct model_ops {
   const char *name; /* the scene file's model name */
   /* One scene step of length h (sub-steps inside). Returns 0, or -1 when
    * the step produced a non-finite state and was rolled back (state as
-   * before the call). */
+   * before the call; rollbacks counted). Every model's step goes through
+   * the one guard of physics/model_guard.h. */
   int (*step)(model_t *m, double h);
   void (*destroy)(model_t *m);
   /* Total energy (J) where the model defines one, NAN otherwise. */
@@ -125,7 +126,9 @@ typedef struct model_ops {
    * node count is refused) and
    * brings its surface to them; it changes m only when all succeeded.
    * Afterwards nodes, surface and topology_version are as when saved.
-   * 0, or -1 with err. */
+   * 0, or -1 with err. A model whose cut topology is held by its cutter
+   * (MODEL_EDIT_TETS, below) leaves both NULL: the cutter saves and
+   * restores it (cutting/tet_model_cut.h). */
   int (*save_topology)(const model_t *m, struct state_blob *b);
   int (*restore_topology)(model_t *m, struct state_blob *b, size_t nnodes, const double *x, const double *v,
                           verr_t *err);
