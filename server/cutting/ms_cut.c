@@ -8,7 +8,6 @@
 #include "cutting/bezier.h"
 #include "cutting/ms_cut_sweep.h"
 #include "cutting/node_match.h"
-#include "physics/model_mass_spring.h"
 #include "vmath.h"
 
 #define MS_CUT_REFINE_ITERATIONS 4 /* power iterations per step after a topology change */
@@ -21,7 +20,7 @@ typedef struct lip {
 
 struct ms_cut {
   model_t *m;
-  mass_spring_t *ms;
+  const model_edit_ops_t *edit; /* m's topology edits (model.h, MODEL_EDIT_SURFACE) */
   ms_cut_params_t p;
   ms_cut_stats_t st;
   double h_mean, l_max; /* rest edge lengths of the uncut model, m */
@@ -53,9 +52,16 @@ static double now_ms(void) {
   return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
 }
 
+/* The model's nodes now (reserve may move the arrays). */
+static model_nodes_t nodes(const ms_cut_t *c) {
+  model_nodes_t nv;
+  c->edit->nodes(c->m, &nv);
+  return nv;
+}
+
 ms_cut_t *ms_cut_create(model_t *m, const ms_cut_params_t *p, verr_t *err) {
-  mass_spring_t *ms = model_mass_spring_surface_system(m);
-  if (!ms) {
+  const model_edit_ops_t *edit = m && m->ops ? m->ops->edit : NULL;
+  if (!edit || edit->kind != MODEL_EDIT_SURFACE) {
     verr_set(err, "cutting: model '%s' cannot be cut (three-stage cutting needs mass_spring_surface)",
              m && m->ops ? m->ops->name : "(none)");
     return NULL;
@@ -69,27 +75,26 @@ ms_cut_t *ms_cut_create(model_t *m, const ms_cut_params_t *p, verr_t *err) {
              q.eps_r, q.segment_length, q.min_radius_rel, q.max_radius);
     return NULL;
   }
-  if (ms->nsprings == 0 || m->nsurf_tris == 0) {
+  double h_mean, l_max;
+  if (edit->rest_edges(m, &h_mean, &l_max) == 0 || m->nsurf_tris == 0) {
     verr_set(err, "cutting: the model has no springs or triangles");
     return NULL;
   }
   /* The stability bound's dominant vectors, for quick re-estimates after
-   * each cut (model_mass_spring.h): computed now, at scene load. */
-  if (model_mass_spring_prepare(m, err)) return NULL;
+   * each cut (model.h edit->prepare): computed now, at scene load. */
+  if (edit->prepare && edit->prepare(m, err)) return NULL;
   ms_cut_t *c = calloc(1, sizeof *c);
   if (!c) {
     verr_set(err, "cutting: out of memory");
     return NULL;
   }
   c->m = m;
-  c->ms = ms;
+  c->edit = edit;
   c->p = q;
-  for (size_t s = 0; s < ms->nsprings; s++) {
-    c->h_mean += ms->springs[s].rest;
-    c->l_max = fmax(c->l_max, ms->springs[s].rest);
-  }
-  c->h_mean /= (double)ms->nsprings;
-  c->m0 = ms->p.mass / (double)ms->n;
+  c->h_mean = h_mean;
+  c->l_max = l_max;
+  model_nodes_t nv = nodes(c);
+  c->m0 = nv.mass_total / (double)nv.n;
   if (c->p.segment_length == 0) c->p.segment_length = 4 * c->h_mean;
   return c;
 }
@@ -114,8 +119,9 @@ size_t ms_cut_bytes(const ms_cut_t *c) {
              3 * c->adj_t_cap * sizeof(uint32_t) * (c->adj_tri != NULL) + c->path_cap * (6 * sizeof(double) + 4) +
              c->lip_cap * sizeof(lip_t);
   for (size_t i = 0; i < c->nlips; i++) b += c->lips[i].len * sizeof(uint32_t);
-  if (c->ms->f_res) b += 3 * c->ms->cap * sizeof(double);
-  b += 6 * c->ms->cap * sizeof(double); /* the model's dominant vectors (model_mass_spring_prepare) */
+  model_nodes_t nv = nodes(c);
+  if (nv.f_res) b += 3 * nv.cap * sizeof(double);
+  b += 6 * nv.cap * sizeof(double); /* the model's dominant vectors (edit->prepare) */
   return b;
 }
 
@@ -123,7 +129,7 @@ size_t ms_cut_bytes(const ms_cut_t *c) {
  * topology change, arrays grown only when the mesh grew. */
 static int adj_update(ms_cut_t *c, verr_t *err) {
   if (c->adj_valid && c->adj_version == c->m->topology_version) return 0;
-  size_t n = c->ms->n, nt = c->m->nsurf_tris;
+  size_t n = nodes(c).n, nt = c->m->nsurf_tris;
   if (!c->adj_start || n > c->adj_n_cap) {
     uint32_t *p = realloc(c->adj_start, (n + 2) * sizeof *p);
     if (!p) return verr_set(err, "cutting: out of memory");
@@ -153,8 +159,9 @@ static int adj_update(ms_cut_t *c, verr_t *err) {
  * cross, -1 on OOM. */
 static int find_crossing(ms_cut_t *c, const double p0[3], const double p1[3], double r, double x[3], double xr[3],
                          uint32_t *tri, verr_t *err) {
-  const double *X = c->ms->x;
-  size_t n = c->ms->n;
+  const model_nodes_t nv = nodes(c);
+  const double *X = nv.x;
+  size_t n = nv.n;
   /* A crossed triangle has every vertex within its longest edge of the
    * crossing point, which is on the axis: scan nodes near the axis (with a
    * margin for stretched edges). */
@@ -184,7 +191,7 @@ static int find_crossing(ms_cut_t *c, const double p0[3], const double p1[3], do
           x[d] = xr[d] = 0;
           for (int v = 0; v < 3; v++) {
             x[d] += bary[v] * X[3 * (size_t)f[v] + d];
-            xr[d] += bary[v] * c->ms->x_rest[3 * (size_t)f[v] + d];
+            xr[d] += bary[v] * nv.x_rest[3 * (size_t)f[v] + d];
           }
         }
       }
@@ -234,7 +241,7 @@ static int process_segment(ms_cut_t *c, verr_t *err) {
   if (c->npath < 2 || len <= merge_tol) return 0; /* no travel: a stab does not cut */
   double t0 = now_ms();
   model_t *m = c->m;
-  mass_spring_t *ms = c->ms;
+  model_nodes_t nv = nodes(c), *ms = &nv;
   const size_t n = ms->n, nt = m->nsurf_tris;
   const uint32_t *tris = m->surf_tris;
   const double r = fmax(c->radius, c->p.min_radius_rel * c->h_mean);
@@ -278,7 +285,8 @@ static int process_segment(ms_cut_t *c, verr_t *err) {
     uint32_t v = nm.tris[k];
     nt_buf[q++] = v < n ? map[v] : (uint32_t)(keep + (v - n));
   }
-  if (model_mass_spring_reserve(m, nn > n ? nn : n, c->p.eps_r > 0, err)) goto out;
+  if (c->edit->reserve(m, nn > n ? nn : n, c->p.eps_r > 0, err)) goto out;
+  nv = nodes(c); /* the arrays may have moved */
   /* Residual stress (eq. 3-4, see ms_cut.h): the surviving ends of the cut
    * springs get eps_r K L0 along the rest direction away from the cut. */
   if (ms->f_res)
@@ -286,7 +294,7 @@ static int process_segment(ms_cut_t *c, verr_t *err) {
       uint32_t u = sw.cut[2 * s], v = sw.cut[2 * s + 1];
       double d[3];
       v3_sub(d, ms->x_rest + 3 * (size_t)u, ms->x_rest + 3 * (size_t)v);
-      double L0 = v3_normalize(d), F = c->p.eps_r * ms->p.stiffness * L0;
+      double L0 = v3_normalize(d), F = c->p.eps_r * ms->edge_stiffness * L0;
       if (!sw.node_dead[u]) v3_axpy(ms->f_res + 3 * (size_t)u, d, F);
       if (!sw.node_dead[v]) v3_axpy(ms->f_res + 3 * (size_t)v, d, -F);
     }
@@ -311,7 +319,8 @@ static int process_segment(ms_cut_t *c, verr_t *err) {
     ms->inv_mass[j] = 1 / c->m0;
   }
   memset(ms->f_ext, 0, 3 * nn * sizeof(double));
-  if (model_mass_spring_commit(m, nn, map, n, nt_buf, ntris_new, err)) {
+  model_topology_t topo = {.n = nn, .old_to_new = map, .old_n = n, .ntris = ntris_new, .tris = nt_buf};
+  if (c->edit->commit(m, &topo, err)) {
     rc = -1; /* the topology did change: report, the caller passes it on */
     goto lips;
   }
@@ -379,8 +388,8 @@ int ms_cut_step(ms_cut_t *c, const double p0[3], const double p1[3], double radi
     return verr_set(err, "cutting: blade radius %g m outside (0, %g]", radius, c->p.max_radius);
   path_refresh(c);
   /* A stability re-estimate left by the last topology change goes on, a few
-   * power iterations per step (model_mass_spring.h). */
-  if (model_mass_spring_refine(c->m, MS_CUT_REFINE_ITERATIONS, err) < 0) return -1;
+   * power iterations per step (model.h edit->refine). */
+  if (c->edit->refine && c->edit->refine(c->m, MS_CUT_REFINE_ITERATIONS, err) < 0) return -1;
   double x[3], xr[3];
   uint32_t tri = UINT32_MAX;
   int hit = find_crossing(c, p0, p1, radius, x, xr, &tri, err);
@@ -415,7 +424,8 @@ int ms_cut_step(ms_cut_t *c, const double p0[3], const double p1[3], double radi
 int ms_cut_end(ms_cut_t *c, verr_t *err) { return finish(c, err); }
 
 size_t ms_cut_incision_width(const ms_cut_t *c, double *mean, double *max) {
-  const double *X = c->ms->x;
+  const model_nodes_t nv = nodes(c);
+  const double *X = nv.x;
   size_t count = 0;
   double sum = 0, mx = 0;
   for (size_t l = 0; l < c->nlips; l++) {

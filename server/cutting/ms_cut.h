@@ -32,7 +32,7 @@
  * per-node mass of the uncut model), triangles and springs are replaced, the
  * sub-steps re-chosen from a bound valid at once and topology_version
  * incremented; the following ms_cut_step calls refine that bound by a few
- * power iterations each (model_mass_spring.h), so call it every step, with
+ * power iterations each (model.h edit->refine), so call it every step, with
  * the blade away from the tissue too.
  *
  * Residual stress (eq. 3-4). sigma_r = E eps_r acts where springs were cut.
@@ -88,7 +88,10 @@ typedef struct ms_cut_stats {
 
 typedef struct ms_cut ms_cut_t;
 
-/* Refuses (NULL, err) any model other than mass_spring_surface and bad params. */
+/* Refuses (NULL, err) a model without surface topology edits (model.h edit
+ * kind MODEL_EDIT_SURFACE: mass_spring_surface) and bad params. The caller
+ * owns the cutter and destroys it before the model. The cutter acts on the
+ * model only through model.h's edit operations. */
 ms_cut_t *ms_cut_create(model_t *m, const ms_cut_params_t *p, verr_t *err);
 void ms_cut_destroy(ms_cut_t *c);
 

@@ -131,7 +131,7 @@ int tet_cut_advance(tet_cut_t *c, const double tip[3], const double handle[3], v
 int tet_cut_end(tet_cut_t *c, verr_t *err);
 int tet_cut_active(const tet_cut_t *c);
 
-/* Checkpoints (the pbd/xpbd model's topology hooks, physics/model.h):
+/* Checkpoints (a cut pbd/xpbd model's topology, cutting/tet_model_cut.h):
  * tet_cut_save appends the mesh (rest positions, attributes, fixed flags,
  * tetrahedra) and the cutter's memory of earlier cuts (cut edges with their
  * points and creation order, cut faces, the snap and quality gates, the

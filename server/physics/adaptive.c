@@ -174,13 +174,14 @@ static double damped_bound(double lk, double lc) {
 void adaptive_destroy(adaptive_t *ad) {
   void *ptrs[] = {
       ad->tris0,      ad->fadj0,     ad->fspr0,   ad->area0,      ad->varea0,     ad->vf_off,       ad->vf_idx,
-      ad->x,          ad->v,         ad->x_rest,  ad->f,          ad->f_ext,      ad->x_prev,       ad->v_prev,
+      ad->x,          ad->v,         ad->x_rest,  ad->f,          ad->f_ext,      ad->ffine,        ad->forced,
       ad->mass,       ad->inv_mass,  ad->kh,      ad->ch,         ad->fixed,      ad->vlevel,       ad->anchor,
       ad->tris,       ad->tri_face,  ad->springs, ad->spring_off, ad->root_face,  ad->root_node,    ad->root_first,
       ad->root_count, ad->face_root, ad->nodes,   ad->disabled,   ad->modv,       ad->vflag,        ad->stamp,
-      ad->ksum,       ad->csum,      ad->vmark,   ad->fine,       ad->fine_nodes, ad->fine_springs, ad->ffine,
-      ad->forced,     ad->is_forced};
+      ad->ksum,       ad->csum,      ad->vmark,   ad->fine,       ad->fine_nodes, ad->fine_springs, ad->is_forced,
+  };
   for (size_t k = 0; k < sizeof ptrs / sizeof ptrs[0]; k++) free(ptrs[k]);
+  model_guard_free(&ad->guard);
   hash_free(&ad->mid);
   hash_free(&ad->edge);
   memset(ad, 0, sizeof *ad);
@@ -372,8 +373,7 @@ int adaptive_create(adaptive_t *ad, const mesh_t *s, const adaptive_params_t *p,
   ad->v = calloc(3 * cv, sizeof(double));
   ad->f = calloc(3 * cv, sizeof(double));
   ad->f_ext = calloc(3 * cv, sizeof(double));
-  ad->x_prev = calloc(3 * cv, sizeof(double));
-  ad->v_prev = calloc(3 * cv, sizeof(double));
+  int guard_rc = model_guard_reserve(&ad->guard, cv);
   ad->mass = calloc(cv, sizeof(double));
   ad->inv_mass = calloc(cv, sizeof(double));
   ad->kh = calloc(cv, sizeof(double));
@@ -404,10 +404,10 @@ int adaptive_create(adaptive_t *ad, const mesh_t *s, const adaptive_params_t *p,
   ad->forced = calloc(cv, sizeof(uint32_t));
   ad->is_forced = calloc(cv, 1);
   if (!ad->vmark || !ad->fine || !ad->fine_nodes || !ad->fine_springs || !ad->ffine || !ad->forced || !ad->is_forced ||
-      !xr || !sp || !ad->x || !ad->v || !ad->f || !ad->f_ext || !ad->x_prev || !ad->v_prev || !ad->mass ||
-      !ad->inv_mass || !ad->kh || !ad->ch || !ad->fixed || !ad->vlevel || !ad->anchor || !ad->tris || !ad->tri_face ||
-      !ad->spring_off || !ad->root_face || !ad->root_node || !ad->root_first || !ad->root_count || !ad->face_root ||
-      !ad->nodes || !ad->disabled || !ad->modv || !ad->vflag || !ad->stamp || !ad->ksum || !ad->csum ||
+      !xr || !sp || !ad->x || !ad->v || !ad->f || !ad->f_ext || guard_rc || !ad->mass || !ad->inv_mass || !ad->kh ||
+      !ad->ch || !ad->fixed || !ad->vlevel || !ad->anchor || !ad->tris || !ad->tri_face || !ad->spring_off ||
+      !ad->root_face || !ad->root_node || !ad->root_first || !ad->root_count || !ad->face_root || !ad->nodes ||
+      !ad->disabled || !ad->modv || !ad->vflag || !ad->stamp || !ad->ksum || !ad->csum ||
       hash_init(&ad->mid, cv - n0) || hash_init(&ad->edge, ad->cap_s - ad->s0)) {
     adaptive_destroy(ad);
     return verr_set(err, "adaptive: out of memory for the refinement capacity (%zu vertices)", cv);
@@ -429,7 +429,7 @@ int adaptive_create(adaptive_t *ad, const mesh_t *s, const adaptive_params_t *p,
   prefault(ad->edge.val, ad->edge.cap * sizeof(uint32_t));
   prefault(ad->edge.used, (ad->cap_s - ad->s0 + 1) * sizeof(uint32_t));
   {
-    double *dz[] = {ad->x, ad->v, ad->f, ad->f_ext, ad->x_prev, ad->v_prev, ad->ffine};
+    double *dz[] = {ad->x, ad->v, ad->f, ad->f_ext, ad->guard.x, ad->guard.v, ad->ffine};
     for (size_t k = 0; k < sizeof dz / sizeof dz[0]; k++) prefault(dz[k], 3 * cv * sizeof(double));
     double *dn[] = {ad->mass, ad->inv_mass, ad->kh, ad->ch, ad->ksum, ad->csum};
     for (size_t k = 0; k < sizeof dn / sizeof dn[0]; k++) prefault(dn[k], cv * sizeof(double));
@@ -468,10 +468,10 @@ int adaptive_create(adaptive_t *ad, const mesh_t *s, const adaptive_params_t *p,
   /* Coarse sub-steps from the semi-implicit Euler bound of the extreme
    * modes, h^2 l_k + 2 h l_c < 4, with the tool spring acting like an extra
    * home spring (it acts on the contact vertices). */
-  double lk = lambda_max(ad, 0, p->tool_stiffness, ad->x_prev, ad->v_prev);
-  double lc = lambda_max(ad, 1, 0, ad->x_prev, ad->v_prev);
-  memset(ad->x_prev, 0, 3 * n0 * sizeof(double));
-  memset(ad->v_prev, 0, 3 * n0 * sizeof(double));
+  double lk = lambda_max(ad, 0, p->tool_stiffness, ad->guard.x, ad->guard.v);
+  double lc = lambda_max(ad, 1, 0, ad->guard.x, ad->guard.v);
+  memset(ad->guard.x, 0, 3 * n0 * sizeof(double));
+  memset(ad->guard.v, 0, 3 * n0 * sizeof(double));
   ad->stable_dt0 = damped_bound(lk, lc);
   if (substeps > 0) {
     ad->substeps0 = substeps;
@@ -1155,9 +1155,7 @@ static inline void kick_drift(adaptive_t *ad, size_t i, const double *f, double 
 }
 
 int adaptive_step(adaptive_t *ad, double h, adaptive_pre_fn pre, void *ctx) {
-  size_t n3 = 3 * ad->n;
-  memcpy(ad->x_prev, ad->x, n3 * sizeof(double));
-  memcpy(ad->v_prev, ad->v, n3 * sizeof(double));
+  model_guard_save(&ad->guard, ad->x, ad->v, ad->n, NULL);
   int sc = ad->substeps0 < 1 ? 1 : ad->substeps0, r = ad->nfine ? ad->fine_ratio : 1;
   double hc = h / sc, hf = hc / r;
   ad->step_touched = ADAPT_NONE;
@@ -1189,13 +1187,7 @@ int adaptive_step(adaptive_t *ad, double h, adaptive_pre_fn pre, void *ctx) {
     for (size_t i = 0; i < ad->n; i++)
       if (!ad->fine[i]) kick_drift(ad, i, ad->f, hc);
   }
-  double sum = 0;
-  for (size_t c = 0; c < n3; c++) sum += ad->x[c] + ad->v[c];
-  if (!isfinite(sum)) {
-    memcpy(ad->x, ad->x_prev, n3 * sizeof(double));
-    memcpy(ad->v, ad->v_prev, n3 * sizeof(double));
-    return -1;
-  }
+  if (model_guard_check(&ad->guard, ad->x, ad->v, ad->n, NULL, NULL)) return -1;
   /* Topology after the step, so the forces of this step went to the mesh
    * they were computed for. */
   if (ad->p.refine_levels > 0 && ad->step_touched != ADAPT_NONE && ad->step_touched_mag >= ad->p.refine_force &&

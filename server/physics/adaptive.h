@@ -61,6 +61,7 @@
 
 #include "mesh.h"
 #include "physics/model.h"
+#include "physics/model_guard.h"
 #include "verr.h"
 
 #define ADAPT_MAX_LEVELS 5
@@ -129,7 +130,8 @@ typedef struct adaptive {
   /* Current mesh and state. */
   size_t n, nt, ns;
   double *x, *v, *x_rest; /* 3 cap_v */
-  double *f, *f_ext, *x_prev, *v_prev;
+  double *f, *f_ext;
+  model_guard_t guard; /* 3 cap_v: the state before the step, for rollback (physics/model_guard.h); scratch at create */
   double *mass, *inv_mass, *kh, *ch;
   uint8_t *fixed;
   uint8_t *vlevel;      /* 0 coarse, else the level that created the vertex */

@@ -26,11 +26,86 @@
 typedef struct model model_t;
 struct state_blob; /* common/state_blob.h */
 
+/* ---- topology edits: what a cutter (server/cutting/) reads and changes ----
+ *
+ * Physics knows nothing of cutting: a cutter is an object of the cutting
+ * layer, created given the model and owned by whoever drives it (the
+ * runtime's cut phase keeps one per organ, runtime/step_cut.c), and it acts
+ * on the model only through model_ops_t.edit. Two kinds of model can be
+ * edited:
+ *   MODEL_EDIT_SURFACE  the nodes are the surface (mass_spring_surface). The
+ *                       cutter reserves room (reserve), rewrites the nodes
+ *                       in place through the arrays of nodes() (re-read
+ *                       after reserve: they may move), then commits the new
+ *                       node count, the old-to-new node map and the new
+ *                       triangles. prepare/refine keep the stability bound
+ *                       after a commit cheap (optional).
+ *   MODEL_EDIT_TETS     a tetrahedral mesh with an embedded surface
+ *                       (pbd/xpbd). The cutter copies the mesh from nodes(),
+ *                       edits its own copy, and commits a whole new mesh
+ *                       (nodes, tetrahedra, boundary triangles, attributes);
+ *                       the model rebuilds its solver and surface from it.
+ * A commit increments topology_version (model.h's contract below) and
+ * changes the model only when it succeeds. */
+typedef enum { MODEL_EDIT_SURFACE = 1, MODEL_EDIT_TETS = 2 } model_edit_kind_t;
+
+/* The model's nodes as a cutter sees them (pointers into the model, valid
+ * until the next reserve or commit). */
+typedef struct model_nodes {
+  size_t n, cap;           /* nodes, and the room the arrays have (SURFACE) */
+  double *x, *v, *x_rest;  /* 3 cap */
+  double *mass, *inv_mass; /* cap, kg and 1/kg (inv_mass 0: fixed node) */
+  double *f_res;           /* 3 cap, residual forces (SURFACE; NULL until reserved with them) */
+  double *f_ext;           /* 3 cap, external forces of the current sub-step */
+  size_t ntets;            /* TETS: tetrahedra, 4 node indices each */
+  const uint32_t *tets;
+  double mass_total;     /* kg, the material's total mass */
+  double edge_stiffness; /* N/m, the material's edge spring stiffness (SURFACE) */
+} model_nodes_t;
+
+/* A new topology. SURFACE: n nodes written in place, old_to_new maps the
+ * old_n nodes before the edit to their new index (UINT32_MAX: deleted;
+ * survivors keep their order, new nodes follow them), tris over the new
+ * nodes. TETS: the nodes (x, v, x_rest: 3 n; fixed: n; attr: 2 n texture
+ * coordinates) and tetrahedra (4 ntets) of the new mesh, and its boundary
+ * triangles over node indices (outward); the model copies what it keeps. */
+typedef struct model_topology {
+  size_t n;
+  const uint32_t *old_to_new;
+  size_t old_n;
+  const double *x, *v, *x_rest, *attr;
+  const uint8_t *fixed;
+  size_t ntets;
+  const uint32_t *tets;
+  size_t ntris;
+  const uint32_t *tris;
+} model_topology_t;
+
+typedef struct model_edit_ops {
+  model_edit_kind_t kind;
+  void (*nodes)(model_t *m, model_nodes_t *out);
+  /* SURFACE: the spring (edge) count and the mean and largest rest length of
+   * the edges, m. TETS: may be NULL. */
+  size_t (*rest_edges)(const model_t *m, double *mean, double *max);
+  /* SURFACE: room for cap nodes (with_f_res: the residual force array too).
+   * 0, or -1 with err (the model unchanged and still steps). */
+  int (*reserve)(model_t *m, size_t cap, int with_f_res, verr_t *err);
+  /* 0, or -1 with err (see model_mass_spring.h and pbd.h for what a failed
+   * commit leaves). */
+  int (*commit)(model_t *m, const model_topology_t *t, verr_t *err);
+  /* Optional (NULL: nothing to do): keep what makes the stability bound
+   * after a commit cheap; refine it between steps, `iterations` at a time
+   * (1: finished, 0: none pending or going on, -1 with err). */
+  int (*prepare)(model_t *m, verr_t *err);
+  int (*refine)(model_t *m, int iterations, verr_t *err);
+} model_edit_ops_t;
+
 typedef struct model_ops {
   const char *name; /* the scene file's model name */
   /* One scene step of length h (sub-steps inside). Returns 0, or -1 when
    * the step produced a non-finite state and was rolled back (state as
-   * before the call). */
+   * before the call; rollbacks counted). Every model's step goes through
+   * the one guard of physics/model_guard.h. */
   int (*step)(model_t *m, double h);
   void (*destroy)(model_t *m);
   /* Total energy (J) where the model defines one, NAN otherwise. */
@@ -51,10 +126,24 @@ typedef struct model_ops {
    * node count is refused) and
    * brings its surface to them; it changes m only when all succeeded.
    * Afterwards nodes, surface and topology_version are as when saved.
-   * 0, or -1 with err. */
+   * 0, or -1 with err. A model whose cut topology is held by its cutter
+   * (MODEL_EDIT_TETS, below) leaves both NULL: the cutter saves and
+   * restores it (cutting/tet_model_cut.h). */
   int (*save_topology)(const model_t *m, struct state_blob *b);
   int (*restore_topology)(model_t *m, struct state_blob *b, size_t nnodes, const double *x, const double *v,
                           verr_t *err);
+  /* Topology edits (cutting, above), NULL for a model that cannot be cut. */
+  const model_edit_ops_t *edit;
+  /* Anchors across a refinement, optional (models whose surface refines
+   * and coarsens in place: adaptive_mass_spring). surface_anchor(m, tri)
+   * names the part of the surface that holds triangle tri and outlives a
+   * topology change (UINT32_MAX: none); after the change surface_locate
+   * returns the triangle of the current surface inside that part nearest
+   * to p, with the barycentric coordinates of p's closest point (UINT32_MAX:
+   * none). The runtime re-attaches a contact through them
+   * (runtime/topology_follow.c). */
+  uint32_t (*surface_anchor)(const model_t *m, uint32_t tri);
+  uint32_t (*surface_locate)(const model_t *m, uint32_t anchor, const double p[3], double bary[3]);
 } model_ops_t;
 
 struct model {
@@ -67,9 +156,9 @@ struct model {
   size_t ntets;         /* 0 for surface models: they allocate no tetrahedra */
   /* Render / contact surface. */
   size_t nsurf, nsurf_tris;
-  double *surf_x;             /* 3 nsurf, current */
-  const double *surf_rest;    /* 3 nsurf */
-  const uint32_t *surf_tris;  /* 3 nsurf_tris */
+  double *surf_x;            /* 3 nsurf, current */
+  const double *surf_rest;   /* 3 nsurf */
+  const uint32_t *surf_tris; /* 3 nsurf_tris */
   /* Stepping. */
   int substeps;     /* per scene step */
   double stable_dt; /* s, the bound the sub-steps were chosen from (INFINITY: unconditionally stable) */
@@ -94,7 +183,7 @@ typedef struct model_params {
   const scene_organ_t *cfg;
   const mesh_t *surface; /* after scale and position; the model copies what it keeps */
   double gravity[3];
-  double dt;             /* scene step */
+  double dt; /* scene step */
   double tool_stiffness;
 } model_params_t;
 

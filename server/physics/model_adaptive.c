@@ -99,6 +99,17 @@ static int am_restore_topology(model_t *m, state_blob_t *b, size_t nnodes, const
   return 0;
 }
 
+/* model.h surface_anchor / surface_locate: the coarse face of a triangle
+ * outlives refinement and simplification, and adaptive_locate finds the
+ * point's triangle inside it. */
+static uint32_t am_surface_anchor(const model_t *m, uint32_t tri) {
+  return adaptive_tri_face(&((const adaptive_model_t *)m)->ad, tri);
+}
+
+static uint32_t am_surface_locate(const model_t *m, uint32_t anchor, const double p[3], double bary[3]) {
+  return adaptive_locate(&((const adaptive_model_t *)m)->ad, anchor, p, bary);
+}
+
 static const model_ops_t adaptive_ops = {
     .name = "adaptive_mass_spring",
     .step = am_step,
@@ -108,6 +119,8 @@ static const model_ops_t adaptive_ops = {
     .add_surface_force = am_add_force,
     .save_topology = am_save_topology,
     .restore_topology = am_restore_topology,
+    .surface_anchor = am_surface_anchor,
+    .surface_locate = am_surface_locate,
 };
 
 model_t *model_adaptive_create(const model_params_t *p, verr_t *err) {

@@ -33,12 +33,13 @@
  * the size, down to 1/256 of the sub-step, after which it is taken as is.
  * After an accepted attempt the size doubles again up to the full sub-step.
  *
- * Rollback: each step starts by saving the state if it is finite; a step
- * that ends non-finite restores the saved state and returns -1. That is the
- * state before the call, or, if something outside wrote a non-finite value
- * into the state since the last step, the state before that step: the last
- * one known finite (saving every step's end as well would cost a second
- * copy of the state per step for a case that should not happen). */
+ * Rollback (physics/model_guard.h): each step starts by saving the state
+ * if it is finite; a step that ends non-finite restores the saved state and
+ * returns -1. That is the state before the call, or, if something outside
+ * wrote a non-finite value into the state since the last step, the state
+ * before that step: the last one known finite (saving every step's end as
+ * well would cost a second copy of the state per step for a case that
+ * should not happen). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -46,6 +47,7 @@
 #include "physics/integrator.h"
 #include "physics/mass_spring.h"
 #include "physics/model.h"
+#include "physics/model_guard.h"
 #include "physics/model_mass_spring.h"
 #include "state_blob.h"
 #include "tet_mesh.h"
@@ -59,7 +61,7 @@ typedef struct ms_model {
   tet_mesh_t tm;                    /* tet variant */
   tet_embedding_t emb;              /* tet variant */
   double volume0;                   /* tet variant: rest volume, m^3 */
-  double *good_x, *good_v;          /* 3 nnodes: last finite state */
+  model_guard_t guard;              /* the last finite state */
   double *surf_buf, *surf_rest_buf; /* tet variant: 3 nsurf */
   uint32_t *tris;                   /* 3 nsurf_tris, the model's own copy */
   double *try_x, *try_v;            /* implicit Euler: 3 nnodes, the state before an attempt */
@@ -67,7 +69,7 @@ typedef struct ms_model {
   double dt, tool_stiffness;
   int requested_substeps;
   size_t tri_cap; /* capacity of tris */
-  /* Cutting only (model_mass_spring_prepare): the dominant vector of M^-1 K
+  /* Cutting only (ms_prepare): the dominant vector of M^-1 K
    * at rest and a scratch vector (3 cap each, NULL otherwise), the bound the
    * sub-steps follow, and the state of a re-estimate spread over steps. */
   double *eig_k, *eig_y;
@@ -75,14 +77,6 @@ typedef struct ms_model {
   int refining, refine_count;
   double refine_lambda;
 } ms_model_t;
-
-static double state_sum(const ms_model_t *mm) {
-  /* One sum instead of a test per coordinate: NaN or Inf anywhere makes it
-   * non-finite (finite values cannot overflow at any realistic size). */
-  double sum = 0;
-  for (size_t c = 0; c < 3 * mm->ms.n; c++) sum += mm->ms.x[c] + mm->ms.v[c];
-  return sum;
-}
 
 static void embed(ms_model_t *mm) {
   if (mm->tet) tet_embedding_apply(&mm->emb, &mm->tm, mm->ms.x, mm->surf_buf);
@@ -143,10 +137,7 @@ static void guarded_implicit(ms_model_t *mm, double h) {
 static int ms_step(model_t *m, double h) {
   ms_model_t *mm = (ms_model_t *)m;
   size_t bytes = 3 * mm->ms.n * sizeof(double);
-  if (isfinite(state_sum(mm))) {
-    memcpy(mm->good_x, mm->ms.x, bytes);
-    memcpy(mm->good_v, mm->ms.v, bytes);
-  }
+  model_guard_save_finite(&mm->guard, mm->ms.x, mm->ms.v, mm->ms.n, NULL);
   int ss = m->substeps < 1 ? 1 : m->substeps;
   double hs = h / ss;
   for (int s = 0; s < ss; s++) {
@@ -156,14 +147,9 @@ static int ms_step(model_t *m, double h) {
       integrator_substep(&mm->it, &mm->ms.fs, hs);
   }
   memset(mm->ms.f_ext, 0, bytes);
-  int ok = isfinite(state_sum(mm));
-  if (!ok) {
-    memcpy(mm->ms.x, mm->good_x, bytes);
-    memcpy(mm->ms.v, mm->good_v, bytes);
-    m->rollbacks++;
-  }
+  int rc = model_guard_check(&mm->guard, mm->ms.x, mm->ms.v, mm->ms.n, NULL, &m->rollbacks);
   embed(mm);
-  return ok ? 0 : -1;
+  return rc;
 }
 
 static void ms_destroy(model_t *m) {
@@ -174,8 +160,7 @@ static void ms_destroy(model_t *m) {
     tet_mesh_free(&mm->tm);
     tet_embedding_free(&mm->emb);
   }
-  free(mm->good_x);
-  free(mm->good_v);
+  model_guard_free(&mm->guard);
   free(mm->surf_buf);
   free(mm->surf_rest_buf);
   free(mm->tris);
@@ -218,6 +203,8 @@ static int surface_save_topology(const model_t *m, state_blob_t *b);
 static int surface_restore_topology(model_t *m, state_blob_t *b, size_t nnodes, const double *x, const double *v,
                                     verr_t *err);
 
+static const model_edit_ops_t SURFACE_EDIT;
+
 static const model_ops_t SURFACE_OPS = {.name = "mass_spring_surface",
                                         .step = ms_step,
                                         .destroy = ms_destroy,
@@ -225,7 +212,8 @@ static const model_ops_t SURFACE_OPS = {.name = "mass_spring_surface",
                                         .error_estimate = surface_error,
                                         .add_surface_force = surface_add_force,
                                         .save_topology = surface_save_topology,
-                                        .restore_topology = surface_restore_topology};
+                                        .restore_topology = surface_restore_topology,
+                                        .edit = &SURFACE_EDIT};
 static const model_ops_t TET_OPS = {.name = "mass_spring_tet",
                                     .step = ms_step,
                                     .destroy = ms_destroy,
@@ -299,8 +287,7 @@ static model_t *ms_create(const model_params_t *p, int tet, verr_t *err) {
   if (cfg->fixed_below_set) mass_spring_fix_below(&mm->ms, cfg->fixed_below);
 
   size_t n = mm->ms.n;
-  mm->good_x = malloc(3 * n * sizeof(double));
-  mm->good_v = malloc(3 * n * sizeof(double));
+  int guard_rc = model_guard_reserve(&mm->guard, n);
   mm->tris = malloc(3 * s->ntris * sizeof(uint32_t) + 1);
   mm->tri_cap = s->ntris;
   if (tet) {
@@ -311,14 +298,13 @@ static model_t *ms_create(const model_params_t *p, int tet, verr_t *err) {
     mm->try_x = malloc(3 * n * sizeof(double));
     mm->try_v = malloc(3 * n * sizeof(double));
   }
-  if (!mm->good_x || !mm->good_v || !mm->tris || (tet && (!mm->surf_buf || !mm->surf_rest_buf)) ||
+  if (guard_rc || !mm->tris || (tet && (!mm->surf_buf || !mm->surf_rest_buf)) ||
       (kind == INT_IMPLICIT_EULER && (!mm->try_x || !mm->try_v))) {
     verr_set(err, "out of memory for %zu nodes", n);
     ms_destroy(&mm->m);
     return NULL;
   }
-  memcpy(mm->good_x, mm->ms.x, 3 * n * sizeof(double));
-  memcpy(mm->good_v, mm->ms.v, 3 * n * sizeof(double));
+  model_guard_save(&mm->guard, mm->ms.x, mm->ms.v, n, NULL);
   memcpy(mm->tris, s->tris, 3 * s->ntris * sizeof(uint32_t));
 
   model_t *m = &mm->m;
@@ -372,7 +358,7 @@ static int grow_buf(double **p, size_t count) {
   return 0;
 }
 
-int model_mass_spring_reserve(model_t *m, size_t cap, int with_f_res, verr_t *err) {
+static int ms_reserve(model_t *m, size_t cap, int with_f_res, verr_t *err) {
   ms_model_t *mm = (ms_model_t *)m;
   if (m->ops != &SURFACE_OPS) return verr_set(err, "topology changes need a mass_spring_surface model");
   size_t old = mm->ms.cap;
@@ -380,8 +366,8 @@ int model_mass_spring_reserve(model_t *m, size_t cap, int with_f_res, verr_t *er
   if (mass_spring_reserve(&mm->ms, cap, with_f_res, err)) return -1;
   if (mm->ms.cap > old || mm->it.n < mm->ms.cap) {
     size_t c3 = 3 * mm->ms.cap;
-    if (grow_buf(&mm->good_x, c3) || grow_buf(&mm->good_v, c3) || grow_buf(&mm->try_x, c3) ||
-        grow_buf(&mm->try_v, c3) || grow_buf(&mm->eig_k, c3) || grow_buf(&mm->eig_y, c3))
+    if (model_guard_reserve(&mm->guard, mm->ms.cap) || grow_buf(&mm->try_x, c3) || grow_buf(&mm->try_v, c3) ||
+        grow_buf(&mm->eig_k, c3) || grow_buf(&mm->eig_y, c3))
       return verr_set(err, "out of memory for %zu nodes", mm->ms.cap);
     integrator_t it;
     if (integrator_init(&it, mm->it.kind, mm->ms.cap, mm->it.cg_tolerance, mm->it.cg_max_iterations, err)) return -1;
@@ -396,7 +382,7 @@ int model_mass_spring_reserve(model_t *m, size_t cap, int with_f_res, verr_t *er
   return 0;
 }
 
-int model_mass_spring_prepare(model_t *m, verr_t *err) {
+static int ms_prepare(model_t *m, verr_t *err) {
   ms_model_t *mm = (ms_model_t *)m;
   if (m->ops != &SURFACE_OPS) return verr_set(err, "topology changes need a mass_spring_surface model");
   if (mm->eig_k) return 0;
@@ -447,8 +433,8 @@ static int substeps_from_k(ms_model_t *mm, double lk, verr_t *err) {
   return substeps_from(mm, mm->it.kind, lk, lc, err);
 }
 
-int model_mass_spring_commit(model_t *m, size_t n, const uint32_t *old_to_new, size_t old_n, const uint32_t *tris,
-                             size_t ntris, verr_t *err) {
+static int ms_commit_nodes(model_t *m, size_t n, const uint32_t *old_to_new, size_t old_n, const uint32_t *tris,
+                           size_t ntris, verr_t *err) {
   ms_model_t *mm = (ms_model_t *)m;
   if (m->ops != &SURFACE_OPS) return verr_set(err, "topology changes need a mass_spring_surface model");
   if (ntris > mm->tri_cap) {
@@ -460,8 +446,7 @@ int model_mass_spring_commit(model_t *m, size_t n, const uint32_t *old_to_new, s
   }
   if (mass_spring_set_surface_topology(&mm->ms, n, tris, ntris, err)) return -1;
   memcpy(mm->tris, tris, 3 * ntris * sizeof(uint32_t));
-  memcpy(mm->good_x, mm->ms.x, 3 * n * sizeof(double));
-  memcpy(mm->good_v, mm->ms.v, 3 * n * sizeof(double));
+  model_guard_save(&mm->guard, mm->ms.x, mm->ms.v, n, NULL);
   m->nnodes = m->nsurf = n;
   m->nsurf_tris = ntris;
   m->surf_tris = mm->tris;
@@ -500,7 +485,7 @@ int model_mass_spring_commit(model_t *m, size_t n, const uint32_t *old_to_new, s
   return substeps_from(mm, mm->it.kind, lk, lc, err);
 }
 
-int model_mass_spring_refine(model_t *m, int iterations, verr_t *err) {
+static int ms_refine(model_t *m, int iterations, verr_t *err) {
   ms_model_t *mm = (ms_model_t *)m;
   if (m->ops != &SURFACE_OPS || !mm->refining || !mm->eig_k) return 0;
   if (!mass_spring_power_steps(&mm->ms, mm->tool_stiffness, mm->eig_k, mm->eig_y, iterations, &mm->refine_count,
@@ -518,7 +503,7 @@ int model_mass_spring_refine(model_t *m, int iterations, verr_t *err) {
 
 /* A cut surface model is its nodes (rest positions, masses, residual
  * forces), its triangles (the springs are their unique edges, rest lengths
- * from the rest positions: model_mass_spring_commit, as after a cut) and
+ * from the rest positions: ms_commit_nodes, as after a cut) and
  * the sub-steps it had chosen. */
 static int surface_save_topology(const model_t *m, state_blob_t *b) {
   const ms_model_t *mm = (const ms_model_t *)m;
@@ -597,7 +582,7 @@ static int surface_restore_topology(model_t *m, state_blob_t *b, size_t nnodes, 
    * if anything below fails). A prepared model (one a scalpel may cut)
    * gets its dominant vector anew for the new topology. */
   int prepared = mm->eig_k != NULL;
-  if (model_mass_spring_reserve(m, n, fres != NULL, err)) goto out;
+  if (ms_reserve(m, n, fres != NULL, err)) goto out;
   memcpy(mm->ms.x, x, 3 * n * sizeof(double));
   memcpy(mm->ms.v, v, 3 * n * sizeof(double));
   memcpy(mm->ms.x_rest, xr, 3 * n * sizeof(double));
@@ -611,8 +596,8 @@ static int surface_restore_topology(model_t *m, state_blob_t *b, size_t nnodes, 
   free(mm->eig_y);
   mm->eig_k = mm->eig_y = NULL;
   mm->refining = 0;
-  if (model_mass_spring_commit(m, n, NULL, 0, tris, nt, err)) goto out;
-  if (prepared && model_mass_spring_prepare(m, err)) goto out;
+  if (ms_commit_nodes(m, n, NULL, 0, tris, nt, err)) goto out;
+  if (prepared && ms_prepare(m, err)) goto out;
   m->substeps = (int)substeps; /* as the running model had them (its re-estimates are not saved) */
   m->topology_version = (uint32_t)version;
   rc = 0;
@@ -624,3 +609,44 @@ out:
   free(tris);
   return rc;
 }
+
+/* ---- topology edits (model.h edit, MODEL_EDIT_SURFACE; model_mass_spring.h) -- */
+
+static void ms_nodes(model_t *m, model_nodes_t *out) {
+  mass_spring_t *ms = &((ms_model_t *)m)->ms;
+  *out = (model_nodes_t){.n = ms->n,
+                         .cap = ms->cap,
+                         .x = ms->x,
+                         .v = ms->v,
+                         .x_rest = ms->x_rest,
+                         .mass = ms->mass,
+                         .inv_mass = ms->inv_mass,
+                         .f_res = ms->f_res,
+                         .f_ext = ms->f_ext,
+                         .mass_total = ms->p.mass,
+                         .edge_stiffness = ms->p.stiffness};
+}
+
+static size_t ms_rest_edges(const model_t *m, double *mean, double *max) {
+  const mass_spring_t *ms = &((const ms_model_t *)m)->ms;
+  double sum = 0, mx = 0;
+  for (size_t s = 0; s < ms->nsprings; s++) {
+    sum += ms->springs[s].rest;
+    mx = fmax(mx, ms->springs[s].rest);
+  }
+  *mean = ms->nsprings ? sum / (double)ms->nsprings : 0;
+  *max = mx;
+  return ms->nsprings;
+}
+
+static int ms_commit(model_t *m, const model_topology_t *t, verr_t *err) {
+  return ms_commit_nodes(m, t->n, t->old_to_new, t->old_n, t->tris, t->ntris, err);
+}
+
+static const model_edit_ops_t SURFACE_EDIT = {.kind = MODEL_EDIT_SURFACE,
+                                              .nodes = ms_nodes,
+                                              .rest_edges = ms_rest_edges,
+                                              .reserve = ms_reserve,
+                                              .commit = ms_commit,
+                                              .prepare = ms_prepare,
+                                              .refine = ms_refine};

@@ -33,15 +33,16 @@
  * contact forces and a force added outside a step acts on the next
  * sub-step only.
  *
- * Rollback: a step starts by saving the state if it is finite; a step that
- * ends non-finite restores the saved state (the last finite one) and
- * returns -1. */
+ * Rollback (physics/model_guard.h): a step starts by saving the state if
+ * it is finite; a step that ends non-finite restores the saved state (the
+ * last finite one) and returns -1. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "physics/integrator.h"
 #include "physics/model.h"
+#include "physics/model_guard.h"
 #include "physics/molecular.h"
 
 model_t *model_molecular_create(const model_params_t *p, verr_t *err);
@@ -50,16 +51,8 @@ typedef struct mol_model {
   model_t m; /* first: the model_t the caller holds */
   molecular_t mol;
   integrator_t it;
-  double *good_x, *good_v; /* 3n: last finite state */
+  model_guard_t guard; /* the last finite state */
 } mol_model_t;
-
-static double state_sum(const molecular_t *mol) {
-  /* One sum instead of a test per coordinate: NaN or Inf anywhere makes it
-   * non-finite. */
-  double sum = 0;
-  for (size_t c = 0; c < 3 * mol->n; c++) sum += mol->x[c] + mol->v[c];
-  return sum;
-}
 
 /* Integrators call this before every force evaluation (twice per Verlet
  * sub-step, four times per RK4 one), so external forces are set afresh each
@@ -75,31 +68,21 @@ static int mm_step(model_t *m, double h) {
   mol_model_t *mm = (mol_model_t *)m;
   molecular_t *mol = &mm->mol;
   size_t bytes = 3 * mol->n * sizeof(double);
-  if (isfinite(state_sum(mol))) {
-    memcpy(mm->good_x, mol->x, bytes);
-    memcpy(mm->good_v, mol->v, bytes);
-  }
+  model_guard_save_finite(&mm->guard, mol->x, mol->v, mol->n, NULL);
   int sub = m->substeps < 1 ? 1 : m->substeps;
   double hs = h / sub;
   for (int s = 0; s < sub; s++) {
     integrator_substep(&mm->it, &mol->fs, hs); /* calls the hook first */
     memset(mol->f_ext, 0, bytes);              /* contact forces hold for one sub-step (model.h) */
   }
-  if (!isfinite(state_sum(mol))) {
-    memcpy(mol->x, mm->good_x, bytes);
-    memcpy(mol->v, mm->good_v, bytes);
-    m->rollbacks++;
-    return -1;
-  }
-  return 0;
+  return model_guard_check(&mm->guard, mol->x, mol->v, mol->n, NULL, &m->rollbacks);
 }
 
 static void mm_destroy(model_t *m) {
   mol_model_t *mm = (mol_model_t *)m;
   integrator_destroy(&mm->it);
   molecular_destroy(&mm->mol);
-  free(mm->good_x);
-  free(mm->good_v);
+  model_guard_free(&mm->guard);
   free(mm);
 }
 
@@ -173,15 +156,12 @@ model_t *model_molecular_create(const model_params_t *p, verr_t *err) {
   mol->definite_jacobian = kind == INT_IMPLICIT_EULER;
   if (cfg->fixed_below_set) molecular_fix_below(mol, cfg->fixed_below);
   size_t n = mol->n;
-  mm->good_x = malloc(3 * n * sizeof(double));
-  mm->good_v = malloc(3 * n * sizeof(double));
-  if (!mm->good_x || !mm->good_v) {
+  if (model_guard_reserve(&mm->guard, n)) {
     verr_set(err, "out of memory for %zu vertices", n);
     mm_destroy(&mm->m);
     return NULL;
   }
-  memcpy(mm->good_x, mol->x, 3 * n * sizeof(double));
-  memcpy(mm->good_v, mol->v, 3 * n * sizeof(double));
+  model_guard_save(&mm->guard, mol->x, mol->v, n, NULL);
 
   model_t *m = &mm->m;
   m->ops = &MOL_OPS;

@@ -7,9 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "cutting/tet_cut.h"
 #include "physics/pbd.h"
-#include "state_blob.h"
 #include "tet_mesh.h"
 
 typedef struct model_pbd {
@@ -19,13 +17,11 @@ typedef struct model_pbd {
   tet_embedding_t emb;
   double *surf_x, *surf_rest;
   uint32_t *surf_tris;
-  /* Cutting: NULL until enabled or a cut starts. After the first split the
-   * surface is the tetrahedral boundary: surf_node maps its vertices to
-   * nodes (and replaces the embedding), surf_attr holds their attribute. */
-  tet_cut_t *cut;
+  /* After the first topology edit (model.h edit, a cut) the surface is the
+   * tetrahedral boundary: surf_node maps its vertices to nodes (and replaces
+   * the embedding), surf_attr holds their attribute. NULL before. */
   uint32_t *surf_node;
   double *surf_attr;
-  int cut_broken; /* a rebuild failed: the solver no longer matches the cutter */
 } model_pbd_t;
 
 /* Sub-steps chosen when the scene leaves solver.substeps at 0: PBD and XPBD
@@ -78,8 +74,6 @@ static void pbd_model_destroy(model_t *m) {
   free(mp->surf_tris);
   free(mp->surf_node);
   free(mp->surf_attr);
-  if (mp->cut) tet_cut_destroy(mp->cut);
-  free(mp->cut);
   free(mp);
 }
 
@@ -112,17 +106,16 @@ static void pbd_model_add_surface_force(model_t *m, uint32_t i, const double f[3
   }
 }
 
-static int pbd_save_topology(const model_t *m, state_blob_t *b);
-static int pbd_restore_topology(model_t *m, state_blob_t *b, size_t nnodes, const double *x, const double *v,
-                                verr_t *err);
+static const model_edit_ops_t PBD_EDIT;
 
 /* pbd and xpbd share every operation; only the name (and the mode the
- * model was created with) differ. */
+ * model was created with) differ. A changed topology is checkpointed by
+ * the cutter that made it (it holds the mesh: cutting/tet_model_cut.h), so
+ * save_topology and restore_topology are not set. */
 #define PBD_FAMILY_OPS(model_name)                                                                                     \
   {                                                                                                                    \
     .name = model_name, .step = pbd_model_step, .destroy = pbd_model_destroy, .energy = pbd_model_energy,              \
-    .error_estimate = pbd_model_error, .add_surface_force = pbd_model_add_surface_force,                               \
-    .save_topology = pbd_save_topology, .restore_topology = pbd_restore_topology                                       \
+    .error_estimate = pbd_model_error, .add_surface_force = pbd_model_add_surface_force, .edit = &PBD_EDIT             \
   }
 static const model_ops_t PBD_OPS = PBD_FAMILY_OPS("pbd");
 static const model_ops_t XPBD_OPS = PBD_FAMILY_OPS("xpbd");
@@ -233,57 +226,45 @@ pbd_t *model_pbd_solver(model_t *m) {
   return &((model_pbd_t *)m)->s;
 }
 
-/* ---- cutting ---------------------------------------------------------------- */
+/* ---- topology edits (model.h edit, MODEL_EDIT_TETS) ------------------------ */
 
-int model_pbd_enable_cutting(model_t *m, verr_t *err) {
-  pbd_t *s = model_pbd_solver(m);
-  if (!s) return verr_set(err, "cutting needs a pbd or xpbd model");
+static void pbd_nodes(model_t *m, model_nodes_t *out) {
   model_pbd_t *mp = (model_pbd_t *)m;
-  if (mp->cut) return 0;
-  uint8_t *fixed = malloc(s->n);
-  mp->cut = calloc(1, sizeof *mp->cut);
-  if (!fixed || !mp->cut) {
-    free(fixed);
-    free(mp->cut);
-    mp->cut = NULL;
-    return verr_set(err, "out of memory for the cutter");
-  }
-  for (size_t i = 0; i < s->n; i++) fixed[i] = s->inv_mass[i] == 0;
-  int rc = tet_cut_create(mp->cut, s->n, s->x_rest, s->x, s->v, fixed, s->ntets, s->tet, err);
-  free(fixed);
-  if (rc) {
-    free(mp->cut);
-    mp->cut = NULL;
-    return -1;
-  }
-  return 0;
+  pbd_t *s = &mp->s;
+  *out = (model_nodes_t){.n = s->n,
+                         .cap = s->n,
+                         .x = s->x,
+                         .v = s->v,
+                         .x_rest = s->x_rest,
+                         .mass = s->mass,
+                         .inv_mass = s->inv_mass,
+                         .f_ext = s->f_ext,
+                         .ntets = s->ntets,
+                         .tets = s->tet,
+                         .mass_total = s->p.mass};
 }
 
-/* The solver and the surface from the cutter's mesh (see pbd.h). Everything
- * new is built first; the model changes only when all of it succeeded. */
-static int rebuild(model_pbd_t *mp, verr_t *err) {
-  tet_cut_t *c = mp->cut;
-  model_t *m = &mp->base;
+/* The solver and the surface from the new mesh (see pbd.h). Everything new
+ * is built first; the model changes only when all of it succeeded. */
+static int pbd_commit(model_t *m, const model_topology_t *t, verr_t *err) {
+  model_pbd_t *mp = (model_pbd_t *)m;
   pbd_t ns;
   verr_t sub;
-  if (pbd_create(&ns, c->n, c->x_rest, c->ntets, c->tet, &mp->s.p, &sub)) {
-    mp->cut_broken = 1;
+  if (pbd_create(&ns, t->n, t->x_rest, t->ntets, t->tets, &mp->s.p, &sub))
     return verr_set(err, "rebuilding the solver after a cut: %s", sub.msg);
-  }
-  uint32_t *tris = NULL;
-  size_t nt = tet_cut_boundary(c, &tris);
-  uint32_t *map = malloc(c->n * sizeof *map);
-  if (nt == (size_t)-1 || !map) {
+  size_t nt = t->ntris;
+  uint32_t *tris = malloc((nt ? 3 * nt : 1) * sizeof *tris);
+  uint32_t *map = malloc((t->n ? t->n : 1) * sizeof *map);
+  if (!tris || !map) {
     free(tris);
     free(map);
     pbd_destroy(&ns);
-    mp->cut_broken = 1;
     return verr_set(err, "out of memory for the surface after a cut");
   }
   size_t nv = 0;
-  for (size_t i = 0; i < c->n; i++) map[i] = UINT32_MAX;
+  for (size_t i = 0; i < t->n; i++) map[i] = UINT32_MAX;
   for (size_t k = 0; k < 3 * nt; k++)
-    if (map[tris[k]] == UINT32_MAX) map[tris[k]] = (uint32_t)nv++;
+    if (map[t->tris[k]] == UINT32_MAX) map[t->tris[k]] = (uint32_t)nv++;
   uint32_t *node = malloc((nv ? nv : 1) * sizeof *node);
   double *sx = malloc((nv ? nv : 1) * 3 * sizeof(double)), *sr = malloc((nv ? nv : 1) * 3 * sizeof(double));
   double *sa = malloc((nv ? nv : 1) * 2 * sizeof(double));
@@ -295,22 +276,21 @@ static int rebuild(model_pbd_t *mp, verr_t *err) {
     free(sr);
     free(sa);
     pbd_destroy(&ns);
-    mp->cut_broken = 1;
     return verr_set(err, "out of memory for the surface after a cut");
   }
-  for (size_t i = 0; i < c->n; i++)
+  for (size_t i = 0; i < t->n; i++)
     if (map[i] != UINT32_MAX) node[map[i]] = (uint32_t)i;
-  for (size_t k = 0; k < 3 * nt; k++) tris[k] = map[tris[k]];
+  for (size_t k = 0; k < 3 * nt; k++) tris[k] = map[t->tris[k]];
   free(map);
-  memcpy(ns.x, c->x, 3 * c->n * sizeof(double));
-  memcpy(ns.v, c->v, 3 * c->n * sizeof(double));
-  for (size_t i = 0; i < c->n; i++)
-    if (c->fixed[i]) pbd_fix_node(&ns, i);
+  memcpy(ns.x, t->x, 3 * t->n * sizeof(double));
+  memcpy(ns.v, t->v, 3 * t->n * sizeof(double));
+  for (size_t i = 0; i < t->n; i++)
+    if (t->fixed[i]) pbd_fix_node(&ns, i);
   ns.rollbacks = mp->s.rollbacks;
   for (size_t v = 0; v < nv; v++) {
-    memcpy(sx + 3 * v, c->x + 3 * (size_t)node[v], 3 * sizeof(double));
-    memcpy(sr + 3 * v, c->x_rest + 3 * (size_t)node[v], 3 * sizeof(double));
-    memcpy(sa + 2 * v, c->attr + 2 * (size_t)node[v], 2 * sizeof(double));
+    memcpy(sx + 3 * v, t->x + 3 * (size_t)node[v], 3 * sizeof(double));
+    memcpy(sr + 3 * v, t->x_rest + 3 * (size_t)node[v], 3 * sizeof(double));
+    memcpy(sa + 2 * v, t->attr + 2 * (size_t)node[v], 2 * sizeof(double));
   }
   pbd_destroy(&mp->s);
   mp->s = ns;
@@ -338,86 +318,9 @@ static int rebuild(model_pbd_t *mp, verr_t *err) {
   return 0;
 }
 
-/* Runs one cutter call on the solver's current state. */
-static int cut_call(model_t *m, const double *tip, const double *handle, verr_t *err) {
-  if (!model_pbd_solver(m)) return verr_set(err, "cutting needs a pbd or xpbd model");
-  model_pbd_t *mp = (model_pbd_t *)m;
-  if (mp->cut_broken) return verr_set(err, "cutting disabled after a failed rebuild");
-  if (!tip && !mp->cut) return 0; /* nothing was cut: nothing to end */
-  if (!mp->cut && model_pbd_enable_cutting(m, err)) return -1;
-  tet_cut_t *c = mp->cut;
-  /* The cutter holds the same nodes as the solver (rebuilt together). */
-  memcpy(c->x, mp->s.x, 3 * c->n * sizeof(double));
-  memcpy(c->v, mp->s.v, 3 * c->n * sizeof(double));
-  uint32_t version = c->version;
-  int n = tip ? tet_cut_advance(c, tip, handle, err) : tet_cut_end(c, err);
-  if (n < 0) return -1;
-  if (c->version != version && rebuild(mp, err)) return -1;
-  return n;
-}
-
-int model_pbd_cut(model_t *m, const double tip[3], const double handle[3], verr_t *err) {
-  if (!tip || !handle) return verr_set(err, "no blade");
-  return cut_call(m, tip, handle, err);
-}
-
-int model_pbd_cut_end(model_t *m, verr_t *err) { return cut_call(m, NULL, NULL, err); }
-
-const struct tet_cut *model_pbd_cutter(const model_t *m) {
-  if (!m || (m->ops != &PBD_OPS && m->ops != &XPBD_OPS)) return NULL;
-  return ((const model_pbd_t *)m)->cut;
-}
+static const model_edit_ops_t PBD_EDIT = {.kind = MODEL_EDIT_TETS, .nodes = pbd_nodes, .commit = pbd_commit};
 
 const double *model_pbd_surface_attr(const model_t *m) {
   if (!m || (m->ops != &PBD_OPS && m->ops != &XPBD_OPS)) return NULL;
   return ((const model_pbd_t *)m)->surf_attr;
-}
-
-/* ---- checkpoints (model.h save/restore_topology) ---------------------------- */
-
-/* A cut model is its cutter's mesh: the solver and the surface are rebuilt
- * from it exactly as after the last cut (rebuild above), so saving the
- * cutter (tet_cut_save) and the topology version is enough. */
-static int pbd_save_topology(const model_t *m, state_blob_t *b) {
-  const model_pbd_t *mp = (const model_pbd_t *)m;
-  if (!mp->cut || mp->cut_broken) return -1;
-  tet_cut_save(mp->cut, b);
-  sb_put_u64(b, m->topology_version);
-  return b->bad ? -1 : 0;
-}
-
-static int pbd_restore_topology(model_t *m, state_blob_t *b, size_t nnodes, const double *x, const double *v,
-                                verr_t *err) {
-  model_pbd_t *mp = (model_pbd_t *)m;
-  tet_cut_t *nc = calloc(1, sizeof *nc);
-  if (!nc) return verr_set(err, "out of memory for the cutter");
-  verr_t sub;
-  if (tet_cut_load(nc, b, &sub)) {
-    free(nc);
-    return verr_set(err, "cut mesh: %s", sub.msg);
-  }
-  uint64_t version = sb_get_u64(b);
-  if (b->bad || version == 0 || version > UINT32_MAX || nc->n != nnodes) {
-    tet_cut_destroy(nc);
-    free(nc);
-    return verr_set(err, "cut mesh: bad topology version or node count");
-  }
-  tet_cut_t *old = mp->cut;
-  mp->cut = nc;
-  if (rebuild(mp, err)) { /* the model is unchanged: back to the old cutter */
-    mp->cut = old;
-    mp->cut_broken = 0;
-    tet_cut_destroy(nc);
-    free(nc);
-    return -1;
-  }
-  if (old) tet_cut_destroy(old);
-  free(old);
-  m->topology_version = (uint32_t)version;
-  memcpy(mp->s.x, x, 3 * m->nnodes * sizeof(double));
-  memcpy(mp->s.v, v, 3 * m->nnodes * sizeof(double));
-  memcpy(nc->x, x, 3 * m->nnodes * sizeof(double));
-  memcpy(nc->v, v, 3 * m->nnodes * sizeof(double));
-  surface_from_nodes(mp, mp->s.x);
-  return 0;
 }

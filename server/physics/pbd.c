@@ -138,8 +138,7 @@ static int create(pbd_t *s, size_t n, const double *x, size_t ntets, const uint3
   s->v = calloc(n3, sizeof(double));
   s->x_rest = calloc(n3, sizeof(double));
   s->x_old = calloc(n3, sizeof(double));
-  s->x_save = calloc(n3, sizeof(double));
-  s->v_save = calloc(n3, sizeof(double));
+  int guard_rc = model_guard_reserve(&s->guard, n);
   s->f_ext = calloc(n3, sizeof(double));
   s->home_lambda = calloc(n3, sizeof(double));
   s->inv_mass = calloc(n, sizeof(double));
@@ -151,9 +150,8 @@ static int create(pbd_t *s, size_t n, const double *x, size_t ntets, const uint3
   s->tet_lambda = calloc(ntets + 1, sizeof(double));
   s->tet_w = calloc(4 * ntets + 1, sizeof(double));
   uint32_t *edges = malloc((12 * ntets + 2 * nextra) * sizeof(uint32_t));
-  if (!s->x || !s->v || !s->x_rest || !s->x_old || !s->x_save || !s->v_save || !s->f_ext || !s->home_lambda ||
-      !s->inv_mass || !s->mass || !s->mark || !s->tet || !s->tet_rest || !s->tet_step2 || !s->tet_lambda || !s->tet_w ||
-      !edges) {
+  if (!s->x || !s->v || !s->x_rest || !s->x_old || guard_rc || !s->f_ext || !s->home_lambda || !s->inv_mass ||
+      !s->mass || !s->mark || !s->tet || !s->tet_rest || !s->tet_step2 || !s->tet_lambda || !s->tet_w || !edges) {
     free(edges);
     pbd_destroy(s);
     return verr_set(err, "pbd: out of memory for %zu nodes, %zu tetrahedra", n, ntets);
@@ -253,8 +251,7 @@ void pbd_destroy(pbd_t *s) {
   free(s->v);
   free(s->x_rest);
   free(s->x_old);
-  free(s->x_save);
-  free(s->v_save);
+  model_guard_free(&s->guard);
   free(s->f_ext);
   free(s->home_lambda);
   free(s->inv_mass);
@@ -634,18 +631,9 @@ static void substep(pbd_t *s, double h, double kd, double kv, double atd, double
   for (size_t c3 = 0; c3 < 3 * n; c3++) v[c3] = (x[c3] - xo[c3]) * ih;
 }
 
-/* The whole state is finite iff this sum is: cheaper than classifying every
- * coordinate, and an overflow to Inf is caught the same way. */
-static int state_finite(const pbd_t *s) {
-  double sum = 0;
-  for (size_t c = 0; c < 3 * s->n; c++) sum += s->x[c] + s->v[c];
-  return isfinite(sum);
-}
-
 int pbd_step(pbd_t *s, double h, pbd_substep_fn pre, void *ctx) {
   size_t n3 = 3 * s->n;
-  memcpy(s->x_save, s->x, n3 * sizeof(double));
-  memcpy(s->v_save, s->v, n3 * sizeof(double));
+  model_guard_save(&s->guard, s->x, s->v, s->n, NULL);
   int ns = s->p.substeps < 1 ? 1 : s->p.substeps, iters = s->p.iterations < 1 ? 1 : s->p.iterations;
   double hs = h / ns;
   double kd = 1, kv = 1, atd = 0, atv = 0;
@@ -669,10 +657,9 @@ int pbd_step(pbd_t *s, double h, pbd_substep_fn pre, void *ctx) {
     memset(s->f_ext, 0, n3 * sizeof(double));
   }
   s->last_h = ok ? hs : 0;
-  if (ok && state_finite(s)) return 0;
-
-  memcpy(s->x, s->x_save, n3 * sizeof(double));
-  memcpy(s->v, s->v_save, n3 * sizeof(double));
+  if ((ok ? model_guard_check(&s->guard, s->x, s->v, s->n, NULL, &s->rollbacks)
+          : model_guard_rollback(&s->guard, s->x, s->v, &s->rollbacks)) == 0)
+    return 0;
   memset(s->f_ext, 0, n3 * sizeof(double));
   /* The multipliers of a failed step mean nothing (and may be NaN). */
   memset(s->edge_lambda, 0, s->nedges * sizeof(double));
@@ -686,7 +673,6 @@ int pbd_step(pbd_t *s, double h, pbd_substep_fn pre, void *ctx) {
       v3_copy(s->x + 3 * i, s->x_rest + 3 * i);
       v3_set(s->v + 3 * i, 0, 0, 0);
     }
-  s->rollbacks++;
   return -1;
 }
 

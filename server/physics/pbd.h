@@ -41,6 +41,7 @@
 #include <stdint.h>
 
 #include "physics/model.h"
+#include "physics/model_guard.h"
 #include "verr.h"
 
 /* Constraints are ordered by colour, at most this many (see pbd.c). */
@@ -68,7 +69,7 @@ typedef struct pbd {
   size_t n, nedges, ntets;
   double *x, *v, *x_rest;  /* 3n */
   double *x_old;           /* 3n, positions at the start of the sub-step */
-  double *x_save, *v_save; /* 3n, state before the step, for rollback */
+  model_guard_t guard;     /* state before the step, for rollback (physics/model_guard.h) */
   double *f_ext;           /* 3n, external forces for the current sub-step */
   double *inv_mass, *mass; /* n */
   uint32_t *edge;          /* 2 nedges, i < j, in colour order */
@@ -218,28 +219,18 @@ model_t *model_pbd_create(const model_params_t *p, verr_t *err);
  * m is another model. */
 pbd_t *model_pbd_solver(model_t *m);
 
-/* Cutting such a model with a scalpel (server/cutting/tet_cut.h). One call
- * per scene step with the blade segment (tip, handle; metres, in the
- * model's coordinates: the scene frame), one to end the cut. When tetrahedra split, the model rebuilds its
- * solver (new nodes, distance constraints with rest lengths measured on the
- * interpolated rest configuration, volume constraints with rest volumes from
- * it, colouring, masses equal again with the total kept, fixed nodes kept,
- * positions and velocities carried) and its surface, then increments
- * topology_version. From the first split on, the render surface is the
- * boundary of the tetrahedral mesh (incision faces included) instead of the
- * embedded organ surface, with a per-vertex 2D attribute (planar projection,
- * interpolated on new vertices: model_pbd_surface_attr). Both return the
- * number of tetrahedra split (>= 0) or -1 with err (m not pbd/xpbd, bad
- * blade, out of memory: the model keeps simulating its last topology). A
- * scene without a cutting tool allocates nothing for cutting:
- * model_pbd_cutter() stays NULL until model_pbd_enable_cutting() (a scene
- * with a scalpel, at load) or the first model_pbd_cut(). */
-struct tet_cut;
-int model_pbd_enable_cutting(model_t *m, verr_t *err);
-int model_pbd_cut(model_t *m, const double tip[3], const double handle[3], verr_t *err);
-int model_pbd_cut_end(model_t *m, verr_t *err);
-const struct tet_cut *model_pbd_cutter(const model_t *m);
-/* 2 nsurf texture coordinates of the current surface, NULL before the first split. */
+/* Topology edits of such a model (model.h edit, MODEL_EDIT_TETS: a cutter
+ * such as cutting/tet_model_cut.h). A commit rebuilds the solver (new
+ * nodes, distance constraints with rest lengths measured on the committed
+ * rest configuration, volume constraints with rest volumes from it,
+ * colouring, masses equal again with the total kept, the committed fixed
+ * nodes, positions and velocities carried) and the surface, then
+ * increments topology_version. From the first commit on, the render
+ * surface is the committed boundary (incision faces included) instead of
+ * the embedded organ surface, with a per-vertex 2D attribute
+ * (model_pbd_surface_attr). A failed commit (out of memory) leaves the
+ * model as it was. The model allocates nothing for editing until a commit.
+ * 2 nsurf texture coordinates of the current surface, NULL before the first commit. */
 const double *model_pbd_surface_attr(const model_t *m);
 
 #endif

@@ -144,8 +144,8 @@ int vb_create(vb_t *vb, const mesh_t *s, const vb_params_t *p, verr_t *err) {
   vb->fixed = calloc(n, 1);
   vb->active = malloc(n * sizeof(uint32_t));
   vb->is_active = calloc(n, 1);
-  vb->bak = malloc(6 * n * sizeof(double));
-  if (!vb->x || !vb->v || !vb->x_rest || !vb->fixed || !vb->active || !vb->is_active || !vb->bak ||
+  int guard_rc = model_guard_reserve(&vb->guard, n);
+  if (!vb->x || !vb->v || !vb->x_rest || !vb->fixed || !vb->active || !vb->is_active || guard_rc ||
       build_ring1(vb, s) || build_ring2(vb)) {
     vb_destroy(vb);
     return verr_set(err, "vertex_based: out of memory for %zu vertices", n);
@@ -176,7 +176,7 @@ void vb_destroy(vb_t *vb) {
   free(vb->r2_idx);
   free(vb->active);
   free(vb->is_active);
-  free(vb->bak);
+  model_guard_free(&vb->guard);
   memset(vb, 0, sizeof *vb);
 }
 
@@ -291,11 +291,7 @@ int vb_step(vb_t *vb, double h, int substeps, vb_pre_fn pre, void *ctx) {
   /* Save only the active nodes: nodes activated during the step were at
    * home with zero velocity, which is what rollback restores them to. */
   size_t n0 = vb->nactive;
-  for (size_t a = 0; a < n0; a++) {
-    uint32_t i = vb->active[a];
-    memcpy(vb->bak + 6 * a, vb->x + 3 * i, 3 * sizeof(double));
-    memcpy(vb->bak + 6 * a + 3, vb->v + 3 * i, 3 * sizeof(double));
-  }
+  model_guard_save(&vb->guard, vb->x, vb->v, n0, vb->active);
   if (substeps < 1) substeps = 1;
   double hs = h / substeps;
   vb->last_node_updates = 0;
@@ -307,22 +303,13 @@ int vb_step(vb_t *vb, double h, int substeps, vb_pre_fn pre, void *ctx) {
     if (pre) pre(ctx);
     substep(vb, hs);
   }
-  double sum = 0;
-  for (size_t a = 0; a < vb->nactive; a++) {
-    uint32_t i = vb->active[a];
-    sum += vb->x[3 * i] + vb->x[3 * i + 1] + vb->x[3 * i + 2] + vb->v[3 * i] + vb->v[3 * i + 1] + vb->v[3 * i + 2];
-  }
-  if (!isfinite(sum)) {
-    for (size_t a = 0; a < vb->nactive; a++) {
+  /* Activation appends: the first n0 active nodes are the saved ones. */
+  if (model_guard_check(&vb->guard, vb->x, vb->v, vb->nactive, vb->active, NULL)) {
+    for (size_t a = n0; a < vb->nactive; a++) {
       uint32_t i = vb->active[a];
-      if (a < n0) {
-        memcpy(vb->x + 3 * i, vb->bak + 6 * a, 3 * sizeof(double));
-        memcpy(vb->v + 3 * i, vb->bak + 6 * a + 3, 3 * sizeof(double));
-      } else {
-        memcpy(vb->x + 3 * i, vb->x_rest + 3 * i, 3 * sizeof(double));
-        v3_set(vb->v + 3 * i, 0, 0, 0);
-        vb->is_active[i] = 0;
-      }
+      memcpy(vb->x + 3 * i, vb->x_rest + 3 * i, 3 * sizeof(double));
+      v3_set(vb->v + 3 * i, 0, 0, 0);
+      vb->is_active[i] = 0;
     }
     vb->nactive = n0;
     return -1;

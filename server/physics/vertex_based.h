@@ -32,6 +32,7 @@
 #include <stdint.h>
 
 #include "mesh.h"
+#include "physics/model_guard.h"
 #include "verr.h"
 
 typedef struct vb_params {
@@ -56,7 +57,7 @@ typedef struct vb {
   uint32_t *active;
   size_t nactive;
   uint8_t *is_active;
-  double *bak; /* 6 per active node at step start, for rollback */
+  model_guard_t guard; /* the active nodes at step start, for rollback (physics/model_guard.h) */
   /* Contact accumulated by vb_add_force for the current sub-step. */
   double f_sum[3];
   uint32_t touched; /* node with the largest single applied force, UINT32_MAX if none */

@@ -5,6 +5,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "runtime/step_cut.h"
+
 /* Layout (native byte order; the session puts its magic before and its
  * CRC after):
  *   scene_name[64] sim_time steps
@@ -28,13 +30,14 @@ int ckpt_state_put(state_blob_t *b, const runtime_t *rt, const ckpt_session_io_t
     sb_put(b, m->x, 3 * m->nnodes * sizeof(double));
     sb_put(b, m->v, 3 * m->nnodes * sizeof(double));
     if (m->topology_version == 0) continue;
-    if (!m->ops->save_topology)
+    int by_cutter = scalpel_owns_topology(rt, i);
+    if (!by_cutter && !m->ops->save_topology)
       return verr_set(err,
                       "organ '%s': its %s model cannot save a changed topology (topology %u): checkpoints stop here",
                       rt->organs[i].cfg->name, m->ops->name, m->topology_version);
     size_t at = b->len;
     sb_put_u64(b, 0); /* length, filled below */
-    if (m->ops->save_topology(m, b))
+    if (by_cutter ? scalpel_save_topology(rt, i, b) : m->ops->save_topology(m, b))
       return verr_set(err, "organ '%s': cannot save its topology%s", rt->organs[i].cfg->name,
                       b->bad ? " (out of memory)" : "");
     if (!b->bad) {
@@ -101,7 +104,8 @@ static int restore_topologies(runtime_t *rt, const state_blob_t *b, const organ_
     } else {
       memcpy(x, b->p + at[i].x, bytes); /* aligned copies: the file's offsets need not be */
       memcpy(v, b->p + at[i].v, bytes);
-      rc = m->ops->restore_topology(m, &tb, at[i].nnodes, x, v, &sub);
+      rc = scalpel_owns_topology(rt, i) ? scalpel_restore_topology(rt, i, &tb, at[i].nnodes, x, v, &sub)
+                                        : m->ops->restore_topology(m, &tb, at[i].nnodes, x, v, &sub);
       if (rc == 0 && (tb.at != tb.len || m->nnodes != at[i].nnodes)) {
         verr_set(&sub, "topology data of unexpected length");
         rc = -1;
@@ -145,7 +149,7 @@ int ckpt_state_get(state_blob_t *b, runtime_t *rt, const ckpt_session_io_t *io, 
     if (topo == 0 && nn != m->nnodes)
       return refuse(what, whatlen, "node count differs from the scene's models (another organ mesh?)");
     if (topo > UINT32_MAX) return refuse(what, whatlen, "bad topology version");
-    if (topo > 0 && !m->ops->restore_topology) {
+    if (topo > 0 && !m->ops->restore_topology && !scalpel_owns_topology(rt, i)) {
       snprintf(what, whatlen, "organ '%s' changed its topology and its %s model cannot restore one",
                rt->organs[i].cfg->name, m->ops->name);
       return -1;

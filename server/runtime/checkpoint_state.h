@@ -5,7 +5,9 @@
  * What the core saves: simulated time and step count; every organ's node
  * positions and velocities and, for an organ whose topology changed (a cut,
  * an adaptive refinement; topology_version > 0), what its model needs to
- * rebuild that topology (model.h save/restore_topology); the tasks
+ * rebuild that topology (model.h save/restore_topology, or, for a
+ * tetrahedral organ cut by a scalpel, its cutter: step_cut.h
+ * scalpel_save_topology); the tasks
  * (started, completed, start and end times); the stones (position, held or
  * not, removed). The session adds its own records where the format gives
  * them a place: one per tool after the organs, and a tail after the stones

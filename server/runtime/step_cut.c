@@ -6,9 +6,7 @@
 #include <string.h>
 
 #include "cutting/ms_cut.h"
-#include "cutting/tet_cut.h"
-#include "physics/model_mass_spring.h"
-#include "physics/pbd.h"
+#include "cutting/tet_model_cut.h"
 #include "vmath.h"
 #include "vtime.h"
 
@@ -16,11 +14,11 @@
 #define PARKED_RADIUS 1e-3
 
 typedef struct scalpel_organ {
-  ms_cut_t *ms;  /* mass_spring_surface organ */
-  int pbd;       /* pbd/xpbd organ, cutter enabled */
-  int tool;      /* scalpel cutting it now, -1 */
-  int touched;   /* the current cut touched tissue (IEV_CUT_BEGIN sent) */
-  size_t edges0; /* pbd: cutter's cut edges when the current cut started */
+  ms_cut_t *ms;         /* mass_spring_surface organ (model.h edit kind SURFACE) */
+  tet_model_cut_t *tet; /* pbd/xpbd organ (edit kind TETS), mesh copied at load */
+  int tool;             /* scalpel cutting it now, -1 */
+  int touched;          /* the current cut touched tissue (IEV_CUT_BEGIN sent) */
+  size_t edges0;        /* pbd: cutter's cut edges when the current cut started */
   uint64_t changes0;
   scalpel_organ_stats_t st;
 } scalpel_organ_t;
@@ -60,11 +58,12 @@ int scalpel_init(runtime_t *rt, verr_t *err) {
     so->tool = -1;
     so->st.nsurf_initial = o->model->nsurf;
     verr_t e;
-    if (model_pbd_solver(o->model)) {
-      if (model_pbd_enable_cutting(o->model, &e))
+    const model_edit_ops_t *edit = o->model->ops->edit;
+    if (edit && edit->kind == MODEL_EDIT_TETS) {
+      so->tet = tet_model_cut_create(o->model, &e);
+      if (!so->tet || tet_model_cut_prepare(so->tet, &e))
         return verr_set(err, "%s:%d: organ '%s': scalpel: %s", sc->path, o->cfg->line, o->cfg->name, e.msg);
-      so->pbd = 1;
-    } else if (model_mass_spring_surface_system(o->model)) {
+    } else if (edit && edit->kind == MODEL_EDIT_SURFACE) {
       ms_cut_params_t p = ms_cut_default_params();
       if (radius > p.max_radius)
         return verr_set(err,
@@ -74,7 +73,7 @@ int scalpel_init(runtime_t *rt, verr_t *err) {
       so->ms = ms_cut_create(o->model, &p, &e);
       if (!so->ms) return verr_set(err, "%s:%d: organ '%s': scalpel: %s", sc->path, o->cfg->line, o->cfg->name, e.msg);
     }
-    so->st.can_cut = so->pbd || so->ms;
+    so->st.can_cut = so->tet || so->ms;
   }
   return 0;
 }
@@ -82,8 +81,11 @@ int scalpel_init(runtime_t *rt, verr_t *err) {
 void scalpel_destroy(runtime_t *rt) {
   struct scalpel *s = rt->scalpel;
   if (!s) return;
-  /* Before the models: an ms cutter refers to its model. */
-  for (size_t i = 0; i < SCENE_MAX_ORGANS; i++) ms_cut_destroy(s->organ[i].ms);
+  /* Before the models: a cutter refers to its model. */
+  for (size_t i = 0; i < SCENE_MAX_ORGANS; i++) {
+    ms_cut_destroy(s->organ[i].ms);
+    tet_model_cut_destroy(s->organ[i].tet);
+  }
   free(s);
   rt->scalpel = NULL;
 }
@@ -177,7 +179,7 @@ static int cutter_for(const runtime_t *rt, const model_t *m, int current) {
   return -1;
 }
 
-static void step_pbd(runtime_t *rt, struct scalpel *s, size_t organ) {
+static void step_tet(runtime_t *rt, struct scalpel *s, size_t organ) {
   scalpel_organ_t *so = &s->organ[organ];
   organ_rt_t *o = &rt->organs[organ];
   model_t *m = o->model;
@@ -193,20 +195,20 @@ static void step_pbd(runtime_t *rt, struct scalpel *s, size_t organ) {
   if (!in) {
     if (so->tool < 0) return;
     uint64_t t0 = vtime_mono_ns();
-    int rc = model_pbd_cut_end(m, &e);
+    int rc = tet_model_cut_end(so->tet, &e);
     account(s, o, v0, t0, rc, &e);
     cut_finished(rt, so, organ);
     return;
   }
   if (so->tool < 0) {
     so->tool = t;
-    const struct tet_cut *c = model_pbd_cutter(m);
+    const tet_cut_t *c = tet_model_cut_mesh(so->tet);
     so->edges0 = c ? c->stats.cut_edges : 0;
   }
   uint64_t t0 = vtime_mono_ns();
-  int rc = model_pbd_cut(m, tip, handle, &e);
+  int rc = tet_model_cut_advance(so->tet, tip, handle, &e);
   account(s, o, v0, t0, rc, &e);
-  const struct tet_cut *c = model_pbd_cutter(m);
+  const tet_cut_t *c = tet_model_cut_mesh(so->tet);
   cut_begin_if_touched(rt, so, organ, c && c->stats.cut_edges > so->edges0);
 }
 
@@ -252,8 +254,8 @@ static void step_ms(runtime_t *rt, struct scalpel *s, size_t organ) {
 void scalpel_after_organ_step(runtime_t *rt, size_t organ) {
   struct scalpel *s = rt->scalpel;
   if (!s || organ >= rt->norgans) return;
-  if (s->organ[organ].pbd)
-    step_pbd(rt, s, organ);
+  if (s->organ[organ].tet)
+    step_tet(rt, s, organ);
   else if (s->organ[organ].ms)
     step_ms(rt, s, organ);
 }
@@ -271,9 +273,24 @@ const scalpel_organ_stats_t *scalpel_stats(const runtime_t *rt, size_t organ) {
 }
 
 int scalpel_has_cutter(const runtime_t *rt, size_t organ) {
-  if (organ >= rt->norgans) return 0;
-  if (model_pbd_cutter(rt->organs[organ].model)) return 1;
-  return rt->scalpel && rt->scalpel->organ[organ].ms != NULL;
+  if (!rt->scalpel || organ >= rt->norgans) return 0;
+  const scalpel_organ_t *so = &rt->scalpel->organ[organ];
+  return tet_model_cut_mesh(so->tet) != NULL || so->ms != NULL;
+}
+
+int scalpel_owns_topology(const runtime_t *rt, size_t organ) {
+  return rt->scalpel && organ < rt->norgans && rt->scalpel->organ[organ].tet != NULL;
+}
+
+int scalpel_save_topology(const runtime_t *rt, size_t organ, state_blob_t *b) {
+  if (!scalpel_owns_topology(rt, organ)) return -1;
+  return tet_model_cut_save(rt->scalpel->organ[organ].tet, b);
+}
+
+int scalpel_restore_topology(runtime_t *rt, size_t organ, state_blob_t *b, size_t nnodes, const double *x,
+                             const double *v, verr_t *err) {
+  if (!scalpel_owns_topology(rt, organ)) return verr_set(err, "no cutter holds this organ's topology");
+  return tet_model_cut_restore(rt->scalpel->organ[organ].tet, b, nnodes, x, v, err);
 }
 
 uint64_t scalpel_take_error(runtime_t *rt, char *msg, size_t len) {

@@ -12,11 +12,13 @@
  * Per organ, after that organ's model step and before the runtime compares
  * topology_version (scene_runtime.c: never inside the sub-step hook, and
  * the runtime's topology follow-up runs at once after a change):
- *   - pbd / xpbd organs: model_pbd_cut(tip, handle) every step while the
- *     blade's box overlaps the organ's current bounds (grown by the blade
- *     radius); model_pbd_cut_end when the blade leaves them, the button is
- *     released or the tool is released (client lost: its buttons read 0);
- *   - mass_spring_surface organs: ms_cut_step every step, with the blade
+ *   - tetrahedral organs (model.h edit kind MODEL_EDIT_TETS: pbd / xpbd):
+ *     tet_model_cut_advance(tip, handle) every step while the blade's box
+ *     overlaps the organ's current bounds (grown by the blade radius);
+ *     tet_model_cut_end when the blade leaves them, the button is released
+ *     or the tool is released (client lost: its buttons read 0);
+ *   - surface organs (edit kind MODEL_EDIT_SURFACE: mass_spring_surface):
+ *     ms_cut_step every step, with the blade
  *     (cylinder of the tool's `radius`, handle -> tip) while cutting and with
  *     a parked blade (a point outside every organ) otherwise, because the
  *     cutter refines its stability estimate over the steps after a cut;
@@ -25,10 +27,17 @@
  * One scalpel cuts an organ at a time (the first one, by tool order, whose
  * blade reaches it); others touch it like probes meanwhile.
  *
- * Cutting structures exist only in a scene with a scalpel:
- * scalpel_init enables the pbd cutter (model_pbd_enable_cutting) and creates
- * an ms_cut per cuttable organ, and nothing (rt->scalpel stays NULL)
- * otherwise.
+ * Cutting structures exist only in a scene with a scalpel: scalpel_init
+ * creates one cutter per cuttable organ, owned here and destroyed before
+ * the models (a tet_model_cut with the mesh copied at load, or an ms_cut),
+ * and nothing (rt->scalpel stays NULL) otherwise. The models know nothing
+ * of them: the cutters act through model.h's edit operations.
+ *
+ * Checkpoints: a tetrahedral organ's cut topology is its cutter's mesh, so
+ * the cutter saves and restores it (scalpel_save_topology /
+ * scalpel_restore_topology, used by runtime/checkpoint_state.c for the
+ * organs scalpel_owns_topology names); other models save their own
+ * (model.h save_topology).
  *
  * Events (rt->events): IEV_CUT_BEGIN when a cut first touches tissue (pbd:
  * the blade crossed a tetrahedron edge; ms: its axis crossed the surface;
@@ -45,10 +54,11 @@
 #include <stdio.h>
 
 #include "runtime/scene_runtime.h"
+#include "state_blob.h"
 #include "verr.h"
 
 typedef struct scalpel_organ_stats {
-  int can_cut;   /* pbd/xpbd or mass_spring_surface */
+  int can_cut;   /* a model with topology edits (pbd/xpbd or mass_spring_surface) */
   uint64_t cuts; /* cuts that touched tissue */
   uint64_t topology_changes;
   uint64_t refused;                    /* cutter calls that returned an error */
@@ -81,6 +91,17 @@ size_t scalpel_incision_width(const runtime_t *rt, size_t organ, double *mean, d
 const scalpel_organ_stats_t *scalpel_stats(const runtime_t *rt, size_t organ);
 /* Whether a cutting structure exists for the organ (tests). */
 int scalpel_has_cutter(const runtime_t *rt, size_t organ);
+
+/* Whether organ's changed topology is held by its cutter (a tetrahedral
+ * organ in a scene with a scalpel) rather than by its model. */
+int scalpel_owns_topology(const runtime_t *rt, size_t organ);
+/* Appends that topology (the cutter's bytes, tet_model_cut_save) to b: 0,
+ * or -1 (nothing to save, out of memory). */
+int scalpel_save_topology(const runtime_t *rt, size_t organ, state_blob_t *b);
+/* Restores it into the organ's model (tet_model_cut_restore): 0, or -1
+ * with err (the model unchanged). The caller follows the topology. */
+int scalpel_restore_topology(runtime_t *rt, size_t organ, state_blob_t *b, size_t nnodes, const double *x,
+                             const double *v, verr_t *err);
 
 /* The message of the latest refused call not yet taken, with the running
  * count of refusals (0: none new). */

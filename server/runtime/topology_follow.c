@@ -3,7 +3,6 @@
 #include <math.h>
 #include <string.h>
 
-#include "physics/adaptive.h"
 #include "vmath.h"
 #include "vtime.h"
 
@@ -22,12 +21,12 @@ double topo_max_edge_bound(const model_t *m) {
 
 void topo_capture(const runtime_t *rt, size_t organ, topo_anchor_t anchors[SCENE_MAX_TOOLS]) {
   const organ_rt_t *o = &rt->organs[organ];
-  adaptive_model_t *am = model_adaptive_of(o->model);
+  const model_t *m = o->model;
   for (size_t t = 0; t < rt->ntools; t++) {
     const proxy_t *p = &rt->tools[t].proxy;
     topo_anchor_t *a = &anchors[t];
     a->in_contact = p->in_contact && p->surface == (int)organ;
-    a->face = a->in_contact && am ? adaptive_tri_face(&am->ad, p->tri) : UINT32_MAX;
+    a->face = a->in_contact && m->ops->surface_anchor ? m->ops->surface_anchor(m, p->tri) : UINT32_MAX;
     v3_copy(a->normal, p->normal);
   }
 }
@@ -68,12 +67,11 @@ static uint32_t nearest_same_side(const model_t *m, const double q[3], const dou
 
 static void reattach(runtime_t *rt, size_t organ, proxy_t *p, const topo_anchor_t *a) {
   model_t *m = rt->organs[organ].model;
-  adaptive_model_t *am = model_adaptive_of(m);
   double bary[3];
   uint32_t tri = UINT32_MAX;
   /* p->pos is where the hook last put the proxy, on the old surface at the
    * last sub-step: the point to keep. */
-  if (am && a->face != UINT32_MAX) tri = adaptive_locate(&am->ad, a->face, p->pos, bary);
+  if (m->ops->surface_locate && a->face != UINT32_MAX) tri = m->ops->surface_locate(m, a->face, p->pos, bary);
   if (tri == UINT32_MAX || tri >= m->nsurf_tris) tri = nearest_same_side(m, p->pos, a->normal, bary);
   if (tri == UINT32_MAX) { /* no triangles left: the contact has nothing to hold on to */
     proxy_reset(p);

@@ -8,13 +8,14 @@
  * pointers and counts, and every proxy in contact with the organ is
  * re-attached to the same place on the new surface, so a tool pressing in
  * keeps its contact and its force does not jump:
- *   - adaptive models: the contact triangle's coarse face is captured before
- *     the step (topo_capture) and the proxy re-located inside that face
- *     (adaptive_locate). Refinement puts new vertices at midpoints of the
+ *   - models that refine in place (model.h surface_anchor/surface_locate:
+ *     adaptive_mass_spring): the contact triangle's anchor (its coarse
+ *     face) is captured before the step (topo_capture) and the proxy
+ *     re-located inside it (surface_locate). Refinement puts new vertices at midpoints of the
  *     current positions, so the proxy point lies exactly on the refined
  *     surface and does not move at all; simplification moves it by the
  *     distance between the refined and coarse surface there.
- *   - any other model (cutting): the nearest point of the new surface whose
+ *   - any other model (cutting), or no triangle found there: the nearest point of the new surface whose
  *     rest normal faces the same way as the old contact normal (the same
  *     0.2 cosine the proxy uses to stay on its side of thin tissue).
  * The caller rebuilds the contact patches afterwards (scene_runtime.c).
@@ -35,7 +36,7 @@
 /* Per tool, where its contact was before the organ's step. */
 typedef struct topo_anchor {
   int in_contact;   /* the tool's proxy was on this organ */
-  uint32_t face;    /* adaptive model: coarse face of the contact triangle; else UINT32_MAX */
+  uint32_t face;    /* model.h surface_anchor of the contact triangle; else UINT32_MAX */
   double normal[3]; /* contact normal before the step */
 } topo_anchor_t;
 

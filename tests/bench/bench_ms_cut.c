@@ -143,7 +143,7 @@ static int timing_run(organ_t *o, int model_steps, timing_t *T) {
     if (m->substeps > T->sub_max) T->sub_max = m->substeps;
   }
   /* The blade lifted: ms_cut_step goes on each step and finishes the
-   * stability re-estimate (model_mass_spring_refine). */
+   * stability re-estimate (model.h edit->refine). */
   for (int s = 0; s < 20; s++) {
     double up0[3] = {o->b[0], o->b[1], o->z + 1.0}, up1[3] = {o->b[0], o->b[1], o->z + 0.9};
     if (ms_cut_step(c, up0, up1, 0.001, &err) < 0) printf("%s: %s\n", o->name, err.msg);

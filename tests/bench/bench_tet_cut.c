@@ -146,6 +146,11 @@ int main(int argc, char **argv) {
     fprintf(stderr, "bench_tet_cut: %s\n", err.msg);
     return 1;
   }
+  tet_model_cut_t *tc = tet_model_cut_create(m, &err);
+  if (!tc) {
+    fprintf(stderr, "bench_tet_cut: %s\n", err.msg);
+    return 1;
+  }
   pbd_t *s = model_pbd_solver(m);
   double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
   for (size_t i = 0; i < s->n; i++)
@@ -166,7 +171,7 @@ int main(int argc, char **argv) {
     fprintf(csv, "cut,nodes,tets,surf_tris,min_quality_rest,min_quality_now,cut_ms,intersect_ms,topology_ms,rebuild_ms,"
                  "step_ms,finite\n");
   for (int k = 0; k < cuts; k++) {
-    cut_random(m, lo, hi, &seed, &rec[k]);
+    cut_random(m, tc, lo, hi, &seed, &rec[k]);
     const cut_record_t *r = &rec[k];
     tets[k] = (double)r->tets;
     q[k] = r->min_q_rest;
@@ -180,7 +185,7 @@ int main(int argc, char **argv) {
   }
   if (csv) fclose(csv);
   s = model_pbd_solver(m);
-  const tet_cut_t *c = model_pbd_cutter(m);
+  const tet_cut_t *c = tet_model_cut_mesh(tc);
   double phys1 = step_median(m, 50);
   double calls = CALLS_PER_CUT * cuts;
   printf(
@@ -226,6 +231,7 @@ int main(int argc, char **argv) {
   free(tets);
   free(q);
   free(ms);
+  tet_model_cut_destroy(tc);
   model_destroy(m);
   mesh_free(&surf);
   return finite ? 0 : 1;

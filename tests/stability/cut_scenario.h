@@ -32,6 +32,7 @@
 #include <string.h>
 
 #include "cutting/tet_cut.h"
+#include "cutting/tet_model_cut.h"
 #include "mesh_import.h"
 #include "physics/pbd.h"
 #include "scene.h"
@@ -64,7 +65,7 @@ static inline model_t *cut_spleen_model(const char *src_dir, mesh_t *surf, scene
 typedef struct cut_record {
   size_t nodes, tets, surf_tris;
   double min_q_rest, min_q_now; /* radius ratio over all tetrahedra */
-  double cut_ms;                /* all model_pbd_cut / _end calls of the cut (intersection, splits, rebuild) */
+  double cut_ms;                /* all tet_model_cut_advance / _end calls of the cut (intersection, splits, rebuild) */
   double intersect_ms, topology_ms, rebuild_ms;
   double step_ms; /* median-free mean of the model steps during the cut */
   int finite;     /* every node and surface coordinate finite after the cut */
@@ -90,8 +91,9 @@ static inline int cut_model_finite(const model_t *m) {
   return 1;
 }
 
-/* One random cut (see the header) on m, whose rest bounds are lo..hi. */
-static inline void cut_random(model_t *m, const double *lo, const double *hi, unsigned *seed, cut_record_t *r) {
+/* One random cut (see the header) on m with its cutter tc, m's rest bounds lo..hi. */
+static inline void cut_random(model_t *m, tet_model_cut_t *tc, const double *lo, const double *hi, unsigned *seed,
+                              cut_record_t *r) {
   memset(r, 0, sizeof *r);
   double ctr[3], R = 0;
   for (int k = 0; k < 3; k++) {
@@ -122,12 +124,12 @@ static inline void cut_random(model_t *m, const double *lo, const double *hi, un
       tip[c] = S[c] + sp * s[c] + depth * d[c];
       han[c] = tip[c] - R * d[c];
     }
-    const tet_cut_t *c0 = model_pbd_cutter(m);
+    const tet_cut_t *c0 = tet_model_cut_mesh(tc);
     double i0 = c0 ? c0->stats.intersect_s : 0, t0 = c0 ? c0->stats.topology_s : 0;
     uint64_t a0 = vtime_mono_ns();
-    if (model_pbd_cut(m, tip, han, &err) < 0) r->rc = -1;
+    if (tet_model_cut_advance(tc, tip, han, &err) < 0) r->rc = -1;
     double all = (double)(vtime_mono_ns() - a0) * 1e-6;
-    const tet_cut_t *c = model_pbd_cutter(m);
+    const tet_cut_t *c = tet_model_cut_mesh(tc);
     r->cut_ms += all;
     double di = 1e3 * (c->stats.intersect_s - i0), dt = 1e3 * (c->stats.topology_s - t0);
     r->intersect_ms += di;
@@ -138,10 +140,10 @@ static inline void cut_random(model_t *m, const double *lo, const double *hi, un
     steps_s += (double)(vtime_mono_ns() - s0) * 1e-9;
     nsteps++;
   }
-  const tet_cut_t *c = model_pbd_cutter(m);
+  const tet_cut_t *c = tet_model_cut_mesh(tc);
   double t0 = c->stats.topology_s;
   uint64_t a0 = vtime_mono_ns();
-  if (model_pbd_cut_end(m, &err) < 0) r->rc = -1;
+  if (tet_model_cut_end(tc, &err) < 0) r->rc = -1;
   double all = (double)(vtime_mono_ns() - a0) * 1e-6, dt = 1e3 * (c->stats.topology_s - t0);
   r->cut_ms += all;
   r->topology_ms += dt;

@@ -32,6 +32,9 @@ int main(void) {
     fprintf(stderr, "stab_cut: %s\n", err.msg);
     return 1;
   }
+  tet_model_cut_t *tc = tet_model_cut_create(m, &err);
+  CHECK(tc != NULL);
+  if (!tc) return 1;
   pbd_t *s = model_pbd_solver(m);
   double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
   double v0 = 0;
@@ -44,7 +47,7 @@ int main(void) {
   pbd_params_t p = s->p;
   double dt0 = cut_stable_dt(s->n, s->x_rest, s->ntets, s->tet, &p);
   size_t tets0 = s->ntets, nodes0 = s->n;
-  CHECK(model_pbd_cutter(m) == NULL);
+  CHECK(tet_model_cut_mesh(tc) == NULL);
   printf("stab_cut: spleen %zu nodes, %zu tetrahedra, stable dt %.4f s\n", nodes0, tets0, dt0);
   printf("%5s %7s %7s %9s %9s %9s %9s\n", "cuts", "nodes", "tets", "maxgrow", "minq", "minq_now", "cut_ms");
   unsigned seed = 20261121u;
@@ -53,7 +56,7 @@ int main(void) {
   int all_ok = 1;
   for (int k = 1; k <= CUTS; k++) {
     cut_record_t r;
-    cut_random(m, lo, hi, &seed, &r);
+    cut_random(m, tc, lo, hi, &seed, &r);
     all_ok &= r.rc == 0 && r.finite;
     if (r.tets - prev > max_growth) max_growth = r.tets - prev;
     prev = r.tets;
@@ -64,7 +67,7 @@ int main(void) {
       printf("%5d %7zu %7zu %9zu %9.4f %9.4f %9.2f\n", k, r.nodes, r.tets, max_growth, worst_q, worst_now, r.cut_ms);
   }
   s = model_pbd_solver(m);
-  const tet_cut_t *c = model_pbd_cutter(m);
+  const tet_cut_t *c = tet_model_cut_mesh(tc);
   double dt1 = cut_stable_dt(c->n, c->x_rest, c->ntets, c->tet, &p);
   printf("stab_cut: after %d cuts %zu nodes, %zu tetrahedra (G1 %zu, G2 %zu, P1 %zu, P2 %zu, P3 %zu splits, %zu node "
          "copies), min rest quality %.4f (now %.4f), max growth %zu per cut, rest volume error %.1e, stable dt %.4f s "
@@ -78,6 +81,7 @@ int main(void) {
   CHECK(max_growth <= 1500);
   CHECK(fabs(s->rest_volume / v0 - 1) < 1e-9);
   CHECK(dt0 > 0 && dt1 >= 0.25 * dt0);
+  tet_model_cut_destroy(tc);
   model_destroy(m);
   mesh_free(&surf);
   return check_report("stab_cut");

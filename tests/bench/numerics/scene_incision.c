@@ -2,7 +2,7 @@
  * 120 x 70 x 40 mm), for every model that cuts: mass_spring_surface (three-
  * stage cutting, server/cutting/ms_cut.h) with symplectic Euler, Verlet, RK4
  * and implicit Euler, and pbd/xpbd on a tetrahedral mesh built at 10 mm
- * (progressive tetrahedral cutting, model_pbd_cut). Explicit Euler is left
+ * (progressive tetrahedral cutting, tet_model_cut_advance). Explicit Euler is left
  * out: undamped it is unstable at every step (NUMERICS.md §6) and its
  * stability bound asks for hundreds of sub-steps per scene step.
  *
@@ -37,6 +37,7 @@
 #include <string.h>
 
 #include "cutting/ms_cut.h"
+#include "cutting/tet_model_cut.h"
 #include "mesh_import.h"
 #include "plot/plot.h"
 #include "vstats.h"
@@ -127,9 +128,11 @@ static int run_incision(const nb_t *nb, const char *model, const char *integ, do
   mesh_free(&surf);
   if (!m) return -1;
   ms_cut_t *mc = NULL;
+  tet_model_cut_t *tc = NULL;
   int pbd = is_pbd(model);
 #ifdef NUMERICS_HAVE_PBD
-  if (pbd && model_pbd_enable_cutting(m, err)) {
+  if (pbd && (!(tc = tet_model_cut_create(m, err)) || tet_model_cut_prepare(tc, err))) {
+    tet_model_cut_destroy(tc);
     model_destroy(m);
     return -1;
   }
@@ -148,6 +151,7 @@ static int run_incision(const nb_t *nb, const char *model, const char *integ, do
   if (!out->n || !out->topo || !out->x || !us || record(out, 0, m)) {
     free(us);
     ms_cut_destroy(mc);
+    tet_model_cut_destroy(tc);
     model_destroy(m);
     cut_run_free(out);
     return verr_set(err, "out of memory");
@@ -164,13 +168,13 @@ static int run_incision(const nb_t *nb, const char *model, const char *integ, do
     /* The cut is part of the scene step's cost: it is timed with it. */
     if (j <= NBLADE) {
 #ifdef NUMERICS_HAVE_PBD
-      if (pbd && moves) rc = model_pbd_cut(m, tip, han, err);
+      if (pbd && moves) rc = tet_model_cut_advance(tc, tip, han, err);
 #endif
       if (!pbd) rc = ms_cut_step(mc, han, tip, BLADE_RADIUS, err);
     } else if (!ended) {
       ended = 1;
 #ifdef NUMERICS_HAVE_PBD
-      if (pbd) rc = model_pbd_cut_end(m, err);
+      if (pbd) rc = tet_model_cut_end(tc, err);
 #endif
       if (!pbd) rc = ms_cut_end(mc, err);
     } else if (!pbd) {
@@ -217,6 +221,7 @@ static int run_incision(const nb_t *nb, const char *model, const char *integ, do
   out->ok = 1;
   free(us);
   ms_cut_destroy(mc);
+  tet_model_cut_destroy(tc);
   model_destroy(m);
   return 0;
 }

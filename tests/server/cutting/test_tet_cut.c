@@ -19,6 +19,7 @@
 
 #include "check.h"
 #include "cutting/tet_cut.h"
+#include "cutting/tet_model_cut.h"
 #include "cutting/tet_split.h"
 #include "mesh.h"
 #include "physics/pbd.h"
@@ -396,11 +397,13 @@ static void test_model_cut(void) {
     mesh_free(&surf);
     return;
   }
-  /* No cutting structures unless a cut starts (or the scene has a scalpel). */
-  CHECK(model_pbd_cutter(m) == NULL && model_pbd_cutter(ref) == NULL);
-  CHECK(model_pbd_surface_attr(m) == NULL);
+  /* No cutting structures unless a cut starts (or the scene has a scalpel):
+   * the models hold none, the cutter copies no mesh until then. */
   verr_t err;
-  CHECK(model_pbd_cut_end(m, &err) == 0 && model_pbd_cutter(m) == NULL);
+  tet_model_cut_t *tc = tet_model_cut_create(m, &err);
+  CHECK(tc != NULL && tet_model_cut_mesh(tc) == NULL && tet_model_cut_mesh(NULL) == NULL);
+  CHECK(model_pbd_surface_attr(m) == NULL);
+  CHECK(tet_model_cut_end(tc, &err) == 0 && tet_model_cut_mesh(tc) == NULL);
   size_t tets0 = m->ntets, tris0 = m->nsurf_tris;
   int ok = 1;
   /* Let both settle a little, then cut the middle with a vertical blade
@@ -410,16 +413,17 @@ static void test_model_cut(void) {
   for (int k = 0; k <= 8; k++) {
     double y = -0.01 + 0.06 * k / 8;
     double tip[3] = {0.153, y, -0.02}, han[3] = {0.153, y, 0.07};
-    int n = model_pbd_cut(m, tip, han, &err);
+    int n = tet_model_cut_advance(tc, tip, han, &err);
     CHECK(n >= 0);
     split += n > 0 ? n : 0;
     ok &= m->ops->step(m, 0.005) == 0 && ref->ops->step(ref, 0.005) == 0;
   }
-  int n = model_pbd_cut_end(m, &err);
+  int n = tet_model_cut_end(tc, &err);
   CHECK(n >= 0);
-  const tet_cut_t *c = model_pbd_cutter(m);
+  const tet_cut_t *c = tet_model_cut_mesh(tc);
   CHECK(c != NULL);
   if (!c) {
+    tet_model_cut_destroy(tc);
     model_destroy(ref);
     model_destroy(m);
     mesh_free(&surf);
@@ -445,6 +449,7 @@ static void test_model_cut(void) {
          tets0, m->ntets, tris0, m->nsurf_tris, -1e3 * s_cut, -1e3 * s_ref, e.inverted, e.strain_max);
   CHECK(s_cut < 3 * s_ref && s_cut < -0.005);
   CHECK(e.inverted == 0);
+  tet_model_cut_destroy(tc);
   model_destroy(ref);
   model_destroy(m);
   mesh_free(&surf);

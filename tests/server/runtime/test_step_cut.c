@@ -74,7 +74,7 @@ static void test_allocation(void) {
   CHECK(load(yaml));
   CHECK(rt.scalpel == NULL);
   for (size_t i = 0; i < rt.norgans; i++) CHECK(!scalpel_has_cutter(&rt, i));
-  CHECK(model_pbd_cutter(rt.organs[0].model) == NULL);
+  CHECK(!scalpel_has_cutter(&rt, 0)); /* the models hold no cutter of their own */
   CHECK(scalpel_stats(&rt, 0) == NULL);
   runtime_destroy(&rt);
   /* A scalpel: cutters for the xpbd and mass-spring organs, none for the
@@ -83,7 +83,7 @@ static void test_allocation(void) {
            SPLEEN_XPBD, BLOCK_MS, KIDNEY_VB);
   CHECK(load(yaml));
   CHECK(rt.scalpel != NULL);
-  CHECK(model_pbd_cutter(rt.organs[0].model) != NULL);
+  CHECK(scalpel_has_cutter(&rt, 0)); /* the xpbd organ's mesh copied at load */
   CHECK(scalpel_has_cutter(&rt, 0) && scalpel_has_cutter(&rt, 1) && !scalpel_has_cutter(&rt, 2));
   CHECK(scalpel_stats(&rt, 1)->can_cut && !scalpel_stats(&rt, 2)->can_cut);
   CHECK_NEAR(rt.tools[1].cfg->blade_length, 0.02, 0);
