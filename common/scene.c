@@ -494,7 +494,7 @@ static const char *const task_keys[K_NKEYS] = {
     [K_OBJECT] = "object",    [K_TARGET] = "target", [K_TARGET_RADIUS] = "target_radius",
     [K_DISTANCE] = "distance", [K_START] = "start"};
 
-/* In the order they must rise: ST < MPF <= SFT (seed 002 ch. 6). */
+/* In the order they must rise: ST < MPF <= SFT (docs/methods.md B ch. 6). */
 enum { H_ST, H_MPF, H_SFT, H_NKEYS };
 static const char *const threshold_keys[H_NKEYS] = {[H_ST] = "st", [H_MPF] = "mpf", [H_SFT] = "sft"};
 
@@ -638,7 +638,7 @@ static int check_model_material(const ctx_t *c, const node_t *model_node, const 
   char fp[128];
   if (!strcmp(o->model, "molecular")) {
     /* Seed 000 eq. 11: the stretch-bend energy is positive definite only if
-     * k_r k_theta > 2 k_sb^2 (NUMERICS.md §6). */
+     * k_r k_theta > 2 k_sb^2 (docs/numerics.md §6). */
     double lhs = m->bond_k * m->angle_k, rhs = 2 * m->stretch_bend_k * m->stretch_bend_k;
     if (!(lhs > rhs)) {
       int key = mv[M_STRETCH_BEND_K] ? M_STRETCH_BEND_K : mv[M_ANGLE_K] ? M_ANGLE_K : M_BOND_K;

@@ -26,21 +26,21 @@ typedef struct scene_material {
   double damping;        /* N s/m, Kelvin-Voigt edge damping (default 0.02) */
   double home_stiffness; /* N/m, spring from each vertex to its rest position (default 30) */
   double home_damping;   /* N s/m, damping relative to the ground (default 0.005) */
-  /* molecular (seed 000 eq. 6-11); the scene is refused unless
+  /* molecular (docs/methods.md A eq. 6-11); the scene is refused unless
    * bond_k * angle_k > 2 * stretch_bend_k^2. */
   double bond_k;         /* N/m, bond stretch k_r [30] */
   double angle_k;        /* J (N m), bond angle k_theta, cosine form [1e-3] */
   double stretch_bend_k; /* N, stretch-bend coupling k_sb [0] */
-  /* PBD / XPBD (seed 003 §4): stiffness in 0..1 for PBD, compliance
+  /* PBD / XPBD (docs/methods.md C §4): stiffness in 0..1 for PBD, compliance
    * (m/N for distance, 1/(N m^2)... per constraint) for XPBD. */
   double distance_stiffness;   /* PBD [1] */
   double volume_stiffness;     /* PBD [1] */
   double distance_compliance;  /* XPBD [1e-4] */
   double volume_compliance;    /* XPBD [1e-6] */
-  /* vertex_based (seed 002 ch. 4): slopes of the slope-intercept rule for
+  /* vertex_based (docs/methods.md B ch. 4): slopes of the slope-intercept rule for
    * the touched node and its first and second rings, m1 > m2 > m3 > 0. */
   double slope_m1, slope_m2, slope_m3; /* [1, 0.6, 0.3] */
-  /* adaptive_mass_spring (seed 002 ch. 5): one-ring faces larger than
+  /* adaptive_mass_spring (docs/methods.md B ch. 5): one-ring faces larger than
    * refine_area are subdivided, up to refine_levels levels. */
   double refine_area;    /* m^2 [2e-5] */
   int refine_levels;     /* [2] */
@@ -97,7 +97,7 @@ typedef struct scene_tool {
   double length;    /* m, shaft length for drawing (default 0.1) */
   double stiffness; /* N/m, proxy virtual spring (default 300) */
   double max_force; /* N, clamp (default 4) */
-  /* Palpation force thresholds (seed 002 ch. 6), N on the contact force
+  /* Palpation force thresholds (docs/methods.md B ch. 6), N on the contact force
    * magnitude; 0 = not set (no events for it). Key `thresholds:`, each
    * optional: st (sound threshold: the audio/visual cue to ease off),
    * mpf (maximum palpation force: the target not to go beyond), sft
@@ -123,7 +123,7 @@ typedef struct scene_tool {
 } scene_tool_t;
 
 /* A rigid object inside an organ (key `objects:`). Only kind "stone" (a
- * rigid sphere, seed 000 kidney-stone removal) so far. The scene file does
+ * rigid sphere, docs/methods.md A kidney-stone removal) so far. The scene file does
  * not open meshes, so "inside the organ" is checked by the runtime. */
 typedef struct scene_object {
   char name[SCENE_NAME_LEN];
@@ -143,7 +143,7 @@ typedef struct scene_object {
  *   palpate_target  tool: any kind that touches (not an extractor); target,
  *                   target_radius; completes at the first contact within
  *                   target_radius of target (its time is the exploration
- *                   time to the target, seed 002 ch. 6).
+ *                   time to the target, docs/methods.md B ch. 6).
  *   grasp_pull      tool: a grasper; distance; completes when the tool,
  *                   holding tissue, is `distance` from where it grasped.
  * start: first_command (default: the clock starts at the tool's first

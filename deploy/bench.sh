@@ -25,10 +25,10 @@ echo
 echo "== recorder throughput and drops: gallbladder at 60 Hz, two haptic clients at 1 kHz, 45 s"
 VISCERA_DOMAIN="$D" bash "$ROOT/tests/bench/recorder_load.sh" "$ROOT/build-bench" "$ROOT" "$OUT/recorder_load" 45
 echo
-echo "== cutting: progressive tetrahedral cutting on the spleen (seed 003 Table 1 style), 100 random cuts"
+echo "== cutting: progressive tetrahedral cutting on the spleen (docs/methods.md C Table 1 style), 100 random cuts"
 "$ROOT/build-bench/tests/bench/bench_tet_cut" "$ROOT" --csv "$OUT/tet_cut.csv" --png "$OUT/tet_cut.png"
 echo
-echo "== cutting: three-stage mass-spring cutting, incision width over time (seed 004 Fig. 6)"
+echo "== cutting: three-stage mass-spring cutting, incision width over time (docs/methods.md D Fig. 6)"
 "$ROOT/build-bench/tests/bench/bench_ms_cut" --out "$OUT/ms_cut"
 echo
 echo "== classroom load: 5 seats, 30 subscribers at 60 Hz (a third joining late), 600 s"

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Numerics benchmark (NUMERICS.md): error against run time and stability for
+# Numerics benchmark (docs/numerics.md): error against run time and stability for
 # every deformation model and integrator. Builds a Release tree and runs
 # bench_numerics on one core; writes CSV files and PNG charts into
 # out/numerics/ and prints the summary table.

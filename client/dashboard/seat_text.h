@@ -2,7 +2,7 @@
  * plain data (no DDS, no drawing), so unit tests pin the wording and the
  * colours an instructor learns to read.
  *
- * Levels are the palpation thresholds of seed 002 ch. 6: below ST, above ST
+ * Levels are the palpation thresholds of docs/methods.md B ch. 6: below ST, above ST
  * (the cue to ease off), above MPF (the most a palpation should use), above
  * SFT (the hard stop). Each has one colour everywhere on the dashboard:
  * threshold lines, tile alert frames, the focus view's level badge. */

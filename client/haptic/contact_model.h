@@ -7,7 +7,7 @@
  * feedback sample moves the plane, not the sign of the work done. A spring
  * sampled at period T with a zero-order hold still generates energy (about
  * k T / 2 per unit squared velocity); the damping b >= k T / 2 removes it
- * (NUMERICS.md §6), and the force never pulls the hand into the wall. */
+ * (docs/numerics.md §6), and the force never pulls the hand into the wall. */
 #ifndef VISCERA_CONTACT_MODEL_H
 #define VISCERA_CONTACT_MODEL_H
 

@@ -22,7 +22,7 @@
  * - The coupling spring (1 - w) k pulls the hand towards the peer. Its
  *   damping, on own velocity only (a differenced peer velocity would be
  *   noisy and one network delay old), is (1 - w) k T: twice the k T / 2 a
- *   zero-order-hold spring at period T generates (NUMERICS.md §6).
+ *   zero-order-hold spring at period T generates (docs/numerics.md §6).
  * - k is clamped to the device's stiffness rating, like the contact wall.
  * - The total is clamped to max_force (direction kept).
  * Fallbacks: no role, no guide, neither side, an invalid role (authority

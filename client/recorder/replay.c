@@ -363,7 +363,7 @@ static int setup_topic(replay_t *r, sqlite3_stmt *st, rp_topic_t *t, verr_t *err
   t->st.type.ops.nops = (uint32_t)nops;
   t->st.type.ops.ops = t->ops;
 
-  /* A wrong ops length makes dds_create_topic hang (DDS_NOTES): the stored
+  /* A wrong ops length makes dds_create_topic hang (docs/dds.md, "Topic descriptors"): the stored
    * count must be what Cyclone counts in the stored program. */
   uint32_t counted = dds_stream_countops(t->ops, t->nkeys, t->keys);
   if (counted != (uint32_t)nops)

@@ -1,6 +1,6 @@
 /* viscera-report: per-trainee report from one or several session
  * recordings: HTML with embedded charts, CSV, and with several recordings a
- * comparison (novice against expert, seed 000 Table 2, seed 002 ch. 6).
+ * comparison (novice against expert, docs/methods.md A Table 2, docs/methods.md B ch. 6).
  *
  * Bad input never stops the others: a file that is not a recording, or has
  * nothing to report, is named with the reason and skipped (exit 1); a

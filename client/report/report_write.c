@@ -162,7 +162,7 @@ int rep_write_html(const rep_recording_t *const *recs, int n, const char *const 
   fprintf(f,
           "<p class=note>%d recording(s). Force measures replay the recorded ContactFeedback (force on the tool "
           "at the server, every physics step) through the server's threshold tracker; times are simulated "
-          "time. Thresholds (seed 002 ch. 6): ST sound threshold, MPF maximum palpation force, SFT stopping "
+          "time. Thresholds (docs/methods.md B ch. 6): ST sound threshold, MPF maximum palpation force, SFT stopping "
           "force threshold; crossings are upward crossings.</p>\n",
           n);
   for (int i = 0; i < n && ret == 0; i++) {

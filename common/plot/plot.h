@@ -1,5 +1,5 @@
 /* plot: line charts rendered with cairo into PNG files: the charts of the
- * numerics benchmark (NUMERICS.md §4) and the report tool's time series; bar
+ * numerics benchmark (docs/numerics.md §4) and the report tool's time series; bar
  * charts are in plot_bars.h.
  *
  * A plot is a set of series (points joined by lines and/or marked) on linear

@@ -369,7 +369,7 @@ int store_add_topic(store_t *s, const char *name, const dds_topic_descriptor_t *
   if (begin_if_needed(s, err) < 0) return -1;
   /* m_nops counts instructions, not words; the ops array's real length
    * comes from dds_stream_countops (a wrong length makes a rebuilt
-   * descriptor hang dds_create_topic, see DDS_NOTES). */
+   * descriptor hang dds_create_topic, see docs/dds.md, "Topic descriptors"). */
   uint32_t nops = dds_stream_countops(desc->m_ops, desc->m_nkeys, desc->m_keys);
   unsigned char *ops = malloc((size_t)nops * 4u + 1u);
   if (!ops) return verr_set(err, "%s: out of memory", s->path);

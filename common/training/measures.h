@@ -13,7 +13,7 @@
  * (client silent) leaves the contact first, while a hole in mid-contact
  * can only be lost samples. A sample out of order counts dt_nominal.
  *
- * Definitions (seed 002 ch. 6, seed 000 Table 2):
+ * Definitions (docs/methods.md B ch. 6, docs/methods.md A Table 2):
  *   contact (exploration) time   time in contact, as the server's Metrics;
  *   time to first contact        from the first tool motion to the first
  *                                contact: reaching the feature (002 §6.6.2.2);

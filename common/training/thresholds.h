@@ -1,4 +1,4 @@
-/* thresholds: per-tool palpation measures (seed 002 ch. 6). Tracks the
+/* thresholds: per-tool palpation measures (docs/methods.md B ch. 6). Tracks the
  * contact force magnitude against the tool's three palpation thresholds
  * (ST sound threshold < MPF maximum palpation force <= SFT stopping force
  * threshold) and reports each crossing, upward and downward, with a small

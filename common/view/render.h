@@ -69,7 +69,7 @@ void render_object(render_t *r, const float centre[3], float radius, const float
  * are not too dense. Draw it last. */
 void render_force_bar(render_t *r, double force, double max_force);
 
-/* The same bar with the tool's palpation thresholds (seed 002 ch. 6), N,
+/* The same bar with the tool's palpation thresholds (docs/methods.md B ch. 6), N,
  * 0 = unset: a line across the bar at each level set; when ST or MPF is
  * set the fill is green below ST, orange above ST and red above MPF
  * instead of the fraction-of-max colours. */

@@ -54,7 +54,7 @@ static uint32_t build_node(build_ctx_t *c, size_t b, size_t e, int level) {
   size_t n = e - b;
   if (n <= AABB_TREE_LEAF_MAX) return AABB_LEAF | (uint32_t)n << 28 | (uint32_t)b;
   uint32_t self = (uint32_t)c->next++;
-  /* Longest axis of the box around this node's triangles (seed 000 §3.1). */
+  /* Longest axis of the box around this node's triangles (docs/methods.md A §3.1). */
   double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
   for (size_t s = b; s < e; s++) {
     const double *tb = c->tbox + 6 * (size_t)c->idx[s];
@@ -515,7 +515,8 @@ int tri_box_overlap(const double a[3], const double b[3], const double c[3], con
   /* Only finite, non-empty boxes select anything, and a triangle with a NaN
    * corner overlaps nothing (NaN would fail every separation test). */
   for (int k = 0; k < 3; k++)
-    if (!(lo[k] <= hi[k]) || !isfinite(lo[k]) || !isfinite(hi[k]) || isnan(a[k]) || isnan(b[k]) || isnan(c[k])) return 0;
+    if (!(lo[k] <= hi[k]) || !isfinite(lo[k]) || !isfinite(hi[k]) || isnan(a[k]) || isnan(b[k]) || isnan(c[k]))
+      return 0;
   double ctr[3], h[3], v[3][3], e[3][3];
   for (int k = 0; k < 3; k++) {
     ctr[k] = 0.5 * (lo[k] + hi[k]);

@@ -1,5 +1,5 @@
 /* aabb_tree: a bounding-volume hierarchy of axis-aligned boxes over a
- * deforming triangle surface (seed 000 §3.1).
+ * deforming triangle surface (docs/methods.md A §3.1).
  *
  * Built once: each node's triangles are split at the median of their
  * centroids along the longest axis of the node's box (moved by at most three

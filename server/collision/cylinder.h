@@ -1,5 +1,5 @@
 /* cylinder: a long, thin tool (scalpel, laparoscope shaft) against mesh
- * nodes (seed 004 §2.2).
+ * nodes (docs/methods.md D §2.2).
  *
  * The tool is a cylinder of radius r around its axis segment p0 -> p1. A
  * node N collides when
@@ -30,7 +30,8 @@ typedef struct cylinder_hit {
   uint32_t node;
   double t;      /* axis parameter of p in [0, 1] (p = p0 + t (p1 - p0)) */
   double dist;   /* d = |N - p| < radius */
-  double dir[3]; /* unit N -> p, the direction the seed pushes the node; zero when N is on the axis */
+  double dir[3]; /* unit N -> p, the direction the published test (docs/methods.md D) pushes the node; zero when N is on
+                    the axis */
 } cylinder_hit_t;
 
 /* The seed's test for one node; fills *hit (node field untouched) when N is

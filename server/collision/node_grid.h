@@ -1,5 +1,5 @@
 /* node_grid: a uniform grid over mesh nodes for "which node does the tool
- * touch" queries (seed 002 §4.3, Tables 4.1-4.2: the touched node found by
+ * touch" queries (docs/methods.md B §4.3, Tables 4.1-4.2: the touched node found by
  * space partitioning instead of a linear scan).
  *
  * The thesis uses an octree of 25-50 nodes per leaf, three levels deep, and
@@ -61,7 +61,8 @@ uint32_t node_grid_nearest(const node_grid_t *g, const double q[3], double *dist
 /* Calls fn for every node whose position lies in [lo, hi] (inclusive), in
  * cell order, with its id and grid position. */
 typedef void (*node_grid_visit_fn)(void *ctx, uint32_t id, const double p[3]);
-void node_grid_visit_box(const node_grid_t *g, const double lo[3], const double hi[3], node_grid_visit_fn fn, void *ctx);
+void node_grid_visit_box(const node_grid_t *g, const double lo[3], const double hi[3], node_grid_visit_fn fn,
+                         void *ctx);
 
 /* The nodes in [lo, hi]: writes up to cap ids to out, returns how many there are. */
 size_t node_grid_query_box(const node_grid_t *g, const double lo[3], const double hi[3], uint32_t *out, size_t cap);

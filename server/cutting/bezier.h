@@ -1,4 +1,4 @@
-/* bezier: the cubic Bezier incision curve of seed 004 §2.3.2 (eq. 5-8).
+/* bezier: the cubic Bezier incision curve of docs/methods.md D §2.3.2 (eq. 5-8).
  *
  * P(a) = sum_k P_k B_k,3(a), a in [0, 1], with the Bernstein polynomials
  * B_k,n(a) = n! / (k! (n-k)!) a^k (1-a)^(n-k) (eq. 6); for n = 3 (eq. 7)

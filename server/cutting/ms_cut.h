@@ -1,5 +1,5 @@
 /* ms_cut: three-stage cutting of a surface mass-spring model with residual
- * stress (seed 004, Zhang et al. 2021, §2.1 and §2.3).
+ * stress (docs/methods.md D, Zhang et al. 2021, §2.1 and §2.3).
  *
  * The scalpel is a cylinder: axis segment p0 (handle side) -> p1 (tip) and
  * radius r. Each physics step the runtime calls ms_cut_step() with the blade
@@ -69,7 +69,7 @@
 #include "verr.h"
 
 typedef struct ms_cut_params {
-  double eps_r;          /* residual strain (seed 004: 0.1); 0 disables residual stress */
+  double eps_r;          /* residual strain (docs/methods.md D: 0.1); 0 disables residual stress */
   double segment_length; /* m of path per processed segment; 0: 4 x the mean rest edge length */
   double min_radius_rel; /* floor of the swept radius, x mean rest edge length (default 0.3) */
   double max_radius;     /* m, larger blade radii are refused (default 0.02) */
@@ -114,7 +114,7 @@ const ms_cut_stats_t *ms_cut_stats(const ms_cut_t *c);
  * dominant vectors from create on, more once the blade comes near. */
 size_t ms_cut_bytes(const ms_cut_t *c);
 
-/* Incision width (seed 004 §4.1: distance between points on both sides):
+/* Incision width (docs/methods.md D §4.1: distance between points on both sides):
  * for every lip node of side 1 (curve ends shared with side 2 excluded) its distance to
  * the nearest lip polyline of side 2 at the current positions; mean and max
  * over them, m. Returns the number of nodes measured (0: no incision yet). */

@@ -1,4 +1,4 @@
-/* node_match: stage 3 of seed 004's cutting (§2.3.3, Algorithm 2, Fig. 3),
+/* node_match: stage 3 of docs/methods.md D's cutting (§2.3.3, Algorithm 2, Fig. 3),
  * the shortest-distance nodes matching method, on the hole that stage 1 left.
  *
  * Input: the hole's boundary as directed edges u -> v with the hole on

@@ -1,5 +1,5 @@
 /* tet_cut: progressive cutting of a tetrahedral mesh by a moving blade
- * (seed 003 §5.2-§5.3).
+ * (docs/methods.md C §5.2-§5.3).
  *
  * The blade is a segment (tip, handle) without thickness. Each call to
  * tet_cut_advance() gives its new position; the quad it swept since the
@@ -11,7 +11,7 @@
  * the set of its six edges that are cut), stored once per edge so neighbours
  * cannot disagree.
  *
- * When is a tetrahedron split (the seed: "when the blade leaves it"):
+ * When is a tetrahedron split (docs/methods.md C: "when the blade leaves it"):
  *   - general case: its cut edges separate its four nodes into two groups
  *     (3 edges: one node from three, G1; 4 edges: two from two, G2) and the
  *     blade segment at its new position no longer intersects it;

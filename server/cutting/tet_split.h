@@ -1,4 +1,4 @@
-/* tet_split: the case table of a tetrahedron's cut state (seed 003 §5.2,
+/* tet_split: the case table of a tetrahedron's cut state (docs/methods.md C §5.2,
  * figs. 8-9) and the seed's rest-length rules. Internal to tet_cut.c and its
  * tests; the splitting itself (recursive bisection, see tet_cut.h) is in
  * tet_cut.c because it needs the edge table.

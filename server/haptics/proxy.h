@@ -1,4 +1,4 @@
-/* proxy: god-object haptic proxy with a virtual spring (seed 000 eq. 12).
+/* proxy: god-object haptic proxy with a virtual spring (docs/methods.md A eq. 12).
  *
  * The device point (SUN) may sink into an organ; the proxy (IUN) may not: it
  * stays on the deforming surface, attached to a triangle by barycentric
@@ -74,7 +74,7 @@ void proxy_reset(proxy_t *p);
 int proxy_update(proxy_t *p, const double device[3], const proxy_surface_t *surfaces, size_t nsurfaces,
                  double stiffness, double max_force, double force[3]);
 
-/* The virtual spring f = K (proxy - device) (seed 000 eq. 12: f = -K x with
+/* The virtual spring f = K (proxy - device) (docs/methods.md A eq. 12: f = -K x with
  * x = device - proxy), clamped to max_force; zero when not in contact.
  * Returns |f|. */
 double proxy_spring_force(const proxy_t *p, const double device[3], double stiffness, double max_force, double f[3]);

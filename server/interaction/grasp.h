@@ -1,4 +1,4 @@
-/* grasp: a grasper holding a small patch of tissue (seed 000: hold, pull).
+/* grasp: a grasper holding a small patch of tissue (docs/methods.md A: hold, pull).
  *
  * When the jaws close with the tip within the grasp radius of a surface,
  * grasp_take() takes the surface vertices within that radius of the tip (at

@@ -1,4 +1,4 @@
-/* shaft: the tool shaft against tissue (issue 4; seed 004 §2.2 cylinder
+/* shaft: the tool shaft against tissue (issue 4; docs/methods.md D §2.2 cylinder
  * test, plus segment-triangle contact). The shaft is a cylinder of radius
  * SHAFT_RADIUS_FRACTION x the tip radius (as the viewer draws it) around the
  * segment from just above the tip sphere to tip + length along the tool

@@ -1,4 +1,4 @@
-/* stone: a rigid spherical object inside an organ (seed 000: kidney-stone
+/* stone: a rigid spherical object inside an organ (docs/methods.md A: kidney-stone
  * removal with a laparoscope).
  *
  * The stone is static unless an extractor holds it; held, its centre

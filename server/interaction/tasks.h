@@ -1,5 +1,5 @@
-/* tasks: progress of the scene's training tasks (scene `tasks:`), seed 000
- * Table 2 (operation time per task) and seed 002 ch. 6 (exploration time).
+/* tasks: progress of the scene's training tasks (scene `tasks:`), docs/methods.md A
+ * Table 2 (operation time per task) and docs/methods.md B ch. 6 (exploration time).
  * A task starts at the first command of its tool (`start: first_command`)
  * or when the instructor starts it (`start: instructor`, SessionControl
  * CONTROL_START_TASK, tasks_start), and completes by its kind's criterion

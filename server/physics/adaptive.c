@@ -118,7 +118,7 @@ static void rest_matvec(const adaptive_t *ad, int use_c, double diag_extra, cons
     for (int k = 0; k < 3; k++) y[3 * i + k] *= ad->inv_mass[i];
 }
 
-/* Largest eigenvalue of M^-1 A by power iteration (NUMERICS.md: omega_max
+/* Largest eigenvalue of M^-1 A by power iteration (docs/numerics.md: omega_max
  * by power iteration), +2 % for the unconverged remainder. */
 static double lambda_max(const adaptive_t *ad, int use_c, double diag_extra, double *x, double *y) {
   unsigned seed = 2024;
@@ -561,7 +561,7 @@ static uint32_t midpoint(adaptive_t *ad, uint32_t a, uint32_t b, int level) {
   return m;
 }
 
-/* Red split of a leaf into four (seed 002 §5.2.2.3: "subdivide it into four
+/* Red split of a leaf into four (docs/methods.md B §5.2.2.3: "subdivide it into four
  * triangles"), children in the parent's orientation. Splitting an edge that
  * lies on the root face's boundary roots the coarse face across it, so the
  * closure below sees it. */
@@ -819,7 +819,7 @@ static void match_home(adaptive_t *ad) {
   }
 }
 
-/* Parameter identification (seed 002 §5.2.3). */
+/* Parameter identification (docs/methods.md B §5.2.3). */
 static void identify(adaptive_t *ad) {
   const adaptive_params_t *p = &ad->p;
   size_t n0 = ad->n0;

@@ -1,14 +1,14 @@
 /* adaptive: adaptive area-based refinement and simplification of a surface
- * Kelvin-Voigt mass-spring model (seed 002 ch. 5).
+ * Kelvin-Voigt mass-spring model (docs/methods.md B ch. 5).
  *
- * Physics (seed 002 §5.2.1): every edge is a spring with a dashpot in
+ * Physics (docs/methods.md B §5.2.1): every edge is a spring with a dashpot in
  * parallel (eq. 5.3, Kelvin-Voigt); every vertex has a damped home spring to
  * its rest position (§5.2.4, shape preservation of a hollow surface model);
  * M a + C v + K u = F_ext (eq. 5.5) integrated by semi-implicit Euler,
  * v += h F / m then x += h v (eq. 5.8-5.9: the position update uses the new
  * velocity). Own small force code: nothing of mass_spring.c is used.
  *
- * Refinement (seed 002 §5.2.2.3): when the contact force exceeds
+ * Refinement (docs/methods.md B §5.2.2.3): when the contact force exceeds
  * refine_force (§5.3), the one-ring faces of the touched node whose area
  * exceeds refine_area are split 1-to-4 (red: edge midpoints), each child
  * again while its area exceeds refine_area, up to refine_levels levels.
@@ -80,7 +80,7 @@ typedef struct adaptive_params {
   double gravity[3];
   double refine_area;    /* m^2, faces larger than this are split */
   int refine_levels;     /* 0..ADAPT_MAX_LEVELS */
-  double refine_force;   /* N, contact force that triggers refinement (seed 002 §5.3) */
+  double refine_force;   /* N, contact force that triggers refinement (docs/methods.md B §5.3) */
   double release_time;   /* s without contact before simplification */
   double tool_stiffness; /* N/m, in the stability bound */
   adapt_mass_rule_t mass_rule;

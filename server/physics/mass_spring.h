@@ -1,9 +1,9 @@
-/* mass_spring: mass-spring forces as a force_system_t (seed 002 §4.2.3,
- * §5.2.4; seed 000 eq. 1-5), for the integrators in integrator.h.
+/* mass_spring: mass-spring forces as a force_system_t (docs/methods.md B §4.2.3,
+ * §5.2.4; docs/methods.md A eq. 1-5), for the integrators in integrator.h.
  *
  * Springs are the unique edges of a triangle surface (surface variant) or of
  * a tetrahedral mesh (volume variant). Every spring has Kelvin-Voigt damping
- * (seed 002 eq. 5.3): the force on i is f = k (L - L0) u + c ((v_j - v_i) . u) u
+ * (docs/methods.md B eq. 5.3): the force on i is f = k (L - L0) u + c ((v_j - v_i) . u) u
  * with u the unit vector from i to j. Every node also has a home spring to
  * its rest position with ground damping (the surrounding tissue holding the
  * organ's shape), and gravity acts on the lumped masses, which are equal
@@ -75,7 +75,8 @@ typedef struct mass_spring {
    * adds or removes springs must keep it in step (or clear it). */
   double *k_scale;
   /* Cutting (server/cutting/ms_cut.h) only; NULL / 0 until a cut happens. */
-  double *f_res; /* 3n or NULL: constant nodal forces (residual stress, seed 004 eq. 4), in forces() and potential() */
+  double *f_res; /* 3n or NULL: constant nodal forces (residual stress, docs/methods.md D eq. 4), in forces() and
+                    potential() */
   size_t cap;    /* node capacity of the node arrays (>= n) */
 } mass_spring_t;
 

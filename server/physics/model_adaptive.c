@@ -1,4 +1,4 @@
-/* model_adaptive: the "adaptive_mass_spring" scene model (seed 002 ch. 5)
+/* model_adaptive: the "adaptive_mass_spring" scene model (docs/methods.md B ch. 5)
  * behind the common model interface. A surface model (surf_x == x) whose
  * surface changes: after a step that refined or simplified, nnodes, nsurf,
  * nsurf_tris and substeps are updated and then model_t.topology_version
@@ -129,10 +129,11 @@ model_t *model_adaptive_create(const model_params_t *p, verr_t *err) {
   /* Seed 002 eq. 5.8-5.9 is semi-implicit (symplectic) Euler; the model
    * integrates itself, since its node count changes under the integrator. */
   if (cfg->integrator[0] && strcmp(cfg->integrator, "symplectic_euler") != 0) {
-    verr_set(err,
-             "adaptive_mass_spring integrates with symplectic Euler (seed 002 eq. 5.8-5.9); integrator '%s' is "
-             "not available for it",
-             cfg->integrator);
+    verr_set(
+        err,
+        "adaptive_mass_spring integrates with symplectic Euler (docs/methods.md B eq. 5.8-5.9); integrator '%s' is "
+        "not available for it",
+        cfg->integrator);
     return NULL;
   }
   adaptive_model_t *am = calloc(1, sizeof *am);

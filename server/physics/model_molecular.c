@@ -1,9 +1,9 @@
-/* model_molecular: the molecular force system (molecular.h, seed 000 eq.
+/* model_molecular: the molecular force system (molecular.h, docs/methods.md A eq.
  * 6-11) as model_t for the scene model name "molecular", stepped by the
  * scene's integrator (integrator.h).
  *
  * Parameters: the set is refused at load unless bond_k angle_k > 2
- * stretch_bend_k^2 (molecular_check_params; NUMERICS.md case 13). The
+ * stretch_bend_k^2 (molecular_check_params; docs/numerics.md case 13). The
  * material's `damping` is the bonds' Kelvin-Voigt damping, as on the
  * mass-spring edges.
  *
@@ -122,7 +122,7 @@ static int choose_substeps(mol_model_t *mm, const model_params_t *p, integrator_
 model_t *model_molecular_create(const model_params_t *p, verr_t *err) {
   const scene_organ_t *cfg = p->cfg;
   const scene_material_t *mat = &cfg->material;
-  /* NUMERICS.md case 13: a non-positive-definite set is refused at load. */
+  /* docs/numerics.md case 13: a non-positive-definite set is refused at load. */
   if (molecular_check_params(mat->bond_k, mat->angle_k, mat->stretch_bend_k, err)) return NULL;
   int kind = integrator_parse(cfg->integrator);
   if (kind < 0) {

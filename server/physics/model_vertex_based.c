@@ -1,4 +1,4 @@
-/* model_vertex_based: the "vertex_based" scene model (seed 002 ch. 4) behind
+/* model_vertex_based: the "vertex_based" scene model (docs/methods.md B ch. 4) behind
  * the common model interface. A surface model: nodes are the surface
  * vertices, surf_x == x. Gravity is not applied: the thesis model has none,
  * and the home springs hold the organ's rest shape (which is the shape under

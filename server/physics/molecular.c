@@ -22,7 +22,7 @@ int molecular_check_params(double k_r, double k_theta, double k_sb, verr_t *err)
   if (!(lhs > rhs))
     return verr_set(err,
                     "molecular: bond_k * angle_k = %g * %g = %g must exceed 2 * stretch_bend_k^2 = 2 * %g^2 = %g, "
-                    "otherwise the stretch-bend energy (seed 000 eq. 11) is not positive-definite",
+                    "otherwise the stretch-bend energy (docs/methods.md A eq. 11) is not positive-definite",
                     k_r, k_theta, lhs, k_sb, rhs);
   return 0;
 }
@@ -157,7 +157,7 @@ int molecular_create(molecular_t *m, const mesh_t *s, const mol_params_t *p, ver
       tr->c0[k] = -v3_dot(e[k], e[kp]) / (l[k] * l[kp]);
     }
   }
-  /* Equal lumped masses (seed 000: equal point masses, as in mass_spring.c). */
+  /* Equal lumped masses (docs/methods.md A: equal point masses, as in mass_spring.c). */
   for (size_t i = 0; i < n; i++) {
     m->mass[i] = p->mass / (double)n;
     m->inv_mass[i] = 1.0 / m->mass[i];

@@ -1,5 +1,5 @@
 /* molecular: the molecular modelling system (MMS) on a triangle surface
- * (seed 000 §2.2, eq. 6-11; Sekercioglu and Duysak 2009).
+ * (docs/methods.md A §2.2, eq. 6-11; Sekercioglu and Duysak 2009).
  *
  * Vertices are atoms and every unique mesh edge is a bond; every triangle
  * has three bond angles (theta at corner j between bonds j-i and j-k). With
@@ -14,7 +14,7 @@
  * approximate direction of eq. 10. Per angle (its two bonds and its cosine)
  * the quadratic form [[k_r,0,k_sb],[0,k_r,k_sb],[k_sb,k_sb,k_theta]] has
  * determinant k_r (k_r k_theta - 2 k_sb^2), hence the parameter rule
- * k_r k_theta > 2 k_sb^2 (NUMERICS.md §6). On a mesh a bond is shared by up
+ * k_r k_theta > 2 k_sb^2 (docs/numerics.md §6). On a mesh a bond is shared by up
  * to four angles, so this is the per-angle condition, not a proof for the
  * whole mesh (k_r k_theta >= 8 k_sb^2 is: see molecular_stiffness_mul);
  * power iteration on the rest Hessian of the tissue block and the spleen
@@ -28,13 +28,13 @@
  * comparable to mass-spring), masses are equal and lumped, gravity acts and
  * vertices can be fixed.
  *
- * Degeneracies (NUMERICS.md case 13): every length is regularised,
+ * Degeneracies (docs/numerics.md case 13): every length is regularised,
  * r = sqrt(|d|^2 + eps^2) with eps = 1e-4 x the mean rest edge, and the
  * rest lengths and cos(theta0) use the same measure. The energy is then
  * smooth everywhere and the forces are its exact gradient: a zero-length bond
  * pushes nothing, the cosine's gradient is bounded by 2 / eps, and angles of
  * 0 or 180 degrees or zero-area triangles need no special case (no acos, no
- * division by sin). The change to the seed's energy is below (eps / r)^2.
+ * division by sin). The change to the published energy (docs/methods.md A) is below (eps / r)^2.
  *
  * Not thread-safe: one physics thread owns a model. Allocation happens in
  * molecular_create only. */

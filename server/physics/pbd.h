@@ -1,7 +1,7 @@
-/* pbd: position based dynamics on a tetrahedral mesh (seed 003 §4; Müller
+/* pbd: position based dynamics on a tetrahedral mesh (docs/methods.md C §4; Müller
  * et al. 2007 for PBD, Macklin et al. 2016 for XPBD).
  *
- * Constraints (seed 003 §4.4, §4.5):
+ * Constraints (docs/methods.md C §4.4, §4.5):
  *   - distance, one per unique tetrahedron edge:  C = |x_i - x_j| - d,
  *     grad_i C = n, grad_j C = -n, n = (x_i - x_j) / |x_i - x_j|;
  *   - volume, one per tetrahedron:  C = 6 (V - V0) with

@@ -72,7 +72,7 @@ static int build_ring1(vb_t *vb, const mesh_t *s) {
 }
 
 /* Ring 2 = neighbours of ring 1 that are neither the node nor in ring 1
- * (seed 002 §4.2.1, FINDSECONDRINGNEIGHBOUR). A stamp array marks the node
+ * (docs/methods.md B §4.2.1, FINDSECONDRINGNEIGHBOUR). A stamp array marks the node
  * and its ring 1, so each vertex costs the sum of its neighbours' valences.
  * Two passes: count, then fill. */
 static int build_ring2(vb_t *vb) {

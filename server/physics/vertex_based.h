@@ -1,4 +1,4 @@
-/* vertex_based: vertex-based local deformation (seed 002 ch. 4).
+/* vertex_based: vertex-based local deformation (docs/methods.md B ch. 4).
  *
  * The touched node and its first and second rings of neighbours are moved
  * directly along the applied force by the slope-intercept rule (eq. 4.2-4.4,
@@ -21,7 +21,7 @@
  * steady force every node sits exactly at eq. 4.2-4.4; after release it
  * returns by eq. 4.11.
  *
- * Cost: rings are precomputed once (CSR, seed 002 §4.2.1 preprocessing); a
+ * Cost: rings are precomputed once (CSR, docs/methods.md B §4.2.1 preprocessing); a
  * sub-step visits only the touched node's two rings plus the nodes still
  * moving back home (the active list), never the whole mesh. Nothing is
  * allocated after vb_create. Not thread-safe: one physics thread owns it. */

@@ -81,7 +81,7 @@ static void print_summary(const scene_t *scene, const server_stats_t *s) {
   for (int t = 0; t < VT_COUNT; t++)
     if (t != VT_TOOL_COMMAND) printf(" %s=%" PRIu64, vdds_topic_name((vdds_topic_id_t)t), s->published[t]);
   printf("\n");
-  /* Trainee measures per tool (seed 002 ch. 6); levels of 0 are unset. */
+  /* Trainee measures per tool (docs/methods.md B ch. 6); levels of 0 are unset. */
   for (size_t t = 0; t < s->ntools; t++) {
     const thr_tracker_t *tr = &s->thr[t];
     printf("PALPATION tool=%s contact_time=%.3f mean_contact_force=%.4f peak_force=%.4f path_length=%.4f",
@@ -91,7 +91,7 @@ static void print_summary(const scene_t *scene, const server_stats_t *s) {
              tr->time_above[k], thr_name((thr_id_t)k), tr->crossings[k]);
     printf("\n");
   }
-  /* Per tool and per task (issue 4; seed 000 Table 2 operation times). */
+  /* Per tool and per task (issue 4; docs/methods.md A Table 2 operation times). */
   for (size_t t = 0; t < s->ntools; t++) {
     const viscera_ToolMetrics *m = &s->tools[t];
     printf("TOOL tool=%s kind=%s peak_force=%.4f contact_time=%.3f path_length=%.4f exploration_time=%.3f grasps=%u "

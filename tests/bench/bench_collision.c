@@ -1,5 +1,5 @@
-/* bench_collision: cost of the collision queries (NUMERICS.md §7: nearest
- * feature on the 23,522-vertex liver <= 1 us median; the thesis of seed 002
+/* bench_collision: cost of the collision queries (docs/numerics.md §7: nearest
+ * feature on the 23,522-vertex liver <= 1 us median; the thesis of docs/methods.md B
  * reports 1.35 us).
  *
  * For each generated organ: AABB tree build and refit, node grid build and
@@ -50,8 +50,8 @@ static void row(const char *organ, const char *what, double *samples_us, size_t 
 }
 
 static void header(const char *title) {
-  printf("\n%s\n  %-12s %-34s %9s %10s %10s %10s %10s\n", title, "organ", "measure", "n", "median_us", "p99_us", "max_us",
-         "batch_us");
+  printf("\n%s\n  %-12s %-34s %9s %10s %10s %10s %10s\n", title, "organ", "measure", "n", "median_us", "p99_us",
+         "max_us", "batch_us");
 }
 
 /* A point of a random triangle, moved along its normal by up to +-offset. */

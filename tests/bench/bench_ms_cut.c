@@ -1,4 +1,4 @@
-/* bench_ms_cut: three-stage mass-spring cutting (seed 004) on the tissue
+/* bench_ms_cut: three-stage mass-spring cutting (docs/methods.md D) on the tissue
  * block (45 v) and the gallbladder (5,393 v).
  *
  *  1. Incision width over time after a straight cut (the seed's Fig. 6):
@@ -205,7 +205,7 @@ int main(int argc, char **argv) {
     return 1;
   }
   fprintf(csv, "organ,eps_r,t_s,width_mm\n");
-  printf("Incision width after a straight interior cut (seed 004 Fig. 6): 1 kg organ, k 30 N/m, home 30 N/m, "
+  printf("Incision width after a straight interior cut (docs/methods.md D Fig. 6): 1 kg organ, k 30 N/m, home 30 N/m, "
          "damping ratios 0.03 (edges) and 0.06 (home springs), blade radius 1 mm, symplectic Euler at 1 kHz\n\n");
   printf("| organ | eps_r | lip nodes | first sample | peak (time) | final (mean of last 20 %%) | final / peak |\n");
   printf("|---|---|---|---|---|---|---|\n");
@@ -237,7 +237,8 @@ int main(int argc, char **argv) {
       plot_add(&pl, lab, (size_t)n, t, w, e == 3 ? PLOT_GREY : e, -1, PLOT_LINE_SOLID);
     }
     plot_note(&pl, "Width: mean distance from each lip node of one side to the other side's lip.");
-    plot_note(&pl, "Residual stress sigma_r = E eps_r as nodal force eps_r K L0 per cut spring (seed 004 eq. 3-4).");
+    plot_note(
+        &pl, "Residual stress sigma_r = E eps_r as nodal force eps_r K L0 per cut spring (docs/methods.md D eq. 3-4).");
     plot_note(&pl, "Material: mass %.1f kg, k %.0f N/m, damping %.3g, home %.0f / %.3g N s/m; blade radius 1 mm.",
               wm.mass, wm.stiffness, wm.damping, wm.home_stiffness, wm.home_damping);
     snprintf(path, sizeof path, "%s/ms_cut_width_%s.png", out, o->name);

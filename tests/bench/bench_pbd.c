@@ -1,4 +1,4 @@
-/* bench_pbd: step time of the PBD / XPBD solver (NUMERICS.md §7 targets).
+/* bench_pbd: step time of the PBD / XPBD solver (docs/numerics.md §7 targets).
  *
  *   bar     the BarDemo bar of the PositionBasedDynamics library: 30x5x5
  *           nodes (750 nodes, 2,320 tetrahedra, 3,565 distance + 2,320

@@ -1,5 +1,5 @@
 /* bench_tet_cut: progressive cutting on the spleen-size XPBD model, in the
- * style of seed 003 Table 1 (vertices, elements, physics ms, topology update
+ * style of docs/methods.md C Table 1 (vertices, elements, physics ms, topology update
  * ms, intersection ms), then 100 random incisions
  * (tests/stability/cut_scenario.h: the model and the cuts): time per cut,
  * element count and minimum quality after each.
@@ -188,15 +188,16 @@ int main(int argc, char **argv) {
   const tet_cut_t *c = tet_model_cut_mesh(tc);
   double phys1 = step_median(m, 50);
   double calls = CALLS_PER_CUT * cuts;
-  printf(
-      "bench_tet_cut: seed 003 Table 1 style, spleen (assets/meshes/spleen.obj, tetrahedra of 7 mm), XPBD, dt %.0f ms, "
-      "1 sub-step x 10 iterations\n",
-      1e3 * CUT_DT);
+  printf("bench_tet_cut: docs/methods.md C Table 1 style, spleen (assets/meshes/spleen.obj, tetrahedra of 7 mm), XPBD, "
+         "dt %.0f ms, "
+         "1 sub-step x 10 iterations\n",
+         1e3 * CUT_DT);
   printf("%-22s %7s %7s %11s %13s %15s\n", "model", "nodes", "tets", "physics_ms", "topology_ms", "intersection_ms");
   printf("%-22s %7zu %7zu %11.3f %13s %15s\n", "spleen uncut", nodes0, tets0, phys0, "-", "-");
   printf("%-22s %7zu %7zu %11.3f %13.3f %15.3f\n", "spleen cutting", c->n, c->ntets, phys1, tsum / calls, isum / calls);
-  printf("(seed 003, GTX 580 + Xeon 2.53 GHz: spleen 711 nodes, 2385 elements, physics 1.2 ms, topology 3.2 ms, "
-         "intersection 2.9 ms)\n\n");
+  printf(
+      "(docs/methods.md C, GTX 580 + Xeon 2.53 GHz: spleen 711 nodes, 2385 elements, physics 1.2 ms, topology 3.2 ms, "
+      "intersection 2.9 ms)\n\n");
   double *cm = malloc((size_t)cuts * sizeof(double));
   memcpy(cm, ms, (size_t)cuts * sizeof(double));
   double med = median(cm, cuts), p95 = cm[(int)(0.95 * (cuts - 1))], mx = cm[cuts - 1];

@@ -1,5 +1,5 @@
 # bench_ms_cut: three-stage mass-spring cutting: incision width over time
-# (seed 004 Fig. 6), cost per cut and per step; CSV and cairo plots.
+# (docs/methods.md D Fig. 6), cost per cut and per step; CSV and cairo plots.
 add_executable(bench_ms_cut ${CMAKE_CURRENT_LIST_DIR}/bench_ms_cut.c)
 target_link_libraries(bench_ms_cut PRIVATE viscera_test_support)
 target_link_libraries(bench_ms_cut PRIVATE viscera_sim viscera_plot)

@@ -662,7 +662,7 @@ static void test_default_asset(void) {
   CHECK_NEAR(t->sft, 1.5, 1e-15);
 }
 
-/* Palpation thresholds (seed 002 ch. 6): optional, each key too, in the order
+/* Palpation thresholds (docs/methods.md B ch. 6): optional, each key too, in the order
  * st < mpf <= sft <= max_force, refused at the offending line. */
 static void test_thresholds(void) {
   /* None given: all unset. */

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Kidney-stone removal over DDS (seed 000, issue 4): two scripted clients,
+# Kidney-stone removal over DDS (docs/methods.md A, issue 4): two scripted clients,
 # the probe (tool 0) palpates the spot of the palpate_target task, the
 # extractor (tool 1) goes in, closes on the stone, carries it out, opens.
 # Asserts from the recording: GRASP_BEGIN/END of the stone, TASK_COMPLETED

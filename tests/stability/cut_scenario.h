@@ -1,5 +1,5 @@
 /* cut_scenario.h: random scalpel cuts through the spleen-size PBD model,
- * shared by the stability test (stab_cut.c, NUMERICS.md §5 case 15) and the
+ * shared by the stability test (stab_cut.c, docs/numerics.md §5 case 15) and the
  * benchmark (tests/bench/bench_tet_cut.c). Header-only.
  *
  * The model: assets/meshes/spleen.obj through the tetrahedral builder at

@@ -1,4 +1,4 @@
-/* stab_cut: NUMERICS.md §5 case 15, 100 random cuts on the spleen-size PBD
+/* stab_cut: docs/numerics.md §5 case 15, 100 random cuts on the spleen-size PBD
  * model (tests/stability/cut_scenario.h: the model, the cuts and what
  * "stable dt" means for PBD). Pass criteria:
  *   - every coordinate finite after every cut, no call fails;

@@ -1,4 +1,4 @@
-/* NUMERICS.md §5 case 5: a zero-length spring, and two vertices moved onto
+/* docs/numerics.md §5 case 5: a zero-length spring, and two vertices moved onto
  * each other: all forces (and the Jacobian products the implicit solver
  * uses) stay finite, and every integrator steps on without a rollback.
  *

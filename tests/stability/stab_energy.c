@@ -1,4 +1,4 @@
-/* NUMERICS.md §5 case 12: 1e6 undamped symplectic Euler steps at half the
+/* docs/numerics.md §5 case 12: 1e6 undamped symplectic Euler steps at half the
  * critical dt (h omega_max = 1) on a small mesh.
  *
  * The octahedron (6 nodes, 12 springs; no home springs, damping or gravity:

@@ -1,4 +1,4 @@
-/* NUMERICS.md §5 cases 9 and 16, the haptic extremes.
+/* docs/numerics.md §5 cases 9 and 16, the haptic extremes.
  *
  * 9: on the default kidney scene, a one-step load of 1000 g on every node
  *    and then the probe commanded 10 cm inside the organ: everything stays

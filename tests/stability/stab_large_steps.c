@@ -1,4 +1,4 @@
-/* NUMERICS.md §5 case 4: 30 Hz large steps on a cloth and a bar; the energy
+/* docs/numerics.md §5 case 4: 30 Hz large steps on a cloth and a bar; the energy
  * never exceeds its start plus the work done on the system from outside.
  *
  *  - cloth: 10 x 10 surface mass-spring, 1 cm spacing, pinned at two

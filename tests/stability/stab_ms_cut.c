@@ -1,4 +1,4 @@
-/* NUMERICS.md §5 case 15 for three-stage mass-spring cutting: 100 random
+/* docs/numerics.md §5 case 15 for three-stage mass-spring cutting: 100 random
  * straight cuts (random position, direction, length and blade radius, many
  * crossing earlier wounds) on a generated sheet and on the spleen. After
  * every cut the surface must stay a valid mesh (manifold edges and

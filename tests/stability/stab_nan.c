@@ -1,4 +1,4 @@
-/* NUMERICS.md §5 case 14: NaN (or Inf) injected into one vertex is
+/* docs/numerics.md §5 case 14: NaN (or Inf) injected into one vertex is
  * detected within one step, the step rolls back and reports, and nothing
  * spreads.
  *

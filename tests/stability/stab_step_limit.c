@@ -1,4 +1,4 @@
-/* NUMERICS.md §5 case 1: step-limit sweep, edge stiffness k = 1 .. 1e6 on a
+/* docs/numerics.md §5 case 1: step-limit sweep, edge stiffness k = 1 .. 1e6 on a
  * 6 x 6 cloth (36 nodes, no damping).
  *
  *  - symplectic Euler: the largest stable dt found by bisection (a run of

@@ -1,4 +1,4 @@
-/* NUMERICS.md §5 case 11: 360 and 720 degree twist, release.
+/* docs/numerics.md §5 case 11: 360 and 720 degree twist, release.
  *
  * A bar 0.24 x 0.03 x 0.03 m (a closed box surface, filled with tetrahedra
  * by the scene models themselves at solver.tet_size 1 cm), 0.2 kg, is

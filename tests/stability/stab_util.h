@@ -1,5 +1,5 @@
 /* stab_util.h: small meshes and model construction shared by the stability
- * tests (NUMERICS.md §5). Header-only; each test is one executable. */
+ * tests (docs/numerics.md §5). Header-only; each test is one executable. */
 #ifndef VISCERA_STAB_UTIL_H
 #define VISCERA_STAB_UTIL_H
 

@@ -1,5 +1,5 @@
 /* bench_numerics: error against run time and stability for every
- * deformation model and integrator (NUMERICS.md §1-§4).
+ * deformation model and integrator (docs/numerics.md §1-§4).
  *
  * usage: bench_numerics [--quick] [--out DIR] [--assets DIR] [--only LIST]
  *   --only spring,chain,cloth,stability,bar,ball,probe,incision,scaling   run some scene families
@@ -82,7 +82,7 @@ static void print_row(const nb_row_t *r, const char *why) {
          ee, us, ms, why);
 }
 
-/* The table NUMERICS §7 asks about: per scene, model and integrator, the
+/* The table docs/numerics.md §7 asks about: per scene, model and integrator, the
  * 60 Hz setting (the interactive one) and the cheapest setting whose error is
  * at most 1 % (the accurate one), or the most accurate one when none is;
  * model-error and timing rows as they are. Every row is in summary.csv. */
@@ -191,12 +191,13 @@ int main(int argc, char **argv) {
     fclose(csv);
   }
   print_summary(&nb);
-  printf("\nerr: e_x = mass-weighted RMS position error / bounding-box diagonal against a converged run of the same "
-         "model (S1: against the exact solution, over the amplitude; S8: probe force RMS error / peak force); "
-         "us/step: median wall time of one scene step (sub-steps included); ms/sim-s: that median x steps per simulated "
-         "second.\n");
+  printf(
+      "\nerr: e_x = mass-weighted RMS position error / bounding-box diagonal against a converged run of the same "
+      "model (S1: against the exact solution, over the amplitude; S8: probe force RMS error / peak force); "
+      "us/step: median wall time of one scene step (sub-steps included); ms/sim-s: that median x steps per simulated "
+      "second.\n");
   if (nb.ntargets) {
-    printf("\nNUMERICS.md §7 targets measured here:\n");
+    printf("\ndocs/numerics.md §7 targets measured here:\n");
     for (int i = 0; i < nb.ntargets; i++) printf("  - %s\n", nb.targets[i]);
   }
   if (nb.nskipped) {

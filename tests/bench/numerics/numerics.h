@@ -1,10 +1,10 @@
-/* numerics: the benchmark of NUMERICS.md (error against run time, stability)
+/* numerics: the benchmark of docs/numerics.md (error against run time, stability)
  * for every deformation model and integrator.
  *
  * Shared pieces: a uniform handle on anything that can be stepped (sim_t:
  * a force system with an integrator, a PBD/XPBD solver, or a scene model),
  * the run loop that samples trajectories and times every step, the error
- * measures of NUMERICS §3, CSV output and the summary table. The scenes live
+ * measures of docs/numerics.md §3, CSV output and the summary table. The scenes live
  * in scene_*.c, one file per family; main.c runs them in order. */
 #ifndef NUMERICS_H
 #define NUMERICS_H
@@ -44,7 +44,7 @@ typedef struct nb {
   char skipped[32][200]; /* what was left out and why, printed at the end */
   int nskipped;
   int probe_lost;         /* S8 runs that lost the probe contact */
-  char targets[24][240];  /* NUMERICS §7 figures measured on the way */
+  char targets[24][240];  /* docs/numerics.md §7 figures measured on the way */
   int ntargets;
 } nb_t;
 

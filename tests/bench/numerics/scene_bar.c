@@ -18,7 +18,7 @@
  *
  * Also here: plot 4 (tip sag of a damped bar vs iterations and dt, PBD and
  * XPBD against the static solution), plot 5 (XPBD sub-steps vs iterations at
- * equal cost), the XPBD BarDemo timing (NUMERICS §7) and the model error of
+ * equal cost), the XPBD BarDemo timing (docs/numerics.md §7) and the model error of
  * the spring network against beam theory with its measured Young's modulus. */
 #include <math.h>
 #include <stdlib.h>
@@ -333,7 +333,8 @@ static void bar_scene(nb_t *nb, bar_t *b, const bar_scene_t *sc, FILE *csv) {
     snprintf(t.label, sizeof t.label, "PBD, 1 iteration (vs PBD 256 sub)");
     plot_series(&p, &t, 0, 0);
   }
-  plot_note(&p, "Slopes: least squares over the five smallest steps with e_x in (1e-12, 0.05). Missing points diverged.");
+  plot_note(&p,
+            "Slopes: least squares over the five smallest steps with e_x in (1e-12, 0.05). Missing points diverged.");
   plot_note(&p, "Symplectic Euler and Verlet need dt < 2/omega_max = %.2g s here (omega_max by power iteration).",
             2 / bar_omega_max(b, BAR_K));
   if (inverted_note[0])
@@ -568,7 +569,7 @@ static void model_error(nb_t *nb, const bar_t *b) {
   nb_add_row(nb, &r);
 }
 
-/* ---- the XPBD BarDemo setting (NUMERICS §7) --------------------------------------------- */
+/* ---- the XPBD BarDemo setting (docs/numerics.md §7) --------------------------------------------- */
 
 static void bardemo(nb_t *nb, const bar_t *b) {
 #ifdef NUMERICS_HAVE_PBD
@@ -600,7 +601,7 @@ static void bardemo(nb_t *nb, const bar_t *b) {
 #endif
 }
 
-/* NUMERICS §7 "cantilever bar at 60 Hz: e_x <= 5 % at the interactive
+/* docs/numerics.md §7 "cantilever bar at 60 Hz: e_x <= 5 % at the interactive
  * setting and <= 1 % at the accurate one, with the cost of each". */
 static void cantilever_targets(nb_t *nb) {
   const nb_row_t *inter = NULL, *acc = NULL, *best60 = NULL;

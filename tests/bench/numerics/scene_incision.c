@@ -3,7 +3,7 @@
  * stage cutting, server/cutting/ms_cut.h) with symplectic Euler, Verlet, RK4
  * and implicit Euler, and pbd/xpbd on a tetrahedral mesh built at 10 mm
  * (progressive tetrahedral cutting, tet_model_cut_advance). Explicit Euler is left
- * out: undamped it is unstable at every step (NUMERICS.md §6) and its
+ * out: undamped it is unstable at every step (docs/numerics.md §6) and its
  * stability bound asks for hundreds of sub-steps per scene step.
  *
  * The scene: gravity on, the organ held by its home springs (scene
@@ -325,7 +325,7 @@ void scene_incision(nb_t *nb) {
                 "against references at 1/960 s (x8 / x4 sub-steps), 1 s simulated");
   nb_skip(nb,
           "S9 mass_spring_surface implicit Euler: swept to 1/120 s only (50-300 ms per step on the loaded machine)");
-  nb_skip(nb, "S9 mass_spring_surface with explicit Euler: unstable undamped at every step (NUMERICS §6), "
+  nb_skip(nb, "S9 mass_spring_surface with explicit Euler: unstable undamped at every step (docs/numerics.md §6), "
               "hundreds of sub-steps; not swept");
 #ifndef NUMERICS_HAVE_PBD
   nb_skip(nb, "S9 pbd/xpbd: this build has no PBD model");

@@ -1,4 +1,4 @@
-/* Plot 7: step time against vertex count (NUMERICS §4 plot 7, §7 "step cost
+/* Plot 7: step time against vertex count (docs/numerics.md §4 plot 7, §7 "step cost
  * vs size: linear").
  *
  * Volumetric: bars of 90 to 11,520 nodes (same 2 cm spacing and material as
@@ -241,14 +241,15 @@ void scene_scaling(nb_t *nb) {
   for (int k = 0; k < NSER; k++) {
     if (cnt[k] < 3) continue;
     double slope = plot_loglog_slope((size_t)cnt[k], xs[k], ys[k], 0, INFINITY, NULL);
-    nb_target(nb, "step cost vs size, %s: log-log slope %.2f over %.0f-%.0f nodes (linear = 1)", LAB[k], slope, xs[k][0],
-              xs[k][cnt[k] - 1]);
+    nb_target(nb, "step cost vs size, %s: log-log slope %.2f over %.0f-%.0f nodes (linear = 1)", LAB[k], slope,
+              xs[k][0], xs[k][cnt[k] - 1]);
   }
   plot_t p;
-  plot_init(&p, "Plot 7: step time vs mesh size (one sub-step, one core)", "nodes (vertices)", "median step time (us)", 1,
-            1);
+  plot_init(&p, "Plot 7: step time vs mesh size (one sub-step, one core)", "nodes (vertices)", "median step time (us)",
+            1, 1);
   for (int k = 0; k < NSER; k++)
-    if (cnt[k]) plot_add(&p, LAB[k], (size_t)cnt[k], xs[k], ys[k], k, k, k == PBD10 ? PLOT_LINE_DASHED : PLOT_LINE_SOLID);
+    if (cnt[k])
+      plot_add(&p, LAB[k], (size_t)cnt[k], xs[k], ys[k], k, k, k == PBD10 ? PLOT_LINE_DASHED : PLOT_LINE_SOLID);
   /* A slope-1 guide through the symplectic mass-spring's middle point. */
   if (cnt[MS_SYM] >= 2) {
     int mid = cnt[MS_SYM] / 2;

@@ -1,6 +1,6 @@
 /* Plot 3: the largest stable time step against stiffness, measured by
  * bisection, beside the bound 2/omega_max with omega_max from power
- * iteration (NUMERICS §4 plot 3, §5 case 1, §6).
+ * iteration (docs/numerics.md §4 plot 3, §5 case 1, §6).
  *
  * System: the product's mass_spring_tet force system on a small bar
  * (10 x 3 x 3 nodes, 2 cm spacing, 0.29 kg, one end fixed), undamped, no
@@ -196,8 +196,8 @@ void scene_stability(nb_t *nb) {
   }
   if (csv) fclose(csv);
   plot_t p;
-  plot_init(&p, "Plot 3: largest stable time step vs spring stiffness (10x3x3 mass-spring bar)", "edge stiffness k (N/m)",
-            "largest stable dt (s)", 1, 1);
+  plot_init(&p, "Plot 3: largest stable time step vs spring stiffness (10x3x3 mass-spring bar)",
+            "edge stiffness k (N/m)", "largest stable dt (s)", 1, 1);
   plot_add(&p, "2 / omega_max (power iteration)", NSTIFF, ks, bound, PLOT_BLACK, -1, PLOT_LINE_DASHED);
   plot_add(&p, "2 sqrt(2) / omega_max (RK4 bound)", NSTIFF, ks, bound_rk4, PLOT_GREY, -1, PLOT_LINE_DOTTED);
   static const char *LAB[4] = {"explicit Euler (growth < 1e4 in N steps)", "symplectic Euler", "Verlet", "RK4"};

@@ -1,4 +1,4 @@
-/* Cylinder tool against nodes (seed 004 §2.2) on hand-made cases: inside,
+/* Cylinder tool against nodes (docs/methods.md D §2.2) on hand-made cases: inside,
  * beyond either end (on the axis line but failing an angle test), on the end
  * planes, at the radius, a slanted axis, a zero-length axis, the force
  * direction N -> p; then the grid-accelerated query against the scan on a

@@ -1,4 +1,4 @@
-/* node_grid against a linear scan (the thesis's "linear method", seed 002
+/* node_grid against a linear scan (the thesis's "linear method", docs/methods.md B
  * Table 4.1): the nearest node (same id, same squared distance, ties to the
  * lowest id) for points on, near, inside, around and far from the organ
  * meshes, and the nodes in random boxes; again after large motion and a

@@ -1,4 +1,4 @@
-/* Three-stage mass-spring cutting (seed 004): Bezier eq. 5-8 against hand
+/* Three-stage mass-spring cutting (docs/methods.md D): Bezier eq. 5-8 against hand
  * values; swept deletion against brute force; node matching (shortest
  * distance, shorter diagonals); straight cuts across and inside the tissue
  * block, a generated sheet and a closed organ leave a valid mesh (manifold,

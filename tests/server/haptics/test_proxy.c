@@ -1,5 +1,5 @@
 /* God-object proxy on a flat square patch (z = 0, normal +z) and on a closed
- * octahedron: force f = K (proxy - device) (seed 000 eq. 12), proxy stays on
+ * octahedron: force f = K (proxy - device) (docs/methods.md A eq. 12), proxy stays on
  * the surface however deep the device goes, clamped force, release above the
  * surface, frictionless sliding, no contact from behind.
  * Then the same proxy with AABB trees against the scan over triangles, on two

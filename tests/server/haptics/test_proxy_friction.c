@@ -1,5 +1,5 @@
 /* test_proxy_friction: friction and force shading on the god-object proxy
- * (server/haptics/proxy.c, seed 000 eq. 12).
+ * (server/haptics/proxy.c, docs/methods.md A eq. 12).
  * - Friction: on a plane, the proxy sticks while the tangential spring
  *   force is within mu times the normal force, then slides keeping the
  *   ratio at mu; mu = 0 slides freely (proxy_update).

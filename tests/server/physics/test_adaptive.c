@@ -1,5 +1,5 @@
 /* Adaptive area-based refinement of a surface Kelvin-Voigt mass-spring
- * (seed 002 ch. 5): refinement raises the local triangle count without
+ * (docs/methods.md B ch. 5): refinement raises the local triangle count without
  * T-junctions (every edge in two triangles, orientation kept, springs =
  * edges), total mass is conserved to 1e-12, the force for the same
  * indentation matches before and after refinement, simplification restores

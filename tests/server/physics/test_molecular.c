@@ -1,11 +1,11 @@
-/* Molecular model (seed 000 eq. 6-11): forces against central differences
+/* Molecular model (docs/methods.md A eq. 6-11): forces against central differences
  * of the energy per term and together, the analytic K y and C y against
  * differences of the forces, momentum conservation of the internal forces,
- * NUMERICS.md case 13 (degenerate angles and triangles, invalid parameter
+ * docs/numerics.md case 13 (degenerate angles and triangles, invalid parameter
  * sets), case 12 (long undamped symplectic runs: energy and momentum), the
  * stability bound, the Gauss-Newton stiffness for implicit Euler, the
  * model_t wrapper (sub-steps, hook, surface forces, rollback, refusals) and
- * the step time on the 5,400-vertex gallbladder (NUMERICS.md §7). */
+ * the step time on the 5,400-vertex gallbladder (docs/numerics.md §7). */
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -306,7 +306,7 @@ static int all_finite(const double *a, size_t n) {
   return 1;
 }
 
-/* NUMERICS.md case 13: degenerate configurations keep forces and K y finite. */
+/* docs/numerics.md case 13: degenerate configurations keep forces and K y finite. */
 static void test_degenerate(void) {
   /* Two triangles sharing the edge 0-1: (0,1,2) and (1,0,3). */
   mesh_t m;
@@ -424,7 +424,7 @@ static double run_energy(const molecular_t *mol, integrator_kind_t kind, double 
   return e;
 }
 
-/* NUMERICS.md case 12: a free icosphere (42 vertices, 80 triangles; no
+/* docs/numerics.md case 12: a free icosphere (42 vertices, 80 triangles; no
  * home springs, no damping, no gravity), started inflated by 3 %, shearing,
  * spinning and drifting, integrated undamped at half the critical step
  * 2 / omega_max for `steps` steps.
@@ -506,7 +506,7 @@ static void test_long_run(integrator_kind_t kind, long steps, double angle_k, do
   mesh_free(&sph);
 }
 
-/* The stability bound from the power iteration (NUMERICS.md case 1 style):
+/* The stability bound from the power iteration (docs/numerics.md case 1 style):
  * symplectic Euler stays bounded just below it and blows up above it. */
 static void test_bound(void) {
   mesh_t sph;
@@ -618,7 +618,7 @@ static void test_model(void) {
   /* Gravity sags it by about m g / k_home per vertex. */
   printf("  released for 3 s: max offset from rest %.3g mm (gravity sag)\n", back * 1e3);
   CHECK(back < 2e-3);
-  /* NUMERICS.md case 14: a NaN written into one vertex between steps is
+  /* docs/numerics.md case 14: a NaN written into one vertex between steps is
    * caught by the next step, which rolls back to the last finite state (the
    * one before the previous step) and reports; nothing spreads. */
   size_t bytes = 3 * m->nnodes * sizeof(double);
@@ -766,7 +766,7 @@ static int cmp_double(const void *a, const void *b) {
   return (x > y) - (x < y);
 }
 
-/* NUMERICS.md §7: molecular step on the 5,400-vertex gallbladder, target
+/* docs/numerics.md §7: molecular step on the 5,400-vertex gallbladder, target
  * <= 1 ms. Timed in RelWithDebInfo; reported, not asserted (machines and
  * sanitizers differ). */
 static void time_gallbladder(void) {
@@ -823,7 +823,7 @@ static void time_gallbladder(void) {
          "    create %.0f ms (bonds, angles, power iteration); default material + 300 N/m tool: stable dt %.3g s, "
          "%d sub-steps per 1 ms step\n"
          "    step median %.2f ms (min %.2f, p95 %.2f) = %.3f ms per sub-step; one force evaluation %.3f ms "
-         "(NUMERICS.md §7 target: <= 1 ms per step)\n",
+         "(docs/numerics.md §7 target: <= 1 ms per step)\n",
          g.nverts, g.ntris, SANITIZED ? " (sanitizer build: times not representative)" : "", tc * 1e3, m->stable_dt,
          m->substeps, dt[N / 2] * 1e3, dt[0] * 1e3, dt[N * 95 / 100] * 1e3, dt[N / 2] * 1e3 / m->substeps,
          per_eval * 1e3);
@@ -837,7 +837,7 @@ int main(void) {
   test_fd();
   printf("momentum:\n");
   test_momentum();
-  printf("degeneracies (NUMERICS.md case 13):\n");
+  printf("degeneracies (docs/numerics.md case 13):\n");
   test_degenerate();
   printf("parameters (case 13):\n");
   test_params();
@@ -855,7 +855,7 @@ int main(void) {
   test_definite();
   printf("model wrapper:\n");
   test_model();
-  printf("timing (NUMERICS.md §7):\n");
+  printf("timing (docs/numerics.md §7):\n");
   time_gallbladder();
   return check_report("test_molecular");
 }

@@ -3,7 +3,7 @@
  * (weight carried by the fixed end, internal forces summing to zero);
  * recovery of a single tetrahedron and of the 30x5x5 bar from inverted,
  * flat, sliver, collapsed, scrambled, stretched and compressed starts
- * (NUMERICS.md §5 cases 6, 7, 8, 10); effective stiffness of the cantilever
+ * (docs/numerics.md §5 cases 6, 7, 8, 10); effective stiffness of the cantilever
  * against iterations (PBD drifts, XPBD does not); a 1:1000 mass-ratio chain
  * (case 3); NaN rollback (case 14); the model_t wrapper. Every run also
  * checks that no coordinate is ever NaN or Inf. Figures are printed. */

@@ -1,4 +1,4 @@
-/* Vertex-based local deformation (seed 002 ch. 4): rings on hand-built
+/* Vertex-based local deformation (docs/methods.md B ch. 4): rings on hand-built
  * meshes, the slope-intercept displacement profile (eq. 4.2-4.4), release
  * through the home springs (eq. 4.11), the closed loop with a tool spring at
  * and beyond the sub-step bound, parameter refusal, rollback on NaN, the
@@ -104,7 +104,7 @@ static void test_rings_hex(void) {
   uint32_t c = (uint32_t)hex_index(3, 0, 0);
   vb_ring1(&vb, c, &n1);
   vb_ring2(&vb, c, &n2);
-  CHECK(n1 == 6 && n2 == 12); /* seed 002 Fig. 4.1: A1..A6, B1..B12 */
+  CHECK(n1 == 6 && n2 == 12); /* docs/methods.md B Fig. 4.1: A1..A6, B1..B12 */
   uint32_t corner = (uint32_t)hex_index(3, 3, 0);
   vb_ring1(&vb, corner, &n1);
   vb_ring2(&vb, corner, &n2);
