@@ -24,7 +24,8 @@
 #include "collision/node_grid.h"
 #include "haptics/proxy.h"
 #include "mesh.h"
-#include "mesh_import.h"
+#include "test_assets.h"
+#include "test_rng.h"
 #include "vmath.h"
 #include "vstats.h"
 #include "vtime.h"
@@ -32,13 +33,7 @@
 static const char *ORGANS[] = {"tissue_block", "spleen", "kidney", "gallbladder", "liver_large"};
 
 static uint64_t rng_state = 0x243f6a8885a308d3ull;
-static double urand(void) {
-  uint64_t z = (rng_state += 0x9e3779b97f4a7c15ull);
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-  z ^= z >> 31;
-  return (double)(z >> 11) * (1.0 / 9007199254740992.0);
-}
+static double urand(void) { return test_rng_uniform(&rng_state); }
 
 static FILE *csv;
 
@@ -233,15 +228,9 @@ int main(int argc, char **argv) {
   if (csv) fprintf(csv, "organ,measure,n,median_us,p99_us,max_us,batch_mean_us\n");
   size_t norgans = sizeof ORGANS / sizeof ORGANS[0];
   mesh_t meshes[sizeof ORGANS / sizeof ORGANS[0]];
-  for (size_t oi = 0; oi < norgans; oi++) {
-    char path[2048];
-    verr_t err;
-    snprintf(path, sizeof path, "%s/meshes/%s.obj", argv[1], ORGANS[oi]);
-    if (mesh_import(path, &meshes[oi], &err)) {
-      fprintf(stderr, "bench_collision: %s\n", err.msg);
-      return 1;
-    }
-  }
+  test_assets_dir_set(argv[1]);
+  for (size_t oi = 0; oi < norgans; oi++)
+    if (test_organ_load(ORGANS[oi], &meshes[oi])) return 1;
   /* The timer's own cost, for reading the per-query figures. */
   double timer[1000];
   for (int i = 0; i < 1000; i++) {

@@ -20,6 +20,8 @@
 
 #include "runtime/scene_runtime.h"
 #include "session/mesh_publisher.h"
+#include "test_assets.h"
+#include "test_runtime.h"
 #include "vstats.h"
 #include "vtime.h"
 
@@ -58,19 +60,18 @@ int main(int argc, char **argv) {
          "ratio");
   /* The quick setting (CI smoke) leaves out the 23k-vertex liver. */
   size_t norgans = sizeof ORGANS / sizeof ORGANS[0] - (quick ? 1 : 0);
+  test_assets_dir_set(argv[1]);
   for (size_t oi = 0; oi < norgans; oi++) {
     char list[256];
     snprintf(list, sizeof list, "%s", integrators);
     for (char *save = NULL, *integ = strtok_r(list, ",", &save); integ; integ = strtok_r(NULL, ",", &save)) {
-      char yaml[2048];
-      snprintf(yaml, sizeof yaml,
-               "scene: bench\norgans:\n  - name: %s\n    mesh: %s/meshes/%s.obj\n    integrator: %s\n"
-               "    material: {mass: 0.15}\ntools:\n  - name: probe\n    radius: 0.003\n    stiffness: 400\n",
-               ORGANS[oi], argv[1], ORGANS[oi], integ);
+      char mesh[64], organ_keys[256];
+      snprintf(mesh, sizeof mesh, "%s.obj", ORGANS[oi]);
+      snprintf(organ_keys, sizeof organ_keys, "    integrator: %s\n    material: {mass: 0.15}\n", integ);
       static scene_t sc;
       static runtime_t rt;
       verr_t err;
-      if (scene_load_string(yaml, "bench", NULL, &sc, &err)) {
+      if (!test_runtime_one_organ(NULL, &sc, "bench", mesh, organ_keys, "radius: 0.003, stiffness: 400", &err)) {
         fprintf(stderr, "bench_server: %s\n", err.msg);
         return 1;
       }

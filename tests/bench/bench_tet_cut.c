@@ -19,6 +19,7 @@
 #include <string.h>
 
 #include "cut_scenario.h"
+#include "test_assets.h"
 
 #if defined(__SANITIZE_ADDRESS__)
 /* cairo's text drawing loads fontconfig's configuration once and keeps it
@@ -141,7 +142,10 @@ int main(int argc, char **argv) {
   mesh_t surf;
   scene_organ_t cfg;
   verr_t err;
-  model_t *m = cut_spleen_model(argv[1], &surf, &cfg, &err);
+  char assets[2048];
+  snprintf(assets, sizeof assets, "%s/assets", argv[1]);
+  test_assets_dir_set(assets);
+  model_t *m = cut_spleen_model(&surf, &cfg, &err);
   if (!m) {
     fprintf(stderr, "bench_tet_cut: %s\n", err.msg);
     return 1;

@@ -21,6 +21,8 @@
 #include "physics/adaptive.h"
 #include "runtime/scene_runtime.h"
 #include "session/mesh_publisher.h"
+#include "test_assets.h"
+#include "test_runtime.h"
 #include "vstats.h"
 #include "vtime.h"
 
@@ -50,12 +52,11 @@ int main(int argc, char **argv) {
     if (!strcmp(argv[i], "--quick")) cycles = 3;
     if (!strcmp(argv[i], "--domain") && i + 1 < argc) domain = vdds_parse_domain(argv[++i]);
   }
-  char path[1024];
-  snprintf(path, sizeof path, "%s/scenes/kidney_adaptive.yaml", argv[1]);
   static scene_t sc;
   static runtime_t rt;
   verr_t err;
-  if (scene_load(path, &sc, &err) || runtime_init(&rt, &sc, &err)) {
+  test_assets_dir_set(argv[1]);
+  if (!test_runtime_load_scene(&rt, &sc, "kidney_adaptive.yaml", &err)) {
     fprintf(stderr, "bench_topology: %s\n", err.msg);
     return 1;
   }

@@ -10,7 +10,30 @@
  *       z displacement over the recorded MeshDeltas (m)
  * Exit 1 when the file cannot be read, is damaged or a sample does not
  * decode.
- * usage: rec_tools FILE.db [--vertex X Y Z] */
+ *
+ * With --expect TEST it is also that integration test's checker: it asserts
+ * over what it read (one "ok:" or "FAIL:" line per check; exit 1 when one
+ * fails) what the test script once asserted with grep and awk over the
+ * lines above (same figures and bounds):
+ *   grasp_pull     GRASP_BEGIN and GRASP_END of tool 0 on organ 0, the
+ *                  lift-kidney task completed; the vertex of --vertex rose
+ *                  > 5 mm and ended within 0.5 mm; ToolMetrics of tool 0:
+ *                  grasps 1, grasp and operation time > 0.2 s, peak force in
+ *                  (0.5, 4] N; with --haptic-csv, the client's force CSV
+ *                  (t,x,y,z,fx,fy,fz,in_contact) shows the hand pulled down
+ *                  (fz < -0.5 N in contact) on > 90 % of > 100 ticks with
+ *                  3.0 < t < 3.8 s; with --server-out, the server's TASK line
+ *                  says completed.
+ *   stone_removal  GRASP_BEGIN and GRASP_END of the stone by tool 1, the
+ *                  remove-stone task completed by tool 1 with an operation
+ *                  time in (0.2, 10) s, the last ObjectState of object 0
+ *                  removed, above z 0.039 m and held by nobody, the find-spot
+ *                  task of tool 0 completed, tool 0's exploration time in
+ *                  (0.1, 10) s, tool 1's ToolMetrics: one task, one grasp,
+ *                  operation time within 2 ms of the event's; with
+ *                  --server-out, the server's TASK and OBJECT lines.
+ * usage: rec_tools FILE.db [--vertex X Y Z] [--expect TEST]
+ *                  [--haptic-csv FILE] [--server-out FILE] */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -42,13 +65,40 @@ static const char *kind_name(viscera_EventKind k) {
   }
 }
 
+/* The grasp and task events, kept for the checks. */
+enum { MAXEV = 256 };
+typedef struct event {
+  viscera_EventKind kind;
+  int tool, organ;
+  double value;
+  char text[sizeof ((viscera_SessionEvent *)0)->text];
+} event_t;
+static event_t ev[MAXEV];
+static int nev;
+
 static int on_event(void *ctx, const void *p, const recfile_row_t *row) {
   (void)row;
   (void)ctx;
   const viscera_SessionEvent *e = p;
   const char *k = kind_name(e->kind);
-  if (k) printf("EVENT %s tool=%d organ=%d value=%.4f %s\n", k, (int)e->tool_id, (int)e->organ_id, e->value, e->text);
+  if (!k) return 0;
+  printf("EVENT %s tool=%d organ=%d value=%.4f %s\n", k, (int)e->tool_id, (int)e->organ_id, e->value, e->text);
+  if (nev < MAXEV) {
+    event_t *d = &ev[nev++];
+    *d = (event_t){.kind = e->kind, .tool = (int)e->tool_id, .organ = (int)e->organ_id, .value = e->value};
+    memcpy(d->text, e->text, sizeof d->text);
+    d->text[sizeof d->text - 1] = 0;
+  }
   return 0;
+}
+
+/* The first kept event of `kind` by `tool` (organ `organ` unless
+ * organ < -1) whose text contains `text`, or NULL. */
+static const event_t *find_event(viscera_EventKind kind, int tool, int organ, const char *text) {
+  for (int i = 0; i < nev; i++)
+    if (ev[i].kind == kind && ev[i].tool == tool && (organ < -1 || ev[i].organ == organ) && strstr(ev[i].text, text))
+      return &ev[i];
+  return NULL;
 }
 
 enum { MAXN = 8 };
@@ -145,9 +195,119 @@ static int on_delta(void *ctx, const void *p, const recfile_row_t *row) {
   return 0;
 }
 
+static int failed;
+static void check(int ok, const char *what) {
+  printf("%s: %s\n", ok ? "ok" : "FAIL", what);
+  if (!ok) failed++;
+}
+
+/* 1 when a line of the text file `path` starts with `prefix`. */
+static int file_has_line(const char *path, const char *prefix) {
+  FILE *f = fopen(path, "r");
+  if (!f) return 0;
+  char line[4096];
+  int found = 0;
+  while (!found && fgets(line, sizeof line, f)) found = !strncmp(line, prefix, strlen(prefix));
+  fclose(f);
+  return found;
+}
+
+/* The haptic client's force CSV (t,x,y,z,fx,fy,fz,in_contact): ticks with
+ * t0 < t < t1 in *n, of them pulled down (fz < -fz_min, in contact) in *ok. */
+static int csv_pull(const char *path, double t0, double t1, double fz_min, long *n, long *ok) {
+  FILE *f = fopen(path, "r");
+  if (!f) return -1;
+  char line[1024];
+  *n = *ok = 0;
+  if (!fgets(line, sizeof line, f)) *n = 0; /* the header */
+  while (fgets(line, sizeof line, f)) {
+    double t, x, y, z, fx, fy, fz, c;
+    if (sscanf(line, "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &t, &x, &y, &z, &fx, &fy, &fz, &c) != 8) continue;
+    if (t > t0 && t < t1) {
+      (*n)++;
+      if (-fz > fz_min && c == 1) (*ok)++;
+    }
+  }
+  fclose(f);
+  return 0;
+}
+
+static void expect_grasp_pull(const vtrack_t *v, const char *haptic_csv, const char *server_out) {
+  check(find_event(viscera_EVENT_GRASP_BEGIN, 0, 0, "") != NULL, "GRASP_BEGIN of tool 0 on organ 0 recorded");
+  check(find_event(viscera_EVENT_GRASP_END, 0, 0, "") != NULL, "GRASP_END of tool 0 on organ 0 recorded");
+  check(find_event(viscera_EVENT_TASK_COMPLETED, 0, -2, "lift-kidney") != NULL, "grasp_pull task lift-kidney completed");
+  check(v && v->index >= 0 && v->max_dz > 0.005 && v->final_dz < 0.0005 && v->final_dz > -0.0005,
+        "grasped vertex rose > 5 mm and ended within 0.5 mm");
+  if (haptic_csv) {
+    long n = 0, ok = 0;
+    int rc = csv_pull(haptic_csv, 3.0, 3.8, 0.5, &n, &ok);
+    printf("haptic pull: %ld of %ld ticks in 3.0..3.8 s pulled down > 0.5 N in contact\n", ok, n);
+    check(rc == 0 && n > 100 && ok > 0.9 * (double)n, "downward pull rendered while held");
+  }
+  /* Times are simulated seconds (the 1.1 s hold shrinks when a loaded
+   * machine slows the server), so only their sign is asserted. */
+  const viscera_ToolMetrics *m = &tm[0];
+  check(have_tm[0], "ToolMetrics of tool 0 recorded");
+  check(have_tm[0] && m->grasps == 1 && m->grasp_time > 0.2 && m->operation_time > 0.2 && m->peak_force > 0.5 &&
+            m->peak_force <= 4,
+        "ToolMetrics in range (grasps 1, grasp and operation time > 0.2 s, peak force in (0.5, 4] N)");
+  if (server_out)
+    check(file_has_line(server_out, "TASK task=lift-kidney kind=grasp_pull tool=grasper state=completed "),
+          "server TASK line says completed");
+}
+
+static void expect_stone_removal(const char *server_out) {
+  check(find_event(viscera_EVENT_GRASP_BEGIN, 1, -1, "stone 'stone'") != NULL, "extractor took the stone");
+  check(find_event(viscera_EVENT_GRASP_END, 1, -1, "stone 'stone'") != NULL, "extractor let go of the stone");
+  const event_t *e = find_event(viscera_EVENT_TASK_COMPLETED, 1, -2, "remove-stone");
+  check(e != NULL, "TASK_COMPLETED for remove-stone by tool 1");
+  /* Operation time in simulated s from the extractor's first command (about
+   * 1.8 s to reach and close plus part of the carry when the server keeps
+   * real time; less simulated time passes when a loaded machine slows it,
+   * so only its sign, bound and agreement with ToolMetrics are asserted). */
+  double optime = e ? e->value : NAN;
+  check(e && optime > 0.2 && optime < 10, "operation time in (0.2, 10) s");
+  const viscera_ObjectState *o = &ob[0];
+  check(have_ob[0], "ObjectState of the stone recorded");
+  check(have_ob[0] && o->removed && o->position[2] > 0.039 && o->held_by == -1,
+        "stone out: removed, above z 0.039 m, held by nobody");
+  check(find_event(viscera_EVENT_TASK_COMPLETED, 0, -2, "find-spot") != NULL, "probe's palpate_target task completed");
+  check(have_tm[0], "ToolMetrics for the probe recorded");
+  check(have_tm[0] && tm[0].exploration_time > 0.1 && tm[0].exploration_time < 10,
+        "probe's exploration time in (0.1, 10) s");
+  check(have_tm[1], "ToolMetrics for the extractor recorded");
+  double d = have_tm[1] ? tm[1].operation_time - optime : NAN;
+  check(have_tm[1] && tm[1].tasks_completed == 1 && tm[1].grasps == 1 && d < 0.002 && d > -0.002,
+        "extractor metrics: one task, one grasp, operation time within 2 ms of the event's");
+  if (server_out) {
+    check(file_has_line(server_out, "TASK task=remove-stone kind=stone_removal tool=extractor state=completed "),
+          "server TASK line");
+    check(file_has_line(server_out, "OBJECT object=stone removed=1"), "server OBJECT line");
+  }
+}
+
 int main(int argc, char **argv) {
-  if (argc != 2 && !(argc == 6 && !strcmp(argv[2], "--vertex"))) {
-    fprintf(stderr, "usage: rec_tools FILE.db [--vertex X Y Z]\n");
+  const char *expect = NULL, *haptic_csv = NULL, *server_out = NULL;
+  int with_vertex = 0;
+  double at[3] = {0, 0, 0};
+  int usage = argc < 2;
+  for (int i = 2; i < argc && !usage; i++) {
+    if (!strcmp(argv[i], "--vertex") && i + 3 < argc) {
+      with_vertex = 1;
+      for (int k = 0; k < 3; k++) at[k] = atof(argv[++i]);
+    } else if (!strcmp(argv[i], "--expect") && i + 1 < argc)
+      expect = argv[++i];
+    else if (!strcmp(argv[i], "--haptic-csv") && i + 1 < argc)
+      haptic_csv = argv[++i];
+    else if (!strcmp(argv[i], "--server-out") && i + 1 < argc)
+      server_out = argv[++i];
+    else
+      usage = 1;
+  }
+  if (expect && strcmp(expect, "grasp_pull") && strcmp(expect, "stone_removal")) usage = 1;
+  if (usage) {
+    fprintf(stderr, "usage: rec_tools FILE.db [--vertex X Y Z] [--expect grasp_pull|stone_removal] "
+                    "[--haptic-csv FILE] [--server-out FILE]\n");
     return 2;
   }
   verr_t err;
@@ -171,9 +331,9 @@ int main(int argc, char **argv) {
       printf("OBJECT id=%d name=%s x=%.4f y=%.4f z=%.4f held_by=%d removed=%d\n", i, ob[i].name, ob[i].position[0],
              ob[i].position[1], ob[i].position[2], (int)ob[i].held_by, ob[i].removed ? 1 : 0);
   printf("FEEDBACK_PAIRS n=%ld min_tip_distance=%.6f\n", fp.n, fp.n ? fp.min_d : -1.0);
-  if (argc == 6) {
-    vtrack_t v = {.index = -1};
-    for (int k = 0; k < 3; k++) v.at[k] = atof(argv[3 + k]);
+  vtrack_t v = {.index = -1};
+  if (with_vertex) {
+    for (int k = 0; k < 3; k++) v.at[k] = at[k];
     each("viscera_MeshState", &viscera_MeshState_desc, on_state, &v);
     each("viscera_MeshDelta", &viscera_MeshDelta_desc, on_delta, &v);
     printf("VERTEX index=%ld key_z=%.5f max_dz=%.5f final_dz=%.5f deltas=%ld\n", v.index, v.key_z, v.max_dz, v.final_dz,
@@ -181,5 +341,8 @@ int main(int argc, char **argv) {
   }
   recfile_close(rf);
   if (bad) fprintf(stderr, "rec_tools: %d samples or rows unreadable\n", bad);
-  return bad ? 1 : 0;
+  if (expect && !strcmp(expect, "grasp_pull")) expect_grasp_pull(with_vertex ? &v : NULL, haptic_csv, server_out);
+  if (expect && !strcmp(expect, "stone_removal")) expect_stone_removal(server_out);
+  if (failed) fprintf(stderr, "rec_tools: %d checks failed\n", failed);
+  return bad || failed ? 1 : 0;
 }

@@ -33,18 +33,21 @@
 
 #include "cutting/tet_cut.h"
 #include "cutting/tet_model_cut.h"
-#include "mesh_import.h"
 #include "physics/pbd.h"
 #include "scene.h"
+#include "test_assets.h"
+#include "test_rng.h"
 #include "vmath.h"
 #include "vtime.h"
 
 #define CUT_DT 0.005
 
-static inline model_t *cut_spleen_model(const char *src_dir, mesh_t *surf, scene_organ_t *cfg, verr_t *err) {
-  char path[1024];
-  snprintf(path, sizeof path, "%s/assets/meshes/spleen.obj", src_dir);
-  if (mesh_import(path, surf, err)) return NULL;
+/* The spleen of the header from test_asset("meshes/spleen.obj"). */
+static inline model_t *cut_spleen_model(mesh_t *surf, scene_organ_t *cfg, verr_t *err) {
+  if (test_organ_load("spleen", surf)) {
+    verr_set(err, "cannot load %s", test_asset("meshes/spleen.obj"));
+    return NULL;
+  }
   memset(cfg, 0, sizeof *cfg);
   snprintf(cfg->name, sizeof cfg->name, "spleen");
   snprintf(cfg->model, sizeof cfg->model, "xpbd");
@@ -72,11 +75,6 @@ typedef struct cut_record {
   int rc;         /* 0, or -1 when a call failed */
 } cut_record_t;
 
-static inline double cut_rand(unsigned *seed) { /* uniform in [0, 1) */
-  *seed = *seed * 1664525u + 1013904223u;
-  return (double)(*seed >> 8) / 16777216.0;
-}
-
 static inline double cut_min_quality(const tet_cut_t *c, const double *x) {
   double q = INFINITY;
   for (size_t t = 0; t < c->ntets; t++) q = fmin(q, tet_cut_quality(c, x, t));
@@ -100,20 +98,20 @@ static inline void cut_random(model_t *m, tet_model_cut_t *tc, const double *lo,
     ctr[k] = 0.5 * (lo[k] + hi[k]);
     R = fmax(R, 0.5 * (hi[k] - lo[k]));
   }
-  size_t sv0 = (size_t)(cut_rand(seed) * (double)m->nsurf) % m->nsurf;
+  size_t sv0 = (size_t)(test_rng_lcg(seed) * (double)m->nsurf) % m->nsurf;
   double S[3], d[3], s[3], tmp[3], s2[3];
   v3_copy(S, m->surf_x + 3 * sv0);
   v3_sub(d, ctr, S);
   v3_normalize(d);
-  for (int k = 0; k < 3; k++) d[k] += 0.7 * (cut_rand(seed) - 0.5);
+  for (int k = 0; k < 3; k++) d[k] += 0.7 * (test_rng_lcg(seed) - 0.5);
   v3_normalize(d);
   v3_set(tmp, fabs(d[0]) < 0.9 ? 1 : 0, fabs(d[0]) < 0.9 ? 0 : 1, 0);
   v3_cross(s, d, tmp);
   v3_normalize(s);
-  double a = 2 * M_PI * cut_rand(seed);
+  double a = 2 * M_PI * test_rng_lcg(seed);
   v3_cross(s2, d, s);
   for (int k = 0; k < 3; k++) s[k] = cos(a) * s[k] + sin(a) * s2[k];
-  double depth = R * (0.05 + 0.15 * cut_rand(seed)), s_end = R * (0.1 + 0.2 * cut_rand(seed));
+  double depth = R * (0.05 + 0.15 * test_rng_lcg(seed)), s_end = R * (0.1 + 0.2 * test_rng_lcg(seed));
   verr_t err;
   const pbd_t *sv = model_pbd_solver(m);
   double steps_s = 0;

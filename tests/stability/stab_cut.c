@@ -23,11 +23,10 @@
 #endif
 
 int main(void) {
-  const char *src = getenv("VISCERA_SOURCE_DIR");
   mesh_t surf;
   scene_organ_t cfg;
   verr_t err;
-  model_t *m = cut_spleen_model(src ? src : ".", &surf, &cfg, &err);
+  model_t *m = cut_spleen_model(&surf, &cfg, &err);
   if (!m) {
     fprintf(stderr, "stab_cut: %s\n", err.msg);
     return 1;

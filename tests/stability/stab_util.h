@@ -11,6 +11,7 @@
 #include "check.h"
 #include "physics/model.h"
 #include "scene.h"
+#include "test_rng.h"
 #include "vmath.h"
 
 /* An organ entry with the scene parser's defaults plus `extra` (YAML lines
@@ -41,10 +42,7 @@ static inline int stab_finite(const double *a, size_t n) {
 }
 
 static unsigned stab_seed = 12345;
-static inline double stab_rand(void) { /* uniform in [-0.5, 0.5) */
-  stab_seed = stab_seed * 1664525u + 1013904223u;
-  return (double)(stab_seed >> 8) / 16777216.0 - 0.5;
-}
+static inline double stab_rand(void) { return test_rng_lcg(&stab_seed) - 0.5; } /* uniform in [-0.5, 0.5) */
 
 static inline void stab_octahedron(mesh_t *m, double r) {
   static const double P[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};

@@ -13,11 +13,18 @@ const char *test_source_dir(void) {
   return src && *src ? src : VISCERA_TEST_SOURCE_DIR;
 }
 
+static char assets_dir[2048]; /* "" = <source>/assets */
+
+void test_assets_dir_set(const char *dir) { snprintf(assets_dir, sizeof assets_dir, "%s", dir ? dir : ""); }
+
 const char *test_asset(const char *sub) {
   static char buf[8][4096];
   static unsigned next;
   char *p = buf[next++ % 8];
-  snprintf(p, sizeof buf[0], "%s/assets/%s", test_source_dir(), sub);
+  if (assets_dir[0])
+    snprintf(p, sizeof buf[0], "%s/%s", assets_dir, sub);
+  else
+    snprintf(p, sizeof buf[0], "%s/assets/%s", test_source_dir(), sub);
   return p;
 }
 

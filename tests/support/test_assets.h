@@ -13,7 +13,13 @@
 /* $VISCERA_SOURCE_DIR, or the source tree of the build. Never NULL. */
 const char *test_source_dir(void);
 
-/* "<source>/assets/<sub>" (e.g. "meshes/kidney.obj", "scenes"); the result
+/* Makes test_asset (and everything built on it: mesh loading, the
+ * test_runtime scenes) read from the assets folder `dir` instead of
+ * "<source>/assets" (a benchmark's ASSETS_DIR argument); NULL restores the
+ * default. The string is copied. */
+void test_assets_dir_set(const char *dir);
+
+/* "<source>/assets/<sub>", or "<dir>/<sub>" after test_assets_dir_set (e.g. "meshes/kidney.obj", "scenes"); the result
  * is valid until the eighth call after this one. */
 const char *test_asset(const char *sub);
 

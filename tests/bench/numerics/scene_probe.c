@@ -24,6 +24,8 @@
 
 #include "plot/plot.h"
 #include "runtime/scene_runtime.h"
+#include "test_assets.h"
+#include "test_runtime.h"
 #include "vstats.h"
 #include "vtime.h"
 
@@ -56,12 +58,8 @@ static void probe_run_free(probe_run_t *r) {
  * sets the model, integrator and sub-steps in code. */
 static int probe_scene(const nb_t *nb, const char *model, const char *integ, double dt, int substeps, scene_t *sc,
                        verr_t *err) {
-  char yaml[2048];
-  snprintf(yaml, sizeof yaml,
-           "scene: numerics_s8\norgans:\n  - name: spleen\n    mesh: %s/meshes/spleen.obj\n"
-           "tools:\n  - name: probe\n",
-           nb->assets);
-  if (scene_load_string(yaml, "numerics_s8", NULL, sc, err)) return -1;
+  test_assets_dir_set(nb->assets);
+  if (!test_runtime_one_organ(NULL, sc, "numerics_s8", "spleen.obj", "", "", err)) return -1;
   /* Set in code so the step is exactly 1/(30 2^k) and divides the 1/30 s
    * sampling (a decimal in the text would be rounded). */
   sc->dt = dt;

@@ -120,11 +120,11 @@ static double step_at(const double pos[3], double *prev_force) {
  * side. Driven by hand on the adaptive kidney: the probe presses with
  * refinement off, then the surface is refined / simplified directly and the
  * model's counts updated the way a model does before it bumps its version. */
-static void test_generic_reattach(const char *scene_path) {
+static void test_generic_reattach(void) {
   static scene_t sc2;
   static runtime_t r2;
   verr_t err;
-  if (scene_load(scene_path, &sc2, &err) || runtime_init(&r2, &sc2, &err)) {
+  if (!test_runtime_load_scene(&r2, &sc2, "kidney_adaptive.yaml", &err)) {
     CHECK(!"adaptive scene loads");
     return;
   }
@@ -249,6 +249,6 @@ int main(void) {
          changes_seen, f_refined, f_simplified, worst_jump, worst_jump_force, worst_step, worst_step_at, JUMP_BOUND,
          DYNAMICS_BOUND);
   runtime_destroy(&rt);
-  test_generic_reattach(test_asset("scenes/kidney_adaptive.yaml"));
+  test_generic_reattach();
   return check_report("test_topology_runtime");
 }
