@@ -7,4 +7,7 @@
 
 void vsignal_on_stop(void (*handler)(int), int flags);
 
+/* The same for one other signal `sig` (e.g. SIGUSR1 with SA_RESTART). */
+void vsignal_on(int sig, void (*handler)(int), int flags);
+
 #endif

@@ -134,9 +134,9 @@ void runtime_destroy(runtime_t *rt) {
   rt->norgans = 0;
 }
 
-/* The tip and force limit of the tool's accepted command (tool->cmd). */
+/* The force limit of the tool's accepted command (tool->cmd; its tip is
+ * tool->cmd.pos). */
 static void take_pose(runtime_t *rt, tool_rt_t *tool) {
-  v3_copy(tool->device, tool->cmd.pos);
   tool->max_force = fmin(tool->cfg->max_force, tool->cmd.max_force);
   tool->active = 1;
   if (tool->first_cmd_time < 0) tool->first_cmd_time = rt->sim_time;
@@ -185,7 +185,7 @@ static void apply_contacts(model_t *m, void *vctx) {
     if (!tool->active || !p->in_contact || (size_t)p->surface != o->id) continue;
     proxy_follow_surface(p, rt->surfaces, rt->norgans);
     double f[3];
-    proxy_spring_force(p, tool->device, tool->cfg->stiffness, tool->max_force, f);
+    proxy_spring_force(p, tool->cmd.pos, tool->cfg->stiffness, tool->max_force, f);
     for (size_t j = 0; j < tool->npatch; j++) {
       double fk[3];
       v3_scale(fk, f, -tool->patch_w[j]);
@@ -273,9 +273,9 @@ static int organ_disturbed(const runtime_t *rt, size_t i) {
     if (tool->proxy.in_contact || (tool->grasp.active && tool->grasp.organ == (int)o->id) || scalpel_cutting(rt, t))
       return 1;
     double r = tool->cfg->radius, reach = r + fmax(0.01, 3 * r), end[3];
-    v3_copy(end, tool->device);
+    v3_copy(end, tool->cmd.pos);
     v3_axpy(end, tool->axis, tool->cfg->length);
-    if (organ_sleep_box_near(o->tree.lo, o->tree.hi, tool->device, end, reach)) return 1;
+    if (organ_sleep_box_near(o->tree.lo, o->tree.hi, tool->cmd.pos, end, reach)) return 1;
     if (tool->stone >= 0) {
       const stone_t *st = &rt->stones[tool->stone];
       if (organ_sleep_box_near(o->tree.lo, o->tree.hi, st->pos, st->pos, st->radius + reach)) return 1;
@@ -292,7 +292,7 @@ static void step_contact(runtime_t *rt) {
   for (size_t t = 0; t < rt->ntools; t++) {
     tool_rt_t *tool = &rt->tools[t];
     if (!tool->active || !interact_uses_proxy(rt, t)) continue;
-    proxy_update_friction(&tool->proxy, tool->device, rt->surfaces, rt->norgans, tool->cfg->stiffness, tool->max_force,
+    proxy_update_friction(&tool->proxy, tool->cmd.pos, rt->surfaces, rt->norgans, tool->cfg->stiffness, tool->max_force,
                           tool->cfg->friction, tool->from.proxy);
     build_patch(rt, tool);
   }
@@ -364,7 +364,7 @@ static void settle_contact(runtime_t *rt) {
     proxy_settle(&tool->proxy, rt->scene.dt);
     proxy_follow_surface(&tool->proxy, rt->surfaces, rt->norgans);
     tool->from.proxy_mag =
-        proxy_spring_force(&tool->proxy, tool->device, tool->cfg->stiffness, tool->max_force, tool->from.proxy);
+        proxy_spring_force(&tool->proxy, tool->cmd.pos, tool->cfg->stiffness, tool->max_force, tool->from.proxy);
   }
 }
 

@@ -98,8 +98,8 @@ int scalpel_cutting(const runtime_t *rt, size_t t) {
 
 /* Tip = the commanded position, handle = tip + blade_length along the axis. */
 static void blade(const tool_rt_t *tool, double tip[3], double handle[3]) {
-  v3_copy(tip, tool->device);
-  v3_copy(handle, tool->device);
+  v3_copy(tip, tool->cmd.pos);
+  v3_copy(handle, tool->cmd.pos);
   v3_axpy(handle, tool->axis, tool->cfg->blade_length);
 }
 

@@ -61,7 +61,7 @@ static void try_grasp_tissue(runtime_t *rt, size_t t) {
   for (size_t i = 0; i < rt->norgans; i++) {
     const model_t *m = rt->organs[i].model;
     for (size_t v = 0; v < m->nsurf; v++) {
-      double d = v3_dist(m->surf_x + 3 * v, tool->device);
+      double d = v3_dist(m->surf_x + 3 * v, tool->cmd.pos);
       if (d < best_d) {
         best_d = d;
         best = (int)i;
@@ -70,7 +70,7 @@ static void try_grasp_tissue(runtime_t *rt, size_t t) {
   }
   if (best < 0 || best_d > tool->cfg->grasp_radius) return;
   const model_t *m = rt->organs[best].model;
-  size_t n = grasp_take(&tool->grasp, best, m->surf_x, m->nsurf, tool->device, tool->cfg->grasp_radius);
+  size_t n = grasp_take(&tool->grasp, best, m->surf_x, m->nsurf, tool->cmd.pos, tool->cfg->grasp_radius);
   if (n) push_event(rt, IEV_GRASP_BEGIN, (int)t, best, -1, (double)n);
 }
 
@@ -81,14 +81,14 @@ static void try_grasp_stone(runtime_t *rt, size_t t) {
   double best_d = INFINITY;
   for (size_t i = 0; i < rt->nstones; i++) {
     const stone_t *s = &rt->stones[i];
-    double d = v3_dist(s->pos, tool->device) - s->radius;
-    if (s->held_by < 0 && stone_within_reach(s, tool->device, tool->cfg->grasp_radius) && d < best_d) {
+    double d = v3_dist(s->pos, tool->cmd.pos) - s->radius;
+    if (s->held_by < 0 && stone_within_reach(s, tool->cmd.pos, tool->cfg->grasp_radius) && d < best_d) {
       best_d = d;
       best = (int)i;
     }
   }
   if (best < 0) return;
-  stone_grab(&rt->stones[best], (int)t, tool->device);
+  stone_grab(&rt->stones[best], (int)t, tool->cmd.pos);
   tool->stone = best;
   push_event(rt, IEV_GRASP_BEGIN, (int)t, -1, best, 1);
 }
@@ -143,7 +143,7 @@ void interact_tools(runtime_t *rt) {
     } else if (tool->opening) {
       release_held(rt, t);
     }
-    if (tool->stone >= 0) stone_follow(&rt->stones[tool->stone], tool->device);
+    if (tool->stone >= 0) stone_follow(&rt->stones[tool->stone], tool->cmd.pos);
     if (!interact_uses_proxy(rt, t)) {
       proxy_reset(&tool->proxy);
       tool->npatch = 0;
@@ -157,7 +157,7 @@ static int shaft_of(const runtime_t *rt, size_t t, double p0[3], double p1[3]) {
   const tool_rt_t *tool = &rt->tools[t];
   /* A cutting scalpel parts the tissue instead of pushing it (runtime/step_cut.h). */
   if (!tool->active || is_kind(tool, "extractor") || scalpel_cutting(rt, t)) return 0;
-  const double *tip = tool->proxy.in_contact ? tool->proxy.pos : tool->device;
+  const double *tip = tool->proxy.in_contact ? tool->proxy.pos : tool->cmd.pos;
   shaft_segment(tip, tool->axis, tool->cfg->radius, tool->cfg->length, p0, p1);
   return 1;
 }
@@ -186,7 +186,7 @@ void interact_apply(runtime_t *rt, organ_rt_t *o, model_t *m) {
       continue;
     }
     double fv[GRASP_MAX_VERTS][3], ft[3];
-    grasp_force(&tool->grasp, m->surf_x, tool->device, tool->cfg->stiffness, tool->max_force, fv, ft);
+    grasp_force(&tool->grasp, m->surf_x, tool->cmd.pos, tool->cfg->stiffness, tool->max_force, fv, ft);
     for (size_t j = 0; j < tool->grasp.n; j++) m->ops->add_surface_force(m, tool->grasp.v[j], fv[j]);
   }
   /* The shafts' crossing test reads the organ's tree as refit at the start
@@ -233,7 +233,7 @@ static void tell_pulled(tool_rt_t *tool, const double f[3], int organ) {
   tool->fb_organ = organ;
   v3_copy(tool->fb_normal, f);
   if (v3_normalize(tool->fb_normal) <= 0) v3_set(tool->fb_normal, 0, 0, 1);
-  v3_copy(tool->fb_pos, tool->device);
+  v3_copy(tool->fb_pos, tool->cmd.pos);
   v3_axpy(tool->fb_pos, f, 1.0 / tool->cfg->stiffness);
 }
 
@@ -278,12 +278,12 @@ static void stone_touch(runtime_t *rt, tool_rt_t *tool) {
   for (size_t i = 0; i < rt->nstones; i++) {
     const stone_t *s = &rt->stones[i];
     double d[3], reach = s->radius + tool->cfg->radius;
-    v3_sub(d, tool->device, s->pos);
+    v3_sub(d, tool->cmd.pos, s->pos);
     double len = v3_norm(d);
     if (!(len < reach) || len < 1e-12) continue;
     v3_copy(from->touch_p, s->pos);
     v3_axpy(from->touch_p, d, reach / len);
-    v3_sub(from->touch_f, from->touch_p, tool->device);
+    v3_sub(from->touch_f, from->touch_p, tool->cmd.pos);
     v3_scale(from->touch_f, from->touch_f, tool->cfg->stiffness);
     v3_scale(from->touch_n, d, 1 / len);
     from->touch = 1;
@@ -304,7 +304,7 @@ static void contributions(runtime_t *rt, size_t t) {
   if (tool->grasp.active) {
     const model_t *m = rt->organs[tool->grasp.organ].model;
     double fv[GRASP_MAX_VERTS][3];
-    grasp_force(&tool->grasp, m->surf_x, tool->device, tool->cfg->stiffness, tool->max_force, fv, from->pull_f);
+    grasp_force(&tool->grasp, m->surf_x, tool->cmd.pos, tool->cfg->stiffness, tool->max_force, fv, from->pull_f);
     from->pull = 1;
     from->pull_organ = tool->grasp.organ;
   } else if (tool->stone >= 0) {
@@ -350,7 +350,7 @@ static void tip_feedback(runtime_t *rt, size_t t) {
     clamp_force(tool, from->pull_f, f);
     tell_pulled(tool, f, from->pull_organ);
   } else if (is_kind(tool, "extractor")) {
-    v3_copy(tool->fb_pos, tool->device);
+    v3_copy(tool->fb_pos, tool->cmd.pos);
     v3_set(tool->fb_normal, 0, 0, 1);
     if (from->touch) {
       tool->fb_contact = 1;
@@ -406,7 +406,7 @@ void interact_hand_force(runtime_t *rt, size_t t) {
   }
   double f[3];
   if (from->tool_tool) {
-    v3_sub(f, tool->fb_pos, tool->device);
+    v3_sub(f, tool->fb_pos, tool->cmd.pos);
     v3_scale(f, f, tool->cfg->stiffness);
     double mag = v3_norm(f);
     if (mag > tool->max_force) v3_scale(f, f, tool->max_force / mag);
@@ -454,7 +454,7 @@ void interact_outputs(runtime_t *rt) {
                                   .fb_contact = tool->fb_contact,
                                   .fb_organ = tool->fb_organ,
                                   .fb_pos = tool->fb_pos,
-                                  .device = tool->device,
+                                  .device = tool->cmd.pos,
                                   .grasp = &tool->grasp};
   }
   tasks_update(rt->tasks, rt->ntasks, views, rt->stones, rt->sim_time, &rt->events);

@@ -1,9 +1,11 @@
 /* tool_rt: one tool of the running scene (scene_runtime.h), the one record
  * of the tool in the core. Its parts, in the order the step uses them:
  *
- *   cmd        the command as last accepted (runtime_command_tool)
- *   mechanics  where the tool is driven and what it does: the tip, the
- *              force limit, the shaft axis, the jaws, what it holds
+ *   cmd        the command as last accepted (runtime_command_tool): its
+ *              pos is the commanded tip the step drives (the device
+ *              point of haptics/proxy.h), kept nowhere else
+ *   mechanics  what the tool does with it: the force limit, the shaft
+ *              axis, the jaws, what it holds
  *   contact    its god-object proxy and the tissue patch that shares the
  *              proxy's reaction
  *   hand       the contributions the step's phases produce (proxy spring,
@@ -13,9 +15,10 @@
  *   feedback   what the tool's client is told (ContactFeedback)
  *
  * The parts are anonymous structs: a field is named as before
- * (tool->device, tool->force), the part only groups it. The session keeps
- * what the network adds (writers, stations, liveliness) in its own records,
- * indexed like rt->tools (session/server.c, session/tool_roles.h). */
+ * (tool->max_force, tool->force), the part only groups it. The session keeps
+ * what the network adds in its own records, indexed like rt->tools
+ * (session/session_tool.h: measures, intake, feedback; session/tool_roles.h:
+ * writers, stations, liveliness). */
 #ifndef VISCERA_TOOL_RT_H
 #define VISCERA_TOOL_RT_H
 
@@ -51,11 +54,11 @@ typedef struct tool_forces {
 typedef struct tool_rt {
   const scene_tool_t *cfg;
   /* The command as last accepted (runtime_command_tool; runtime_set_* set
-   * its parts). */
+   * its parts). cmd.pos is the tool's commanded tip, m: the one copy every
+   * phase reads (a release leaves it where it was, like the rest of cmd). */
   tool_input_t cmd;
   struct {                 /* mechanics */
     int active;            /* a valid command has been received */
-    double device[3];      /* commanded tip, m */
     double max_force;      /* N: min(tool, device capability) */
     double axis[3];        /* unit shaft direction from the tip (command orientation applied to +z) */
     uint32_t buttons;      /* the command's buttons, bit 0 = jaws closed; 0 after a release */

@@ -46,18 +46,17 @@ static void seal(buf_t *b) {
 }
 
 /* The session's records in the core's state (runtime/checkpoint_state.h):
- * per tool, its tracker measures and tally; after the stones, the tools'
- * roles. On load they are kept aside until the whole file checked out. */
+ * per tool, the measures of its session record (session_tool.h: tracker
+ * measures and tally); after the stones, the tools' roles. On load they
+ * are kept aside until the whole file checked out. */
 typedef struct session_saved {
-  const thr_tracker_t *thr;
-  const tool_tally_t *tally;
+  const session_tool_t *tools;
   const tool_roles_t *roles; /* NULL: none saved */
 } session_saved_t;
 
 typedef struct session_records {
   const runtime_t *rt;
-  thr_tracker_t *thr;
-  tool_tally_t *tally;
+  session_tool_t *tools;
   tool_roles_t *roles; /* NULL: the file's are ignored */
   thr_tracker_t tmp[SCENE_MAX_TOOLS];
   tool_tally_t tl[SCENE_MAX_TOOLS];
@@ -71,7 +70,8 @@ typedef struct session_records {
 /* Per tool: tracker measures, then tally (grasps, grasp_time). */
 static void put_tool(void *ctx, buf_t *b, size_t t) {
   const session_saved_t *r = ctx;
-  const thr_tracker_t *tr = &r->thr[t];
+  const thr_tracker_t *tr = &r->tools[t].thr;
+  const tool_tally_t *tl = &r->tools[t].tally;
   for (int k = 0; k < THR_COUNT; k++) {
     sb_put_f64(b, tr->time_above[k]);
     sb_put_u64(b, tr->crossings[k]);
@@ -80,8 +80,8 @@ static void put_tool(void *ctx, buf_t *b, size_t t) {
   sb_put_f64(b, tr->contact_time);
   sb_put_f64(b, tr->contact_force_integral);
   sb_put_f64(b, tr->path_length);
-  sb_put_u64(b, r->tally[t].grasps);
-  sb_put_f64(b, r->tally[t].grasp_time);
+  sb_put_u64(b, tl->grasps);
+  sb_put_f64(b, tl->grasp_time);
 }
 
 /* nroles (0 when saved without roles, else ntools), per tool:
@@ -105,7 +105,7 @@ static void put_tail(void *ctx, buf_t *b) {
 static const char *get_tool(void *ctx, buf_t *b, size_t t) {
   session_records_t *r = ctx;
   thr_tracker_t *tr = &r->tmp[t];
-  *tr = r->thr[t]; /* levels and live state stay the scene's */
+  *tr = r->tools[t].thr; /* levels and live state stay the scene's */
   for (int k = 0; k < THR_COUNT; k++) {
     tr->time_above[k] = sb_get_f64(b);
     tr->crossings[k] = (uint32_t)sb_get_u64(b);
@@ -147,8 +147,8 @@ static const char *get_tail(void *ctx, buf_t *b) {
 static void apply(void *ctx) {
   session_records_t *r = ctx;
   for (size_t t = 0; t < r->rt->ntools; t++) {
-    r->thr[t] = r->tmp[t];
-    r->tally[t] = r->tl[t];
+    r->tools[t].thr = r->tmp[t];
+    r->tools[t].tally = r->tl[t];
   }
   if (r->roles)
     for (size_t t = 0; t < r->nroles; t++)
@@ -160,12 +160,12 @@ static void apply(void *ctx) {
  * gives the layout), then, appended by seal() (the checkpointer's writer
  * thread computes it, not the physics loop), the crc32 (as u64) of
  * everything before it. */
-static int serialise(buf_t *b, const runtime_t *rt, const thr_tracker_t *thr, const tool_tally_t *tally,
-                     const tool_roles_t *roles, verr_t *err) {
+static int serialise(buf_t *b, const runtime_t *rt, const session_tool_t *tools, const tool_roles_t *roles,
+                     verr_t *err) {
   b->len = 0;
   b->bad = 0;
   sb_put(b, MAGIC, 8);
-  session_saved_t saved = {.thr = thr, .tally = tally, .roles = roles};
+  session_saved_t saved = {.tools = tools, .roles = roles};
   ckpt_session_io_t io = {.ctx = &saved, .put_tool = put_tool, .put_tail = put_tail};
   return ckpt_state_put(b, rt, &io, err);
 }
@@ -194,10 +194,10 @@ static int write_atomic(const char *path, const unsigned char *p, size_t len, ve
   return 0;
 }
 
-int checkpoint_save(const char *path, const runtime_t *rt, const thr_tracker_t *thr, const tool_tally_t *tally,
-                    const tool_roles_t *roles, verr_t *err) {
+int checkpoint_save(const char *path, const runtime_t *rt, const session_tool_t *tools, const tool_roles_t *roles,
+                    verr_t *err) {
   buf_t b = {0};
-  int bad = serialise(&b, rt, thr, tally, roles, err);
+  int bad = serialise(&b, rt, tools, roles, err);
   if (!bad) {
     seal(&b);
     if (b.bad) bad = verr_set(err, "checkpoint: out of memory");
@@ -274,13 +274,13 @@ checkpointer_t *checkpointer_start(const char *path, verr_t *err) {
   return c;
 }
 
-void checkpointer_submit(checkpointer_t *c, const runtime_t *rt, const thr_tracker_t *thr, const tool_tally_t *tally,
+void checkpointer_submit(checkpointer_t *c, const runtime_t *rt, const session_tool_t *tools,
                          const tool_roles_t *roles) {
   /* Never block the physics loop: if the writer holds the lock right now,
    * skip this checkpoint; the next one comes soon. */
   if (pthread_mutex_trylock(&c->lock)) return;
   verr_t err;
-  if (serialise(&c->pending, rt, thr, tally, roles, &err) == 0) {
+  if (serialise(&c->pending, rt, tools, roles, &err) == 0) {
     c->have_pending = 1;
     pthread_cond_signal(&c->cond);
   } else if (c->refused++ == 0) {
@@ -314,8 +314,7 @@ static int refuse(buf_t *b, verr_t *err, const char *path, const char *what) {
   return verr_set(err, "checkpoint %s: %s; starting from rest", path, what);
 }
 
-int checkpoint_load(const char *path, runtime_t *rt, thr_tracker_t *thr, tool_tally_t *tally, tool_roles_t *roles,
-                    verr_t *err) {
+int checkpoint_load(const char *path, runtime_t *rt, session_tool_t *tools, tool_roles_t *roles, verr_t *err) {
   FILE *f = fopen(path, "rb");
   if (!f) {
     if (errno == ENOENT) return 0;
@@ -346,7 +345,7 @@ int checkpoint_load(const char *path, runtime_t *rt, thr_tracker_t *thr, tool_ta
   if (stored_crc != crc32(b.p, b.len - 8)) return refuse(&b, err, path, "damaged (CRC mismatch: truncated or corrupt)");
   b.len -= 8;
   b.at = 8;
-  session_records_t rec = {.rt = rt, .thr = thr, .tally = tally, .roles = roles};
+  session_records_t rec = {.rt = rt, .tools = tools, .roles = roles};
   ckpt_session_io_t io = {.ctx = &rec, .get_tool = get_tool, .get_tail = get_tail, .apply = apply};
   char what[200];
   int rc = ckpt_state_get(&b, rt, &io, what, sizeof what, err);

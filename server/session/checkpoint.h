@@ -4,8 +4,9 @@
  *
  * What is saved (format 2): the core's state (runtime/checkpoint_state.h:
  * simulated time and step count, organs with a changed topology, stones,
- * tasks) with the session's records in it: each tool's palpation measures
- * (training/thresholds.h) and tally (tool_metrics.h: grasps, time holding);
+ * tasks) with the session's records in it: from each tool's session record
+ * (session_tool.h) its palpation measures (training/thresholds.h) and tally
+ * (tool_metrics.h: grasps, time holding);
  * each tool's role (tool_roles.h: owner, guide, authority, coupling), so an
  * instructor's assignment or take-over outlives a crash. A model that
  * cannot save its changed topology stops the checkpoints: the file keeps
@@ -23,29 +24,30 @@
 #define VISCERA_CHECKPOINT_H
 
 #include "runtime/scene_runtime.h"
-#include "session/tool_metrics.h"
+#include "session/session_tool.h"
 #include "session/tool_roles.h"
-#include "training/thresholds.h"
 #include "verr.h"
 
 #include <stdint.h>
 
-/* Writes the state of `rt`, the per-tool trackers `thr` and tallies
- * `tally` (rt->ntools each) and the tools' roles (`roles`, NULL: none
- * saved; on load NULL ignores the file's) to `path`. -1 with err when it cannot (a model
- * that cannot save its changed topology, out of memory, write error). */
-int checkpoint_save(const char *path, const runtime_t *rt, const thr_tracker_t *thr, const tool_tally_t *tally,
-                    const tool_roles_t *roles, verr_t *err);
-
-/* Restores a checkpoint written for the same scene into `rt`, `thr` and
- * `tally`. Returns 1 when restored (organs with a restored topology already
- * followed: runtime_topology_restored), 0 when `path` does not exist (fresh
- * start), -1 with err when the file is unreadable, damaged, of another
- * format or for another scene (rt, thr and tally are then as from rest:
- * unchanged, or rebuilt from the scene when a topology restore failed
- * midway), -2 when that rebuild failed too (out of memory: rt is unusable). */
-int checkpoint_load(const char *path, runtime_t *rt, thr_tracker_t *thr, tool_tally_t *tally, tool_roles_t *roles,
+/* Writes the state of `rt`, the measures of the tools' session records
+ * `tools` (rt->ntools of them: tracker and tally) and the tools' roles
+ * (`roles`, NULL: none saved; on load NULL ignores the file's) to `path`.
+ * -1 with err when it cannot (a model that cannot save its changed
+ * topology, out of memory, write error). */
+int checkpoint_save(const char *path, const runtime_t *rt, const session_tool_t *tools, const tool_roles_t *roles,
                     verr_t *err);
+
+/* Restores a checkpoint written for the same scene into `rt` and the
+ * measures of `tools` (tracker measures and tally; the levels and the rest
+ * of each record stay as they are). Returns 1 when restored (organs with a
+ * restored topology already followed: runtime_topology_restored), 0 when
+ * `path` does not exist (fresh start), -1 with err when the file is
+ * unreadable, damaged, of another format or for another scene (rt and
+ * tools are then as from rest: unchanged, or rt rebuilt from the scene
+ * when a topology restore failed midway), -2 when that rebuild failed too
+ * (out of memory: rt is unusable). */
+int checkpoint_load(const char *path, runtime_t *rt, session_tool_t *tools, tool_roles_t *roles, verr_t *err);
 
 /* Periodic checkpoints from the physics loop without waiting on the disk:
  * submit() copies the state (no allocation once the buffers have grown;
@@ -54,7 +56,7 @@ int checkpoint_load(const char *path, runtime_t *rt, thr_tracker_t *thr, tool_ta
  * joins the thread and frees it; -1 with err if any write failed. */
 typedef struct checkpointer checkpointer_t;
 checkpointer_t *checkpointer_start(const char *path, verr_t *err);
-void checkpointer_submit(checkpointer_t *c, const runtime_t *rt, const thr_tracker_t *thr, const tool_tally_t *tally,
+void checkpointer_submit(checkpointer_t *c, const runtime_t *rt, const session_tool_t *tools,
                          const tool_roles_t *roles);
 int checkpointer_stop(checkpointer_t *c, uint64_t *written, verr_t *err);
 

@@ -12,6 +12,7 @@
 #include "session/command_intake.h"
 #include "session/liveliness_watch.h"
 #include "session/session_control.h"
+#include "session/session_tool.h"
 #include "session/tool_metrics.h"
 #include "session/tool_roles.h"
 #include "session/writer_stations.h"
@@ -23,26 +24,15 @@
 
 #define STEP_RING 65536
 
-/* What the session adds to a tool, by the tool's index in the core's
- * s->rt.tools (runtime/tool_rt.h: the tool's one record, with the command
- * as last accepted, its mechanics, contact, hand force and feedback). The
- * writers and stations that drive it, and when each was last heard, are
- * the tool's role (roles.tool[t], tool_roles.h); its training measures
- * are thr[t] and tally[t]. */
-typedef struct session_tool {
-  uint64_t last_cmd_mono; /* monotonic ns when its last command was accepted (the command timeout) */
-  int lost;               /* released for a lost client (to report its return) */
-  int was_contact;        /* the contact last written in ContactFeedback (CONTACT_BEGIN/END) */
-} session_tool_t;
-
 typedef struct server {
   const server_opts_t *opts;
   runtime_t rt;
   vdds_t dds;
   dds_entity_t w_scene, w_state, w_delta, w_feedback, w_event, w_metrics, r_cmd, r_control;
   dds_entity_t w_objects, w_tool_metrics, w_role;
-  tool_tally_t tally[SCENE_MAX_TOOLS];
   mesh_publisher_t pubs[SCENE_MAX_ORGANS];
+  /* Each tool's session record (session_tool.h: measures, intake,
+   * feedback), by its index in the core's rt.tools. */
   session_tool_t tool[SCENE_MAX_TOOLS];
   /* Loss detection: the writers driving each tool are in roles (per side). */
   liveliness_watch_t lw;
@@ -50,7 +40,6 @@ typedef struct server {
    * the station of each command writer (writer_stations.h). */
   tool_roles_t roles;
   writer_stations_t stations;
-  thr_tracker_t thr[SCENE_MAX_TOOLS];
   session_control_t control;
   uint64_t event_seq;
   double *step_us;           /* ring of recent step times */
@@ -362,8 +351,8 @@ static int rebuild_runtime(server_t *s, const scene_t *sc, const scene_t *old, v
   }
   for (size_t t = 0; t < s->rt.ntools; t++) {
     const scene_tool_t *c = s->rt.tools[t].cfg;
-    thr_init(&s->thr[t], c->st, c->mpf, c->sft);
-    memset(&s->tally[t], 0, sizeof s->tally[t]);
+    thr_init(&s->tool[t].thr, c->st, c->mpf, c->sft);
+    memset(&s->tool[t].tally, 0, sizeof s->tool[t].tally);
     s->tool[t].was_contact = 0;
   }
   tool_roles_forget_all(&s->roles); /* tools released; roles kept and published again */
@@ -403,7 +392,7 @@ static int read_controls(server_t *s) {
       if (edit && old) {
         *edit = s->rt.scene;
         *old = s->rt.scene;
-        r = session_control_apply(&s->control, c, s->thr, s->rt.ntools, maxf, edit, text, sizeof text);
+        r = session_control_apply(&s->control, c, s->tool, s->rt.ntools, maxf, edit, text, sizeof text);
       } else {
         snprintf(text, sizeof text, "SessionControl refused: out of memory");
       }
@@ -489,7 +478,7 @@ static void track_thresholds(server_t *s) {
     double f = tool->active ? v3_norm(tool->force) : 0.0;
     int contact = tool->active && tool->fb_contact;
     thr_event_t ev[THR_COUNT];
-    int n = thr_update(&s->thr[t], s->rt.scene.dt, f, contact, tool->active ? tool->device : NULL, ev);
+    int n = thr_update(&s->tool[t].thr, s->rt.scene.dt, f, contact, tool->active ? tool->cmd.pos : NULL, ev);
     for (int i = 0; i < n; i++) {
       char text[200];
       snprintf(text, sizeof text, "%s %s: tool '%s' force %.3f N %s %.3f N", thr_name(ev[i].which),
@@ -535,7 +524,7 @@ static void publish_metrics(server_t *s, uint64_t window_steps) {
   for (size_t t = 0; t < s->rt.ntools; t++) peak = fmax(peak, s->rt.tools[t].peak_force);
   double above[THR_COUNT] = {0}, contact = 0, fint = 0, path = 0;
   for (size_t t = 0; t < s->rt.ntools; t++) {
-    const thr_tracker_t *tr = &s->thr[t];
+    const thr_tracker_t *tr = &s->tool[t].thr;
     for (int k = 0; k < THR_COUNT; k++) above[k] += tr->time_above[k];
     contact += tr->contact_time;
     fint += tr->contact_force_integral;
@@ -646,7 +635,7 @@ static void publish_objects(server_t *s) {
 static void publish_tool_metrics(server_t *s) {
   for (size_t t = 0; t < s->rt.ntools; t++) {
     viscera_ToolMetrics m;
-    tool_metrics_fill(&m, &s->rt, t, &s->thr[t], &s->tally[t], sim_ns(s));
+    tool_metrics_fill(&m, &s->rt, t, &s->tool[t].thr, &s->tool[t].tally, sim_ns(s));
     dds_write(s->w_tool_metrics, &m);
   }
 }
@@ -738,7 +727,7 @@ static int session_step(server_t *s, uint64_t t0, uint64_t c0, uint64_t *t1) {
   publish_feedback(s);
   if (!s->control.paused) {
     track_thresholds(s);
-    for (size_t t = 0; t < s->rt.ntools; t++) tool_tally_update(&s->tally[t], &s->rt.tools[t], s->rt.scene.dt);
+    for (size_t t = 0; t < s->rt.ntools; t++) tool_tally_update(&s->tool[t].tally, &s->rt.tools[t], s->rt.scene.dt);
     publish_interactions(s); /* the events of the step just taken */
   }
   if (s->rt.steps % s->publish_every == 0) publish_frames(s);
@@ -782,13 +771,13 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
   }
   for (size_t t = 0; t < s.rt.ntools; t++) {
     const scene_tool_t *c = s.rt.tools[t].cfg;
-    thr_init(&s.thr[t], c->st, c->mpf, c->sft);
+    thr_init(&s.tool[t].thr, c->st, c->mpf, c->sft);
   }
   checkpointer_t *ckpt = NULL;
   char resumed[300] = "";
   if (opts->checkpoint) {
     verr_t e;
-    int r = checkpoint_load(opts->checkpoint, &s.rt, s.thr, s.tally, &s.roles, &e);
+    int r = checkpoint_load(opts->checkpoint, &s.rt, s.tool, &s.roles, &e);
     if (r == -2) {
       verr_set(err, "%s (cannot rebuild the scene after it)", e.msg);
       teardown(&s);
@@ -844,7 +833,7 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
       stats->overruns++;
       break; /* the scene could not be rebuilt: nothing left to simulate */
     }
-    if (ckpt && s.rt.steps % ckpt_every == 0) checkpointer_submit(ckpt, &s.rt, s.thr, s.tally, &s.roles);
+    if (ckpt && s.rt.steps % ckpt_every == 0) checkpointer_submit(ckpt, &s.rt, s.tool, &s.roles);
     next += dt_ns;
     if (t1 > next + 100 * 1000000ull) { /* far behind (debugger, overload): resynchronise */
       stats->overruns++;
@@ -856,7 +845,7 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
   publish_metrics(&s, s.metrics_every);
   publish_tool_metrics(&s);
   if (ckpt) {
-    checkpointer_submit(ckpt, &s.rt, s.thr, s.tally, &s.roles);
+    checkpointer_submit(ckpt, &s.rt, s.tool, &s.roles);
     verr_t e;
     if (checkpointer_stop(ckpt, &stats->checkpoints_written, &e)) fprintf(stderr, "server: %s\n", e.msg);
   }
@@ -870,9 +859,10 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
     stats->deltas_skipped += s.pubs[i].skipped;
   }
   stats->ntools = s.rt.ntools;
-  memcpy(stats->thr, s.thr, sizeof stats->thr);
-  for (size_t t = 0; t < s.rt.ntools; t++)
-    tool_metrics_fill(&stats->tools[t], &s.rt, t, &s.thr[t], &s.tally[t], sim_ns(&s));
+  for (size_t t = 0; t < s.rt.ntools; t++) {
+    stats->thr[t] = s.tool[t].thr;
+    tool_metrics_fill(&stats->tools[t], &s.rt, t, &s.tool[t].thr, &s.tool[t].tally, sim_ns(&s));
+  }
   stats->ntasks = s.rt.ntasks;
   stats->sim_time = s.rt.sim_time;
   memcpy(stats->tasks, s.rt.tasks, sizeof stats->tasks);

@@ -101,7 +101,7 @@ static const char *find_task(const viscera_SessionControl *c, const scene_t *sce
   return NULL;
 }
 
-int session_control_apply(session_control_t *sc, const viscera_SessionControl *c, thr_tracker_t *thr, size_t ntools,
+int session_control_apply(session_control_t *sc, const viscera_SessionControl *c, session_tool_t *tools, size_t ntools,
                           const double *tool_max_force, scene_t *scene, char *text, size_t n) {
   switch (c->kind) {
   case viscera_CONTROL_PAUSE:
@@ -125,7 +125,7 @@ int session_control_apply(session_control_t *sc, const viscera_SessionControl *c
      * stay with the trainee. The hysteretic state restarts below every
      * level, so a force already above a new level is reported as crossing
      * it on the next step. */
-    thr_tracker_t *t = &thr[c->tool_id];
+    thr_tracker_t *t = &tools[c->tool_id].thr;
     for (int k = 0; k < THR_COUNT; k++) {
       t->level[k] = v[k];
       t->above[k] = 0;

@@ -16,7 +16,7 @@
 #include <stdint.h>
 
 #include "scene.h"
-#include "training/thresholds.h"
+#include "session/session_tool.h"
 #include "viscera.h"
 
 /* Stations remembered for de-duplication; a deployment has a handful of
@@ -44,8 +44,8 @@ typedef struct session_control {
 int session_control_duplicate(session_control_t *sc, const viscera_SessionControl *c);
 
 /* Applies `c` to the seat: pause/resume, or new thresholds for one tool
- * (thr[tool] re-initialised with the new levels; its accumulated measures
- * are kept). Tool thresholds are checked like the scene file's:
+ * (the levels of tools[tool].thr, the tool's session record of
+ * session_tool.h, replaced; its accumulated measures are kept). Tool thresholds are checked like the scene file's:
  * 0 <= st < mpf <= sft <= max_force for those that are non-zero.
  * RESET and SET_MATERIAL need the scene rebuilt, which only the server can
  * do: for them `scene` (the running scene, copied by the caller) is edited
@@ -63,7 +63,7 @@ int session_control_duplicate(session_control_t *sc, const viscera_SessionContro
  * SESSION_CONTROL_START_TASK returned: the caller starts (or restarts) the
  * runtime's task (tasks_start) and publishes EVENT_TASK_STARTED with `text`. */
 #define SESSION_CONTROL_START_TASK 2
-int session_control_apply(session_control_t *sc, const viscera_SessionControl *c, thr_tracker_t *thr, size_t ntools,
+int session_control_apply(session_control_t *sc, const viscera_SessionControl *c, session_tool_t *tools, size_t ntools,
                           const double *tool_max_force, scene_t *scene, char *text, size_t n);
 
 #endif

@@ -91,7 +91,7 @@ static void case9(void) {
   }
   const tool_rt_t *t = &rt.tools[0];
   printf("case 9: device at z = %.3f m, proxy at z = %.4f m (lowest %.4f), force %.3f N (peak %.3f, clamp 4)\n",
-         t->device[2], t->proxy.pos[2], min_proxy_z, v3_norm(t->force), peak);
+         t->cmd.pos[2], t->proxy.pos[2], min_proxy_z, v3_norm(t->force), peak);
   CHECK(contact_all_way);
   CHECK(min_proxy_z > 0.0); /* never through to the far side (the kidney spans z 0..0.035) */
   CHECK(peak <= 4.0 + 1e-9 && peak > 3.99);

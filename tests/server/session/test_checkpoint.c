@@ -45,19 +45,20 @@ int main(void) {
   snprintf(path, sizeof path, "/tmp/viscera_test_ckpt_%d.bin", (int)getpid());
   snprintf(bad, sizeof bad, "%s.bad", path);
   static runtime_t a, b, c;
-  thr_tracker_t ta[SCENE_MAX_TOOLS], tb[SCENE_MAX_TOOLS];
-  tool_tally_t la[SCENE_MAX_TOOLS] = {{0}}, lb[SCENE_MAX_TOOLS] = {{0}};
+  session_tool_t ta[SCENE_MAX_TOOLS], tb[SCENE_MAX_TOOLS]; /* the session's tool records */
+  memset(ta, 0, sizeof ta);
+  memset(tb, 0, sizeof tb);
   CHECK(make(&a, src, "ck", "spleen.obj") == 0);
   CHECK(make(&b, src, "ck", "spleen.obj") == 0);
-  thr_init(&ta[0], 0.5, 0.8, 1.5);
-  thr_init(&tb[0], 0.5, 0.8, 1.5);
+  thr_init(&ta[0].thr, 0.5, 0.8, 1.5);
+  thr_init(&tb[0].thr, 0.5, 0.8, 1.5);
   press(&a, 200);
-  ta[0].time_above[THR_ST] = 0.25;
-  ta[0].path_length = 0.03;
+  ta[0].thr.time_above[THR_ST] = 0.25;
+  ta[0].thr.path_length = 0.03;
   verr_t err;
   unlink(path);
-  CHECK(checkpoint_load(path, &b, tb, lb, NULL, &err) == 0); /* no file: fresh start */
-  CHECK(checkpoint_save(path, &a, ta, la, NULL, &err) == 0);
+  CHECK(checkpoint_load(path, &b, tb, NULL, &err) == 0); /* no file: fresh start */
+  CHECK(checkpoint_save(path, &a, ta, NULL, &err) == 0);
 
   /* Damaged copies first: each refused, b untouched (still at rest). */
   FILE *f = fopen(path, "rb");
@@ -81,26 +82,26 @@ int main(void) {
     fwrite(bytes, 1, cases[k].len, g);
     fclose(g);
     if (cases[k].flip >= 0) bytes[cases[k].flip] = save;
-    CHECK(checkpoint_load(bad, &b, tb, lb, NULL, &err) == -1);
+    CHECK(checkpoint_load(bad, &b, tb, NULL, &err) == -1);
     CHECK(strstr(err.msg, cases[k].expect) != NULL);
     CHECK(b.sim_time == 0 && b.steps == 0);
     CHECK(max_diff(a.organs[0].model, b.organs[0].model) > 1e-3); /* still at rest, a is pressed */
   }
   /* Another scene (name) and another organ (node count): refused. */
   CHECK(make(&c, src, "other", "spleen.obj") == 0);
-  CHECK(checkpoint_load(path, &c, tb, lb, NULL, &err) == -1 && strstr(err.msg, "another scene"));
+  CHECK(checkpoint_load(path, &c, tb, NULL, &err) == -1 && strstr(err.msg, "another scene"));
   runtime_destroy(&c);
   CHECK(make(&c, src, "ck", "kidney.obj") == 0);
-  CHECK(checkpoint_load(path, &c, tb, lb, NULL, &err) == -1 && strstr(err.msg, "node count"));
+  CHECK(checkpoint_load(path, &c, tb, NULL, &err) == -1 && strstr(err.msg, "node count"));
   runtime_destroy(&c);
 
   /* The real one: restored exactly, and both continue identically. */
-  CHECK(checkpoint_load(path, &b, tb, lb, NULL, &err) == 1);
+  CHECK(checkpoint_load(path, &b, tb, NULL, &err) == 1);
   CHECK(b.sim_time == a.sim_time && b.steps == a.steps);
   CHECK(max_diff(a.organs[0].model, b.organs[0].model) == 0);
-  CHECK(tb[0].time_above[THR_ST] == 0.25 && tb[0].path_length == 0.03);
-  CHECK(tb[0].level[THR_MPF] == 0.8); /* levels stay the scene's */
-  for (int s = 0; s < 50; s++) {      /* tool released in both: the dent relaxes the same way */
+  CHECK(tb[0].thr.time_above[THR_ST] == 0.25 && tb[0].thr.path_length == 0.03);
+  CHECK(tb[0].thr.level[THR_MPF] == 0.8); /* levels stay the scene's */
+  for (int s = 0; s < 50; s++) {          /* tool released in both: the dent relaxes the same way */
     runtime_release_tool(&a, 0);
     runtime_release_tool(&b, 0);
     runtime_step(&a);
@@ -114,12 +115,12 @@ int main(void) {
   if (w) {
     for (int s = 0; s < 20; s++) {
       runtime_step(&a);
-      checkpointer_submit(w, &a, ta, la, NULL);
+      checkpointer_submit(w, &a, ta, NULL);
     }
     uint64_t written = 0;
     CHECK(checkpointer_stop(w, &written, &err) == 0);
     CHECK(written >= 1);
-    CHECK(checkpoint_load(path, &b, tb, lb, NULL, &err) == 1);
+    CHECK(checkpoint_load(path, &b, tb, NULL, &err) == 1);
     CHECK(b.steps == a.steps);
     CHECK(max_diff(a.organs[0].model, b.organs[0].model) == 0);
   }

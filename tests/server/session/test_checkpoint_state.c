@@ -34,16 +34,16 @@
 
 static runtime_t a, b; /* large */
 static scene_t sc;
-static thr_tracker_t ta[SCENE_MAX_TOOLS], tb[SCENE_MAX_TOOLS];
-static tool_tally_t la[SCENE_MAX_TOOLS], lb[SCENE_MAX_TOOLS];
+static session_tool_t ta[SCENE_MAX_TOOLS], tb[SCENE_MAX_TOOLS]; /* the session's tool records */
 static tool_roles_t ra, rb;
 static char path[200], bad[240];
 static verr_t err;
 
 static int load(runtime_t *rt, const char *yaml) {
   if (!test_runtime_load(rt, &sc, yaml, &err)) return 0;
-  for (size_t t = 0; t < rt->ntools; t++) thr_init(rt == &a ? &ta[t] : &tb[t], 0.5, 0.8, 1.5);
-  memset(rt == &a ? la : lb, 0, sizeof la);
+  session_tool_t *st = rt == &a ? ta : tb;
+  for (size_t t = 0; t < rt->ntools; t++) thr_init(&st[t].thr, 0.5, 0.8, 1.5);
+  for (size_t t = 0; t < SCENE_MAX_TOOLS; t++) memset(&st[t].tally, 0, sizeof st[t].tally);
   return 1;
 }
 
@@ -56,7 +56,8 @@ static void drive(runtime_t *rt, size_t t, const double p[3], const double q[3],
     runtime_set_tool(rt, t, x, 4);
     runtime_set_buttons(rt, t, buttons);
     runtime_step(rt);
-    for (size_t k = 0; k < rt->ntools; k++) tool_tally_update(rt == &a ? &la[k] : &lb[k], &rt->tools[k], rt->scene.dt);
+    for (size_t k = 0; k < rt->ntools; k++)
+      tool_tally_update(rt == &a ? &ta[k].tally : &tb[k].tally, &rt->tools[k], rt->scene.dt);
     rt->events.n = 0;
   }
 }
@@ -118,17 +119,17 @@ static void test_objects_tasks_tallies(void) {
   drive(&a, 0, at2, mid2, 200, 1);
   CHECK(a.stones[0].removed && a.tasks[0].completed && a.stones[0].held_by < 0);
   CHECK(!a.stones[1].removed && a.stones[1].held_by == 0 && a.tasks[1].started && !a.tasks[1].completed);
-  CHECK(la[0].grasps == 2 && la[0].grasp_time > 1.0 && la[0].was_holding);
-  ta[0].time_above[THR_MPF] = 0.125; /* measures ride along as before */
+  CHECK(ta[0].tally.grasps == 2 && ta[0].tally.grasp_time > 1.0 && ta[0].tally.was_holding);
+  ta[0].thr.time_above[THR_MPF] = 0.125; /* measures ride along as before */
   tool_roles_init(&ra, &sc);
   CHECK(tool_roles_restore(&ra, 0, "alice", "drsmith", 0.5, 150) == 0);
   CHECK(tool_roles_restore(&ra, 0, "alice", "alice", 0.5, 150) == -1); /* the owner cannot guide */
-  CHECK(checkpoint_save(path, &a, ta, la, &ra, &err) == 0);
+  CHECK(checkpoint_save(path, &a, ta, &ra, &err) == 0);
 
   CHECK(load(&b, KIDNEY_STONES));
   tool_roles_init(&rb, &sc);
   rb.changed = 0;
-  CHECK(checkpoint_load(path, &b, tb, lb, &rb, &err) == 1);
+  CHECK(checkpoint_load(path, &b, tb, &rb, &err) == 1);
   CHECK(!strcmp(rb.tool[0].owner, "alice") && !strcmp(rb.tool[0].guide, "drsmith"));
   CHECK(rb.tool[0].authority == 0.5 && rb.tool[0].coupling == 150 && rb.tool[0].version == 2 && (rb.changed & 1u));
   CHECK(b.sim_time == a.sim_time && b.steps == a.steps);
@@ -139,15 +140,17 @@ static void test_objects_tasks_tallies(void) {
     CHECK(b.tasks[k].t_start == a.tasks[k].t_start && (!a.tasks[k].completed || b.tasks[k].t_end == a.tasks[k].t_end));
   }
   CHECK(b.stones[1].held_by == -1); /* dropped where it was: the extractor re-enters */
-  CHECK(lb[0].grasps == la[0].grasps && lb[0].grasp_time == la[0].grasp_time && !lb[0].was_holding);
-  CHECK(tb[0].time_above[THR_MPF] == 0.125);
+  CHECK(tb[0].tally.grasps == ta[0].tally.grasps && tb[0].tally.grasp_time == ta[0].tally.grasp_time &&
+        !tb[0].tally.was_holding);
+  CHECK(tb[0].thr.time_above[THR_MPF] == 0.125);
   viscera_ToolMetrics ma, mb;
-  tool_metrics_fill(&ma, &a, 0, &ta[0], &la[0], 0);
-  tool_metrics_fill(&mb, &b, 0, &tb[0], &lb[0], 0);
+  tool_metrics_fill(&ma, &a, 0, &ta[0].thr, &ta[0].tally, 0);
+  tool_metrics_fill(&mb, &b, 0, &tb[0].thr, &tb[0].tally, 0);
   CHECK(mb.tasks_total == 2 && mb.tasks_completed == 1 && mb.operation_time == ma.operation_time);
   CHECK(mb.grasps == ma.grasps && mb.grasp_time == ma.grasp_time);
   printf("objects: s1 removed at z %.4f, s2 held at z %.4f restored dropped; out1 %.3f s; %u grasps, %.3f s held\n",
-         b.stones[0].pos[2], b.stones[1].pos[2], b.tasks[0].t_end - b.tasks[0].t_start, lb[0].grasps, lb[0].grasp_time);
+         b.stones[0].pos[2], b.stones[1].pos[2], b.tasks[0].t_end - b.tasks[0].t_start, tb[0].tally.grasps,
+         tb[0].tally.grasp_time);
 
   /* Crafted task and object states behind a valid CRC: refused, a fresh b
    * at rest and left so. */
@@ -182,7 +185,7 @@ static void test_objects_tasks_tallies(void) {
       memcpy(bytes + bad_fields[k].at, &bad_fields[k].v, 8);
       write_bad(bytes, body, 1);
       memcpy(bytes + bad_fields[k].at, &save, 8);
-      CHECK(checkpoint_load(bad, &b, tb, lb, &rb, &err) == -1); /* b stays at rest: no reload needed */
+      CHECK(checkpoint_load(bad, &b, tb, &rb, &err) == -1); /* b stays at rest: no reload needed */
       if (!strstr(err.msg, bad_fields[k].why)) fprintf(stderr, "  case %zu: %s\n", k, err.msg);
       CHECK(strstr(err.msg, bad_fields[k].why) != NULL);
       CHECK(b.steps == 0 && !b.tasks[0].started && !b.stones[0].removed);
@@ -227,11 +230,11 @@ static void test_cut_xpbd(void) {
   const model_t *ma = a.organs[0].model;
   CHECK(ma->topology_version > 0 && ma->nsurf > nv0);
   uint64_t t0 = vtime_mono_ns();
-  CHECK(checkpoint_save(path, &a, ta, la, NULL, &err) == 0);
+  CHECK(checkpoint_save(path, &a, ta, NULL, &err) == 0);
   double save_ms = (double)(vtime_mono_ns() - t0) * 1e-6;
   CHECK(load(&b, SPLEEN_XPBD));
   t0 = vtime_mono_ns();
-  int r = checkpoint_load(path, &b, tb, lb, NULL, &err);
+  int r = checkpoint_load(path, &b, tb, NULL, &err);
   double load_ms = (double)(vtime_mono_ns() - t0) * 1e-6;
   if (r != 1) fprintf(stderr, "  %s\n", err.msg);
   CHECK(r == 1);
@@ -247,7 +250,7 @@ static void test_cut_xpbd(void) {
   if (w) {
     for (int k = 0; k < 5; k++) {
       t0 = vtime_mono_ns();
-      checkpointer_submit(w, &a, ta, la, NULL);
+      checkpointer_submit(w, &a, ta, NULL);
       double us = (double)(vtime_mono_ns() - t0) * 1e-3;
       if (k == 0)
         first_us = us; /* buffers grow */
@@ -318,7 +321,7 @@ static void test_cut_xpbd(void) {
       }
       write_bad(bytes, cases[k].len, cases[k].reseal);
       if (cases[k].at != SIZE_MAX) memcpy(bytes + cases[k].at, &save, 8);
-      CHECK(checkpoint_load(bad, &b, tb, lb, NULL, &err) == -1);
+      CHECK(checkpoint_load(bad, &b, tb, NULL, &err) == -1);
       if (!strstr(err.msg, cases[k].why)) fprintf(stderr, "  case %zu: %s\n", k, err.msg);
       CHECK(strstr(err.msg, cases[k].why) != NULL && strstr(err.msg, "starting from rest") != NULL);
       const model_t *m = b.organs[0].model;
@@ -344,9 +347,9 @@ static void test_cut_ms(void) {
   drive(&a, 0, mid, above, 100, 0);
   const model_t *ma = a.organs[0].model;
   CHECK(ma->topology_version > 0 && ma->nsurf != nv0);
-  CHECK(checkpoint_save(path, &a, ta, la, NULL, &err) == 0);
+  CHECK(checkpoint_save(path, &a, ta, NULL, &err) == 0);
   CHECK(load(&b, BLOCK_MS));
-  int r = checkpoint_load(path, &b, tb, lb, NULL, &err);
+  int r = checkpoint_load(path, &b, tb, NULL, &err);
   if (r != 1) fprintf(stderr, "  %s\n", err.msg);
   CHECK(r == 1);
   const model_t *mb = b.organs[0].model;
@@ -382,7 +385,7 @@ static void test_cut_ms(void) {
     uint32_t big = (uint32_t)nn + 5;
     memcpy(bytes + tri_at + 4, &big, 4);
     write_bad(bytes, n - 8, 1);
-    CHECK(checkpoint_load(bad, &b, tb, lb, NULL, &err) == -1);
+    CHECK(checkpoint_load(bad, &b, tb, NULL, &err) == -1);
     CHECK(strstr(err.msg, "triangle") && strstr(err.msg, "starting from rest"));
     CHECK(b.steps == 0 && b.organs[0].model->topology_version == 0 && b.organs[0].model->nsurf == nv0);
   }
@@ -397,7 +400,7 @@ static void test_cut_ms(void) {
  * crafted refinement centre is refused. */
 static int load_adaptive(runtime_t *rt) {
   if (!test_runtime_load_scene(rt, &sc, "kidney_adaptive.yaml", &err)) return 0;
-  for (size_t t = 0; t < rt->ntools; t++) thr_init(rt == &a ? &ta[t] : &tb[t], 0, 0, 0);
+  for (size_t t = 0; t < rt->ntools; t++) thr_init(rt == &a ? &ta[t].thr : &tb[t].thr, 0, 0, 0);
   return 1;
 }
 
@@ -413,9 +416,9 @@ static void test_adaptive(void) {
   }
   const model_t *ma = a.organs[0].model;
   CHECK(ma->topology_version > 0 && ma->nsurf > nv0);
-  CHECK(checkpoint_save(path, &a, ta, la, NULL, &err) == 0);
+  CHECK(checkpoint_save(path, &a, ta, NULL, &err) == 0);
   CHECK(load_adaptive(&b));
-  int r = checkpoint_load(path, &b, tb, lb, NULL, &err);
+  int r = checkpoint_load(path, &b, tb, NULL, &err);
   if (r != 1) fprintf(stderr, "  %s\n", err.msg);
   CHECK(r == 1);
   const model_t *mb = b.organs[0].model;
@@ -443,7 +446,7 @@ static void test_adaptive(void) {
     write_bad(bytes, n - 8, 1);
     runtime_destroy(&b);
     CHECK(load_adaptive(&b));
-    CHECK(checkpoint_load(bad, &b, tb, lb, NULL, &err) == -1);
+    CHECK(checkpoint_load(bad, &b, tb, NULL, &err) == -1);
     CHECK(strstr(err.msg, "bad centre") != NULL);
     CHECK(b.organs[0].model->topology_version == 0 && b.organs[0].model->nsurf == nv0);
   }

@@ -87,9 +87,9 @@ static viscera_SessionControl start_cmd(uint64_t seq, const char *name, double i
 
 /* What the server does with a START_TASK (server.c start_task). */
 static int apply(session_control_t *ctl, const viscera_SessionControl *c, char *text, size_t n) {
-  thr_tracker_t thr[1];
+  session_tool_t tools[1];
   double maxf[1] = {4};
-  int r = session_control_apply(ctl, c, thr, 1, maxf, &rt.scene, text, n);
+  int r = session_control_apply(ctl, c, tools, 1, maxf, &rt.scene, text, n);
   if (r == SESSION_CONTROL_START_TASK) tasks_start(&rt.tasks[ctl->start_task], rt.sim_time);
   return r;
 }

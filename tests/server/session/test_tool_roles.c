@@ -270,19 +270,19 @@ static void test_session_control_answers(void) {
   tool_roles_init(&r, &scene);
   session_control_t sc;
   memset(&sc, 0, sizeof sc);
-  thr_tracker_t thr[2];
+  session_tool_t tools[2];
   double maxf[2] = {4, 4};
   char text[300];
   viscera_SessionControl c = control(viscera_CONTROL_ASSIGN_TOOL, 0, "alice", 0, 0);
   /* Without the server's table: refused, not crashed. */
-  CHECK(session_control_apply(&sc, &c, thr, 2, maxf, &scene, text, sizeof text) == -1);
+  CHECK(session_control_apply(&sc, &c, tools, 2, maxf, &scene, text, sizeof text) == -1);
   sc.roles = &r;
   c.seq = 2;
-  CHECK(session_control_apply(&sc, &c, thr, 2, maxf, &scene, text, sizeof text) == 0);
+  CHECK(session_control_apply(&sc, &c, tools, 2, maxf, &scene, text, sizeof text) == 0);
   CHECK(strstr(text, "assigned to station 'alice'") && strstr(text, "[station 1 seq 2]"));
   c = control(viscera_CONTROL_GUIDE, 0, "bob", 2, 0);
   c.seq = 3;
-  CHECK(session_control_apply(&sc, &c, thr, 2, maxf, &scene, text, sizeof text) == -1);
+  CHECK(session_control_apply(&sc, &c, tools, 2, maxf, &scene, text, sizeof text) == -1);
   CHECK(strstr(text, "SessionControl refused: authority 2") && strstr(text, "[station 1 seq 3]"));
   CHECK(sc.applied == 1 && sc.refused == 2);
 }
