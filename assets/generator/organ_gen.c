@@ -29,6 +29,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "cli.h"
 #include "mesh.h"
 #include "mesh_check.h"
 #include "vmath.h"
@@ -534,6 +535,7 @@ static int make_organ(const organ_t *o, const char *dir, mesh_report_t *r, verr_
 
 static void usage(FILE *f) {
   fprintf(f, "usage: viscera-organ-gen OUTDIR\n"
+             "       viscera-organ-gen --help | --version\n"
              "Writes tissue_block, spleen, kidney, gallbladder and liver_large (.obj, metres, z up)\n"
              "into OUTDIR (created if missing) and prints their sizes. The repository copies live\n"
              "in assets/meshes/; regenerate them with this tool rather than editing them.\n");
@@ -542,6 +544,10 @@ static void usage(FILE *f) {
 int main(int argc, char **argv) {
   if (argc == 2 && (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h"))) {
     usage(stdout);
+    return 0;
+  }
+  if (argc == 2 && !strcmp(argv[1], "--version")) {
+    printf("viscera-organ-gen %s\n", cli_version());
     return 0;
   }
   if (argc != 2 || argv[1][0] == '-') {

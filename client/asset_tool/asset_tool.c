@@ -8,6 +8,7 @@
 #include <string.h>
 #include <strings.h>
 
+#include "cli.h"
 #include "mesh.h"
 #include "mesh_check.h"
 #include "mesh_import.h"
@@ -19,7 +20,7 @@ static void usage(FILE *f) {
   fprintf(f, "usage: viscera-asset info [--strict] FILE...\n"
              "       viscera-asset convert IN OUT.obj [--scale S] [--center] [--strict]\n"
              "       viscera-asset tet FILE [--size S]\n"
-             "       viscera-asset --help\n"
+             "       viscera-asset --help | --version\n"
              "\n"
              "info     imports each FILE (any format assimp reads: OBJ, STL, PLY, glTF, ...),\n"
              "         welds it as the server would and prints its check report: size,\n"
@@ -258,6 +259,10 @@ int main(int argc, char **argv) {
     }
   if (!strcmp(cmd, "help")) {
     usage(stdout);
+    return EXIT_OK;
+  }
+  if (!strcmp(cmd, "--version")) {
+    printf("viscera-asset %s\n", cli_version());
     return EXIT_OK;
   }
   if (!strcmp(cmd, "info")) return cmd_info(argc - 2, argv + 2);
