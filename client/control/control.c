@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "station.h"
 #include "cli.h"
 #include "control_run.h"
 #include "dds/vdds.h"
@@ -101,7 +102,7 @@ static int parse_role(const char *verb, int argc, char **argv, int has_text, vis
   if (release) return 0; /* GUIDE with station "": guiding ends */
   const char *station = argv[2];
   int any = cmd->kind == viscera_CONTROL_ASSIGN_TOOL && strcmp(station, "*") == 0;
-  if (!any && !vdds_station_valid(station)) {
+  if (!any && !station_name_valid(station)) {
     fprintf(stderr, "viscera-control: %s: station '%s' is not 1..%d characters of A-Z a-z 0-9 _ . -%s\n", verb, station,
             VDDS_STATION_MAX - 1, cmd->kind == viscera_CONTROL_ASSIGN_TOOL ? " (or * for any station)" : "");
     return -1;

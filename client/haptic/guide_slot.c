@@ -4,6 +4,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "station.h"
 #include "vtime.h"
 
 _Static_assert(GUIDE_STATION_MAX == VDDS_STATION_MAX, "guide_force.h and vdds.h disagree on station length");
@@ -22,7 +23,7 @@ static int copy_station(char out[GUIDE_STATION_MAX], const char *in, size_t cap,
   size_t n = strnlen(in, cap);
   if (n == cap || n >= GUIDE_STATION_MAX) return -1; /* unterminated or too long */
   if (star_is_any && n == 1 && in[0] == '*') n = 0;
-  if (n > 0 && !vdds_station_valid(in)) return -1;
+  if (n > 0 && !station_name_valid(in)) return -1;
   memcpy(out, in, n);
   out[n] = 0;
   return 0;

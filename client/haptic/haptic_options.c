@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "station.h"
 #include "cli.h"
 #include "dds/vdds.h"
 #include "vrt.h"
@@ -129,7 +130,7 @@ static int on_option(void *ctx, int code, const char *arg) {
     o->tool = (unsigned)v;
     return 0;
   case OPT_STATION:
-    if (!vdds_station_valid(arg)) {
+    if (!station_name_valid(arg)) {
       fprintf(stderr, "viscera-haptic: --station '%s': 1..%d characters of A-Z a-z 0-9 _ . -\n", arg,
               VDDS_STATION_MAX - 1);
       return 2;

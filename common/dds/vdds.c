@@ -1,6 +1,5 @@
 #include "dds/vdds.h"
 
-#include "cli.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -129,13 +128,11 @@ dds_entity_t vdds_reader_listener(vdds_t *v, vdds_topic_id_t t, const dds_listen
   return r;
 }
 
-int vdds_station_valid(const char *name) { return station_name_valid(name); }
-
 #define STATION_TAG "station="
 
 dds_entity_t vdds_writer_station(vdds_t *v, vdds_topic_id_t t, const char *station, verr_t *err) {
   if (!station || !*station) return vdds_writer(v, t, err);
-  if (!vdds_station_valid(station)) {
+  if (!station_name_valid(station)) {
     verr_set(err, "station name '%.40s' is not 1..%d characters of A-Z a-z 0-9 _ . -", station, VDDS_STATION_MAX - 1);
     return DDS_RETCODE_BAD_PARAMETER;
   }
@@ -163,14 +160,9 @@ int vdds_station_of_writer(dds_entity_t reader, dds_instance_handle_t pub, char 
     size_t len = sz - strlen(STATION_TAG);
     memcpy(name, (const char *)ud + strlen(STATION_TAG), len);
     name[len] = 0;
-    if (strlen(name) == len && vdds_station_valid(name)) memcpy(out, name, len + 1);
+    if (strlen(name) == len && station_name_valid(name)) memcpy(out, name, len + 1);
   }
   dds_free(ud);
   dds_builtintopic_free_endpoint(ep);
   return 0;
 }
-
-/* One parser for every program: cli.h. */
-int vdds_parse_domain(const char *s) { return cli_parse_domain(s); }
-
-int vdds_env_domain(verr_t *err) { return cli_env_domain(err); }

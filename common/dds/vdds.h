@@ -72,10 +72,9 @@ dds_entity_t vdds_reader_listener(vdds_t *v, vdds_topic_id_t t, const dds_listen
 
 /* Stations (idl ToolRole): a ToolCommand writer names the station driving
  * it in its USER_DATA QoS as "station=NAME". NAME must be 1..VDDS_STATION_MAX-1
- * characters of [A-Za-z0-9_.-]; vdds_station_valid() says whether it is
- * (station_name_valid, station.h). */
+ * characters of [A-Za-z0-9_.-]; station_name_valid() (station.h) says
+ * whether it is. */
 #define VDDS_STATION_MAX STATION_NAME_MAX
-int vdds_station_valid(const char *name);
 /* A writer with the table's QoS plus USER_DATA "station=NAME" (NAME NULL or
  * "": no USER_DATA, the anonymous station). An invalid name is refused. */
 dds_entity_t vdds_writer_station(vdds_t *v, vdds_topic_id_t t, const char *station, verr_t *err);
@@ -86,11 +85,5 @@ dds_entity_t vdds_writer_station(vdds_t *v, vdds_topic_id_t t, const char *stati
  * (out = "") when the publication is not (or no longer) matched. Costs a
  * lookup in Cyclone's matched-endpoint table: callers cache it per handle. */
 int vdds_station_of_writer(dds_entity_t reader, dds_instance_handle_t pub, char out[VDDS_STATION_MAX]);
-
-/* Parses a domain id string (0..230); -1 on bad input. */
-int vdds_parse_domain(const char *s);
-/* The default domain of every binary: $VISCERA_DOMAIN if set and non-empty,
- * else 0; -1 with err when the variable is not a domain id. */
-int vdds_env_domain(verr_t *err);
 
 #endif

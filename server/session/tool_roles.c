@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "station.h"
 #include "dds/vdds.h"
 
 _Static_assert(TOOL_ROLE_STATION_MAX == VDDS_STATION_MAX, "one station name size");
@@ -140,7 +141,7 @@ static int refuse(char *text, size_t n, const char *fmt, const char *arg) {
 static int apply_assign(tool_roles_t *r, size_t t, const char *station, char *text, size_t n) {
   tool_role_t *tr = &r->tool[t];
   int any = !station[0] || !strcmp(station, "*");
-  if (!any && !vdds_station_valid(station))
+  if (!any && !station_name_valid(station))
     return refuse(text, n, "station name '%.40s' is not 1..31 characters of A-Z a-z 0-9 _ . - (or \"*\": any station)",
                   station);
   char was_guide[TOOL_ROLE_STATION_MAX], who[64];
@@ -174,7 +175,7 @@ static int apply_guide(tool_roles_t *r, size_t t, const viscera_SessionControl *
     return 0;
   }
   if (!strcmp(station, "*")) return refuse(text, n, "a guide is one named station, not '%s'", station);
-  if (!vdds_station_valid(station))
+  if (!station_name_valid(station))
     return refuse(text, n, "station name '%.40s' is not 1..31 characters of A-Z a-z 0-9 _ . -", station);
   if (tr->owner[0] && !strcmp(station, tr->owner))
     return refuse(text, n, "station '%s' owns the tool: it cannot also guide it", station);
@@ -211,9 +212,9 @@ int tool_roles_apply(tool_roles_t *r, const viscera_SessionControl *c, char *tex
 
 int tool_roles_valid(const tool_roles_t *r, size_t t, const char *owner, const char *guide, double a, double k) {
   if (t >= r->ntools) return -1;
-  if (owner[0] && !vdds_station_valid(owner)) return -1;
+  if (owner[0] && !station_name_valid(owner)) return -1;
   if (!guide[0]) return 0;
-  if (!vdds_station_valid(guide) || !strcmp(guide, owner)) return -1;
+  if (!station_name_valid(guide) || !strcmp(guide, owner)) return -1;
   if (!isfinite(a) || a < 0 || a > 1 || !isfinite(k) || !(k > 0) || k > r->tool[t].max_coupling) return -1;
   return 0;
 }

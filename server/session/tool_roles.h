@@ -24,13 +24,14 @@
  *   stiffness) and writes what it did, or why not, for the SessionEvent.
  *
  * Plain data: no DDS calls, no allocation; the server feeds it and tests
- * drive it directly. Station names are checked with vdds_station_valid(). */
+ * drive it directly. Station names are checked with station_name_valid(). */
 #ifndef VISCERA_TOOL_ROLES_H
 #define VISCERA_TOOL_ROLES_H
 
 #include <stddef.h>
 #include <stdint.h>
 
+#include "station.h"
 #include "runtime/tool_command.h"
 #include "scene.h"
 #include "viscera.h"

@@ -17,6 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cli.h"
 #include "dds/vdds.h"
 #include "physics/adaptive.h"
 #include "runtime/scene_runtime.h"
@@ -50,7 +51,7 @@ int main(int argc, char **argv) {
   int cycles = 20, domain = 84;
   for (int i = 2; i < argc; i++) {
     if (!strcmp(argv[i], "--quick")) cycles = 3;
-    if (!strcmp(argv[i], "--domain") && i + 1 < argc) domain = vdds_parse_domain(argv[++i]);
+    if (!strcmp(argv[i], "--domain") && i + 1 < argc) domain = cli_parse_domain(argv[++i]);
   }
   static scene_t sc;
   static runtime_t rt;

@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cli.h"
 #include "dds/vdds.h"
 #include "viscera.h"
 #include "vstats.h"
@@ -30,7 +31,7 @@ int main(int argc, char **argv) {
     else return 2;
   }
   verr_t err;
-  int domain = vdds_env_domain(&err);
+  int domain = cli_env_domain(&err);
   vdds_t dds;
   if (domain < 0 || vdds_open(&dds, domain, partition, &err)) {
     fprintf(stderr, "delta_sub: %s\n", err.msg);

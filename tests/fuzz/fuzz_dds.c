@@ -25,6 +25,7 @@
 #include <dds/dds.h>
 #include <dds/ddsi/ddsi_serdata.h>
 
+#include "cli.h"
 #include "dds/vdds.h"
 #include "replay_serdata.h"
 #include "viscera.h"
@@ -224,7 +225,7 @@ int main(int argc, char **argv) {
   long samples = 20000;
   double seconds = 5;
   verr_t err;
-  int domain = vdds_env_domain(&err), c;
+  int domain = cli_env_domain(&err), c;
   while ((c = getopt_long(argc, argv, "", opts, NULL)) != -1) {
     switch (c) {
     case 'c':
@@ -246,7 +247,7 @@ int main(int argc, char **argv) {
       partition = optarg;
       break;
     case 'd':
-      domain = vdds_parse_domain(optarg);
+      domain = cli_parse_domain(optarg);
       break;
     case 'h':
       usage(stdout);

@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cli.h"
 #include "dds/vdds.h"
 #include "viscera.h"
 #include "vtime.h"
@@ -82,7 +83,7 @@ int main(int argc, char **argv) {
   }
   vdds_t v;
   verr_t err;
-  if (vdds_open(&v, vdds_parse_domain(argv[1]), argv[2], &err)) {
+  if (vdds_open(&v, cli_parse_domain(argv[1]), argv[2], &err)) {
     fprintf(stderr, "bad_commands: %s\n", err.msg);
     return 1;
   }

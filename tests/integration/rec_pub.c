@@ -19,6 +19,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cli.h"
 #include "dds/vdds.h"
 #include "rec_values.h"
 #include "viscera.h"
@@ -78,7 +79,7 @@ int main(int argc, char **argv) {
   while ((c = getopt_long(argc, argv, "d:p:r:n:z:u", longopts, NULL)) != -1) {
     switch (c) {
     case 'd':
-      domain = vdds_parse_domain(optarg);
+      domain = cli_parse_domain(optarg);
       break;
     case 'p':
       partition = optarg;

@@ -19,6 +19,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cli.h"
 #include "dds/vdds.h"
 #include "viscera.h"
 #include "vtime.h"
@@ -74,7 +75,7 @@ int main(int argc, char **argv) {
     }
   }
   verr_t err;
-  int domain = vdds_env_domain(&err);
+  int domain = cli_env_domain(&err);
   vdds_t dds;
   if (domain < 0 || vdds_open(&dds, domain, partition, &err)) {
     fprintf(stderr, "roles_watch: %s\n", err.msg);
