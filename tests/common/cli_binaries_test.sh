@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# cli_binaries_test.sh VERSION BAD_STATUS BINARY NAME: one program answers the
+# options every viscera program shares (common/cli.c): --version prints
+# exactly "NAME VERSION" and exits 0; --help prints a usage text on stdout
+# and exits 0; an unknown option exits with the program's usage status
+# (BAD_STATUS) and writes nothing on stdout.
+set -uo pipefail
+VERSION="$1" BAD="$2" BIN="$3" NAME="$4"
+fail() { echo "FAIL: $NAME: $*"; exit 1; }
+out="$("$BIN" --version)"; rc=$?
+[ "$rc" = 0 ] || fail "--version exited $rc"
+[ "$out" = "$NAME $VERSION" ] || fail "--version printed '$out', expected '$NAME $VERSION'"
+out="$("$BIN" --help)"; rc=$?
+[ "$rc" = 0 ] || fail "--help exited $rc"
+echo "$out" | grep -qi 'usage' || fail "--help printed no usage text"
+out="$("$BIN" --no-such-option 2>/dev/null)"; rc=$?
+[ "$rc" = "$BAD" ] || fail "an unknown option exited $rc, expected $BAD"
+[ -z "$out" ] || fail "an unknown option wrote on stdout: $out"
+echo "ok: $NAME --version, --help, unknown option ($BAD)"
