@@ -449,12 +449,12 @@ static const char *const solver_keys[V_NKEYS] = {[V_SUBSTEPS] = "substeps",
 
 enum {
   O_NAME, O_MESH, O_MODEL, O_INTEGRATOR, O_SOLVER, O_POSITION, O_SCALE, O_COLOR, O_FIXED_BELOW, O_MATERIAL,
-  O_NKEYS
+  O_VOLUME, O_NKEYS
 };
 static const char *const organ_keys[O_NKEYS] = {
     [O_NAME] = "name",         [O_MESH] = "mesh",          [O_MODEL] = "model", [O_INTEGRATOR] = "integrator",
     [O_SOLVER] = "solver",     [O_POSITION] = "position",  [O_SCALE] = "scale", [O_COLOR] = "color",
-    [O_FIXED_BELOW] = "fixed_below", [O_MATERIAL] = "material"};
+    [O_FIXED_BELOW] = "fixed_below", [O_MATERIAL] = "material", [O_VOLUME] = "volume"};
 
 enum {
   T_NAME,
@@ -695,7 +695,7 @@ static int parse_organ(const ctx_t *c, const node_t *n, size_t idx, const char *
   o->line = n->line;
   if (get_fields(c, n, path, organ_keys, O_NKEYS, v)) return -1;
   if (!v[O_NAME]) return missing(c, n, path, "name");
-  if (!v[O_MESH]) return missing(c, n, path, "mesh");
+  if (!v[O_MESH] && !v[O_VOLUME]) return missing(c, n, path, "mesh");
   join(fp, sizeof fp, path, "name");
   if (get_name(c, v[O_NAME], fp, o->name, sizeof o->name)) return -1;
   for (size_t j = 0; j < idx; j++)
@@ -703,10 +703,20 @@ static int parse_organ(const ctx_t *c, const node_t *n, size_t idx, const char *
       return field_err(c, v[O_NAME], fp, "duplicate organ name '%s' (first used by organs[%zu] at line %d)", o->name, j,
                        s->organs[j].line);
   join(fp, sizeof fp, path, "mesh");
-  if (resolve_mesh(c, v[O_MESH], fp, base_dir, o->mesh, sizeof o->mesh)) return -1;
+  if (v[O_MESH] && resolve_mesh(c, v[O_MESH], fp, base_dir, o->mesh, sizeof o->mesh)) return -1;
   join(fp, sizeof fp, path, "model");
   if (v[O_MODEL] && get_choice(c, v[O_MODEL], fp, scene_models, COUNT(scene_models), o->model, sizeof o->model))
     return -1;
+  if (v[O_VOLUME]) {
+    join(fp, sizeof fp, path, "volume");
+    if (resolve_mesh(c, v[O_VOLUME], fp, base_dir, o->volume, sizeof o->volume)) return -1;
+    /* Only these models simulate tetrahedra; the others would ignore it. */
+    if (strcmp(o->model, "mass_spring_tet") && strcmp(o->model, "pbd") && strcmp(o->model, "xpbd"))
+      return field_err(c, v[O_VOLUME], fp,
+                       "a tetrahedral mesh is simulated only by the models mass_spring_tet, pbd and xpbd (this organ's "
+                       "model is %s: set `model:`)",
+                       o->model);
+  }
   join(fp, sizeof fp, path, "integrator");
   if (v[O_INTEGRATOR] && get_choice(c, v[O_INTEGRATOR], fp, scene_integrators, COUNT(scene_integrators), o->integrator,
                                     sizeof o->integrator))

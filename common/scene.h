@@ -58,7 +58,13 @@ typedef struct scene_solver {
 
 typedef struct scene_organ {
   char name[SCENE_NAME_LEN];
-  char mesh[SCENE_PATH_LEN]; /* resolved path */
+  char mesh[SCENE_PATH_LEN]; /* resolved path of the surface; "" when only `volume` is given */
+  /* Key `volume:`, optional, only for the tetrahedral models (mass_spring_tet,
+   * pbd, xpbd): a tetrahedral mesh made offline (gmsh .msh, VTK .vtk, TetGen
+   * .node/.ele; common/volume_mesh.h) used instead of the automatic fill.
+   * The surface is then `mesh` embedded in it, or its boundary when `mesh`
+   * is not given. Resolved path, "" when not given. */
+  char volume[SCENE_PATH_LEN];
   /* One of: mass_spring_surface, mass_spring_tet, molecular, pbd, xpbd,
    * vertex_based, adaptive_mass_spring. */
   char model[32];

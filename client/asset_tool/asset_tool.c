@@ -14,12 +14,14 @@
 #include "mesh_import.h"
 #include "tet_mesh.h"
 
-enum { EXIT_OK = 0, EXIT_ERROR = 1, EXIT_USAGE = 2, EXIT_PROBLEMS = 3 };
+#include "asset_volume.h"
+
 
 static void usage(FILE *f) {
   fprintf(f, "usage: viscera-asset info [--strict] FILE...\n"
              "       viscera-asset convert IN OUT.obj [--scale S] [--center] [--strict]\n"
-             "       viscera-asset tet FILE [--size S]\n"
+             "       viscera-asset tet FILE [--size S] [--out OUT [--format F]]\n"
+             "       viscera-asset volume FILE\n"
              "       viscera-asset --help | --version\n"
              "\n"
              "info     imports each FILE (any format assimp reads: OBJ, STL, PLY, glTF, ...),\n"
@@ -33,7 +35,12 @@ static void usage(FILE *f) {
              "         quality (radius ratio, 1 = regular), tetrahedra volume over the volume\n"
              "         the surface encloses, and surface vertices outside every tetrahedron\n"
              "         (embedded by their nearest one). Fails on a surface enclosing nothing\n"
-             "         (an open patch) and on more than 200,000 tetrahedra.\n"
+             "         (an open patch) and on more than 200,000 tetrahedra. With --out, writes\n"
+             "         the tetrahedra to OUT for other tools or a scene's `volume:` key.\n"
+             "volume   reads a tetrahedral mesh (gmsh .msh 2/4 ASCII, VTK legacy .vtk, TetGen\n"
+             "         .node/.ele) as the server does for an organ's `volume:` and prints what\n"
+             "         it holds and what was repaired (flipped tetrahedra, unused nodes), or\n"
+             "         the line it refuses.\n"
              "\n"
              "options:\n"
              "  --scale S   multiply every coordinate by S (> 0), e.g. 0.01 for a file in\n"
@@ -45,13 +52,16 @@ static void usage(FILE *f) {
              "  --size S    tet: edge of the grid cells in the file's units (> 0); default:\n"
              "              automatic, about 8 cells across the smallest extent and at least\n"
              "              1,000 tetrahedra\n"
+             "  --out OUT   tet: write the tetrahedra to OUT (.msh, .vtk or .node)\n"
+             "  --format F  tet: msh2, msh4, vtk or tetgen (default: from OUT's name; .msh\n"
+             "              is written as msh4)\n"
              "\n"
-             "exit status: 0 success, 1 a file could not be read or written or (tet) could not\n"
-             "be filled, 2 bad usage, 3 --strict and a problem was found.\n");
+             "exit status: 0 success, 1 a file could not be read or written, (tet) could not\n"
+             "be filled or (volume) was refused, 2 bad usage, 3 --strict and a problem was\n"
+             "found.\n");
 }
 
-static int bad_usage(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
-static int bad_usage(const char *fmt, ...) {
+int bad_usage(const char *fmt, ...) {
   va_list ap;
   va_start(ap, fmt);
   fprintf(stderr, "viscera-asset: ");
@@ -194,7 +204,7 @@ static int cmd_convert(int argc, char **argv) {
 }
 
 static int cmd_tet(int argc, char **argv) {
-  const char *in = NULL;
+  const char *in = NULL, *out = NULL, *format = NULL;
   double size = 0;
   for (int i = 0; i < argc; i++) {
     const char *a = argv[i];
@@ -205,6 +215,9 @@ static int cmd_tet(int argc, char **argv) {
       size = strtod(v, &end);
       if (end == v || *end || !isfinite(size) || size <= 0)
         return bad_usage("tet: --size must be a positive number, not '%s'", v);
+    } else if (!strcmp(a, "--out") || !strcmp(a, "--format")) {
+      if (i + 1 >= argc) return bad_usage("tet: %s needs a value", a);
+      *(a[2] == 'o' ? &out : &format) = argv[++i];
     } else if (a[0] == '-' && a[1]) {
       return bad_usage("tet: unknown option '%s'", a);
     } else if (!in) {
@@ -214,6 +227,9 @@ static int cmd_tet(int argc, char **argv) {
     }
   }
   if (!in) return bad_usage("tet: no FILE given");
+  if (format && !out) return bad_usage("tet: --format needs --out");
+  int fmt = -1;
+  if (out && (fmt = asset_volume_format(out, format)) < 0) return EXIT_USAGE;
 
   mesh_t m;
   verr_t err = {{0}};
@@ -241,9 +257,15 @@ static int cmd_tet(int argc, char **argv) {
          r.surface_volume != 0 ? r.volume / fabs(r.surface_volume) : NAN);
   printf("  outside         %zu of %zu surface vertices embedded by their nearest tetrahedron\n", r.outside_vertices,
          nverts);
+  if (out && volume_export(&t, (volume_format_t)fmt, out, &err)) {
+    fprintf(stderr, "viscera-asset: %s\n", err.msg);
+    rc = EXIT_ERROR;
+  } else if (out) {
+    printf("  written         %s\n", out);
+  }
   tet_mesh_free(&t);
   tet_embedding_free(&e);
-  return EXIT_OK;
+  return rc;
 }
 
 int main(int argc, char **argv) {
@@ -268,5 +290,6 @@ int main(int argc, char **argv) {
   if (!strcmp(cmd, "info")) return cmd_info(argc - 2, argv + 2);
   if (!strcmp(cmd, "convert")) return cmd_convert(argc - 2, argv + 2);
   if (!strcmp(cmd, "tet")) return cmd_tet(argc - 2, argv + 2);
+  if (!strcmp(cmd, "volume")) return asset_volume_info(argc - 2, argv + 2);
   return bad_usage("unknown command '%s'", cmd);
 }

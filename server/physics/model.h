@@ -21,6 +21,7 @@
 
 #include "mesh.h"
 #include "scene.h"
+#include "tet_mesh.h"
 #include "verr.h"
 
 typedef struct model model_t;
@@ -185,6 +186,10 @@ typedef struct model_params {
   double gravity[3];
   double dt; /* scene step */
   double tool_stiffness;
+  /* The organ's own tetrahedra (scene key `volume`), after scale and
+   * position; NULL: volumetric models fill the surface themselves. Only
+   * mass_spring_tet, pbd and xpbd read it; they copy what they keep. */
+  const tet_mesh_t *volume;
 } model_params_t;
 
 /* Dispatches on p->cfg->model; errors name the organ and what is wrong. */

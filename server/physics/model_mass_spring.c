@@ -49,6 +49,7 @@
 #include "physics/model.h"
 #include "physics/model_guard.h"
 #include "physics/model_mass_spring.h"
+#include "physics/model_volume.h"
 #include "state_blob.h"
 #include "tet_mesh.h"
 #include "vmath.h"
@@ -267,8 +268,7 @@ static model_t *ms_create(const model_params_t *p, int tet, verr_t *err) {
                     .gravity = {p->gravity[0], p->gravity[1], p->gravity[2]}};
   int rc;
   if (tet) {
-    tet_build_report_t rep;
-    rc = tet_mesh_build(s, cfg->solver.tet_size, &mm->tm, &mm->emb, &rep, err);
+    rc = model_volume_obtain(p, &mm->tm, &mm->emb, err);
     if (rc == 0) rc = mass_spring_create_tets(&mm->ms, &mm->tm, &mp, err);
     if (rc) {
       tet_mesh_free(&mm->tm);

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "physics/model_volume.h"
 #include "physics/pbd.h"
 #include "tet_mesh.h"
 
@@ -146,9 +147,7 @@ model_t *model_pbd_create(const model_params_t *p, verr_t *err) {
     return NULL;
   }
   verr_t sub;
-  tet_build_report_t rep;
-  if (tet_mesh_build(surf, cfg->solver.tet_size, &mp->tm, &mp->emb, &rep, &sub)) {
-    verr_set(err, "cannot build a tetrahedral mesh: %s", sub.msg);
+  if (model_volume_obtain(p, &mp->tm, &mp->emb, err)) {
     free(mp);
     return NULL;
   }

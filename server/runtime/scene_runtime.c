@@ -7,7 +7,7 @@
 #include <string.h>
 
 #include "interaction/shaft.h"
-#include "mesh_import.h"
+#include "runtime/organ_geometry.h"
 #include "runtime/step_cut.h"
 #include "runtime/step_tools.h"
 #include "vmath.h"
@@ -21,15 +21,16 @@ static int organ_init(organ_rt_t *o, runtime_t *rt, const scene_organ_t *cfg, ui
   o->id = id;
   o->rt = rt;
   verr_t e;
-  if (mesh_import(cfg->mesh, &o->rest, &e))
+  tet_mesh_t volume = {0};
+  if (organ_geometry_load(cfg, &o->rest, &volume, &e))
     return verr_set(err, "%s:%d: organ '%s': %s", sc->path, cfg->line, cfg->name, e.msg);
-  for (size_t i = 0; i < o->rest.nverts; i++)
-    for (int k = 0; k < 3; k++) o->rest.pos[3 * i + k] = o->rest.pos[3 * i + k] * cfg->scale + cfg->position[k];
   /* The proxy spring acts on the contact vertices like an extra home
    * spring, so explicit schemes include the stiffest tool in their bound. */
-  model_params_t mp = {.cfg = cfg, .surface = &o->rest, .dt = sc->dt, .tool_stiffness = tool_k};
+  model_params_t mp = {
+      .cfg = cfg, .surface = &o->rest, .dt = sc->dt, .tool_stiffness = tool_k, .volume = volume.ntets ? &volume : NULL};
   v3_copy(mp.gravity, sc->gravity);
   o->model = model_create(&mp, &e);
+  tet_mesh_free(&volume);
   if (!o->model) {
     mesh_free(&o->rest);
     return verr_set(err, "%s:%d: %s", sc->path, cfg->line, e.msg);
