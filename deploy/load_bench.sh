@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Classroom load benchmark (issue 7): SEATS servers (assets/scenes/
-# classroom_kidney.yaml, meshes at 60 Hz) with a scripted trainee each
-# pressing and releasing for the whole run, SUBSCRIBERS light viewers
+# classroom_kidney.yaml, meshes at 60 Hz, or --scene FILE) with a scripted
+# trainee each pressing and releasing for the whole run (--busy: pressing
+# and sweeping without ever letting go, so no organ ever rests or sleeps:
+# the worst case of a classroom), SUBSCRIBERS light viewers
 # (tests/bench/delta_sub: keyframe + every MeshDelta, latency measured) spread
 # over the seats, a third of them joining late (at a third of the run).
 # Samples every server's CPU time and resident memory every 10 s, and the CPU
@@ -34,11 +36,16 @@
 #
 # usage: deploy/load_bench.sh [--build DIR] [--out DIR] [--seats N] [--subscribers M] [--duration S]
 #                             [--baseline S] [--rt-priority S] [--haptic-rt-priority H]
+#                             [--scene FILE] [--busy]
+# (the press is at x 12 mm, y 4 mm from above, 8 mm deep into an organ whose
+# top is at z = 35 mm: the shipped kidney and gallbladder; classroom
+# scenes: classroom_kidney.yaml, classroom_gallbladder.yaml)
 # defaults: build/, out/load, 5 seats, 30 subscribers, 600 s (the issue's setting), baseline 30 s,
 #           servers SCHED_FIFO 70, trainees SCHED_FIFO 80
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD="$ROOT/build" OUT="$ROOT/out/load" SEATS=5 SUBS=30 DURATION=600 BASELINE=30 RTPRIO=70 HRTPRIO=80
+SCENE="$ROOT/assets/scenes/classroom_kidney.yaml" BUSY=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --build) BUILD="$2"; shift 2 ;;
@@ -49,7 +56,9 @@ while [ $# -gt 0 ]; do
     --baseline) BASELINE="$2"; shift 2 ;;
     --rt-priority) RTPRIO="$2"; shift 2 ;;
     --haptic-rt-priority) HRTPRIO="$2"; shift 2 ;;
-    -h|--help) sed -n 2,34p "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --scene) SCENE="$2"; shift 2 ;;
+    --busy) BUSY=1; shift ;;
+    -h|--help) sed -n 2,42p "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "load_bench.sh: unknown option '$1'" >&2; exit 2 ;;
   esac
 done
@@ -67,13 +76,24 @@ SRV_RT=() HAP_RT=()
 [ -x "$BUILD/tests/bench/delta_sub" ] || { echo "load_bench.sh: $BUILD/tests/bench/delta_sub missing (build with -DVISCERA_BUILD_BENCH=ON)" >&2; exit 1; }
 export CYCLONEDDS_URI="${CYCLONEDDS_URI:-file://$ROOT/deploy/cyclonedds-loopback.xml}"
 export VISCERA_DOMAIN="${VISCERA_DOMAIN:-8}"
+[ -r "$SCENE" ] || { echo "load_bench.sh: cannot read the scene '$SCENE'" >&2; exit 2; }
+SCENE_NAME=$(basename "$SCENE" .yaml)
 rm -rf "$OUT"; mkdir -p "$OUT"
-SCENE="$ROOT/assets/scenes/classroom_kidney.yaml"
-# Press 8 mm, hold, release, every 4 s, for the whole run.
+"$BUILD/server/viscera-server" --scene "$SCENE" --check > "$OUT/check.txt" ||
+  { echo "load_bench.sh: the scene does not load" >&2; exit 2; }
 TRAJ="$OUT/press_release.traj"
-{ t=0; echo "0 0.012 0.004 0.07"; while [ $t -lt $((DURATION + 4)) ]; do
-    echo "$t.5 0.012 0.004 0.07"; echo "$((t + 1)).5 0.012 0.004 0.027"; echo "$((t + 2)).5 0.012 0.004 0.027"
-    echo "$((t + 3)).9 0.012 0.004 0.07"; t=$((t + 4)); done; } > "$TRAJ"
+if [ "$BUSY" = 1 ]; then
+  # Down 8 mm in 0.5 s, then sweep 5 mm either side in x every 2 s without
+  # letting go, for the whole run: every step moves the tissue.
+  { echo "0 0.012 0.004 0.07"; echo "0.5 0.012 0.004 0.027"; t=1
+    while [ $t -lt $((DURATION + 4)) ]; do
+      echo "$t 0.017 0.004 0.027"; echo "$((t + 1)) 0.007 0.004 0.027"; t=$((t + 2)); done; } > "$TRAJ"
+else
+  # Press 8 mm, hold, release, every 4 s, for the whole run.
+  { t=0; echo "0 0.012 0.004 0.07"; while [ $t -lt $((DURATION + 4)) ]; do
+      echo "$t.5 0.012 0.004 0.07"; echo "$((t + 1)).5 0.012 0.004 0.027"; echo "$((t + 2)).5 0.012 0.004 0.027"
+      echo "$((t + 3)).9 0.012 0.004 0.07"; t=$((t + 4)); done; } > "$TRAJ"
+fi
 awake_line() { # server log -> "asleep in P % of steps; steps that stepped the organ: ..." (or nothing)
   sed -n 's/^server: organs slept .* every organ asleep in [0-9]* of [0-9]* steps (\([0-9.]*\) %); steps with an organ awake ([0-9]* recent): wall median \([0-9.]*\) us p99 \([0-9.]*\) us, CPU median \([0-9.]*\) us p99 \([0-9.]*\) us/asleep in \1 % of steps; steps that stepped the organ: wall median \2 us, p99 \3 us; CPU median \4 us, p99 \5 us/p' "$1"
 }
@@ -176,7 +196,7 @@ for _ in $(seq 1 15); do
 done
 pids=()
 {
-  echo "load_bench: $SEATS seats x classroom_kidney (2,000 vertices, 1 kHz physics, meshes at 60 Hz), $SUBS subscribers ($late late), $DURATION s"
+  echo "load_bench: $SEATS seats x $SCENE_NAME ($(sed -n 's/.*organ .\(.*\).: model \([a-z_]*\),.* \([0-9]*\) nodes.*/\1, \2, \3 nodes/p' "$OUT/check.txt" | head -1 | grep . || echo "see the scene"), 1 kHz physics), $([ "$BUSY" = 1 ] && echo "every seat pressed all the time" || echo "press and release every 4 s"), $SUBS subscribers ($late late), $DURATION s"
   sched() { # what PRIO LOG...: the policy asked and how many processes refused it
     local what=$1 prio=$2; shift 2
     if [ "$prio" = 0 ]; then echo "$what normal scheduling"; return; fi
