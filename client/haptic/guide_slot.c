@@ -9,13 +9,26 @@
 
 _Static_assert(GUIDE_STATION_MAX == VDDS_STATION_MAX, "guide_force.h and vdds.h disagree on station length");
 
+/* vdds_gate_check_fn: our tool's commands with a finite position only
+ * (reason 1: another tool, 2: not finite). */
+static int peer_command_check(const void *sample, void *arg) {
+  const viscera_ToolCommand *c = sample;
+  const guide_slot_t *s = arg;
+  if (c->tool_id != s->tool_id) return 1;
+  return isfinite(c->position[0]) && isfinite(c->position[1]) && isfinite(c->position[2]) ? 0 : 2;
+}
+
 int guide_slot_init(guide_slot_t *s, uint32_t tool_id) {
   memset(s, 0, sizeof *s);
   s->tool_id = tool_id;
+  vdds_gate_init(&s->gate, tool_id + 1, peer_command_check, s);
   return pthread_mutex_init(&s->lock, NULL) == 0 ? 0 : -1;
 }
 
-void guide_slot_destroy(guide_slot_t *s) { pthread_mutex_destroy(&s->lock); }
+void guide_slot_destroy(guide_slot_t *s) {
+  pthread_mutex_destroy(&s->lock);
+  vdds_gate_destroy(&s->gate);
+}
 
 /* A station name from the wire: "" (anonymous / any) or a valid station.
  * The owner may also arrive as "*" (the control verb's spelling of "any"). */
@@ -183,15 +196,16 @@ int guide_slot_attach(guide_slot_t *s, vdds_t *v, dds_entity_t own_writer, verr_
   /* Every writer of the tool shares one keyed instance: keep a few samples
    * so our own 1 kHz commands cannot push the peer's out of the history
    * before the listener takes them. */
-  dds_qos_t *q = dds_create_qos();
-  dds_entity_t r_cmd = r_role < 0 ? r_role : dds_get_qos(v->topics[VT_TOOL_COMMAND], q);
-  if (r_cmd >= 0) {
+  dds_qos_t *q = vdds_topic_qos(VT_TOOL_COMMAND);
+  dds_entity_t tp = r_role < 0 ? r_role : vdds_gated_topic(v, VT_TOOL_COMMAND, &s->gate, err), r_cmd = tp;
+  if (tp >= 0) {
     dds_qset_history(q, DDS_HISTORY_KEEP_LAST, GUIDE_TAKE);
     /* Our own 1 kHz commands are not delivered at all (no listener call
      * per tick for nothing); the handle check in on_command stays for a
      * DDS that delivers them anyway. */
     dds_qset_ignorelocal(q, DDS_IGNORELOCAL_PARTICIPANT);
-    r_cmd = dds_create_reader(v->subscriber, v->topics[VT_TOOL_COMMAND], q, l);
+    dds_qset_resource_limits(q, DDS_LENGTH_UNLIMITED, 1, DDS_LENGTH_UNLIMITED); /* our tool's instance only */
+    r_cmd = dds_create_reader(v->subscriber, tp, q, l);
     if (r_cmd < 0) verr_set(err, "DDS: cannot create the ToolCommand reader: %s", dds_strretcode(r_cmd));
   }
   dds_delete_qos(q);

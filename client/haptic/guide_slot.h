@@ -29,6 +29,7 @@
 
 #include "guide_force.h"
 #include "dds/vdds.h"
+#include "dds/vdds_gate.h"
 #include "viscera.h"
 
 #define GUIDE_SLOT_STATIONS 8
@@ -57,6 +58,10 @@ typedef struct guide_slot {
   /* Listener thread only (no lock needed): publication handle -> station. */
   guide_handle_station_t handles[GUIDE_SLOT_HANDLES];
   uint64_t handle_clock;
+  /* The peer ToolCommand reader's gate (dds/vdds_gate.h): only this tool's
+   * finite commands take an instance or a place in the history, so a flood
+   * of other tool ids or garbage neither grows memory nor evicts the peer. */
+  vdds_gate_t gate;
 } guide_slot_t;
 
 /* What the loop reads each tick. */

@@ -1,0 +1,5 @@
+# Network hardening (issue 15.1, 15.2, 14.2 tool streams): floods and
+# impostors against a seat. Domains 186-190.
+add_executable(flood_commands ${CMAKE_CURRENT_LIST_DIR}/flood_commands.c)
+target_link_libraries(flood_commands PRIVATE viscera_dds)
+viscera_integration_test(flood_commands 186 flood_commands_test.sh)
