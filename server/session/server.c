@@ -50,6 +50,7 @@ typedef struct server {
   uint64_t gate_seen[VDDS_GATE_REASONS], gate_seen_range, gate_seen_blocked;
   session_control_t control;
   uint64_t event_seq;
+  uint64_t feedback_seq;     /* ContactFeedback.seq of the last sample written */
   double *step_us;           /* ring of recent step times */
   double *step_cpu_us;       /* the same steps' thread CPU times */
   unsigned char *step_awake; /* the same steps: 1 when an organ was stepped (not all asleep, not paused) */
@@ -507,6 +508,7 @@ static void publish_feedback(server_t *s) {
     fb.cmd_seq = tool->cmd.seq;
     fb.cmd_client_mono_ns = tool->cmd.echo;
     fb.sim_time_ns = sim_ns(s);
+    fb.seq = ++s->feedback_seq;
     /* fb_*: the god-object, or what a grasp, a stone or another tool
      * makes the hand feel (runtime/step_tools.c). */
     fb.in_contact = tool->fb_contact != 0;
