@@ -199,6 +199,11 @@ static void on_object(scene_view_t *sv, const viscera_ObjectState *s) {
   o->removed = removed;
 }
 
+/* Samples kept per instance until the next poll: a writer that is not the
+ * server gets its first samples in before it is judged and blocked, and
+ * must not push the server's keyframe out meanwhile. */
+#define SERVER_DEPTH 8
+
 int scene_view_open(scene_view_t *sv, int domain, const char *partition, scene_view_log_fn log, void *log_ctx,
                     verr_t *err) {
   memset(sv, 0, sizeof *sv);
@@ -228,9 +233,9 @@ int scene_view_open(scene_view_t *sv, int domain, const char *partition, scene_v
              {&sv->rd_contact, VT_CONTACT_FEEDBACK, &sv->gate_contact, SCENE_VIEW_MAX_TOOLS},
              {&sv->rd_object, VT_OBJECT_STATE, &sv->gate_object, SCENE_VIEW_MAX_OBJECTS}};
   for (size_t i = 0; i < sizeof rds / sizeof rds[0]; i++) {
-    *rds[i].rd = rds[i].gate
-                     ? vdds_reader_gated(&sv->dds, rds[i].topic, rds[i].gate, 0, rds[i].max_instances, NULL, err)
-                     : vdds_reader(&sv->dds, rds[i].topic, err);
+    *rds[i].rd = rds[i].gate ? vdds_reader_gated(&sv->dds, rds[i].topic, rds[i].gate, SERVER_DEPTH,
+                                                 rds[i].max_instances, NULL, err)
+                             : vdds_reader(&sv->dds, rds[i].topic, err);
     if (*rds[i].rd < 0) {
       vdds_close(&sv->dds);
       return -1;

@@ -3,3 +3,6 @@
 add_executable(flood_commands ${CMAKE_CURRENT_LIST_DIR}/flood_commands.c)
 target_link_libraries(flood_commands PRIVATE viscera_dds)
 viscera_integration_test(flood_commands 186 flood_commands_test.sh)
+add_executable(impostor ${CMAKE_CURRENT_LIST_DIR}/impostor.c)
+target_link_libraries(impostor PRIVATE viscera_dds)
+viscera_integration_test(impostor 187 impostor_test.sh)
