@@ -54,8 +54,11 @@ static int run(char **argv) {
     fb.seq = UINT64_MAX - 1; /* "newest" forever, were it believed */
     fb.in_contact = 1;
     fb.organ_id = 0;
-    fb.proxy_position[2] = -0.5f; /* 0.5 m below: a 4 N pull down into the kidney */
-    fb.normal[2] = 1;
+    /* A plane 1 cm below the trainee's hand (held at z = 0.07 m) facing
+     * down: F = k d n = 400 N/m x 0.01 m, a 4 N pull down into the kidney. */
+    fb.proxy_position[1] = 0.004f;
+    fb.proxy_position[2] = 0.06f;
+    fb.normal[2] = -1;
     fb.stiffness = 400;
     fb.force[2] = -4;
     if (dds_write(w_fb, &fb) >= 0) n_fb++;
