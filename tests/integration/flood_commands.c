@@ -12,6 +12,15 @@
  *   5 MB at any time. Prints "FLOOD sent_new_ids=... sent_garbage=...
  *   sent_impostor=...".
  *
+ * reorder DOMAIN PARTITION PAIRS
+ *   Issue 14.2: one anonymous writer sends PAIRS pairs of ToolCommands for
+ *   tool 0 in free space, each pair newer first (seq 2, 1, 4, 3, ...),
+ *   2 ms apart, as a reordering link would deliver them. DDS delivers all
+ *   (they are in order on the wire); the server must apply the newer of
+ *   each pair and skip the older: its INTAKE line, checked by
+ *   `reorder-check SERVER_OUT PAIRS`, shows stale >= 90 % of PAIRS and
+ *   commands + stale = what arrived.
+ *
  * check SERVER_OUT HAPTIC_OUT FLOOD_OUT
  *   From the server's INTAKE line, the haptic client's SUMMARY line and the
  *   FLOOD line (the processes' own counters, never wall time): every kind
@@ -126,6 +135,55 @@ static int flood(int argc, char **argv) {
   return 0;
 }
 
+static int reorder(char **argv) {
+  vdds_t v;
+  verr_t err;
+  if (vdds_open(&v, cli_parse_domain(argv[2]), argv[3], &err)) {
+    fprintf(stderr, "flood_commands: %s\n", err.msg);
+    return 1;
+  }
+  dds_entity_t w = vdds_writer(&v, VT_TOOL_COMMAND, &err);
+  dds_entity_t r = vdds_reader(&v, VT_SCENE_INFO, &err);
+  for (int i = 0; i < 2000; i++) { /* the server is up */
+    void *s[1] = {0};
+    dds_sample_info_t si;
+    int n = dds_take(r, s, &si, 1, 1);
+    if (n > 0) dds_return_loan(r, s, n);
+    if (n > 0) break;
+    dds_sleepfor(DDS_MSECS(10));
+  }
+  dds_sleepfor(DDS_MSECS(300));
+  long pairs = atol(argv[4]);
+  viscera_ToolCommand c;
+  for (long i = 0; i < pairs; i++) {
+    command(&c, 0, (uint64_t)(2 * i + 2), 0.001f * (float)(i % 10));
+    dds_write(w, &c);
+    command(&c, 0, (uint64_t)(2 * i + 1), 0.001f * (float)(i % 10));
+    dds_write(w, &c);
+    dds_sleepfor(DDS_MSECS(2));
+  }
+  dds_sleepfor(DDS_MSECS(200));
+  vdds_close(&v);
+  return 0;
+}
+
+static int field(const char *path, const char *tag, const char *key, double *out);
+
+static int reorder_check(char **argv) {
+  double stale, commands, pairs = atof(argv[3]);
+  if (field(argv[2], "INTAKE", "stale", &stale) || field(argv[2], "INTAKE", "commands", &commands)) return 1;
+  printf("server: %.0f commands applied, %.0f older ones skipped, of %.0f reordered pairs\n", commands, stale, pairs);
+  if (stale < 0.9 * pairs || stale > pairs) {
+    fprintf(stderr, "FAIL: %.0f older commands skipped, expected one per pair (%.0f)\n", stale, pairs);
+    return 1;
+  }
+  if (commands < 0.9 * pairs || commands > pairs) {
+    fprintf(stderr, "FAIL: %.0f commands applied, expected the newer of each pair (%.0f)\n", commands, pairs);
+    return 1;
+  }
+  return 0;
+}
+
 /* The value of `key=` on the first line of `path` starting with `tag`. */
 static int field(const char *path, const char *tag, const char *key, double *out) {
   FILE *f = fopen(path, "r");
@@ -180,8 +238,12 @@ int main(int argc, char **argv) {
   int rc = 2;
   if (argc > 1 && strcmp(argv[1], "flood") == 0) rc = flood(argc, argv);
   if (argc > 1 && strcmp(argv[1], "check") == 0) rc = check(argc, argv);
+  if (argc == 5 && strcmp(argv[1], "reorder") == 0) rc = reorder(argv);
+  if (argc == 4 && strcmp(argv[1], "reorder-check") == 0) rc = reorder_check(argv);
   if (rc == 2)
     fprintf(stderr, "usage: flood_commands flood DOMAIN PARTITION SERVER_PID COUNT SECONDS\n"
-                    "       flood_commands check SERVER_OUT HAPTIC_OUT FLOOD_OUT\n");
+                    "       flood_commands check SERVER_OUT HAPTIC_OUT FLOOD_OUT\n"
+                    "       flood_commands reorder DOMAIN PARTITION PAIRS\n"
+                    "       flood_commands reorder-check SERVER_OUT PAIRS\n");
   return rc;
 }
