@@ -18,16 +18,23 @@ static int peer_command_check(const void *sample, void *arg) {
   return isfinite(c->position[0]) && isfinite(c->position[1]) && isfinite(c->position[2]) ? 0 : 2;
 }
 
+/* vdds_gate_check_fn: our tool's ToolRole only (reason 1). */
+static int own_role_check(const void *sample, void *arg) {
+  return ((const viscera_ToolRole *)sample)->tool_id == ((const guide_slot_t *)arg)->tool_id ? 0 : 1;
+}
+
 int guide_slot_init(guide_slot_t *s, uint32_t tool_id) {
   memset(s, 0, sizeof *s);
   s->tool_id = tool_id;
   vdds_gate_init(&s->gate, tool_id + 1, peer_command_check, s);
+  vdds_gate_init(&s->role_gate, tool_id + 1, own_role_check, s);
   return pthread_mutex_init(&s->lock, NULL) == 0 ? 0 : -1;
 }
 
 void guide_slot_destroy(guide_slot_t *s) {
   pthread_mutex_destroy(&s->lock);
   vdds_gate_destroy(&s->gate);
+  vdds_gate_destroy(&s->role_gate);
 }
 
 /* A station name from the wire: "" (anonymous / any) or a valid station.
@@ -173,6 +180,16 @@ static void on_role(dds_entity_t reader, void *arg) {
   int n = dds_take(reader, samples, infos, GUIDE_TAKE, GUIDE_TAKE);
   for (int i = 0; i < n; i++) {
     const viscera_ToolRole *r = samples[i];
+    seat_verdict_t v = s->server ? seat_server_from(s->server, reader, infos[i].publication_handle) : SEAT_FROM_SERVER;
+    if (v != SEAT_FROM_SERVER) { /* not the seat's server: counted, never coupled to */
+      if (v == SEAT_NOT_SERVER) vdds_gate_block(&s->role_gate, infos[i].publication_handle, VDDS_GATE_ANY_KEY);
+      if (infos[i].valid_data) {
+        pthread_mutex_lock(&s->lock);
+        s->roles_ignored++;
+        pthread_mutex_unlock(&s->lock);
+      }
+      continue;
+    }
     if (infos[i].valid_data) {
       guide_slot_role(s, r);
     } else if (r->tool_id == s->tool_id && infos[i].instance_state != DDS_IST_ALIVE) {
@@ -191,7 +208,7 @@ int guide_slot_attach(guide_slot_t *s, vdds_t *v, dds_entity_t own_writer, verr_
   }
   dds_listener_t *l = dds_create_listener(s);
   dds_lset_data_available(l, on_role);
-  dds_entity_t r_role = vdds_reader_listener(v, VT_TOOL_ROLE, l, err);
+  dds_entity_t r_role = vdds_reader_gated(v, VT_TOOL_ROLE, &s->role_gate, 0, 1, l, err);
   dds_lset_data_available(l, on_command);
   /* Every writer of the tool shares one keyed instance: keep a few samples
    * so our own 1 kHz commands cannot push the peer's out of the history

@@ -59,6 +59,7 @@ int haptic_dds_open(haptic_dds_t *h, const haptic_options_t *o, size_t latency_c
     seat_server_close(&h->server);
     return 1;
   }
+  h->guide.server = &h->server; /* ToolRole from the seat's server only */
   if (h->w_cmd < 0 || h->r_fb < 0 || h->r_scene < 0 || guide_slot_attach(&h->guide, &h->dds, h->w_cmd, &err)) {
     fprintf(stderr, "viscera-haptic: %s\n", err.msg);
     haptic_dds_close(h);

@@ -46,10 +46,11 @@ void haptic_summary_print(const haptic_options_t *o, haptic_stats_t *st, haptic_
   guide_report_summary(guide, 1.0 / o->rate, stderr);
   pthread_mutex_lock(&h->guide.lock);
   fprintf(stderr,
-          "haptic: guide: %" PRIu64 " ToolRole samples (%" PRIu64 " refused), %" PRIu64
-          " commands from other stations (%" PRIu64 " not finite), %" PRIu64 " of ours skipped\n",
-          h->guide.roles_received, h->guide.roles_rejected, h->guide.peer_samples, h->guide.bad_samples,
-          h->guide.own_samples_skipped);
+          "haptic: guide: %" PRIu64 " ToolRole samples (%" PRIu64 " refused, %" PRIu64
+          " not from the seat's server), %" PRIu64 " commands from other stations (%" PRIu64 " not finite), %" PRIu64
+          " of ours skipped\n",
+          h->guide.roles_received, h->guide.roles_rejected, h->guide.roles_ignored, h->guide.peer_samples,
+          h->guide.bad_samples, h->guide.own_samples_skipped);
   pthread_mutex_unlock(&h->guide.lock);
   printf("SUMMARY ticks=%" PRIu64 " rate_hz=%.1f peak_force=%.4f contact_ticks=%" PRIu64 " latency_us_median=%.1f "
          "latency_us_p99=%.1f period_us_p99=%.1f jitter_us_p99=%.1f late_ticks=%" PRIu64 " guide_coupled_s=%.2f\n",
