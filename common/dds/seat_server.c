@@ -17,7 +17,8 @@ int seat_server_open(seat_server_t *s, dds_entity_t participant, verr_t *err) {
 
 void seat_server_close(seat_server_t *s) { pthread_mutex_destroy(&s->lock); }
 
-/* 1 when the participant of endpoint ep announces role "server". */
+/* 1 when the participant of endpoint ep announces role "server", or
+ * "replay" (viscera-replay stands in for the recorded server in its domain). */
 static int claims_server(seat_server_t *s, const dds_builtintopic_endpoint_t *ep) {
   dds_builtintopic_participant_t key;
   memset(&key, 0, sizeof key);
@@ -35,7 +36,8 @@ static int claims_server(seat_server_t *s, const dds_builtintopic_endpoint_t *ep
     if (p->qos && dds_qget_userdata(p->qos, &ud, &sz) && ud) {
       char ident[VDDS_IDENT_MAX], role[VDDS_ROLE_MAX];
       vdds_ident_sanitize(ident, sizeof ident, ud, sz);
-      yes = vdds_ident_role(ident, role, sizeof role) == 0 && strcmp(role, "server") == 0;
+      yes = vdds_ident_role(ident, role, sizeof role) == 0 &&
+            (strcmp(role, "server") == 0 || strcmp(role, "replay") == 0);
     }
     dds_free(ud);
   }

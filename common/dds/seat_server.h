@@ -3,7 +3,8 @@
  * ObjectState, Metrics, SessionEvent, ToolMetrics...) from it alone.
  *
  * Identity: the participant of the SceneInfo writer, provided that
- * participant announces role "server" in its USER_DATA (vdds_ident.h).
+ * participant announces role "server" in its USER_DATA (vdds_ident.h), or
+ * "replay" (viscera-replay plays a recorded server's part in its domain).
  * The newest such SceneInfo writer wins, so a restarted server (a new
  * participant) is adopted as soon as its SceneInfo arrives. Without DDS
  * Security anyone can claim the role and write SceneInfo, so this keeps
