@@ -1,15 +1,16 @@
 /* flood_commands: a hostile participant against one seat (issue 15.1), and
  * the checker of what the seat's processes counted.
  *
- * flood DOMAIN PARTITION SERVER_PID COUNT SECONDS
+ * flood DOMAIN PARTITION PIDS COUNT SECONDS
  *   Writes COUNT samples paced evenly over SECONDS (stopping at 2 x
  *   SECONDS whatever was sent), round robin: well-formed
  *   ToolCommands each for a new tool id (8, 9, ...), garbage (NaN
  *   positions) for tool 0, and well-formed commands for tool 0 from a
  *   writer announcing station "mallory" (tool 0 belongs to another
- *   station). Samples the server's resident set (/proc/PID/status VmRSS)
- *   before, during and 1 s after, and fails when it grew by more than
- *   5 MB at any time. Prints "FLOOD sent_new_ids=... sent_garbage=...
+ *   station). Samples the resident set (/proc/PID/status VmRSS) of each
+ *   process of PIDS (comma-separated: the server, and clients that read
+ *   ToolCommand: a viewer, the trainee's haptic client) before, during and
+ *   1 s after, and fails when one grew by more than 5 MB at any time. Prints "FLOOD sent_new_ids=... sent_garbage=...
  *   sent_impostor=...".
  *
  * reorder DOMAIN PARTITION PAIRS
@@ -68,9 +69,16 @@ static void command(viscera_ToolCommand *c, uint32_t tool, uint64_t seq, float x
   c->max_force = 4;
 }
 
+#define MAX_PIDS 4
+
 static int flood(int argc, char **argv) {
   if (argc != 7) return 2;
-  long pid = atol(argv[4]);
+  long pid[MAX_PIDS];
+  int npid = 0;
+  for (char *p = argv[4]; *p && npid < MAX_PIDS; p++) {
+    pid[npid++] = strtol(p, &p, 10);
+    if (*p != ',') break;
+  }
   long count = atol(argv[5]);
   double seconds = atof(argv[6]);
   vdds_t v;
@@ -86,10 +94,13 @@ static int flood(int argc, char **argv) {
     return 1;
   }
   dds_sleepfor(DDS_MSECS(500)); /* discovery: the server's reader matches ours */
-  long rss0 = rss_kb(pid), rss_max = rss0;
-  if (rss0 <= 0) {
-    fprintf(stderr, "flood_commands: cannot read the resident set of pid %ld\n", pid);
-    return 1;
+  long rss0[MAX_PIDS], rss_max[MAX_PIDS];
+  for (int k = 0; k < npid; k++) {
+    rss0[k] = rss_max[k] = rss_kb(pid[k]);
+    if (rss0[k] <= 0) {
+      fprintf(stderr, "flood_commands: cannot read the resident set of pid %ld\n", pid[k]);
+      return 1;
+    }
   }
   uint64_t sent[3] = {0, 0, 0}, seq = 0;
   uint64_t t0 = vtime_mono_ns(), until = t0 + (uint64_t)(2 * seconds * 1e9);
@@ -112,27 +123,33 @@ static int flood(int argc, char **argv) {
       uint64_t due = t0 + (uint64_t)((double)(i + 1) / per_ns);
       if (due > vtime_mono_ns()) vtime_sleep_until(due);
     }
-    if (i % 5000 == 0) {
-      long kb = rss_kb(pid);
-      if (kb > rss_max) rss_max = kb;
+    if (i % 5000 == 0)
+      for (int k = 0; k < npid; k++) {
+        long kb = rss_kb(pid[k]);
+        if (kb > rss_max[k]) rss_max[k] = kb;
+      }
+  }
+  for (int t = 0; t < 10; t++) { /* memory given back, or never taken */
+    dds_sleepfor(DDS_MSECS(100));
+    for (int k = 0; k < npid; k++) {
+      long kb = rss_kb(pid[k]);
+      if (kb > rss_max[k]) rss_max[k] = kb;
     }
   }
-  for (int k = 0; k < 10; k++) { /* memory given back, or never taken */
-    dds_sleepfor(DDS_MSECS(100));
-    long kb = rss_kb(pid);
-    if (kb > rss_max) rss_max = kb;
+  printf("FLOOD sent_new_ids=%" PRIu64 " sent_garbage=%" PRIu64 " sent_impostor=%" PRIu64, sent[0], sent[1], sent[2]);
+  int bad = 0;
+  for (int k = 0; k < npid; k++) {
+    long rss1 = rss_kb(pid[k]);
+    printf(" rss%d_kb=%ld/%ld/%ld", k, rss0[k], rss_max[k], rss1);
+    if (rss_max[k] - rss0[k] > RSS_SLACK_KB || rss1 - rss0[k] > RSS_SLACK_KB) {
+      fprintf(stderr, "flood_commands: FAIL: the resident set of pid %ld grew from %ld kB to %ld kB (after: %ld kB)\n",
+              pid[k], rss0[k], rss_max[k], rss1);
+      bad = 1;
+    }
   }
-  long rss1 = rss_kb(pid);
-  printf("FLOOD sent_new_ids=%" PRIu64 " sent_garbage=%" PRIu64 " sent_impostor=%" PRIu64
-         " rss_before_kb=%ld rss_max_kb=%ld rss_after_kb=%ld\n",
-         sent[0], sent[1], sent[2], rss0, rss_max, rss1);
+  printf("\n");
   vdds_close(&v);
-  if (rss_max - rss0 > RSS_SLACK_KB || rss1 - rss0 > RSS_SLACK_KB) {
-    fprintf(stderr, "flood_commands: FAIL: the server's resident set grew from %ld kB to %ld kB (after: %ld kB)\n",
-            rss0, rss_max, rss1);
-    return 1;
-  }
-  return 0;
+  return bad;
 }
 
 static int reorder(char **argv) {
@@ -241,7 +258,7 @@ int main(int argc, char **argv) {
   if (argc == 5 && strcmp(argv[1], "reorder") == 0) rc = reorder(argv);
   if (argc == 4 && strcmp(argv[1], "reorder-check") == 0) rc = reorder_check(argv);
   if (rc == 2)
-    fprintf(stderr, "usage: flood_commands flood DOMAIN PARTITION SERVER_PID COUNT SECONDS\n"
+    fprintf(stderr, "usage: flood_commands flood DOMAIN PARTITION PID[,PID...] COUNT SECONDS\n"
                     "       flood_commands check SERVER_OUT HAPTIC_OUT FLOOD_OUT\n"
                     "       flood_commands reorder DOMAIN PARTITION PAIRS\n"
                     "       flood_commands reorder-check SERVER_OUT PAIRS\n");
