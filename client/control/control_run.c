@@ -4,7 +4,9 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "dds/seat_server.h"
 #include "dds/vdds.h"
+#include "dds/vdds_gate.h"
 #include "vtime.h"
 
 int control_run(const control_options_t *o) {
@@ -15,8 +17,20 @@ int control_run(const control_options_t *o) {
     return 2;
   }
   int rc = 2;
+  /* The answer is believed from the seat's server only (seat_server.h,
+   * issue 15.2); its events are source 0, the only key let in. */
+  seat_server_t server;
+  vdds_gate_t gate;
+  vdds_gate_init(&gate, 1, NULL, NULL);
+  uint64_t ignored = 0;
+  if (seat_server_open(&server, dds.participant, &err)) {
+    fprintf(stderr, "viscera-control: %s\n", err.msg);
+    vdds_close(&dds);
+    vdds_gate_destroy(&gate);
+    return 2;
+  }
   dds_entity_t w = vdds_writer(&dds, VT_SESSION_CONTROL, &err);
-  dds_entity_t r = vdds_reader(&dds, VT_SESSION_EVENT, &err);
+  dds_entity_t r = vdds_reader_gated(&dds, VT_SESSION_EVENT, &gate, 0, 1, NULL, &err);
   if (w < 0 || r < 0) {
     fprintf(stderr, "viscera-control: %s (is this identity allowed to send SessionControl in this partition?)\n",
             err.msg);
@@ -36,7 +50,7 @@ int control_run(const control_options_t *o) {
     dds_sample_info_t info;
     int n = dds_take(r_scene, samples, &info, 1, 1);
     if (n > 0) {
-      have_server = info.valid_data;
+      have_server = info.valid_data && seat_server_scene(&server, r_scene, &info, samples[0]);
       dds_return_loan(r_scene, samples, n);
     } else {
       dds_sleepfor(DDS_MSECS(20));
@@ -69,7 +83,14 @@ int control_run(const control_options_t *o) {
     int n = dds_take(r, samples, infos, 8, 8);
     for (int i = 0; i < n; i++) {
       const viscera_SessionEvent *e = samples[i];
-      if (!infos[i].valid_data || !strstr(e->text, mine)) continue;
+      if (!infos[i].valid_data) continue;
+      seat_verdict_t v = seat_server_from(&server, r, infos[i].publication_handle);
+      if (v != SEAT_FROM_SERVER) {
+        if (v == SEAT_NOT_SERVER) vdds_gate_block(&gate, infos[i].publication_handle, VDDS_GATE_ANY_KEY);
+        ignored++;
+        continue;
+      }
+      if (!strstr(e->text, mine)) continue;
       if (e->kind == viscera_EVENT_CONTROL_APPLIED && rc == 1) {
         printf("applied: %s\n", e->text);
         rc = 0;
@@ -84,7 +105,11 @@ int control_run(const control_options_t *o) {
   }
   if (rc == 1) fprintf(stderr, "viscera-control: no answer from the server within %.1f s\n", o->wait_s);
   if (rc == 3) rc = 1;
+  if (ignored)
+    fprintf(stderr, "viscera-control: %" PRIu64 " SessionEvent samples ignored: not from the seat's server\n", ignored);
 out:
   vdds_close(&dds);
+  seat_server_close(&server);
+  vdds_gate_destroy(&gate);
   return rc;
 }

@@ -10,9 +10,16 @@ int seat_open(seat_t *s, int domain, const char *partition, verr_t *err) {
   memset(s, 0, sizeof *s);
   snprintf(s->partition, sizeof s->partition, "%s", partition);
   if (scene_view_open(&s->sv, domain, partition, NULL, NULL, err)) return -1;
-  s->rd_event = vdds_reader(&s->sv.dds, VT_SESSION_EVENT, err);
-  if (s->rd_event >= 0) s->rd_role = vdds_reader(&s->sv.dds, VT_TOOL_ROLE, err);
-  if (s->rd_event >= 0 && s->rd_role >= 0) s->rd_measures = vdds_reader(&s->sv.dds, VT_TOOL_METRICS, err);
+  /* Keys bounded (issue 15.1): the server's events are source 0, tools
+   * below viscera_MAX_TOOLS. */
+  vdds_gate_init(&s->gate_event, 1, NULL, NULL);
+  vdds_gate_init(&s->gate_role, viscera_MAX_TOOLS, NULL, NULL);
+  vdds_gate_init(&s->gate_measures, viscera_MAX_TOOLS, NULL, NULL);
+  s->rd_event = vdds_reader_gated(&s->sv.dds, VT_SESSION_EVENT, &s->gate_event, 0, 1, NULL, err);
+  if (s->rd_event >= 0)
+    s->rd_role = vdds_reader_gated(&s->sv.dds, VT_TOOL_ROLE, &s->gate_role, 0, viscera_MAX_TOOLS, NULL, err);
+  if (s->rd_event >= 0 && s->rd_role >= 0)
+    s->rd_measures = vdds_reader_gated(&s->sv.dds, VT_TOOL_METRICS, &s->gate_measures, 0, viscera_MAX_TOOLS, NULL, err);
   if (s->rd_event < 0 || s->rd_role < 0 || s->rd_measures < 0) {
     scene_view_close(&s->sv);
     return -1;
@@ -20,7 +27,12 @@ int seat_open(seat_t *s, int domain, const char *partition, verr_t *err) {
   return 0;
 }
 
-void seat_close(seat_t *s) { scene_view_close(&s->sv); }
+void seat_close(seat_t *s) {
+  scene_view_close(&s->sv);
+  vdds_gate_destroy(&s->gate_event);
+  vdds_gate_destroy(&s->gate_role);
+  vdds_gate_destroy(&s->gate_measures);
+}
 
 static void keep_event(seat_t *s, const viscera_SessionEvent *e) {
   if (!seat_event_label((int)e->kind)) return;
@@ -66,15 +78,28 @@ static void on_measures(seat_t *s, const void *x, double now) {
   for (int i = 0; i < 3; i++) d->above[i] = v[i + 1];
 }
 
-/* Takes every sample of reader rd and hands each valid one to fn. */
-static void take_all(seat_t *s, dds_entity_t rd, void (*fn)(seat_t *, const void *, double), double now) {
+/* Takes every sample of reader rd and hands each valid one of the seat's
+ * server to fn (seat_server.h, learnt by the scene view); the rest are
+ * counted in the view's `ignored` and their writers blocked at gate g.
+ * Until the server is known the samples wait in the reader. */
+static void take_all(seat_t *s, dds_entity_t rd, vdds_gate_t *g, void (*fn)(seat_t *, const void *, double),
+                     double now) {
+  if (!s->sv.server.known) return;
   for (;;) {
     void *samples[16] = {0};
     dds_sample_info_t infos[16];
     int n = dds_take(rd, samples, infos, 16, 16);
     if (n <= 0) break;
-    for (int i = 0; i < n; i++)
-      if (infos[i].valid_data) fn(s, samples[i], now);
+    for (int i = 0; i < n; i++) {
+      if (!infos[i].valid_data) continue;
+      seat_verdict_t v = seat_server_from(&s->sv.server, rd, infos[i].publication_handle);
+      if (v == SEAT_FROM_SERVER) {
+        fn(s, samples[i], now);
+        continue;
+      }
+      if (v == SEAT_NOT_SERVER) vdds_gate_block(g, infos[i].publication_handle, VDDS_GATE_ANY_KEY);
+      s->sv.ignored++;
+    }
     dds_return_loan(rd, samples, n);
   }
 }
@@ -108,9 +133,9 @@ static void on_event(seat_t *s, const void *x, double now) {
 
 int seat_poll(seat_t *s, double now, verr_t *err) {
   if (scene_view_poll(&s->sv, err) < 0) return -1;
-  take_all(s, s->rd_event, on_event, now);
-  take_all(s, s->rd_role, on_role, now);
-  take_all(s, s->rd_measures, on_measures, now);
+  take_all(s, s->rd_event, &s->gate_event, on_event, now);
+  take_all(s, s->rd_role, &s->gate_role, on_role, now);
+  take_all(s, s->rd_measures, &s->gate_measures, on_measures, now);
   if (now > s->alert_until) s->alert = SEAT_OK;
   /* A trainee still pressing above a threshold stays alerted after the
    * crossing's hold runs out. */

@@ -15,6 +15,7 @@
 #include <stdint.h>
 
 #include "view/camera.h"
+#include "dds/vdds_gate.h"
 #include "view/scene_view.h"
 #include "seat_text.h"
 
@@ -47,7 +48,8 @@ typedef struct seat_tool_measures {
 typedef struct seat {
   char partition[128];
   scene_view_t sv;
-  dds_entity_t rd_event, rd_role, rd_measures;
+  dds_entity_t rd_event, rd_role, rd_measures;      /* believed from the seat's server only (sv.server) */
+  vdds_gate_t gate_event, gate_role, gate_measures; /* bounded: source 0, the tools */
   int have_camera;
   camera_t cam;
   float history[SEAT_HISTORY]; /* N, newest at (nhist - 1) % SEAT_HISTORY */

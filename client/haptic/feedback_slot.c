@@ -8,9 +8,15 @@
 #include "vmath.h"
 #include "vtime.h"
 
+/* vdds_gate_check_fn: this tool's samples only (reason 1). */
+static int own_tool_check(const void *sample, void *arg) {
+  return ((const viscera_ContactFeedback *)sample)->tool_id == ((const feedback_slot_t *)arg)->tool_id ? 0 : 1;
+}
+
 int feedback_slot_init(feedback_slot_t *s, uint32_t tool_id, size_t latency_capacity) {
   memset(s, 0, sizeof *s);
   s->tool_id = tool_id;
+  vdds_gate_init(&s->gate, tool_id + 1, own_tool_check, s);
   s->cap = latency_capacity;
   s->latency_us = malloc((latency_capacity + 1) * sizeof(double));
   if (!s->latency_us) return -1;
@@ -21,6 +27,7 @@ int feedback_slot_init(feedback_slot_t *s, uint32_t tool_id, size_t latency_capa
 
 void feedback_slot_destroy(feedback_slot_t *s) {
   pthread_mutex_destroy(&s->lock);
+  vdds_gate_destroy(&s->gate);
   free(s->latency_us);
   s->latency_us = NULL;
 }
@@ -29,20 +36,55 @@ void feedback_slot_sent(feedback_slot_t *s, uint64_t seq, uint64_t client_mono_n
   atomic_store_explicit(&s->sent_mono_ns[seq % FEEDBACK_SENT_RING], client_mono_ns, memory_order_relaxed);
 }
 
+void feedback_slot_set_limits(feedback_slot_t *s, float max_stiffness, float max_force) {
+  pthread_mutex_lock(&s->lock);
+  s->max_stiffness = max_stiffness > 0 && isfinite(max_stiffness) ? max_stiffness : 0;
+  s->max_force = max_force > 0 && isfinite(max_force) ? max_force : 0;
+  pthread_mutex_unlock(&s->lock);
+}
+
+/* Within what the scene gives the tool (a float rounding's margin): a
+ * stiffer plane or a larger force than the server can mean is a forgery. */
+static int within_limits(const feedback_slot_t *s, const viscera_ContactFeedback *fb) {
+  if (s->max_stiffness > 0 && fb->stiffness > s->max_stiffness * 1.001f) return 0;
+  double f2 = 0;
+  for (int k = 0; k < 3; k++) f2 += (double)fb->force[k] * fb->force[k];
+  return !(s->max_force > 0 && sqrt(f2) > s->max_force * 1.001);
+}
+
 int feedback_slot_accept(feedback_slot_t *s, const viscera_ContactFeedback *fb, uint64_t now) {
+  return feedback_slot_accept_from(s, fb, 0, now);
+}
+
+int feedback_slot_accept_from(feedback_slot_t *s, const viscera_ContactFeedback *fb, dds_instance_handle_t writer,
+                              uint64_t now) {
   if (fb->tool_id != s->tool_id) return 0;
   /* Untrusted: never render a plane built from NaN or a negative stiffness. */
   int ok = isfinite(fb->stiffness) && fb->stiffness >= 0;
-  for (int k = 0; k < 3; k++) ok = ok && isfinite(fb->proxy_position[k]) && isfinite(fb->normal[k]);
+  for (int k = 0; k < 3; k++)
+    ok = ok && isfinite(fb->proxy_position[k]) && isfinite(fb->normal[k]) && isfinite(fb->force[k]);
   /* Our own command's echo (seq and send time as we sent them), or another
    * station's sharing the tool: only ours is a round trip of ours. */
   int ours = fb->cmd_client_mono_ns > 0 && atomic_load_explicit(&s->sent_mono_ns[fb->cmd_seq % FEEDBACK_SENT_RING],
                                                                 memory_order_relaxed) == fb->cmd_client_mono_ns;
   pthread_mutex_lock(&s->lock);
+  if (ok && !within_limits(s, fb)) {
+    s->out_of_limits++;
+    ok = 0;
+  }
   if (!ok) {
     s->rejected++;
     pthread_mutex_unlock(&s->lock);
     return -1;
+  }
+  if (writer) { /* newest wins per writer: best effort may deliver out of order */
+    if (writer == s->last_writer && fb->seq <= s->last_seq) {
+      s->stale++;
+      pthread_mutex_unlock(&s->lock);
+      return -2;
+    }
+    s->last_writer = writer;
+    s->last_seq = fb->seq;
   }
   s->model.in_contact = fb->in_contact;
   s->model.stiffness = fb->stiffness;
@@ -62,21 +104,39 @@ int feedback_slot_accept(feedback_slot_t *s, const viscera_ContactFeedback *fb, 
   return 1;
 }
 
+/* The seat's server's samples only (seat_server.h); a writer that can
+ * never be the server is blocked at the gate. */
+static int from_server(feedback_slot_t *s, dds_entity_t reader, dds_instance_handle_t pub) {
+  if (!s->server) return 1;
+  seat_verdict_t v = seat_server_from(s->server, reader, pub);
+  if (v == SEAT_FROM_SERVER) return 1;
+  if (v == SEAT_NOT_SERVER) vdds_gate_block(&s->gate, pub, VDDS_GATE_ANY_KEY);
+  pthread_mutex_lock(&s->lock);
+  s->ignored++;
+  pthread_mutex_unlock(&s->lock);
+  return 0;
+}
+
 static void on_data(dds_entity_t reader, void *arg) {
   feedback_slot_t *s = arg;
   void *samples[8] = {0};
   dds_sample_info_t infos[8];
   int n = dds_take(reader, samples, infos, 8, 8);
   uint64_t now = vtime_mono_ns();
+  seat_limits_t lim;
+  if (n > 0 && s->server && seat_server_limits(s->server, &lim) && s->tool_id < lim.ntools)
+    feedback_slot_set_limits(s, lim.tool_stiffness[s->tool_id], lim.tool_max_force[s->tool_id]);
   for (int i = 0; i < n; i++)
-    if (infos[i].valid_data) feedback_slot_accept(s, samples[i], now);
+    if (infos[i].valid_data && from_server(s, reader, infos[i].publication_handle))
+      feedback_slot_accept_from(s, samples[i], infos[i].publication_handle, now);
   if (n > 0) dds_return_loan(reader, samples, n);
 }
 
 void feedback_slot_liveliness(feedback_slot_t *s, const dds_liveliness_changed_status_t *st, uint64_t now) {
   pthread_mutex_lock(&s->lock);
-  s->writers_alive = st->alive_count;
-  if (st->alive_count == 0 && st->alive_count_change < 0 && !s->server_lost) {
+  int32_t alive = (int32_t)st->alive_count - s->nonserver_alive;
+  s->writers_alive = alive > 0 ? (uint32_t)alive : 0;
+  if (s->writers_alive == 0 && st->alive_count_change < 0 && !s->server_lost) {
     /* The server is gone: stop rendering its wall now rather than after the
      * feedback timeout. */
     s->model.in_contact = 0;
@@ -84,7 +144,7 @@ void feedback_slot_liveliness(feedback_slot_t *s, const dds_liveliness_changed_s
     s->lost_mono_ns = now;
     s->lost_last_arrival = s->arrival_mono_ns;
     s->lost_events++;
-  } else if (st->alive_count > 0 && s->server_lost) {
+  } else if (s->writers_alive > 0 && s->server_lost) {
     s->server_lost = 0;
     s->regained_events++;
   }
@@ -92,8 +152,17 @@ void feedback_slot_liveliness(feedback_slot_t *s, const dds_liveliness_changed_s
 }
 
 static void on_liveliness(dds_entity_t reader, const dds_liveliness_changed_status_t status, void *arg) {
-  (void)reader;
-  feedback_slot_liveliness(arg, &status, vtime_mono_ns());
+  feedback_slot_t *s = arg;
+  /* A writer that is not the server (an impostor's) neither keeps the
+   * server alive nor loses it: its changes are set apart. */
+  if (s->server && status.last_publication_handle &&
+      seat_server_from(s->server, reader, status.last_publication_handle) == SEAT_NOT_SERVER) {
+    pthread_mutex_lock(&s->lock);
+    s->nonserver_alive += status.alive_count_change;
+    pthread_mutex_unlock(&s->lock);
+    return;
+  }
+  feedback_slot_liveliness(s, &status, vtime_mono_ns());
 }
 
 int feedback_slot_server_lost(feedback_slot_t *s, uint64_t *lost_ns, uint64_t *last_arrival) {
@@ -109,7 +178,9 @@ dds_entity_t feedback_slot_attach(feedback_slot_t *s, vdds_t *v, verr_t *err) {
   dds_listener_t *l = dds_create_listener(s);
   dds_lset_data_available(l, on_data);
   dds_lset_liveliness_changed(l, on_liveliness);
-  dds_entity_t r = vdds_reader_listener(v, VT_CONTACT_FEEDBACK, l, err);
+  /* Gated (dds/vdds_gate.h): one instance, this tool's, and no writer once
+   * judged never to be the server. */
+  dds_entity_t r = vdds_reader_gated(v, VT_CONTACT_FEEDBACK, &s->gate, 0, 1, l, err);
   dds_delete_listener(l);
   return r;
 }

@@ -16,7 +16,16 @@
  * server's ContactFeedback writer lose its liveliness (lease
  * VDDS_FEEDBACK_LEASE_MS, vdds.h) when the server process dies, and clears
  * the slot's contact at once, so the loop renders zero force from its next
- * tick on; the loop asks feedback_slot_server_lost to report it. */
+ * tick on; the loop asks feedback_slot_server_lost to report it.
+ *
+ * Whose feedback (issue 15.2): with a seat_server attached, only the seat's
+ * server's samples are used; the rest are counted (`ignored`) and their
+ * writers blocked at the reader's gate (dds/vdds_gate.h: only this tool's
+ * instance exists at all), and their liveliness does not count as the
+ * server's. A sample whose stiffness or force exceeds what the adopted
+ * scene gives the tool is refused (`out_of_limits`). Order (issue 14.2):
+ * a sample whose seq is not above the last one taken from the same writer
+ * is never used after it (`stale`). */
 #ifndef VISCERA_FEEDBACK_SLOT_H
 #define VISCERA_FEEDBACK_SLOT_H
 
@@ -27,7 +36,9 @@
 #include <stdint.h>
 
 #include "contact_model.h"
+#include "dds/seat_server.h"
 #include "dds/vdds.h"
+#include "dds/vdds_gate.h"
 #include "viscera.h"
 
 #define FEEDBACK_SENT_RING 1024
@@ -52,6 +63,14 @@ typedef struct feedback_slot {
   uint64_t lost_mono_ns;      /* when the listener heard of it */
   uint64_t lost_last_arrival; /* arrival of the last feedback before that */
   uint64_t lost_events, regained_events;
+  /* Whose feedback and which values (issue 15.2), and its order (14.2). */
+  seat_server_t *server; /* NULL: every writer is believed (unit tests) */
+  vdds_gate_t gate;
+  float max_stiffness, max_force; /* the scene's for this tool; 0 = not known */
+  uint64_t ignored, out_of_limits, stale;
+  int32_t nonserver_alive;           /* alive feedback writers that are not the server */
+  dds_instance_handle_t last_writer; /* the writer of the last sample taken, and its seq */
+  uint64_t last_seq;
 } feedback_slot_t;
 
 int feedback_slot_init(feedback_slot_t *s, uint32_t tool_id, size_t latency_capacity);
@@ -62,8 +81,16 @@ dds_entity_t feedback_slot_attach(feedback_slot_t *s, vdds_t *v, verr_t *err);
 /* The loop sent command `seq` at client_mono_ns (lock-free). */
 void feedback_slot_sent(feedback_slot_t *s, uint64_t seq, uint64_t client_mono_ns);
 /* Applies one ContactFeedback arriving at now (the listener calls this;
- * tests may too): -1 refused (not finite), 0 another tool's, 1 taken. */
+ * tests may too): -1 refused (not finite, or beyond the limits), 0 another
+ * tool's, 1 taken. */
 int feedback_slot_accept(feedback_slot_t *s, const viscera_ContactFeedback *fb, uint64_t now);
+/* The same for a sample of `writer` (its publication handle): -2 when its
+ * seq is not above the last one taken from that writer (never used after
+ * a newer one). */
+int feedback_slot_accept_from(feedback_slot_t *s, const viscera_ContactFeedback *fb, dds_instance_handle_t writer,
+                              uint64_t now);
+/* The scene's stiffness and force maxima for this tool (0: unknown). */
+void feedback_slot_set_limits(feedback_slot_t *s, float max_stiffness, float max_force);
 /* Copies the newest value; returns its arrival time (0: none yet). */
 uint64_t feedback_slot_read(feedback_slot_t *s, contact_model_t *out);
 /* 1 while the server is lost by liveliness (its feedback writer's lease

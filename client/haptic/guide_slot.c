@@ -9,13 +9,33 @@
 
 _Static_assert(GUIDE_STATION_MAX == VDDS_STATION_MAX, "guide_force.h and vdds.h disagree on station length");
 
+/* vdds_gate_check_fn: our tool's commands with a finite position only
+ * (reason 1: another tool, 2: not finite). */
+static int peer_command_check(const void *sample, void *arg) {
+  const viscera_ToolCommand *c = sample;
+  const guide_slot_t *s = arg;
+  if (c->tool_id != s->tool_id) return 1;
+  return isfinite(c->position[0]) && isfinite(c->position[1]) && isfinite(c->position[2]) ? 0 : 2;
+}
+
+/* vdds_gate_check_fn: our tool's ToolRole only (reason 1). */
+static int own_role_check(const void *sample, void *arg) {
+  return ((const viscera_ToolRole *)sample)->tool_id == ((const guide_slot_t *)arg)->tool_id ? 0 : 1;
+}
+
 int guide_slot_init(guide_slot_t *s, uint32_t tool_id) {
   memset(s, 0, sizeof *s);
   s->tool_id = tool_id;
+  vdds_gate_init(&s->gate, tool_id + 1, peer_command_check, s);
+  vdds_gate_init(&s->role_gate, tool_id + 1, own_role_check, s);
   return pthread_mutex_init(&s->lock, NULL) == 0 ? 0 : -1;
 }
 
-void guide_slot_destroy(guide_slot_t *s) { pthread_mutex_destroy(&s->lock); }
+void guide_slot_destroy(guide_slot_t *s) {
+  pthread_mutex_destroy(&s->lock);
+  vdds_gate_destroy(&s->gate);
+  vdds_gate_destroy(&s->role_gate);
+}
 
 /* A station name from the wire: "" (anonymous / any) or a valid station.
  * The owner may also arrive as "*" (the control verb's spelling of "any"). */
@@ -160,6 +180,16 @@ static void on_role(dds_entity_t reader, void *arg) {
   int n = dds_take(reader, samples, infos, GUIDE_TAKE, GUIDE_TAKE);
   for (int i = 0; i < n; i++) {
     const viscera_ToolRole *r = samples[i];
+    seat_verdict_t v = s->server ? seat_server_from(s->server, reader, infos[i].publication_handle) : SEAT_FROM_SERVER;
+    if (v != SEAT_FROM_SERVER) { /* not the seat's server: counted, never coupled to */
+      if (v == SEAT_NOT_SERVER) vdds_gate_block(&s->role_gate, infos[i].publication_handle, VDDS_GATE_ANY_KEY);
+      if (infos[i].valid_data) {
+        pthread_mutex_lock(&s->lock);
+        s->roles_ignored++;
+        pthread_mutex_unlock(&s->lock);
+      }
+      continue;
+    }
     if (infos[i].valid_data) {
       guide_slot_role(s, r);
     } else if (r->tool_id == s->tool_id && infos[i].instance_state != DDS_IST_ALIVE) {
@@ -178,20 +208,21 @@ int guide_slot_attach(guide_slot_t *s, vdds_t *v, dds_entity_t own_writer, verr_
   }
   dds_listener_t *l = dds_create_listener(s);
   dds_lset_data_available(l, on_role);
-  dds_entity_t r_role = vdds_reader_listener(v, VT_TOOL_ROLE, l, err);
+  dds_entity_t r_role = vdds_reader_gated(v, VT_TOOL_ROLE, &s->role_gate, 0, 1, l, err);
   dds_lset_data_available(l, on_command);
   /* Every writer of the tool shares one keyed instance: keep a few samples
    * so our own 1 kHz commands cannot push the peer's out of the history
    * before the listener takes them. */
-  dds_qos_t *q = dds_create_qos();
-  dds_entity_t r_cmd = r_role < 0 ? r_role : dds_get_qos(v->topics[VT_TOOL_COMMAND], q);
-  if (r_cmd >= 0) {
+  dds_qos_t *q = vdds_topic_qos(VT_TOOL_COMMAND);
+  dds_entity_t tp = r_role < 0 ? r_role : vdds_gated_topic(v, VT_TOOL_COMMAND, &s->gate, err), r_cmd = tp;
+  if (tp >= 0) {
     dds_qset_history(q, DDS_HISTORY_KEEP_LAST, GUIDE_TAKE);
     /* Our own 1 kHz commands are not delivered at all (no listener call
      * per tick for nothing); the handle check in on_command stays for a
      * DDS that delivers them anyway. */
     dds_qset_ignorelocal(q, DDS_IGNORELOCAL_PARTICIPANT);
-    r_cmd = dds_create_reader(v->subscriber, v->topics[VT_TOOL_COMMAND], q, l);
+    dds_qset_resource_limits(q, DDS_LENGTH_UNLIMITED, 1, DDS_LENGTH_UNLIMITED); /* our tool's instance only */
+    r_cmd = dds_create_reader(v->subscriber, tp, q, l);
     if (r_cmd < 0) verr_set(err, "DDS: cannot create the ToolCommand reader: %s", dds_strretcode(r_cmd));
   }
   dds_delete_qos(q);

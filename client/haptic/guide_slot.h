@@ -28,7 +28,9 @@
 #include <stdint.h>
 
 #include "guide_force.h"
+#include "dds/seat_server.h"
 #include "dds/vdds.h"
+#include "dds/vdds_gate.h"
 #include "viscera.h"
 
 #define GUIDE_SLOT_STATIONS 8
@@ -57,6 +59,15 @@ typedef struct guide_slot {
   /* Listener thread only (no lock needed): publication handle -> station. */
   guide_handle_station_t handles[GUIDE_SLOT_HANDLES];
   uint64_t handle_clock;
+  /* The peer ToolCommand reader's gate (dds/vdds_gate.h): only this tool's
+   * finite commands take an instance or a place in the history, so a flood
+   * of other tool ids or garbage neither grows memory nor evicts the peer. */
+  vdds_gate_t gate;
+  /* ToolRole: only this tool's, believed from the seat's server alone
+   * (issue 15.2; NULL server: from anyone, unit tests). */
+  vdds_gate_t role_gate;
+  seat_server_t *server;
+  uint64_t roles_ignored;
 } guide_slot_t;
 
 /* What the loop reads each tick. */

@@ -6,6 +6,9 @@
 
 #include <signal.h>
 
+#include <stdatomic.h>
+
+#include "dds/seat_server.h"
 #include "dds/vdds.h"
 #include "feedback_slot.h"
 #include "guide_slot.h"
@@ -15,7 +18,11 @@ typedef struct haptic_dds {
   vdds_t dds;
   dds_entity_t w_cmd;   /* ToolCommand, announcing the station */
   dds_entity_t r_fb;    /* ContactFeedback, into slot */
-  dds_entity_t r_scene; /* SceneInfo */
+  dds_entity_t r_scene; /* SceneInfo, taken by a listener: the seat's server (seat_server.h) */
+  seat_server_t server; /* whose ContactFeedback is believed */
+  _Atomic int scenes;   /* SceneInfo samples adopted from the seat's server */
+  char scene_name[65];  /* the first adopted scene (written before `scenes` becomes 1) */
+  uint32_t scene_tools;
   feedback_slot_t slot; /* the latest contact model and the latency samples */
   guide_slot_t guide;   /* the tool's role and the other station's positions */
 } haptic_dds_t;

@@ -13,7 +13,9 @@ void haptic_summary_print(const haptic_options_t *o, haptic_stats_t *st, haptic_
   vstats_summary_t lat = vstats_summarise(h->slot.latency_us, h->slot.nlatency);
   uint64_t feedback = h->slot.received, live_lost = h->slot.lost_events, live_back = h->slot.regained_events;
   uint64_t foreign = h->slot.foreign_echoes;
+  uint64_t ignored = h->slot.ignored, beyond = h->slot.out_of_limits, stale = h->slot.stale;
   pthread_mutex_unlock(&h->slot.lock);
+  uint64_t gate_dropped = vdds_gate_dropped(&h->slot.gate);
   /* Jitter: the p99 of |period - nominal| (early and late ticks alike). */
   for (size_t i = 0; i < st->nperiod; i++) st->period_us[i] = fabs(st->period_us[i] - 1e6 / o->rate);
   vstats_summary_t jit = vstats_summarise(st->period_us, st->nperiod);
@@ -35,16 +37,27 @@ void haptic_summary_print(const haptic_options_t *o, haptic_stats_t *st, haptic_
   if (foreign)
     fprintf(stderr, "haptic: %" PRIu64 " feedback samples answered another station's commands (not in the latency)\n",
             foreign);
+  if (ignored || beyond || stale || gate_dropped)
+    fprintf(stderr,
+            "haptic: feedback: %" PRIu64 " samples ignored (not the seat's server) and %" PRIu64
+            " dropped at the reader (other tools, blocked writers), %" PRIu64 " beyond the scene's limits, %" PRIu64
+            " older than one already used\n",
+            ignored, gate_dropped, beyond, stale);
   guide_report_summary(guide, 1.0 / o->rate, stderr);
   pthread_mutex_lock(&h->guide.lock);
   fprintf(stderr,
-          "haptic: guide: %" PRIu64 " ToolRole samples (%" PRIu64 " refused), %" PRIu64
-          " commands from other stations (%" PRIu64 " not finite), %" PRIu64 " of ours skipped\n",
-          h->guide.roles_received, h->guide.roles_rejected, h->guide.peer_samples, h->guide.bad_samples,
-          h->guide.own_samples_skipped);
+          "haptic: guide: %" PRIu64 " ToolRole samples (%" PRIu64 " refused, %" PRIu64
+          " not from the seat's server), %" PRIu64 " commands from other stations (%" PRIu64 " not finite), %" PRIu64
+          " of ours skipped\n",
+          h->guide.roles_received, h->guide.roles_rejected, h->guide.roles_ignored, h->guide.peer_samples,
+          h->guide.bad_samples, h->guide.own_samples_skipped);
   pthread_mutex_unlock(&h->guide.lock);
   printf("SUMMARY ticks=%" PRIu64 " rate_hz=%.1f peak_force=%.4f contact_ticks=%" PRIu64 " latency_us_median=%.1f "
          "latency_us_p99=%.1f period_us_p99=%.1f jitter_us_p99=%.1f late_ticks=%" PRIu64 " guide_coupled_s=%.2f\n",
          st->ticks, (double)st->ticks / st->elapsed_s, st->peak_force, st->contact_ticks, lat.median, lat.p99, per.p99,
          jitter_p99, st->late_ticks, guide_report_coupled_s(guide, 1.0 / o->rate));
+  /* Whose feedback was believed (issue 15.2) and its order (14.2). */
+  printf("FEEDBACK received=%" PRIu64 " ignored=%" PRIu64 " gate_dropped=%" PRIu64 " out_of_limits=%" PRIu64
+         " stale=%" PRIu64 " servers_adopted=%" PRIu64 "\n",
+         feedback, ignored, gate_dropped, beyond, stale, h->server.adopted);
 }

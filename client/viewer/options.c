@@ -61,7 +61,9 @@ void options_usage(FILE *f, const char *prog) {
           "towards +x) and %g degrees above, far enough that all of them are in view.\n"
           "\n"
           "On exit prints 'viewer: N frames written to DIR' and 'SUMMARY frames=N\n"
-          "rejected=M' (M: samples refused as malformed). Exit status: 0 on success or\n"
+          "rejected=M ignored=I gate_dropped=G' (M: samples refused as malformed; I:\n"
+          "samples of server topics not from the seat's server; G: samples its readers'\n"
+          "gates dropped: ids beyond the tables, writers blocked). Exit status: 0 on success or\n"
           "SIGINT/SIGTERM, 1 when OSMesa, DDS or output setup fails, 2 on bad usage.\n"
           "DDS configuration comes from CYCLONEDDS_URI.\n",
           prog, RENDER_MAX_SIZE, RENDER_MAX_SIZE,

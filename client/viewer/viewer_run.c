@@ -1,5 +1,6 @@
 #include "viewer_run.h"
 
+#include <inttypes.h>
 #include <signal.h>
 #include <stdio.h>
 #include <string.h>
@@ -172,7 +173,10 @@ int viewer_run(const viewer_opts_t *o) {
       printf("viewer: %d mesh%s written to %s%s\n", n, n > 1 ? "es" : "", o->dump_mesh, n > 1 ? ".<organ id>" : "");
     }
   }
-  unsigned long rejected = sv.rejected;
+  unsigned long rejected = sv.rejected, ignored = sv.ignored;
+  uint64_t gated = vdds_gate_dropped(&sv.gate_state) + vdds_gate_dropped(&sv.gate_delta) +
+                   vdds_gate_dropped(&sv.gate_cmd) + vdds_gate_dropped(&sv.gate_contact) +
+                   vdds_gate_dropped(&sv.gate_object);
   scene_view_close(&sv);
   render_close(r);
   if (frame_log_close(&fl, &err)) {
@@ -180,6 +184,6 @@ int viewer_run(const viewer_opts_t *o) {
     status = 1;
   }
   printf("viewer: %ld frames written to %s\n", fl.frames, o->out_dir);
-  printf("SUMMARY frames=%ld rejected=%lu\n", fl.frames, rejected);
+  printf("SUMMARY frames=%ld rejected=%lu ignored=%lu gate_dropped=%" PRIu64 "\n", fl.frames, rejected, ignored, gated);
   return status;
 }

@@ -73,6 +73,10 @@ static dds_qos_t *make_qos(qos_kind_t k, int lease_ms) {
   return q;
 }
 
+const dds_topic_descriptor_t *vdds_topic_desc(vdds_topic_id_t t) { return TOPICS[t].desc; }
+
+dds_qos_t *vdds_topic_qos(vdds_topic_id_t t) { return make_qos(TOPICS[t].qos, TOPICS[t].lease_ms); }
+
 int vdds_open(vdds_t *v, dds_domainid_t domain, const char *partition, verr_t *err) {
   memset(v, 0, sizeof *v);
   /* USER_DATA announces role, host and pid (vdds_ident.h), so recorders

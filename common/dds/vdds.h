@@ -64,6 +64,11 @@ void vdds_close(vdds_t *v);
 
 /* Topic name on the wire, e.g. "viscera_MeshDelta". */
 const char *vdds_topic_name(vdds_topic_id_t t);
+/* The topic's type descriptor, and a new copy of its QoS from the table
+ * (the caller deletes it): for readers that need a topic entity of their
+ * own (dds/vdds_gate.h). */
+const dds_topic_descriptor_t *vdds_topic_desc(vdds_topic_id_t t);
+dds_qos_t *vdds_topic_qos(vdds_topic_id_t t);
 /* Writer / reader with the table's QoS; negative DDS return code on failure. */
 dds_entity_t vdds_writer(vdds_t *v, vdds_topic_id_t t, verr_t *err);
 dds_entity_t vdds_reader(vdds_t *v, vdds_topic_id_t t, verr_t *err);

@@ -199,6 +199,11 @@ static void on_object(scene_view_t *sv, const viscera_ObjectState *s) {
   o->removed = removed;
 }
 
+/* Samples kept per instance until the next poll: a writer that is not the
+ * server gets its first samples in before it is judged and blocked, and
+ * must not push the server's keyframe out meanwhile. */
+#define SERVER_DEPTH 8
+
 int scene_view_open(scene_view_t *sv, int domain, const char *partition, scene_view_log_fn log, void *log_ctx,
                     verr_t *err) {
   memset(sv, 0, sizeof *sv);
@@ -206,14 +211,31 @@ int scene_view_open(scene_view_t *sv, int domain, const char *partition, scene_v
   sv->log_ctx = log_ctx;
   for (int i = 0; i < SCENE_VIEW_MAX_ORGANS; i++) organ_defaults(&sv->organs[i]);
   for (int i = 0; i < SCENE_VIEW_MAX_TOOLS; i++) tool_defaults(&sv->tools[i]);
+  vdds_gate_init(&sv->gate_state, SCENE_VIEW_MAX_ORGANS, NULL, NULL);
+  vdds_gate_init(&sv->gate_delta, SCENE_VIEW_MAX_ORGANS, NULL, NULL);
+  vdds_gate_init(&sv->gate_cmd, SCENE_VIEW_MAX_TOOLS, NULL, NULL);
+  vdds_gate_init(&sv->gate_contact, SCENE_VIEW_MAX_TOOLS, NULL, NULL);
+  vdds_gate_init(&sv->gate_object, SCENE_VIEW_MAX_OBJECTS, NULL, NULL);
   if (vdds_open(&sv->dds, (dds_domainid_t)domain, partition, err)) return -1;
+  if (seat_server_open(&sv->server, sv->dds.participant, err)) {
+    vdds_close(&sv->dds);
+    return -1;
+  }
   struct {
     dds_entity_t *rd;
     vdds_topic_id_t topic;
-  } rds[] = {{&sv->rd_scene, VT_SCENE_INFO}, {&sv->rd_state, VT_MESH_STATE},         {&sv->rd_delta, VT_MESH_DELTA},
-             {&sv->rd_cmd, VT_TOOL_COMMAND}, {&sv->rd_contact, VT_CONTACT_FEEDBACK}, {&sv->rd_object, VT_OBJECT_STATE}};
+    vdds_gate_t *gate;
+    int max_instances;
+  } rds[] = {{&sv->rd_scene, VT_SCENE_INFO, NULL, 0},
+             {&sv->rd_state, VT_MESH_STATE, &sv->gate_state, SCENE_VIEW_MAX_ORGANS},
+             {&sv->rd_delta, VT_MESH_DELTA, &sv->gate_delta, SCENE_VIEW_MAX_ORGANS},
+             {&sv->rd_cmd, VT_TOOL_COMMAND, &sv->gate_cmd, SCENE_VIEW_MAX_TOOLS},
+             {&sv->rd_contact, VT_CONTACT_FEEDBACK, &sv->gate_contact, SCENE_VIEW_MAX_TOOLS},
+             {&sv->rd_object, VT_OBJECT_STATE, &sv->gate_object, SCENE_VIEW_MAX_OBJECTS}};
   for (size_t i = 0; i < sizeof rds / sizeof rds[0]; i++) {
-    *rds[i].rd = vdds_reader(&sv->dds, rds[i].topic, err);
+    *rds[i].rd = rds[i].gate ? vdds_reader_gated(&sv->dds, rds[i].topic, rds[i].gate, SERVER_DEPTH,
+                                                 rds[i].max_instances, NULL, err)
+                             : vdds_reader(&sv->dds, rds[i].topic, err);
     if (*rds[i].rd < 0) {
       vdds_close(&sv->dds);
       return -1;
@@ -224,6 +246,9 @@ int scene_view_open(scene_view_t *sv, int domain, const char *partition, scene_v
 
 void scene_view_close(scene_view_t *sv) {
   vdds_close(&sv->dds);
+  seat_server_close(&sv->server);
+  vdds_gate_t *gates[] = {&sv->gate_state, &sv->gate_delta, &sv->gate_cmd, &sv->gate_contact, &sv->gate_object};
+  for (size_t i = 0; i < sizeof gates / sizeof gates[0]; i++) vdds_gate_destroy(gates[i]);
   for (int i = 0; i < SCENE_VIEW_MAX_ORGANS; i++) organ_state_free(&sv->organs[i].mesh);
 }
 
@@ -240,18 +265,42 @@ static void on_contact_gone(scene_view_t *sv, const viscera_ContactFeedback *s) 
 
 typedef void (*handler_fn)(scene_view_t *sv, const void *sample);
 
+/* Who may write a topic: anyone, the seat's server (SceneInfo decides
+ * who that is), or the SceneInfo itself. */
+typedef enum source { FROM_ANYONE, FROM_SERVER, SCENE_INFO } source_t;
+
+/* 1 when sample i may be used (counts and blocks the rest). */
+static int believed(scene_view_t *sv, dds_entity_t rd, source_t src, vdds_gate_t *gate, const dds_sample_info_t *info,
+                    const void *sample) {
+  if (src == FROM_ANYONE) return 1;
+  if (src == SCENE_INFO) {
+    if (!info->valid_data) return 0;
+    if (seat_server_scene(&sv->server, rd, info, sample)) return 1;
+    sv->ignored++;
+    return 0;
+  }
+  seat_verdict_t v = seat_server_from(&sv->server, rd, info->publication_handle);
+  if (v == SEAT_FROM_SERVER) return 1;
+  if (v == SEAT_NOT_SERVER && gate) vdds_gate_block(gate, info->publication_handle, VDDS_GATE_ANY_KEY);
+  if (info->valid_data) sv->ignored++;
+  return 0;
+}
+
 /* Takes with loans (no copies of large meshes) until the reader is empty.
  * `gone` (may be NULL) runs for an instance that is no longer alive; its
- * sample's key fields are valid even when the data is not. */
+ * sample's key fields are valid even when the data is not. A server
+ * topic waits in its reader until the seat's server is known. */
 static int take_all(scene_view_t *sv, dds_entity_t rd, handler_fn handle, handler_fn gone, const char *topic,
-                    verr_t *err) {
+                    source_t src, vdds_gate_t *gate, verr_t *err) {
   int taken = 0;
+  if (src == FROM_SERVER && !sv->server.known) return 0;
   for (;;) {
     void *samples[TAKE_BATCH] = {NULL};
     dds_sample_info_t infos[TAKE_BATCH];
     dds_return_t n = dds_take(rd, samples, infos, TAKE_BATCH, TAKE_BATCH);
     if (n < 0) return verr_set(err, "DDS: take on %s failed: %s", topic, dds_strretcode(n));
     for (int i = 0; i < n; i++) {
+      if (!believed(sv, rd, src, gate, &infos[i], samples[i])) continue;
       if (infos[i].valid_data) {
         handle(sv, samples[i]);
         taken++;
@@ -279,15 +328,17 @@ int scene_view_poll(scene_view_t *sv, verr_t *err) {
     dds_entity_t rd;
     handler_fn h, gone;
     const char *name;
-  } order[] = {{sv->rd_scene, h_scene, NULL, "SceneInfo"},
-               {sv->rd_state, h_state, NULL, "MeshState"},
-               {sv->rd_delta, h_delta, NULL, "MeshDelta"},
-               {sv->rd_cmd, h_cmd, h_tool_gone, "ToolCommand"},
-               {sv->rd_contact, h_contact, h_contact_gone, "ContactFeedback"},
-               {sv->rd_object, h_object, NULL, "ObjectState"}};
+    source_t src;
+    vdds_gate_t *gate;
+  } order[] = {{sv->rd_scene, h_scene, NULL, "SceneInfo", SCENE_INFO, NULL},
+               {sv->rd_state, h_state, NULL, "MeshState", FROM_SERVER, &sv->gate_state},
+               {sv->rd_delta, h_delta, NULL, "MeshDelta", FROM_SERVER, &sv->gate_delta},
+               {sv->rd_cmd, h_cmd, h_tool_gone, "ToolCommand", FROM_ANYONE, &sv->gate_cmd},
+               {sv->rd_contact, h_contact, h_contact_gone, "ContactFeedback", FROM_SERVER, &sv->gate_contact},
+               {sv->rd_object, h_object, NULL, "ObjectState", FROM_SERVER, &sv->gate_object}};
   int total = 0;
   for (size_t i = 0; i < sizeof order / sizeof order[0]; i++) {
-    int n = take_all(sv, order[i].rd, order[i].h, order[i].gone, order[i].name, err);
+    int n = take_all(sv, order[i].rd, order[i].h, order[i].gone, order[i].name, order[i].src, order[i].gate, err);
     if (n < 0) return -1;
     total += n;
   }

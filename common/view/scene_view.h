@@ -11,13 +11,24 @@
  * entry of a SceneInfo) is dropped, counted in `rejected` and described
  * through the log callback; it never changes what is drawn. A tool stops
  * being drawn when its ToolCommand (or ContactFeedback) writer goes away;
- * meshes stay as last received. Not thread-safe. */
+ * meshes stay as last received.
+ *
+ * Whose samples (issue 15.2): MeshState, MeshDelta, ContactFeedback and
+ * ObjectState are believed only from the seat's server (seat_server.h:
+ * the participant of the SceneInfo writer that claims role "server");
+ * until it is known they wait in their readers; the rest are counted in
+ * `ignored` and their writers blocked at the readers' gates
+ * (dds/vdds_gate.h), which also bound every reader to the tables' ids, so
+ * a flood of ids or a forged keyframe neither grows memory nor replaces
+ * the server's mesh. Not thread-safe. */
 #ifndef VISCERA_VIEWER_SCENE_VIEW_H
 #define VISCERA_VIEWER_SCENE_VIEW_H
 
 #include <stdint.h>
 
+#include "dds/seat_server.h"
 #include "dds/vdds.h"
+#include "dds/vdds_gate.h"
 #include "view/organ_state.h"
 #include "verr.h"
 
@@ -75,6 +86,9 @@ typedef struct scene_view {
   sv_tool_t tools[SCENE_VIEW_MAX_TOOLS];
   sv_object_t objects[SCENE_VIEW_MAX_OBJECTS];
   unsigned long rejected;
+  unsigned long ignored; /* samples of server topics not from the seat's server */
+  seat_server_t server;
+  vdds_gate_t gate_state, gate_delta, gate_cmd, gate_contact, gate_object;
   scene_view_log_fn log;
   void *log_ctx;
 } scene_view_t;

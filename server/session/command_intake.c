@@ -9,3 +9,10 @@ void command_from_dds(const viscera_ToolCommand *in, tool_cmd_t *out) {
   out->seq = in->seq;
   out->echo = in->client_mono_ns;
 }
+
+int command_gate_check(const void *sample, void *arg) {
+  const command_gate_t *g = arg;
+  tool_cmd_t c;
+  command_from_dds(sample, &c);
+  return (int)tool_command_check(&c, g->ntools, &g->workspace);
+}

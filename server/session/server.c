@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "mesh.h"
 #include "runtime/step_cut.h"
@@ -16,6 +17,7 @@
 #include "session/tool_metrics.h"
 #include "session/tool_roles.h"
 #include "session/writer_stations.h"
+#include "dds/vdds_gate.h"
 #include "viscera.h"
 #include "vmath.h"
 #include "vrt.h"
@@ -40,8 +42,15 @@ typedef struct server {
    * the station of each command writer (writer_stations.h). */
   tool_roles_t roles;
   writer_stations_t stations;
+  /* The ToolCommand reader's gate (dds/vdds_gate.h): only the scene's tools,
+   * only well-formed commands, and no writer once its station was refused
+   * for a tool, ever reach the reader's cache; the counters seen so far. */
+  vdds_gate_t cmd_gate;
+  command_gate_t cmd_check;
+  uint64_t gate_seen[VDDS_GATE_REASONS], gate_seen_range, gate_seen_blocked;
   session_control_t control;
   uint64_t event_seq;
+  uint64_t feedback_seq;     /* ContactFeedback.seq of the last sample written */
   double *step_us;           /* ring of recent step times */
   double *step_cpu_us;       /* the same steps' thread CPU times */
   unsigned char *step_awake; /* the same steps: 1 when an organ was stepped (not all asleep, not paused) */
@@ -109,23 +118,37 @@ static void publish_scene_info(server_t *s) {
   if (dds_write(s->w_scene, &si) >= 0) s->stats->published[VT_SCENE_INFO]++;
 }
 
-/* The ToolCommand reader. Its topic keeps the last sample per tool, but two
- * writers share a tool when it is guided (tool_roles.h): with depth 1 one
- * station's sample would overwrite the other's before the loop takes it.
- * 16 per tool covers both at 1 kHz through an 8 ms stall of the loop. */
-#define CMD_READER_DEPTH 16
+/* The ToolCommand reader, behind the intake gate. Its topic keeps the last
+ * sample per tool, but two writers share a tool when it is guided
+ * (tool_roles.h): with depth 1 one station's sample would overwrite the
+ * other's before the loop takes it. 32 per tool covers both at 1 kHz
+ * through a 16 ms stall of the loop; writers of other stations, garbage and
+ * unknown tools never take a place (the gate). At most one instance per
+ * scene tool. */
+#define CMD_READER_DEPTH 32
 static dds_entity_t command_reader(server_t *s, const dds_listener_t *l, verr_t *err) {
-  dds_qos_t *q = dds_create_qos();
-  dds_return_t rc = dds_get_qos(s->dds.topics[VT_TOOL_COMMAND], q); /* the table's QoS (liveliness, best effort) */
-  dds_qset_history(q, DDS_HISTORY_KEEP_LAST, CMD_READER_DEPTH);
-  dds_entity_t r = rc < 0 ? rc : dds_create_reader(s->dds.subscriber, s->dds.topics[VT_TOOL_COMMAND], q, l);
+  s->cmd_check.ntools = s->rt.ntools;
+  s->cmd_check.workspace = s->rt.workspace;
+  s->cmd_gate.key_bound = (uint32_t)s->rt.ntools; /* before the reader exists: no receive thread reads it yet */
+  int ntools = s->rt.ntools > 0 ? (int)s->rt.ntools : 1;
+  return vdds_reader_gated(&s->dds, VT_TOOL_COMMAND, &s->cmd_gate, CMD_READER_DEPTH, ntools, l, err);
+}
+
+/* SessionControl instances are per instructor station number, which any
+ * participant may mint: bounded, like every keyed reader (issue 15.1). */
+#define CONTROL_MAX_STATIONS 64
+static dds_entity_t control_reader(server_t *s, verr_t *err) {
+  dds_qos_t *q = vdds_topic_qos(VT_SESSION_CONTROL);
+  dds_qset_resource_limits(q, DDS_LENGTH_UNLIMITED, CONTROL_MAX_STATIONS, DDS_LENGTH_UNLIMITED);
+  dds_entity_t r = dds_create_reader(s->dds.subscriber, s->dds.topics[VT_SESSION_CONTROL], q, NULL);
   dds_delete_qos(q);
-  if (r < 0) verr_set(err, "DDS: cannot create the ToolCommand reader: %s", dds_strretcode(r));
+  if (r < 0) verr_set(err, "DDS: cannot create the SessionControl reader: %s", dds_strretcode(r));
   return r;
 }
 
 static int setup(server_t *s, const scene_t *scene, verr_t *err) {
-  liveliness_watch_init(&s->lw); /* first: teardown always destroys it */
+  liveliness_watch_init(&s->lw); /* first: teardown always destroys them */
+  vdds_gate_init(&s->cmd_gate, 0, command_gate_check, &s->cmd_check);
   if (runtime_init(&s->rt, scene, err)) return -1;
   if (vdds_open(&s->dds, s->opts->domain, s->opts->partition, err)) return -1;
   s->w_scene = vdds_writer(&s->dds, VT_SCENE_INFO, err);
@@ -138,7 +161,7 @@ static int setup(server_t *s, const scene_t *scene, verr_t *err) {
   liveliness_watch_listen(&s->lw, l);
   s->r_cmd = command_reader(s, l, err);
   dds_delete_listener(l);
-  s->r_control = vdds_reader(&s->dds, VT_SESSION_CONTROL, err);
+  s->r_control = control_reader(s, err);
   s->w_objects = vdds_writer(&s->dds, VT_OBJECT_STATE, err);
   s->w_tool_metrics = vdds_writer(&s->dds, VT_TOOL_METRICS, err);
   s->w_role = vdds_writer(&s->dds, VT_TOOL_ROLE, err);
@@ -167,6 +190,7 @@ static void teardown(server_t *s) {
   runtime_destroy(&s->rt);
   vdds_close(&s->dds); /* stops the listener before the watch goes */
   liveliness_watch_destroy(&s->lw);
+  vdds_gate_destroy(&s->cmd_gate);
   free(s->step_us);
   free(s->step_cpu_us);
   free(s->step_awake);
@@ -253,16 +277,60 @@ static void publish_roles(server_t *s) {
   }
 }
 
+/* One rejected ToolCommand: counted, and reported for the first few and
+ * then every 1000th, so a flood of garbage cannot flood the event topic or
+ * the log. */
+static void report_rejected(server_t *s, tool_cmd_verdict_t v, uint32_t tool, const char *station, const char *how) {
+  s->stats->rejected[v]++;
+  uint64_t r = ++s->stats->rejected_total;
+  if (r > 5 && r % 1000 != 0) return;
+  char text[200], who[64];
+  if (v == TOOLCMD_NOT_ASSIGNED)
+    snprintf(text, sizeof text,
+             "ToolCommand for tool %u from %s rejected%s: tool assigned to station '%s' (%" PRIu64 " rejected so far)",
+             tool, station[0] ? tool_roles_who(station, who, sizeof who) : "an anonymous station", how,
+             tool < s->roles.ntools ? s->roles.tool[tool].owner : "?", r);
+  else
+    snprintf(text, sizeof text, "ToolCommand from tool %u rejected%s: %s (%" PRIu64 " rejected so far)", tool, how,
+             tool_command_verdict_str(v), r);
+  if (!s->opts->quiet) fprintf(stderr, "server: %s\n", text);
+  publish_event(s, viscera_EVENT_INPUT_REJECTED, -1, (int)(tool < 1u << 30 ? tool : 0), (double)r, text);
+}
+
+/* Counts what the intake gate dropped since the last step as rejected
+ * commands (the gate keeps them out of the reader: vdds_gate.h). */
+static void count_gate_drops(server_t *s) {
+  vdds_gate_t *g = &s->cmd_gate;
+  uint32_t key = atomic_load(&g->last_refused_key);
+  uint64_t range = atomic_load(&g->out_of_range), blocked = atomic_load(&g->from_blocked);
+  for (; s->gate_seen_range < range; s->gate_seen_range++) report_rejected(s, TOOLCMD_BAD_ID, key, "", " at intake");
+  for (int v = 1; v < VDDS_GATE_REASONS && v < TOOLCMD_VERDICT_COUNT; v++)
+    for (uint64_t n = atomic_load(&g->reason[v]); s->gate_seen[v] < n; s->gate_seen[v]++)
+      report_rejected(s, (tool_cmd_verdict_t)v, key, "", " at intake");
+  for (; s->gate_seen_blocked < blocked; s->gate_seen_blocked++) {
+    s->stats->rejected[TOOLCMD_NOT_ASSIGNED]++;
+    s->stats->rejected_total++;
+  }
+  s->stats->gate_out_of_range = range;
+  s->stats->gate_refused = atomic_load(&g->refused);
+  s->stats->gate_blocked = blocked;
+}
+
 /* Takes every pending ToolCommand from DDS as the core's command
  * (command_intake.h), checks it (tool_command_check) and its station
  * (tool_roles_classify), and keeps a valid one as its side's latest
- * (tool_roles_note); counts and reports the rest. Returns the tools with a
- * new command (bit t). */
+ * (tool_roles_note) unless its writer already gave that side a newer one
+ * (seq: best effort may deliver out of order; issue 14.2); counts and
+ * reports the rest. A writer whose station may not drive the tool is
+ * blocked at the gate for that tool, so its flood cannot evict the
+ * owner's commands from the reader. Returns the tools with a new command
+ * (bit t). */
 static uint32_t take_commands(server_t *s, uint64_t now) {
   enum { MAXS = 16 };
   void *samples[MAXS] = {0};
   dds_sample_info_t infos[MAXS];
   uint32_t fresh = 0; /* tools with a new command this step */
+  count_gate_drops(s);
   for (;;) {
     int n = dds_take(s->r_cmd, samples, infos, MAXS, MAXS);
     if (n <= 0) break;
@@ -277,28 +345,18 @@ static uint32_t take_commands(server_t *s, uint64_t now) {
       if (v == TOOLCMD_OK) { /* well-formed: does its station drive this tool? */
         station = writer_stations_get(&s->stations, s->r_cmd, infos[i].publication_handle);
         side = tool_roles_classify(&s->roles, c->tool_id, station);
-        if (side == TOOL_SIDE_REJECTED) v = TOOLCMD_NOT_ASSIGNED;
+        if (side == TOOL_SIDE_REJECTED) {
+          v = TOOLCMD_NOT_ASSIGNED;
+          vdds_gate_block(&s->cmd_gate, infos[i].publication_handle, c->tool_id);
+        }
       }
       if (v != TOOLCMD_OK) {
-        s->stats->rejected[v]++;
-        uint64_t r = ++s->stats->rejected_total;
-        /* Report the first few and then every 1000th, so a flood of garbage
-         * cannot flood the event topic or the log. */
-        if (r <= 5 || r % 1000 == 0) {
-          char text[200], who[64];
-          if (v == TOOLCMD_NOT_ASSIGNED)
-            snprintf(text, sizeof text,
-                     "ToolCommand for tool %u from %s rejected: tool assigned to station '%s' (%" PRIu64
-                     " rejected so far)",
-                     c->tool_id, station[0] ? tool_roles_who(station, who, sizeof who) : "an anonymous station",
-                     s->roles.tool[c->tool_id].owner, r);
-          else
-            snprintf(text, sizeof text, "ToolCommand from tool %u rejected: %s (%" PRIu64 " rejected so far)",
-                     c->tool_id, tool_command_verdict_str(v), r);
-          if (!s->opts->quiet) fprintf(stderr, "server: %s\n", text);
-          publish_event(s, viscera_EVENT_INPUT_REJECTED, -1, (int)(c->tool_id < 1u << 30 ? c->tool_id : 0), (double)r,
-                        text);
-        }
+        report_rejected(s, v, c->tool_id, station, "");
+        continue;
+      }
+      const tool_pose_t *last = &s->roles.tool[c->tool_id].side[side];
+      if (last->has && last->writer == infos[i].publication_handle && cmd.seq <= last->cmd.seq) {
+        s->stats->commands_stale++; /* older than what this writer already gave: never applied after it */
         continue;
       }
       tool_roles_note(&s->roles, c->tool_id, side, station, infos[i].publication_handle, &cmd, now);
@@ -450,6 +508,7 @@ static void publish_feedback(server_t *s) {
     fb.cmd_seq = tool->cmd.seq;
     fb.cmd_client_mono_ns = tool->cmd.echo;
     fb.sim_time_ns = sim_ns(s);
+    fb.seq = ++s->feedback_seq;
     /* fb_*: the god-object, or what a grasp, a stone or another tool
      * makes the hand feel (runtime/step_tools.c). */
     fb.in_contact = tool->fb_contact != 0;
@@ -688,6 +747,16 @@ static void write_final_mesh(server_t *s) {
   }
 }
 
+/* Resident set of this process in kB (0 when /proc is not there). */
+static long rss_kb(void) {
+  FILE *f = fopen("/proc/self/statm", "r");
+  long pages = 0, resident = 0;
+  if (!f) return 0;
+  if (fscanf(f, "%ld %ld", &pages, &resident) != 2) resident = 0;
+  fclose(f);
+  return resident * (sysconf(_SC_PAGESIZE) / 1024);
+}
+
 /* The step's wall and CPU time since t0, c0 (the step-time rings). */
 static void record_step_time(server_t *s, uint64_t t0, uint64_t c0, uint64_t t1) {
   s->step_cpu_us[s->nstep_us % STEP_RING] = (double)(vtime_thread_cpu_ns() - c0) * 1e-3;
@@ -711,7 +780,12 @@ static int session_step(server_t *s, uint64_t t0, uint64_t c0, uint64_t *t1) {
     if (fresh & (1u << t)) drive_tool(s, t, t0);
   release_lost_tools(s, t0);
   if (read_controls(s)) return -1;
-  if (s->roles.changed) publish_roles(s);
+  if (s->roles.changed) {
+    /* A changed role may let a refused station in: it is judged afresh. */
+    for (size_t t = 0; t < s->roles.ntools; t++)
+      if (s->roles.changed & (1u << t)) vdds_gate_unblock_key(&s->cmd_gate, (uint32_t)t);
+    publish_roles(s);
+  }
   /* Step: paused, the organs and the measures freeze; commands are still
    * read (so nothing queues up) and the last contact model keeps going out. */
   int rolled = s->control.paused ? 0 : runtime_step(&s->rt);
@@ -734,6 +808,9 @@ static int session_step(server_t *s, uint64_t t0, uint64_t c0, uint64_t *t1) {
   *t1 = vtime_mono_ns();
   record_step_time(s, t0, c0, *t1);
   if (s->rt.steps % s->metrics_every == 0) {
+    long kb = rss_kb();
+    if (!s->stats->rss_start_kb) s->stats->rss_start_kb = kb;
+    if (kb > s->stats->rss_max_kb) s->stats->rss_max_kb = kb;
     publish_metrics(s, s->metrics_every);
     publish_tool_metrics(s);
   }

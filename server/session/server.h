@@ -31,6 +31,11 @@ typedef struct server_stats {
   int resumed; /* started from a checkpoint */
   uint64_t steps, overruns, rollbacks, rejected[TOOLCMD_VERDICT_COUNT], rejected_total, commands;
   uint64_t liveliness_blips; /* client liveliness lapses that were not a lost client */
+  /* ToolCommand intake (issue 15.1, 14.2): samples the gate dropped before
+   * DDS stored them (also counted in rejected[]), by cause; commands not
+   * applied because their writer had already sent a newer one. */
+  uint64_t gate_out_of_range, gate_refused, gate_blocked, commands_stale;
+  long rss_start_kb, rss_max_kb; /* resident set at the first step, and the largest seen at a metrics period */
   double peak_force;
   double step_us_median, step_us_p99, step_us_max;
   /* The same steps in this thread's CPU time: the work a step costs, apart

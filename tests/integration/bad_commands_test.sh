@@ -14,7 +14,7 @@ kill -0 $SERVER || { echo "FAIL: server died"; exit 1; }
 kill -INT $SERVER; wait $SERVER
 trap - EXIT
 cat "$OUT/server.out"
-rejected=$(grep -o 'rejected=[0-9]*' "$OUT/server.out" | cut -d= -f2)
+rejected=$(grep "^SUMMARY" "$OUT/server.out" | grep -o 'rejected=[0-9]*' | cut -d= -f2)
 line=$(grep "rejected (" "$OUT/server.log"); echo "$line"
 # 270 bad commands, one every 2 ms; best-effort on a loaded machine may lose some,
 # but every kind must have been seen and counted. (Not "tool assigned to

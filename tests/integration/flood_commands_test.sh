@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# Issue 15.1: a bounded ToolCommand flood against a seat whose tool 0 is
+# owned by station "trainee" (a scripted haptic client holding still in free
+# space): new tool ids, garbage for tool 0, and well-formed commands for
+# tool 0 from station "mallory". The memory of the server, the trainee's
+# haptic client and a viewer (both read ToolCommand) stays flat (within
+# 5 MB each), every kind is dropped at the intake gate and counted, the owner's
+# commands are applied and the server never falls behind (its own counters:
+# flood_commands check).
+# usage: flood_commands_test.sh BUILD SRC OUT
+set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/prelude.sh"
+PART=hardnet/flood
+A=0.000,0.004,0.070
+printf '# holds still above the kidney\n0 %s\n100 %s\n' "${A//,/ }" "${A//,/ }" > "$OUT/trainee.traj"
+"$BUILD/server/viscera-server" --scene "$SRC/assets/scenes/default.yaml" --partition $PART --duration 30 \
+  > "$OUT/server.out" 2> "$OUT/server.log" & SRV=$!; PIDS+=($SRV)
+"$BUILD/client/haptic/viscera-haptic" --partition $PART --tool 0 --station trainee --trajectory "$OUT/trainee.traj" \
+  --duration 12 --wait-server 20 --quiet > "$OUT/haptic.out" 2> "$OUT/haptic.log" & HAP=$!; PIDS+=($HAP)
+"$BUILD/client/viewer/viscera-viewer" --partition $PART --out "$OUT/frames" --interval-ms 500 --duration 14 \
+  > "$OUT/viewer.out" 2> "$OUT/viewer.log" & VIEWER=$!; PIDS+=($VIEWER)
+"$BUILD/client/control/viscera-control" --partition $PART --wait 15 assign 0 trainee > "$OUT/ctl.txt" 2>&1 \
+  || fail "assign not applied"
+"$BUILD/tests/integration/flood_commands" flood "$VISCERA_DOMAIN" $PART $SRV,$HAP,$VIEWER "${FLOOD_COUNT:-75000}" 5 \
+  > "$OUT/flood.out" 2> "$OUT/flood.log" || fail "flood: $(cat "$OUT/flood.out")"
+cat "$OUT/flood.out"
+wait $HAP || fail "haptic client failed"
+wait $VIEWER || fail "viewer failed"
+kill -0 $SRV || fail "server died"
+kill -INT $SRV; wait $SRV || fail "server exit status"
+"$BUILD/tests/integration/flood_commands" check "$OUT/server.out" "$OUT/haptic.out" "$OUT/flood.out" || fail "check"
+grep -h "intake gate\|rejected (" "$OUT/server.log" || true
+echo PASS
