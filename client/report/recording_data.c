@@ -191,6 +191,7 @@ static int on_event(void *arg, const void *sample, const recfile_row_t *row) {
     rep_task_event_t *te = &r->task_events[r->ntask_events++];
     te->t = (double)e->sim_time_ns * 1e-9;
     te->mark = kind == c->task_started ? REP_TASK_STARTED : REP_TASK_COMPLETED;
+    te->value = te->mark == REP_TASK_COMPLETED && isfinite(e->value) ? e->value : NAN;
     task_of_event(e, te);
   } else if (kind > (int32_t)viscera_EVENT_THRESHOLD_CROSSED_DOWN) {
     c->events_other_kind++;

@@ -80,6 +80,7 @@ typedef struct rep_task_event {
   rep_task_mark_t mark;
   int id; /* the scene's task index, -1 when the event carries none */
   char name[64];
+  double value; /* completion: the operation time the server measured (s), NAN unknown */
 } rep_task_event_t;
 
 typedef struct rep_task {
@@ -90,7 +91,9 @@ typedef struct rep_task {
 } rep_task_t;
 
 /* Pairs start and completion events by task id (by name when either has
- * no id), in time order; a second
+ * no id), in time order. A completion that carries the server's operation
+ * time (value) sets the start to end - value: the server starts a task's
+ * clock at its tool's first command, a step before the event; a second
  * start of a running task restarts it. `session_start` stands in for a
  * missing start. Writes at most `cap` tasks (in order of first appearance)
  * and returns how many. */

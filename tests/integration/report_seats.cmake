@@ -1,0 +1,5 @@
+# viscera-report per task and per seat, and the recording exports
+# (issue 16 items 3, 4, 6). Domains 201-205.
+if(TARGET viscera-report AND TARGET viscera-viewer)
+  viscera_integration_test(report_tasks 201 report_tasks_test.sh)
+endif()
