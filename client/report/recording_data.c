@@ -300,11 +300,13 @@ static void describe_identity(rep_recording_t *r, recfile_t *rf, const load_ctx_
       snprintf(station, sizeof station, "anonymous");
     rec_ident_field(w->participant, "host", host, sizeof host);
     rec_ident_field(w->participant, "pid", pid, sizeof pid);
-    len += (size_t)snprintf(r->identity + len, sizeof r->identity - len, "%s station %s (%s on %s, pid %s)",
-                            shown++ ? ";" : ",", station, w->role[0] ? w->role : "client", host, pid);
+    /* no commas: the CSV's readers split naively */
+    len += (size_t)snprintf(r->identity + len, sizeof r->identity - len, "; station %s (%s on %s pid %s)", station,
+                            w->role[0] ? w->role : "client", host, pid);
+    shown++;
   }
   if (!shown && len + 40 < sizeof r->identity)
-    snprintf(r->identity + len, sizeof r->identity - len, ", no trainee client recorded");
+    snprintf(r->identity + len, sizeof r->identity - len, "; no trainee client recorded");
 }
 
 int rep_recording_seats(const char *path, char (*seats)[128], int max, verr_t *err) {

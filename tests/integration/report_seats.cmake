@@ -3,3 +3,6 @@
 if(TARGET viscera-report AND TARGET viscera-viewer)
   viscera_integration_test(report_tasks 201 report_tasks_test.sh)
 endif()
+if(TARGET viscera-report AND TARGET viscera-haptic)
+  viscera_integration_test(report_lab 202 report_lab_test.sh)
+endif()
