@@ -158,6 +158,7 @@ static const char *STYLE =
     "body{font-family:'DejaVu Sans',Arial,sans-serif;max-width:1000px;margin:24px auto;color:#222;padding:0 12px}"
     "h1{font-size:24px}h2{font-size:19px;border-bottom:2px solid #1f77b4;padding-bottom:3px;margin-top:34px}"
     "h3{font-size:15px;margin:16px 0 4px}"
+    ".summary td:nth-child(2),.summary th:nth-child(2){text-align:left}.summary td:first-child{white-space:nowrap}"
     "table{border-collapse:collapse;margin:10px 0}td,th{border:1px solid #ccc;padding:4px 10px;text-align:right}"
     "th{background:#eef3f8}td:first-child,th:first-child{text-align:left}td.na{color:#999}"
     "td.pass{color:#176d2c;font-weight:bold}td.fail{color:#b00020;font-weight:bold}"
@@ -173,7 +174,7 @@ static const char *STYLE =
     "@media print{body{max-width:none;margin:0;padding:0;font-size:11px}"
     "h2{break-before:page;page-break-before:always;margin-top:0}h2.first{break-before:auto;page-break-before:auto}"
     "table,img,.who,.warn,tr{break-inside:avoid;page-break-inside:avoid}h2,h3{break-after:avoid;page-break-after:avoid}"
-    ".grid img{width:48%}td,th{padding:2px 6px}"
+    ".grid img{width:48%}td,th{padding:2px 6px}.note{font-size:9px}"
     "*{-webkit-print-color-adjust:exact;print-color-adjust:exact}}";
 
 static const char *outcome_class(rep_outcome_t o) { return o == REP_PASS ? "pass" : o == REP_FAIL ? "fail" : "na"; }
@@ -219,14 +220,14 @@ static void html_verdict(FILE *f, const rep_recording_t *r, const rep_limits_t *
 /* One row per section: who, the key measures, tasks and the verdict. */
 static void html_summary(FILE *f, const rep_recording_t *const *recs, int n, const rep_layout_t *lay) {
   fprintf(f, "<h2 class=first id=summary>%s</h2>\n", lay->lab ? "Lab summary" : "Summary");
-  fputs("<table><tr><th>trainee</th><th>who</th><th>peak force</th><th>contact time</th><th>above MPF</th>"
+  fputs("<table class=summary><tr><th>trainee</th><th>who</th><th>peak force</th><th>contact time</th><th>above MPF</th>"
         "<th>tasks completed</th><th>verdict</th></tr>\n",
         f);
   for (int i = 0; i < n; i++) {
     const rep_recording_t *r = recs[i];
     fprintf(f, "<tr><td><a href=\"#s%d\">", i + 1);
     html_text(f, r->label);
-    fputs("</a></td><td style=\"text-align:left\">", f);
+    fputs("</a></td><td>", f);
     html_text(f, r->identity);
     fputs("</td>", f);
     html_value(f, r, 0);
