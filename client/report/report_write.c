@@ -220,9 +220,10 @@ static void html_verdict(FILE *f, const rep_recording_t *r, const rep_limits_t *
 /* One row per section: who, the key measures, tasks and the verdict. */
 static void html_summary(FILE *f, const rep_recording_t *const *recs, int n, const rep_layout_t *lay) {
   fprintf(f, "<h2 class=first id=summary>%s</h2>\n", lay->lab ? "Lab summary" : "Summary");
-  fputs("<table class=summary><tr><th>trainee</th><th>who</th><th>peak force</th><th>contact time</th><th>above MPF</th>"
-        "<th>tasks completed</th><th>verdict</th></tr>\n",
-        f);
+  fputs(
+      "<table class=summary><tr><th>trainee</th><th>who</th><th>peak force</th><th>contact time</th><th>above MPF</th>"
+      "<th>tasks completed</th><th>verdict</th></tr>\n",
+      f);
   for (int i = 0; i < n; i++) {
     const rep_recording_t *r = recs[i];
     fprintf(f, "<tr><td><a href=\"#s%d\">", i + 1);
