@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "events_by_name.h"
 #include "recording/rec_decode.h"
 #include "recording/rec_writers.h"
 #include "viscera.h"
@@ -215,15 +216,16 @@ static int on_metrics(void *arg, const void *sample, const recfile_row_t *row) {
   return 0;
 }
 
-/* Reads one topic and turns what went wrong into warnings. */
-static void load_topic(rep_recording_t *r, recfile_t *rf, const char *topic, const dds_topic_descriptor_t *desc,
-                       rec_decode_cb cb, load_ctx_t *c, bool needed) {
+/* Reads one topic and turns what went wrong into warnings; returns the
+ * samples that did not decode (warned about unless `quiet_undecodable`). */
+static uint64_t load_topic(rep_recording_t *r, recfile_t *rf, const char *topic, const dds_topic_descriptor_t *desc,
+                           rec_decode_cb cb, load_ctx_t *c, bool needed, bool quiet_undecodable) {
   rec_decode_report_t rep;
   if (rec_decode_topic(rf, topic, desc, cb, c, &rep) < 0) c->oom = true;
   const char *shortname = strncmp(topic, "viscera_", 8) == 0 ? topic + 8 : topic;
   if (rep.topic_missing) {
     if (needed) warn(r, "no %s topic in the recording", shortname);
-    return;
+    return 0;
   }
   if (rep.scan.damaged || rep.scan.invalid) {
     r->damaged = true;
@@ -231,9 +233,10 @@ static void load_topic(rep_recording_t *r, recfile_t *rf, const char *topic, con
          rep.scan.damaged, (unsigned long long)rep.scan.invalid, rep.scan.gave_up ? ", gave up on the rest" : "",
          rep.scan.first_error[0] ? rep.scan.first_error : "invalid rows", (unsigned long long)rep.decoded);
   }
-  if (rep.undecodable)
+  if (rep.undecodable && !quiet_undecodable)
     warn(r, "%s: %llu sample(s) do not decode (damaged, or written with a newer type) and were skipped", shortname,
          (unsigned long long)rep.undecodable);
+  return rep.undecodable;
 }
 
 static void summarise(rep_recording_t *r) {
@@ -367,11 +370,19 @@ int rep_recording_load(rep_recording_t *r, const char *path, const char *label, 
    * compiled type, so they work as soon as the IDL has them. */
   rec_decode_enum_value(&viscera_SessionEvent_desc, "EVENT_TASK_STARTED", &c.task_started);
   rec_decode_enum_value(&viscera_SessionEvent_desc, "EVENT_TASK_COMPLETED", &c.task_completed);
-  load_topic(r, rf, "viscera_SceneInfo", &viscera_SceneInfo_desc, on_scene, &c, true);
-  load_topic(r, rf, "viscera_ContactFeedback", &viscera_ContactFeedback_desc, on_feedback, &c, true);
-  load_topic(r, rf, "viscera_ToolCommand", &viscera_ToolCommand_desc, on_command, &c, true);
-  load_topic(r, rf, "viscera_SessionEvent", &viscera_SessionEvent_desc, on_event, &c, true);
-  load_topic(r, rf, "viscera_Metrics", &viscera_Metrics_desc, on_metrics, &c, false);
+  load_topic(r, rf, "viscera_SceneInfo", &viscera_SceneInfo_desc, on_scene, &c, true, false);
+  load_topic(r, rf, "viscera_ContactFeedback", &viscera_ContactFeedback_desc, on_feedback, &c, true, false);
+  load_topic(r, rf, "viscera_ToolCommand", &viscera_ToolCommand_desc, on_command, &c, true, false);
+  if (load_topic(r, rf, "viscera_SessionEvent", &viscera_SessionEvent_desc, on_event, &c, true, true)) {
+    /* Events of an older (or newer) SessionEvent type: by field name. */
+    uint64_t left = 0, salvaged = rep_events_by_name(rf, on_event, &c, &left);
+    if (salvaged)
+      warn(r, "SessionEvent: %llu event(s) of another version of the type were read by field name",
+           (unsigned long long)salvaged);
+    if (left)
+      warn(r, "SessionEvent: %llu sample(s) do not decode (damaged?) and were skipped", (unsigned long long)left);
+  }
+  load_topic(r, rf, "viscera_Metrics", &viscera_Metrics_desc, on_metrics, &c, false, false);
   describe_identity(r, rf, &c);
   free(writers);
   recfile_close(rf);

@@ -1,6 +1,7 @@
 #include "recording/rec_cdr.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -70,9 +71,13 @@ static void json_string(rt_str_t *o, const char *s, size_t len) {
   rt_str_append(o, "\"", 1);
 }
 
-/* A scalar as text: JSON (strings quoted, non-finite null) or CSV (strings
- * quoted with "" doubling, non-finite as nan/inf). */
-static int scalar(cur_t *c, const rt_type_t *t, rt_str_t *o, bool csv) {
+enum { AS_JSON, AS_CSV, AS_RAW };
+
+/* A scalar as text: JSON (strings quoted, non-finite null), CSV (strings
+ * quoted with "" doubling, non-finite as nan/inf) or raw (strings and enum
+ * literals as they are, booleans 1/0, for rt_cdr_fields). */
+static int scalar(cur_t *c, const rt_type_t *t, rt_str_t *o, int mode) {
+  bool csv = mode != AS_JSON;
   union {
     uint8_t u8;
     int8_t i8;
@@ -89,7 +94,7 @@ static int scalar(cur_t *c, const rt_type_t *t, rt_str_t *o, bool csv) {
   case RT_BOOL:
     if (rd(c, &v.u8, 1) < 0) return -1;
     if (v.u8 > 1) return fail(c, "boolean neither 0 nor 1");
-    rt_str_printf(o, "%s", v.u8 ? "true" : "false");
+    rt_str_printf(o, "%s", mode == AS_RAW ? (v.u8 ? "1" : "0") : v.u8 ? "true" : "false");
     return 0;
   case RT_OCTET:
   case RT_UINT8:
@@ -99,7 +104,9 @@ static int scalar(cur_t *c, const rt_type_t *t, rt_str_t *o, bool csv) {
   case RT_CHAR: {
     if (rd(c, &v.u8, 1) < 0) return -1;
     char ch = (char)v.u8;
-    if (csv)
+    if (mode == AS_RAW)
+      rt_str_append(o, &ch, 1);
+    else if (csv)
       rt_str_printf(o, "\"%s%c\"", ch == '"' ? "\"" : "", ch);
     else
       json_string(o, &ch, 1);
@@ -148,7 +155,7 @@ static int scalar(cur_t *c, const rt_type_t *t, rt_str_t *o, bool csv) {
     }
     const char *name = rt_enum_name(t, e);
     if (name)
-      rt_str_printf(o, "\"%s\"", name);
+      rt_str_printf(o, mode == AS_RAW ? "%s" : "\"%s\"", name);
     else
       rt_str_printf(o, "%d", (int)e);
     return 0;
@@ -161,6 +168,10 @@ static int scalar(cur_t *c, const rt_type_t *t, rt_str_t *o, bool csv) {
     const char *s = (const char *)c->b + c->pos;
     if (s[len - 1] != 0 || memchr(s, 0, len - 1)) return fail(c, "string not NUL-terminated");
     c->pos += len;
+    if (mode == AS_RAW) {
+      rt_str_append(o, s, len - 1);
+      return 0;
+    }
     if (!csv) {
       json_string(o, s, len - 1);
       return 0;
@@ -228,7 +239,7 @@ static int json_elements(cur_t *c, const rt_type_t *elem, uint64_t n, rt_str_t *
 
 static int json_value(cur_t *c, const rt_type_t *t, rt_str_t *o, int depth) {
   if (depth > RT_MAX_DEPTH * 2) return fail(c, "nested too deep");
-  if (is_scalar(t)) return scalar(c, t, o, false);
+  if (is_scalar(t)) return scalar(c, t, o, AS_JSON);
   size_t end;
   switch (t->kind) {
   case RT_STRUCT: {
@@ -341,12 +352,12 @@ static int csv_struct(cur_t *c, const rt_type_t *t, rt_str_t *o, bool *first) {
       for (uint32_t k = 0; k < mt->dims[0]; k++) {
         rt_str_printf(o, "%s", *first ? "" : ",");
         *first = false;
-        if (scalar(c, mt->elem, o, true) < 0) return -1;
+        if (scalar(c, mt->elem, o, AS_CSV) < 0) return -1;
       }
     } else if (is_scalar(mt)) {
       rt_str_printf(o, "%s", *first ? "" : ",");
       *first = false;
-      if (scalar(c, mt, o, true) < 0) return -1;
+      if (scalar(c, mt, o, AS_CSV) < 0) return -1;
     } else {
       rt_str_t j = {0};
       int r = json_value(c, mt, &j, 1);
@@ -375,4 +386,52 @@ int rt_cdr_csv(const rt_type_t *top, const void *cdr, size_t len, rt_str_t *out,
     return -1;
   }
   return out->oom ? verr_set(err, "out of memory") : 0;
+}
+
+typedef struct visit {
+  rt_field_cb cb;
+  void *arg;
+  rt_str_t tmp;
+} visit_t;
+
+static int visit_struct(cur_t *c, const rt_type_t *t, const char *prefix, visit_t *v, int depth) {
+  if (t->ext == RT_MUTABLE) return fail(c, "mutable struct");
+  if (depth > RT_MAX_DEPTH) return fail(c, "nested too deep");
+  size_t end;
+  if (dheader(c, t->ext == RT_APPENDABLE, &end) < 0) return -1;
+  if (t->base && visit_struct(c, t->base, prefix, v, depth + 1) < 0) return -1;
+  for (uint32_t i = 0; i < t->nmembers && (end == SIZE_MAX || c->pos < end); i++) {
+    const rt_member_t *m = &t->members[i];
+    char path[512];
+    snprintf(path, sizeof path, "%s%s%s", prefix, prefix[0] ? "." : "", m->name);
+    c->where = m->name;
+    if (m->optional) return fail(c, "optional members are not decoded");
+    v->tmp.len = 0;
+    if (v->tmp.s) v->tmp.s[0] = 0;
+    if (m->type->kind == RT_STRUCT) {
+      if (visit_struct(c, m->type, path, v, depth + 1) < 0) return -1;
+    } else if (is_scalar(m->type)) {
+      if (scalar(c, m->type, &v->tmp, AS_RAW) < 0) return -1;
+      if (v->tmp.oom) return verr_set(c->err, "out of memory");
+      rt_field_t f = {path, m->type, strtod(v->tmp.s, NULL), v->tmp.s};
+      if (m->type->kind == RT_ENUM)
+        for (uint32_t k = 0; k < m->type->nliterals; k++)
+          if (strcmp(m->type->literals[k].name, v->tmp.s) == 0) f.num = m->type->literals[k].value;
+      v->cb(v->arg, &f);
+    } else if (json_value(c, m->type, &v->tmp, depth + 1) < 0) { /* collections: skipped over */
+      return -1;
+    }
+  }
+  if (end != SIZE_MAX) c->pos = end;
+  return 0;
+}
+
+int rt_cdr_fields(const rt_type_t *top, const void *cdr, size_t len, rt_field_cb cb, void *arg, verr_t *err) {
+  cur_t c;
+  if (begin(&c, cdr, len, err) < 0) return -1;
+  if (top->kind != RT_STRUCT) return verr_set(err, "the topic type is not a struct");
+  visit_t v = {cb, arg, {0}};
+  int r = visit_struct(&c, top, "", &v, 0);
+  rt_str_free(&v.tmp);
+  return r;
 }

@@ -27,4 +27,19 @@ int rt_cdr_json(const rt_type_t *top, const void *cdr, size_t len, rt_str_t *out
 void rt_csv_header(const rt_type_t *top, rt_str_t *out);
 int rt_cdr_csv(const rt_type_t *top, const void *cdr, size_t len, rt_str_t *out, verr_t *err);
 
+/* The scalar members of a sample (nested structs as "a.b"; collections are
+ * skipped), in type order, each once: `num` holds numbers, booleans (0/1)
+ * and enum values, `str` the text (strings as they are, enum literals,
+ * numbers as printed), valid during the call. Members the sample lacks
+ * (written with an older, shorter type) are not visited. Lets a reader
+ * take fields by name from a sample its compiled type cannot decode. */
+typedef struct rt_field {
+  const char *path;
+  const rt_type_t *type;
+  double num;
+  const char *str;
+} rt_field_t;
+typedef void (*rt_field_cb)(void *arg, const rt_field_t *f);
+int rt_cdr_fields(const rt_type_t *top, const void *cdr, size_t len, rt_field_cb cb, void *arg, verr_t *err);
+
 #endif

@@ -106,7 +106,7 @@ size_t rep_tasks(const rep_task_event_t *ev, size_t n, double session_start, rep
     } else {
       if (t && isnan(t->end)) {
         t->end = ev[i].t;
-        if (isfinite(ev[i].value) && ev[i].value >= 0 && t->id >= 0) t->start = t->end - ev[i].value;
+        if (isfinite(ev[i].value) && ev[i].value >= 0) t->start = t->end - ev[i].value;
         continue;
       }
       if (nt >= cap) break;

@@ -176,7 +176,47 @@ static void test_sequences(void) {
   rt_model_free(&m);
 }
 
+typedef struct seen {
+  int n;
+  char kind[64], text[300];
+  double tool_id, value, task_id;
+} seen_t;
+
+static void on_field(void *arg, const rt_field_t *f) {
+  seen_t *s = arg;
+  s->n++;
+  if (!strcmp(f->path, "kind")) snprintf(s->kind, sizeof s->kind, "%s", f->str);
+  if (!strcmp(f->path, "text")) snprintf(s->text, sizeof s->text, "%s", f->str);
+  if (!strcmp(f->path, "tool_id")) s->tool_id = f->num;
+  if (!strcmp(f->path, "value")) s->value = f->num;
+  if (!strcmp(f->path, "task_id")) s->task_id = f->num;
+}
+
+/* Fields by name (how the report reads events of another type version). */
+static void test_fields(void) {
+  viscera_SessionEvent e;
+  memset(&e, 0, sizeof e);
+  e.kind = viscera_EVENT_THRESHOLD_CROSSED_UP;
+  e.tool_id = -3;
+  e.value = 0.8;
+  e.task_id = -1;
+  snprintf(e.text, sizeof e.text, "MPF crossed up: \"raw\" text");
+  rt_model_t m;
+  CHECK(load(&m, &viscera_SessionEvent_desc, "viscera::SessionEvent") == 0);
+  size_t len;
+  unsigned char *b = serialize(&e, &viscera_SessionEvent_desc, 1, &len);
+  seen_t s = {0};
+  verr_t err = {{0}};
+  CHECK(rt_cdr_fields(m.top, b, len, on_field, &s, &err) == 0);
+  CHECK(s.n == 10 && !strcmp(s.kind, "EVENT_THRESHOLD_CROSSED_UP") && !strcmp(s.text, e.text));
+  CHECK(s.tool_id == -3 && s.value == 0.8 && s.task_id == -1);
+  CHECK(rt_cdr_fields(m.top, b, len - 9, on_field, &s, &err) < 0);
+  free(b);
+  rt_model_free(&m);
+}
+
 int main(void) {
+  test_fields();
   test_idl();
   test_json();
   test_csv();
