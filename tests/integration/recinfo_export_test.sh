@@ -11,6 +11,7 @@
 #  - SceneInfo JSONL: the probe's ST/MPF/SFT equal the PALPATION levels;
 #  - SessionEvent JSONL: one line per sample; every TASK_COMPLETED names its
 #    task (task_id, task_name) with the server's TASK operation time;
+#  - a truncated copy exports what is readable, exit status 1;
 #  - errors: no --topic, an unknown topic or format is a usage error (2).
 # usage: recinfo_export_test.sh BUILD SRC OUT
 set -euo pipefail
@@ -59,6 +60,11 @@ want=$(sed -n 's/^TASK task=\([^ ]*\) .*state=completed operation_time=\([0-9.]*
 echo "tasks: $(echo $got)"
 [ -n "$want" ] && [ "$got" = "$want" ] || fail "TASK_COMPLETED events '$got' differ from the TASK lines '$want'"
 
+# A truncated copy: what is readable is exported, the exit status says damaged.
+cp "$REC" "$OUT/trunc.db"; truncate -s $(( $(stat -c %s "$REC") * 6 / 10 )) "$OUT/trunc.db"
+st=0; "$RECINFO" "$OUT/trunc.db" --export csv --topic viscera_ContactFeedback "$OUT/trunc.csv" 2> "$OUT/trunc.err" || st=$?
+[ $st = 1 ] && grep -q "damaged" "$OUT/trunc.err" && [ "$(wc -l < "$OUT/trunc.csv")" -gt 100 ] \
+  || fail "a truncated recording: exit $st, $(wc -l < "$OUT/trunc.csv") rows (want 1, a warning and the readable rows)"
 st=0; "$RECINFO" "$REC" --export csv "$OUT/x.csv" 2> "$OUT/e1.err" || st=$?
 [ $st = 2 ] && grep -q -- '--topic' "$OUT/e1.err" || fail "csv without --topic should be a usage error"
 st=0; "$RECINFO" "$REC" --export csv --topic nope "$OUT/x.csv" 2> "$OUT/e2.err" || st=$?
