@@ -59,7 +59,7 @@ async function main() {
     }
   }
   const perTopic = new Map(), indexedCount = new Map();
-  let decoded = 0, total = 0;
+  let decoded = 0, total = 0, peak = 0, inContact = 0;
   for await (const m of indexed.readMessages({ validateCrcs: true })) {
     const ch = indexed.channelsById.get(m.channelId);
     if (ch.messageEncoding !== "cdr") fail(`channel ${ch.topic}: encoding ${ch.messageEncoding}`);
@@ -73,6 +73,11 @@ async function main() {
       fail(`${ch.topic} message ${m.sequence} does not decode: ${e.message}`);
     }
     if (typeof msg !== "object" || msg === null) fail(`${ch.topic}: decoded to nothing`);
+    if (ch.metadata.get("dds_topic") === "viscera_ContactFeedback" && msg.tool_id === 0) {
+      const f = Math.hypot(msg.force[0], msg.force[1], msg.force[2]);
+      if (f > peak) peak = f;
+      if (msg.in_contact) inContact++;
+    }
     decoded++;
     total++;
     indexedCount.set(m.channelId, (indexedCount.get(m.channelId) || 0) + 1);
@@ -94,6 +99,8 @@ async function main() {
   }
   for (const [t] of perTopic) if (!want.has(t)) fail(`topic ${t} in the MCAP file but not in the recording`);
   if (bad) fail(`${bad} topic(s) differ`);
+  // decoded values, for the caller to compare with the server's figures
+  console.log(`tool0_peak_force=${peak.toFixed(4)} tool0_contact_time=${(inContact * 0.001).toFixed(3)}`);
   console.log(`ok: ${total} messages in ${indexed.channelsById.size} channels, ${indexed.chunkIndexes.length} chunks, ` +
               `all ${decoded} decoded with their OMG IDL schema`);
 }

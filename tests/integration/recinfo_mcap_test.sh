@@ -6,8 +6,8 @@
 # format's reference TypeScript reader, plus Foxglove's OMG IDL parser and
 # CDR deserializer), installed at test time into the build directory:
 # stream and indexed reading with CRC checks, every message decoded with
-# its channel's IDL schema, and the messages per topic equal to recinfo's
-# sample counts. Skips (77) when node or npm is missing or the packages
+# its channel's IDL schema, the messages per topic equal to recinfo's
+# sample counts, and the decoded force equal to the server's PALPATION line. Skips (77) when node or npm is missing or the packages
 # cannot be installed (no registry).
 # usage: recinfo_mcap_test.sh BUILD SRC OUT
 set -euo pipefail
@@ -32,7 +32,18 @@ cat "$OUT/export.err"
 "$RECINFO" "$REC" | awk '/^topic /{ t = 1; next } /^total:/{ t = 0 } t && NF > 3 { print $1, $3 }' > "$OUT/counts.txt"
 [ "$(wc -l < "$OUT/counts.txt")" -ge 8 ] || fail "recinfo listed too few topics: $(cat "$OUT/counts.txt")"
 NODE_PATH="$NPM/node_modules" node "$SRC/tests/integration/mcap_read.js" "$OUT/demo.mcap" "$OUT/counts.txt" \
-  || fail "the MCAP reader rejected the export (above)"
+  > "$OUT/read.out" || { cat "$OUT/read.out"; fail "the MCAP reader rejected the export (above)"; }
+cat "$OUT/read.out"
+# The decoded values are the session's: the probe's peak force and time in
+# contact (1 ms per in-contact sample) against the server's PALPATION line.
+srv() { grep '^PALPATION tool=probe ' "$OUT/demo/server.out" | tr ' ' '\n' | sed -n "s/^$1=//p"; }
+got() { tr ' ' '\n' < "$OUT/read.out" | sed -n "s/^$1=//p"; }
+awk -v g="$(got tool0_peak_force)" -v w="$(srv peak_force)" 'BEGIN { d = g - w; exit !(g != "" && d < 0.02 && d > -0.02) }' \
+  || fail "decoded peak force $(got tool0_peak_force), server $(srv peak_force)"
+awk -v g="$(got tool0_contact_time)" -v w="$(srv contact_time)" \
+  'BEGIN { d = g - w; t = 0.03 * w; if (t < 0.05) t = 0.05; exit !(g != "" && d <= t && -d <= t) }' \
+  || fail "decoded contact time $(got tool0_contact_time), server $(srv contact_time)"
+echo "ok: decoded peak $(got tool0_peak_force) N, contact $(got tool0_contact_time) s = the server's PALPATION line"
 # A damaged export is caught: the reader must fail on a flipped byte in a chunk.
 cp "$OUT/demo.mcap" "$OUT/bad.mcap"
 # (the middle of the file lies inside a chunk: its CRC must catch the change)
