@@ -45,7 +45,6 @@ typedef struct load_ctx {
   uint64_t last_event_seq[REP_MAX_TOOLS + 1];
   int64_t last_event_writer[REP_MAX_TOOLS + 1];
   bool seen_event_source[REP_MAX_TOOLS + 1];
-  uint64_t events_other_kind;
   /* ContactFeedback writers: a server restarted mid-session follows its
    * predecessor (few switches); servers of several sessions recorded into
    * one file (a partition pattern) interleave (many). */
@@ -194,9 +193,9 @@ static int on_event(void *arg, const void *sample, const recfile_row_t *row) {
     te->mark = kind == c->task_started ? REP_TASK_STARTED : REP_TASK_COMPLETED;
     te->value = te->mark == REP_TASK_COMPLETED && isfinite(e->value) ? e->value : NAN;
     task_of_event(e, te);
-  } else if (kind > (int32_t)viscera_EVENT_THRESHOLD_CROSSED_DOWN) {
-    c->events_other_kind++;
   }
+  /* Other kinds (grasps, cuts, instructor commands, topology changes) are
+   * the session's record, not measures: nothing is lost by leaving them. */
   return 0;
 }
 
@@ -393,8 +392,6 @@ int rep_recording_load(rep_recording_t *r, const char *path, const char *label, 
          "ContactFeedback from several servers interleaves (%llu switches): the recording holds several sessions "
          "(recorded with a partition pattern?) and the figures mix them; record one partition per file",
          (unsigned long long)c.fb_writer_switches);
-  if (c.events_other_kind)
-    warn(r, "%llu event(s) of kinds this report does not use were ignored", (unsigned long long)c.events_other_kind);
   size_t nforce = 0, ncmd = 0;
   for (int i = 0; i < r->ntools; i++) nforce += r->tools[i].nforce, ncmd += r->tools[i].ncmd;
   if (!nforce && !ncmd)
