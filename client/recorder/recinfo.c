@@ -12,7 +12,7 @@
 
 static void usage(FILE *f) {
   fprintf(f, "usage: viscera-recinfo FILE.db [--topic NAME] [--check-monotonic]\n"
-             "       viscera-recinfo FILE.db --export mcap OUT.mcap\n"
+             "       viscera-recinfo FILE.db --export mcap [--foxglove-scene] OUT.mcap\n"
              "       viscera-recinfo FILE.db --export csv|jsonl --topic NAME OUT|-\n"
              "Prints the session metadata of a viscera recording and a table per topic:\n"
              "samples (data/dispose/unregister), CDR bytes, first and last source\n"
@@ -31,6 +31,8 @@ static void usage(FILE *f) {
              "                                 (opens in Foxglove and any MCAP reader)\n"
              "                          csv    one topic (--topic), decoded fields, one row per sample\n"
              "                          jsonl  one topic, one JSON object per sample\n"
+             "      --foxglove-scene    with mcap: the organ meshes also as Foxglove scene primitives\n"
+             "                          (channel /viscera/scene, foxglove.SceneUpdate in JSON, 10 Hz)\n"
              "  -q, --quiet             no summary line after an export\n"
              "  -h, --help              this text\n"
              "      --version           print the version and exit\n"
@@ -39,7 +41,7 @@ static void usage(FILE *f) {
              "could be salvaged is still printed); 2 usage error; 3 timestamps not monotonic.\n");
 }
 
-enum { OPT_TOPIC = 't', OPT_CHECK_MONOTONIC = 'm', OPT_EXPORT = 'e' };
+enum { OPT_TOPIC = 't', OPT_CHECK_MONOTONIC = 'm', OPT_EXPORT = 'e', OPT_SCENE = 1000 };
 
 static int on_option(void *ctx, int code, const char *arg) {
   recinfo_options_t *o = ctx;
@@ -57,6 +59,9 @@ static int on_option(void *ctx, int code, const char *arg) {
       return EXIT_USAGE;
     }
     return EXIT_OK;
+  case OPT_SCENE:
+    o->foxglove_scene = true;
+    return EXIT_OK;
   }
   return 0; /* not reached: cli_parse passes only the codes above */
 }
@@ -66,6 +71,7 @@ int main(int argc, char **argv) {
       {"topic", required_argument, 0, OPT_TOPIC},
       {"check-monotonic", no_argument, 0, OPT_CHECK_MONOTONIC},
       {"export", required_argument, 0, OPT_EXPORT},
+      {"foxglove-scene", no_argument, 0, OPT_SCENE},
       {0, 0, 0, 0},
   };
   const cli_spec_t spec = {.program = "viscera-recinfo",

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "export_scene.h"
 #include "mcap_writer.h"
 #include "recording/rec_cdr.h"
 #include "recording/rec_idl.h"
@@ -30,6 +31,8 @@ typedef struct chan {
 
 typedef struct mcap_ctx {
   mcap_writer_t *w;
+  recfile_t *rf;
+  export_scene_t *scene; /* --foxglove-scene, or NULL */
   const rec_writer_t *writers;
   size_t nwriters;
   chan_t *chans;
@@ -67,6 +70,15 @@ static int on_mcap_row(void *arg, const recfile_row_t *row) {
     return 1;
   }
   c->messages++;
+  if (c->scene) {
+    const char *topic = "";
+    for (size_t i = 0; i < recfile_topic_count(c->rf); i++)
+      if (recfile_topic(c->rf, i)->id == row->topic_id) topic = recfile_topic(c->rf, i)->name;
+    if (export_scene_row(c->scene, topic, row, &c->err) < 0) {
+      c->failed = true;
+      return 1;
+    }
+  }
   return 0;
 }
 
@@ -96,13 +108,13 @@ static int plan_channels(recfile_t *rf, const rec_writer_t *w, size_t nw, chan_t
   return 0;
 }
 
-static int export_mcap(recfile_t *rf, const char *out, bool quiet) {
+static int export_mcap(recfile_t *rf, const char *out, bool scene, bool quiet) {
   const char *path = recfile_path(rf);
   verr_t err = {{0}};
   rec_writer_t *writers = NULL;
   size_t nw = 0;
   if (rec_writers_load(rf, &writers, &nw, &err) < 0) fprintf(stderr, "recinfo: warning: %s\n", err.msg);
-  mcap_ctx_t c = {.writers = writers, .nwriters = nw};
+  mcap_ctx_t c = {.writers = writers, .nwriters = nw, .rf = rf};
   int status = 0;
   char library[64];
   snprintf(library, sizeof library, "viscera-recinfo %s", cli_version());
@@ -142,6 +154,9 @@ static int export_mcap(recfile_t *rf, const char *out, bool quiet) {
     const char *meta[] = {"dds_topic", t->name, "partition", c.chans[k].partitions, "type", t->type_name};
     if (mcap_channel(c.w, (uint16_t)(k + 1), schema_of[ti], name, "cdr", meta, 3, &err) < 0) status = 1;
   }
+  if (status == 0 && schema_of && scene &&
+      !(c.scene = export_scene_open(c.w, (uint16_t)(nschemas + 1), (uint16_t)(c.nchans + 1), &err)))
+    status = 1;
   recfile_scan_report_t rep;
   if (status == 0 && schema_of) {
     recfile_scan(rf, 0, true, on_mcap_row, &c, &rep);
@@ -153,6 +168,13 @@ static int export_mcap(recfile_t *rf, const char *out, bool quiet) {
     }
   }
   if (!schema_of) status = 1, verr_set(&err, "out of memory");
+  uint64_t scene_msgs = 0, scene_skipped = 0;
+  export_scene_close(c.scene, &scene_msgs, &scene_skipped);
+  if (scene && !quiet)
+    fprintf(stderr,
+            "recinfo: %s: %llu Foxglove scene updates on /viscera/scene; %llu mesh samples without their keyframe "
+            "skipped\n",
+            out, (unsigned long long)scene_msgs, (unsigned long long)scene_skipped);
   verr_t cerr = {{0}};
   if (mcap_close(c.w, &cerr) < 0 && status == 0) err = cerr, status = 1;
   if (status && err.msg[0]) fprintf(stderr, "recinfo: %s\n", err.msg);
@@ -270,14 +292,14 @@ static int export_table(recfile_t *rf, export_format_t fmt, const char *out, con
   return status;
 }
 
-int recinfo_export(const char *path, export_format_t fmt, const char *out, const char *topic, bool quiet) {
+int recinfo_export(const char *path, export_format_t fmt, const char *out, const char *topic, bool scene, bool quiet) {
   verr_t err = {{0}};
   recfile_t *rf = NULL;
   if (recfile_open(&rf, path, &err) < 0) {
     fprintf(stderr, "recinfo: %s\n", err.msg);
     return 1;
   }
-  int r = fmt == EXPORT_MCAP ? export_mcap(rf, out, quiet) : export_table(rf, fmt, out, topic, quiet);
+  int r = fmt == EXPORT_MCAP ? export_mcap(rf, out, scene, quiet) : export_table(rf, fmt, out, topic, quiet);
   if (recfile_damaged(rf) && r == 0) r = 1;
   recfile_close(rf);
   return r;

@@ -7,6 +7,8 @@
  *          data sample as recorded (CDR with its encoding header), log and
  *          publish time = the sample's source time (ns since the epoch).
  *          Dispose and unregister rows carry no message and are counted.
+ *          With `scene`, the organ meshes also as Foxglove scene
+ *          primitives on one more channel (export_scene.h).
  *   csv    one topic (--topic): a header, then one row per data sample:
  *          source_time_ns, partition, then the decoded fields (rec_cdr.h).
  *   jsonl  one topic: one JSON object per data sample,
@@ -25,6 +27,6 @@ export_format_t export_format_parse(const char *name);
 /* Exit code: 0 all exported; 1 unreadable recording, unwritable OUT, or
  * samples that did not decode (the others are exported); 2 no such topic
  * or no --topic for csv/jsonl. A summary goes to stderr unless quiet. */
-int recinfo_export(const char *path, export_format_t fmt, const char *out, const char *topic, bool quiet);
+int recinfo_export(const char *path, export_format_t fmt, const char *out, const char *topic, bool scene, bool quiet);
 
 #endif

@@ -16,6 +16,7 @@ typedef struct recinfo_options {
   bool check_mono;               /* --check-monotonic */
   export_format_t export_format; /* --export FORMAT, EXPORT_NONE: print the summary */
   const char *export_out;        /* the file it goes to */
+  bool foxglove_scene;           /* --foxglove-scene */
   bool quiet;
 } recinfo_options_t;
 

@@ -50,6 +50,7 @@ async function main() {
   if (indexed.chunkIndexes.length === 0) fail("no chunk index in the summary");
   const readers = new Map();
   for (const [id, s] of indexed.schemasById) {
+    if (s.name === "foxglove.SceneUpdate" && s.encoding === "jsonschema") continue; // --foxglove-scene
     if (s.encoding !== "omgidl") fail(`schema ${s.name}: encoding ${s.encoding}`);
     const text = new TextDecoder().decode(s.data);
     try {
@@ -59,9 +60,19 @@ async function main() {
     }
   }
   const perTopic = new Map(), indexedCount = new Map();
-  let decoded = 0, total = 0, peak = 0, inContact = 0;
+  let decoded = 0, total = 0, peak = 0, inContact = 0, sceneUpdates = 0;
   for await (const m of indexed.readMessages({ validateCrcs: true })) {
     const ch = indexed.channelsById.get(m.channelId);
+    if (ch.topic === "/viscera/scene") { // Foxglove scene primitives: one organ surface per message
+      const u = JSON.parse(new TextDecoder().decode(m.data));
+      const t = u.entities[0].triangles[0];
+      if (!t.points.length || t.indices.length % 3 || t.indices.some((i) => i >= t.points.length))
+        fail(`scene update ${m.sequence}: ${t.points.length} points, ${t.indices.length} indices out of range`);
+      sceneUpdates++;
+      total++;
+      indexedCount.set(m.channelId, (indexedCount.get(m.channelId) || 0) + 1);
+      continue;
+    }
     if (ch.messageEncoding !== "cdr") fail(`channel ${ch.topic}: encoding ${ch.messageEncoding}`);
     if (m.logTime !== m.publishTime) fail(`channel ${ch.topic}: log time differs from publish time`);
     const reader = readers.get(ch.schemaId);
@@ -98,10 +109,13 @@ async function main() {
     if (got !== n) bad++;
   }
   for (const [t] of perTopic) if (!want.has(t)) fail(`topic ${t} in the MCAP file but not in the recording`);
+  const hasScene = [...indexed.channelsById.values()].some((c) => c.topic === "/viscera/scene");
+  if (hasScene && !sceneUpdates) fail("a /viscera/scene channel without scene updates");
+  if (hasScene) console.log(`scene_updates=${sceneUpdates}`);
   if (bad) fail(`${bad} topic(s) differ`);
   // decoded values, for the caller to compare with the server's figures
   console.log(`tool0_peak_force=${peak.toFixed(4)} tool0_contact_time=${(inContact * 0.001).toFixed(3)}`);
   console.log(`ok: ${total} messages in ${indexed.channelsById.size} channels, ${indexed.chunkIndexes.length} chunks, ` +
-              `all ${decoded} decoded with their OMG IDL schema`);
+              `all ${decoded} DDS samples decoded with their OMG IDL schema`);
 }
 main().catch((e) => fail(e.stack || String(e)));

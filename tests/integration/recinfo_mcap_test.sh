@@ -7,7 +7,9 @@
 # CDR deserializer), installed at test time into the build directory:
 # stream and indexed reading with CRC checks, every message decoded with
 # its channel's IDL schema, the messages per topic equal to recinfo's
-# sample counts, and the decoded force equal to the server's PALPATION line. Skips (77) when node or npm is missing or the packages
+# sample counts, and the decoded force equal to the server's PALPATION line;
+# with --foxglove-scene, the organ surface as scene updates (JSON) whose
+# triangles index points that exist. Skips (77) when node or npm is missing or the packages
 # cannot be installed (no registry).
 # usage: recinfo_mcap_test.sh BUILD SRC OUT
 set -euo pipefail
@@ -26,7 +28,8 @@ rm -rf "$OUT"; mkdir -p "$OUT"
 VIEWER_ARGS="--interval-ms 1000" bash "$SRC/deploy/session.sh" "$BUILD" "$OUT/demo" > "$OUT/session.out" 2>&1 \
   || { cat "$OUT/session.out"; fail "demo session did not run"; }
 REC="$OUT/demo/session.db"
-"$RECINFO" "$REC" --export mcap "$OUT/demo.mcap" 2> "$OUT/export.err" || { cat "$OUT/export.err"; fail "export failed"; }
+"$RECINFO" "$REC" --export mcap --foxglove-scene "$OUT/demo.mcap" 2> "$OUT/export.err" \
+  || { cat "$OUT/export.err"; fail "export failed"; }
 cat "$OUT/export.err"
 # recinfo's own table: topic and data samples
 "$RECINFO" "$REC" | awk '/^topic /{ t = 1; next } /^total:/{ t = 0 } t && NF > 3 { print $1, $3 }' > "$OUT/counts.txt"
@@ -43,6 +46,7 @@ awk -v g="$(got tool0_peak_force)" -v w="$(srv peak_force)" 'BEGIN { d = g - w; 
 awk -v g="$(got tool0_contact_time)" -v w="$(srv contact_time)" \
   'BEGIN { d = g - w; t = 0.03 * w; if (t < 0.05) t = 0.05; exit !(g != "" && d <= t && -d <= t) }' \
   || fail "decoded contact time $(got tool0_contact_time), server $(srv contact_time)"
+grep -q '^scene_updates=[1-9]' "$OUT/read.out" || fail "no Foxglove scene update in the export"
 echo "ok: decoded peak $(got tool0_peak_force) N, contact $(got tool0_contact_time) s = the server's PALPATION line"
 # A damaged export is caught: the reader must fail on a flipped byte in a chunk.
 cp "$OUT/demo.mcap" "$OUT/bad.mcap"
