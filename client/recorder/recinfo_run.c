@@ -206,6 +206,8 @@ static int print_participants(recfile_t *rf, const char *path) {
 }
 
 int recinfo_run(const recinfo_options_t *o) {
+  if (o->export_format != EXPORT_NONE)
+    return recinfo_export(o->path, o->export_format, o->export_out, o->topic, o->foxglove_scene, o->quiet);
   const char *path = o->path, *topic = o->topic;
   bool check_mono = o->check_mono;
   verr_t err = {{0}};

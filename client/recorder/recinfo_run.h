@@ -6,12 +6,18 @@
 
 #include <stdbool.h>
 
+#include "recinfo_export.h"
+
 enum { EXIT_OK = 0, EXIT_BAD_FILE = 1, EXIT_USAGE = 2, EXIT_NOT_MONOTONIC = 3 };
 
 typedef struct recinfo_options {
-  const char *path;  /* the recording */
-  const char *topic; /* --topic NAME, or NULL: every topic */
-  bool check_mono;   /* --check-monotonic */
+  const char *path;              /* the recording */
+  const char *topic;             /* --topic NAME, or NULL: every topic */
+  bool check_mono;               /* --check-monotonic */
+  export_format_t export_format; /* --export FORMAT, EXPORT_NONE: print the summary */
+  const char *export_out;        /* the file it goes to */
+  bool foxglove_scene;           /* --foxglove-scene */
+  bool quiet;
 } recinfo_options_t;
 
 /* Exit code: EXIT_OK, EXIT_BAD_FILE or EXIT_NOT_MONOTONIC. */

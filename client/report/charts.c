@@ -78,6 +78,67 @@ int rep_chart_force(const rep_recording_t *r, const char *path, verr_t *err) {
   return ret;
 }
 
+int rep_chart_force_overlay(const rep_recording_t *const *recs, int n, const char *path, verr_t *err) {
+  plot_t *p = calloc(1, sizeof *p);
+  if (!p) return verr_set(err, "%s: out of memory", path);
+  plot_init(p, "contact force of every trainee", "simulated time since the trainee's first sample (s)",
+            "contact force |F| (N), all tools", 0, 0);
+  int ret = 0, drawn = 0;
+  double tmax = 0;
+  for (int i = 0; i < n && ret == 0 && i < PLOT_MAX_SERIES - THR_COUNT - 1; i++) {
+    const rep_recording_t *r = recs[i];
+    /* The busiest tool's samples give the time base; the force at each is
+     * the sum over tools of their latest sample (one server step apart). */
+    int base = -1;
+    for (int t = 0; t < r->ntools; t++)
+      if (r->tools[t].nforce && (base < 0 || r->tools[t].nforce > r->tools[base].nforce)) base = t;
+    if (base < 0) continue;
+    const rep_tool_t *b = &r->tools[base];
+    double *x = malloc(2 * b->nforce * sizeof *x), *y = malloc(2 * b->nforce * sizeof *y);
+    size_t cur[REP_MAX_TOOLS] = {0};
+    if (!x || !y) {
+      ret = verr_set(err, "%s: out of memory", path);
+    } else {
+      size_t m = 0;
+      double t0 = b->force[0].t;
+      for (size_t k = 0; k < b->nforce; k++) {
+        double t = b->force[k].t, f = 0;
+        for (int u = 0; u < r->ntools; u++) {
+          const rep_tool_t *o = &r->tools[u];
+          while (cur[u] + 1 < o->nforce && o->force[cur[u] + 1].t <= t) cur[u]++;
+          if (o->nforce && o->force[cur[u]].t <= t && t - o->force[cur[u]].t <= REP_GAP_S) f += o->force[cur[u]].force;
+        }
+        if (k > 0 && t - b->force[k - 1].t > REP_GAP_S) x[m] = t - t0, y[m++] = NAN;
+        x[m] = t - t0, y[m++] = f;
+        tmax = fmax(tmax, t - t0);
+      }
+      char lab[112];
+      snprintf(lab, sizeof lab, "%s (peak %.2f N)", r->label, r->sum.peak_force);
+      /* palette colours other than the threshold lines' */
+      static const int COL[] = {0, 2, 4, 5, 6, 7, 8, 9};
+      int col = i < (int)(sizeof COL / sizeof COL[0]) ? COL[i] : i + 2;
+      if (plot_add(p, lab, m, x, y, col, -1, PLOT_LINE_SOLID)) drawn++;
+    }
+    free(x);
+    free(y);
+  }
+  if (ret == 0 && !drawn) ret = verr_set(err, "%s: no force samples to draw", path);
+  for (int k = 0; k < THR_COUNT && ret == 0; k++) {
+    double L = recs[0]->sum.levels[k];
+    if (!(L > 0)) continue;
+    double x[2] = {0, tmax}, y[2] = {L, L};
+    char lab[112];
+    snprintf(lab, sizeof lab, "%s %.2f N", thr_name((thr_id_t)k), L);
+    plot_add(p, lab, 2, x, y, LEVEL_COLOR[k], -1, k == THR_SFT ? PLOT_LINE_DOTTED : PLOT_LINE_DASHED);
+  }
+  double ax[1] = {0}, ay[1] = {0};
+  if (ret == 0) plot_add(p, "", 1, ax, ay, PLOT_GREY, -1, PLOT_LINE_NONE);
+  if (ret == 0) ret = plot_write_png(p, path, err);
+  plot_free(p);
+  free(p);
+  return ret;
+}
+
 int rep_chart_compare(const rep_recording_t *const *recs, int n, int measure, const char *path, verr_t *err) {
   const rep_measure_def_t *d = rep_measure(measure);
   if (!d) return verr_set(err, "%s: no measure %d", path, measure);

@@ -14,7 +14,7 @@
 
 static void usage(FILE *f) {
   fprintf(f,
-          "usage: viscera-report [--out DIR] [--label NAME=REC.db ...] [REC.db ...]\n"
+          "usage: viscera-report [--out DIR] [--label NAME=REC.db ...] [--limits FILE] [--limit L ...] [REC.db ...]\n"
           "Writes a trainee report of session recordings (viscera-recorder files):\n"
           "  DIR/report.html  per recording: force over time with the ST/MPF/SFT lines, peak and\n"
           "                   mean palpation force, exploration (contact) time, time to first\n"
@@ -22,11 +22,20 @@ static void usage(FILE *f) {
           "                   events), time above each threshold, crossings, path length; with\n"
           "                   several recordings a comparison (table and one bar chart per\n"
           "                   measure). Self-contained: the charts are embedded.\n"
-          "  DIR/report.csv   one row per recording\n"
+          "                   A lab recording (deploy/lab.sh, partitions lab/*) gives one section per\n"
+          "                   seat and a lab summary table; every section names its seat and station\n"
+          "                   and gives a verdict (PASS/FAIL per limit). Prints cleanly to PDF.\n"
+          "  DIR/report.csv   one row per recording (per seat), with the verdict\n"
           "  DIR/*.png        the charts\n"
           "\n"
           "  -o, --out DIR           output directory (default: report), created if missing\n"
           "  -l, --label NAME=FILE   a recording with the name to show (e.g. expert=a.db)\n"
+          "  -L, --limits FILE       the verdict's limits, one per line: MEASURE <= BOUND or\n"
+          "                          MEASURE >= BOUND; MEASURE a report.csv column (peak_force_N,\n"
+          "                          time_above_MPF_s, ...), BOUND a number or ST, MPF, SFT, 1.2*MPF\n"
+          "                          (the session's own thresholds). Default: peak_force_N <= SFT,\n"
+          "                          time_above_SFT_s <= 0, time_above_MPF_s <= 1\n"
+          "      --limit L           one more limit (same form), replacing one on the same measure\n"
           "  -q, --quiet             no progress lines\n"
           "  -h, --help              this text\n"
           "      --version           print the version and exit\n"
@@ -56,7 +65,7 @@ static void label_from_path(const char *path, char *out, size_t size) {
   if (!out[0]) snprintf(out, size, "recording");
 }
 
-enum { OPT_OUT = 'o', OPT_LABEL = 'l' };
+enum { OPT_OUT = 'o', OPT_LABEL = 'l', OPT_LIMITS = 'L', OPT_LIMIT = 1000 };
 
 static int on_option(void *ctx, int code, const char *optarg) {
   report_options_t *o = ctx;
@@ -64,6 +73,16 @@ static int on_option(void *ctx, int code, const char *optarg) {
   case OPT_OUT:
     o->out = optarg;
     return 0;
+  case OPT_LIMITS:
+  case OPT_LIMIT: {
+    verr_t err = {{0}};
+    if ((code == OPT_LIMITS ? rep_limits_load(&o->limits, optarg, &err) : rep_limits_add(&o->limits, optarg, &err)) <
+        0) {
+      fprintf(stderr, "report: %s\n", err.msg);
+      return 2;
+    }
+    return 0;
+  }
   case OPT_LABEL: {
     const char *eq = strchr(optarg, '=');
     if (!eq || eq == optarg || !eq[1]) {
@@ -90,16 +109,19 @@ int main(int argc, char **argv) {
   static const struct option longopts[] = {
       {"out", required_argument, 0, OPT_OUT},
       {"label", required_argument, 0, OPT_LABEL},
+      {"limits", required_argument, 0, OPT_LIMITS},
+      {"limit", required_argument, 0, OPT_LIMIT},
       {0, 0, 0, 0},
   };
   const cli_spec_t spec = {.program = "viscera-report",
                            .tag = "report",
                            .common = CLI_QUIET,
-                           .shortopts = "o:l:qh",
+                           .shortopts = "o:l:L:qh",
                            .options = longopts,
                            .option = on_option,
                            .usage = usage};
   static report_options_t o = {.out = "report"};
+  rep_limits_default(&o.limits);
   cli_common_t common = {0};
   int rc = cli_parse(&spec, argc, argv, &common, &o);
   if (rc != CLI_RUN) return rc;

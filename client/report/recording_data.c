@@ -6,7 +6,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "events_by_name.h"
 #include "recording/rec_decode.h"
+#include "recording/rec_writers.h"
 #include "viscera.h"
 
 /* A tool tip that moved less than this has not started moving (m): the
@@ -43,13 +45,22 @@ typedef struct load_ctx {
   uint64_t last_event_seq[REP_MAX_TOOLS + 1];
   int64_t last_event_writer[REP_MAX_TOOLS + 1];
   bool seen_event_source[REP_MAX_TOOLS + 1];
-  uint64_t events_other_kind;
   /* ContactFeedback writers: a server restarted mid-session follows its
    * predecessor (few switches); servers of several sessions recorded into
    * one file (a partition pattern) interleave (many). */
   int64_t last_fb_writer;
   uint64_t fb_writer_switches;
+  /* One seat of a lab: only rows of writers in partition `seat` count. */
+  const char *seat;
+  const rec_writer_t *writers;
+  size_t nwriters;
 } load_ctx_t;
+
+static bool in_seat(const load_ctx_t *c, const recfile_row_t *row) {
+  if (!c->seat) return true;
+  const rec_writer_t *w = rec_writer_find(c->writers, c->nwriters, row->writer_id);
+  return w && strcmp(w->partitions, c->seat) == 0;
+}
 
 static rep_tool_t *tool_of(rep_recording_t *r, uint32_t id) {
   if (id >= REP_MAX_TOOLS) return NULL;
@@ -63,8 +74,8 @@ static rep_tool_t *tool_of(rep_recording_t *r, uint32_t id) {
 }
 
 static int on_scene(void *arg, const void *sample, const recfile_row_t *row) {
-  (void)row;
   load_ctx_t *c = arg;
+  if (!in_seat(c, row)) return 0;
   const viscera_SceneInfo *si = sample;
   rep_recording_t *r = c->r;
   r->have_scene_info = true;
@@ -83,6 +94,7 @@ static int on_scene(void *arg, const void *sample, const recfile_row_t *row) {
 
 static int on_feedback(void *arg, const void *sample, const recfile_row_t *row) {
   load_ctx_t *c = arg;
+  if (!in_seat(c, row)) return 0;
   if (row->writer_id > 0) {
     if (c->last_fb_writer > 0 && row->writer_id != c->last_fb_writer) c->fb_writer_switches++;
     c->last_fb_writer = row->writer_id;
@@ -106,6 +118,7 @@ static int on_feedback(void *arg, const void *sample, const recfile_row_t *row) 
 
 static int on_command(void *arg, const void *sample, const recfile_row_t *row) {
   load_ctx_t *c = arg;
+  if (!in_seat(c, row)) return 0;
   const viscera_ToolCommand *cmd = sample;
   rep_tool_t *t = tool_of(c->r, cmd->tool_id);
   if (!t) return 0;
@@ -128,8 +141,32 @@ static int threshold_of_text(const char *text) {
   return -1;
 }
 
+/* The task an event is about: the id and name the server puts in it; an
+ * event without them (another writer) is named by its text, "task 'NAME'
+ * ..." as the server words it, else the text's first word. */
+static void task_of_event(const viscera_SessionEvent *e, rep_task_event_t *te) {
+  te->id = e->task_id >= 0 && e->task_name[0] ? e->task_id : -1;
+  if (te->id >= 0) {
+    snprintf(te->name, sizeof te->name, "%.63s", e->task_name);
+    return;
+  }
+  const char *b = e->text;
+  size_t len = strcspn(b, " :");
+  const char *q = strstr(e->text, "task '");
+  if (q) {
+    b = q + 6;
+    const char *end = strchr(b, '\'');
+    len = end ? (size_t)(end - b) : strlen(b);
+  }
+  if (len >= sizeof te->name) len = sizeof te->name - 1;
+  memcpy(te->name, b, len);
+  te->name[len] = 0;
+  if (!te->name[0]) snprintf(te->name, sizeof te->name, "task");
+}
+
 static int on_event(void *arg, const void *sample, const recfile_row_t *row) {
   load_ctx_t *c = arg;
+  if (!in_seat(c, row)) return 0;
   const viscera_SessionEvent *e = sample;
   rep_recording_t *r = c->r;
   /* A reliable transient-local event can reach the recorder twice (late
@@ -154,22 +191,17 @@ static int on_event(void *arg, const void *sample, const recfile_row_t *row) {
     rep_task_event_t *te = &r->task_events[r->ntask_events++];
     te->t = (double)e->sim_time_ns * 1e-9;
     te->mark = kind == c->task_started ? REP_TASK_STARTED : REP_TASK_COMPLETED;
-    /* The task is named by the event text; its first word when the text
-     * goes on ("stone_removal: ..."). */
-    size_t len = strcspn(e->text, " :");
-    if (len >= sizeof te->name) len = sizeof te->name - 1;
-    memcpy(te->name, e->text, len);
-    te->name[len] = 0;
-    if (!te->name[0]) snprintf(te->name, sizeof te->name, "task");
-  } else if (kind > (int32_t)viscera_EVENT_THRESHOLD_CROSSED_DOWN) {
-    c->events_other_kind++;
+    te->value = te->mark == REP_TASK_COMPLETED && isfinite(e->value) ? e->value : NAN;
+    task_of_event(e, te);
   }
+  /* Other kinds (grasps, cuts, instructor commands, topology changes) are
+   * the session's record, not measures: nothing is lost by leaving them. */
   return 0;
 }
 
 static int on_metrics(void *arg, const void *sample, const recfile_row_t *row) {
-  (void)row;
   load_ctx_t *c = arg;
+  if (!in_seat(c, row)) return 0;
   const viscera_Metrics *m = sample;
   rep_recording_t *r = c->r;
   r->have_metrics = true;
@@ -183,15 +215,16 @@ static int on_metrics(void *arg, const void *sample, const recfile_row_t *row) {
   return 0;
 }
 
-/* Reads one topic and turns what went wrong into warnings. */
-static void load_topic(rep_recording_t *r, recfile_t *rf, const char *topic, const dds_topic_descriptor_t *desc,
-                       rec_decode_cb cb, load_ctx_t *c, bool needed) {
+/* Reads one topic and turns what went wrong into warnings; returns the
+ * samples that did not decode (warned about unless `quiet_undecodable`). */
+static uint64_t load_topic(rep_recording_t *r, recfile_t *rf, const char *topic, const dds_topic_descriptor_t *desc,
+                           rec_decode_cb cb, load_ctx_t *c, bool needed, bool quiet_undecodable) {
   rec_decode_report_t rep;
   if (rec_decode_topic(rf, topic, desc, cb, c, &rep) < 0) c->oom = true;
   const char *shortname = strncmp(topic, "viscera_", 8) == 0 ? topic + 8 : topic;
   if (rep.topic_missing) {
     if (needed) warn(r, "no %s topic in the recording", shortname);
-    return;
+    return 0;
   }
   if (rep.scan.damaged || rep.scan.invalid) {
     r->damaged = true;
@@ -199,9 +232,10 @@ static void load_topic(rep_recording_t *r, recfile_t *rf, const char *topic, con
          rep.scan.damaged, (unsigned long long)rep.scan.invalid, rep.scan.gave_up ? ", gave up on the rest" : "",
          rep.scan.first_error[0] ? rep.scan.first_error : "invalid rows", (unsigned long long)rep.decoded);
   }
-  if (rep.undecodable)
+  if (rep.undecodable && !quiet_undecodable)
     warn(r, "%s: %llu sample(s) do not decode (damaged, or written with a newer type) and were skipped", shortname,
          (unsigned long long)rep.undecodable);
+  return rep.undecodable;
 }
 
 static void summarise(rep_recording_t *r) {
@@ -252,13 +286,74 @@ static void summarise(rep_recording_t *r) {
       rep_tasks(r->task_events, r->ntask_events, isfinite(first_motion) ? first_motion : 0, r->tasks, REP_MAX_TASKS);
 }
 
-int rep_recording_load(rep_recording_t *r, const char *path, const char *label, verr_t *err) {
+/* Who trained in this section: its seat (partition) and, per ToolCommand
+ * writer (the trainee's hands), the station and process its participant
+ * announced (a claim, vdds_ident.h; authenticated only with DDS Security). */
+static void describe_identity(rep_recording_t *r, recfile_t *rf, const load_ctx_t *c) {
+  size_t len = (size_t)snprintf(r->identity, sizeof r->identity, "seat %s",
+                                c->seat ? c->seat : (r->session.partition[0] ? r->session.partition : "?"));
+  const recfile_topic_t *cmd = recfile_topic_by_name(rf, "viscera_ToolCommand");
+  int shown = 0;
+  for (size_t i = 0; cmd && i < c->nwriters && len + 96 < sizeof r->identity; i++) {
+    const rec_writer_t *w = &c->writers[i];
+    if (w->topic_id != cmd->id || (c->seat && strcmp(w->partitions, c->seat) != 0)) continue;
+    char station[40] = "", host[64] = "?", pid[16] = "?";
+    if (!rec_ident_field(w->participant, "station", station, sizeof station) || !station[0])
+      snprintf(station, sizeof station, "anonymous");
+    rec_ident_field(w->participant, "host", host, sizeof host);
+    rec_ident_field(w->participant, "pid", pid, sizeof pid);
+    /* no commas: the CSV's readers split naively */
+    len += (size_t)snprintf(r->identity + len, sizeof r->identity - len, "; station %s (%s on %s pid %s)", station,
+                            w->role[0] ? w->role : "client", host, pid);
+    shown++;
+  }
+  if (!shown && len + 40 < sizeof r->identity)
+    snprintf(r->identity + len, sizeof r->identity - len, "; no trainee client recorded");
+}
+
+int rep_recording_seats(const char *path, char (*seats)[128], int max, verr_t *err) {
+  recfile_t *rf = NULL;
+  if (recfile_open(&rf, path, err) < 0) return -1;
+  rec_writer_t *w = NULL;
+  size_t nw = 0;
+  int n = 0;
+  const recfile_topic_t *fb = recfile_topic_by_name(rf, "viscera_ContactFeedback");
+  if (fb && rec_writers_load(rf, &w, &nw, err) == 0) {
+    for (size_t i = 0; i < nw; i++) {
+      if (w[i].topic_id != fb->id || !w[i].partitions[0] || strchr(w[i].partitions, ',')) continue;
+      int k = 0;
+      while (k < n && strcmp(seats[k], w[i].partitions) < 0) k++;
+      if (k < n && strcmp(seats[k], w[i].partitions) == 0) continue;
+      if (n == max) break;
+      memmove(seats[k + 1], seats[k], (size_t)(n - k) * sizeof seats[0]);
+      snprintf(seats[k], sizeof seats[0], "%.127s", w[i].partitions);
+      n++;
+    }
+  }
+  free(w);
+  recfile_close(rf);
+  return n;
+}
+
+int rep_recording_load(rep_recording_t *r, const char *path, const char *label, const char *seat, verr_t *err) {
   memset(r, 0, sizeof *r);
   snprintf(r->path, sizeof r->path, "%s", path);
   snprintf(r->label, sizeof r->label, "%s", label);
+  if (seat) snprintf(r->seat, sizeof r->seat, "%s", seat);
   r->physics_dt = 1e-3;
   recfile_t *rf = NULL;
   if (recfile_open(&rf, path, err) < 0) return -1;
+  rec_writer_t *writers = NULL;
+  size_t nwriters = 0;
+  verr_t werr = {{0}};
+  if (rec_writers_load(rf, &writers, &nwriters, &werr) < 0) {
+    warn(r, "%s", werr.msg);
+    if (seat) {
+      free(writers);
+      recfile_close(rf);
+      return verr_set(err, "%s: cannot tell the seats apart: %s", path, werr.msg);
+    }
+  }
   r->session = *recfile_session(rf);
   r->damaged = recfile_damaged(rf);
   const char *w = recfile_warnings(rf);
@@ -268,16 +363,27 @@ int rep_recording_load(rep_recording_t *r, const char *path, const char *label, 
   else if (!r->session.has_end)
     warn(r, "%s", "the recording has no end time (recorder killed or still running): it may stop early");
 
-  load_ctx_t c = {.r = r, .task_started = -1, .task_completed = -1};
+  load_ctx_t c = {
+      .r = r, .task_started = -1, .task_completed = -1, .seat = seat, .writers = writers, .nwriters = nwriters};
   /* Task events are newer than this tool's code: found by name in the
    * compiled type, so they work as soon as the IDL has them. */
   rec_decode_enum_value(&viscera_SessionEvent_desc, "EVENT_TASK_STARTED", &c.task_started);
   rec_decode_enum_value(&viscera_SessionEvent_desc, "EVENT_TASK_COMPLETED", &c.task_completed);
-  load_topic(r, rf, "viscera_SceneInfo", &viscera_SceneInfo_desc, on_scene, &c, true);
-  load_topic(r, rf, "viscera_ContactFeedback", &viscera_ContactFeedback_desc, on_feedback, &c, true);
-  load_topic(r, rf, "viscera_ToolCommand", &viscera_ToolCommand_desc, on_command, &c, true);
-  load_topic(r, rf, "viscera_SessionEvent", &viscera_SessionEvent_desc, on_event, &c, true);
-  load_topic(r, rf, "viscera_Metrics", &viscera_Metrics_desc, on_metrics, &c, false);
+  load_topic(r, rf, "viscera_SceneInfo", &viscera_SceneInfo_desc, on_scene, &c, true, false);
+  load_topic(r, rf, "viscera_ContactFeedback", &viscera_ContactFeedback_desc, on_feedback, &c, true, false);
+  load_topic(r, rf, "viscera_ToolCommand", &viscera_ToolCommand_desc, on_command, &c, true, false);
+  if (load_topic(r, rf, "viscera_SessionEvent", &viscera_SessionEvent_desc, on_event, &c, true, true)) {
+    /* Events of an older (or newer) SessionEvent type: by field name. */
+    uint64_t left = 0, salvaged = rep_events_by_name(rf, on_event, &c, &left);
+    if (salvaged)
+      warn(r, "SessionEvent: %llu event(s) of another version of the type were read by field name",
+           (unsigned long long)salvaged);
+    if (left)
+      warn(r, "SessionEvent: %llu sample(s) do not decode (damaged?) and were skipped", (unsigned long long)left);
+  }
+  load_topic(r, rf, "viscera_Metrics", &viscera_Metrics_desc, on_metrics, &c, false, false);
+  describe_identity(r, rf, &c);
+  free(writers);
   recfile_close(rf);
   if (c.oom) return verr_set(err, "%s: out of memory while reading", path);
   if (!r->have_scene_info) warn(r, "%s", "no SceneInfo: thresholds unknown (ST/MPF/SFT measures are 0)");
@@ -286,8 +392,6 @@ int rep_recording_load(rep_recording_t *r, const char *path, const char *label, 
          "ContactFeedback from several servers interleaves (%llu switches): the recording holds several sessions "
          "(recorded with a partition pattern?) and the figures mix them; record one partition per file",
          (unsigned long long)c.fb_writer_switches);
-  if (c.events_other_kind)
-    warn(r, "%llu event(s) of kinds this report does not use were ignored", (unsigned long long)c.events_other_kind);
   size_t nforce = 0, ncmd = 0;
   for (int i = 0; i < r->ntools; i++) nforce += r->tools[i].nforce, ncmd += r->tools[i].ncmd;
   if (!nforce && !ncmd)

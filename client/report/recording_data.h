@@ -56,6 +56,8 @@ typedef struct rep_summary {
 typedef struct rep_recording {
   char path[512];
   char label[64];
+  char seat[128];     /* the partition this section covers, "" = the whole file */
+  char identity[512]; /* who trained: seat, station, the trainee's process */
   recfile_session_t session;
   char scene[72];
   double physics_dt;
@@ -75,9 +77,17 @@ typedef struct rep_recording {
   char warnings[2048]; /* one per line, "" when none */
 } rep_recording_t;
 
-/* Loads and computes. Returns 0 (possibly with warnings), or -1 with err
- * naming the file; `r` must be freed with rep_recording_free either way. */
-int rep_recording_load(rep_recording_t *r, const char *path, const char *label, verr_t *err);
+/* Loads and computes. With `seat` (a partition, e.g. "lab/seat02") only the
+ * samples of writers in that partition count: one seat of a lab recorded
+ * with a partition pattern; NULL takes every sample. Returns 0 (possibly
+ * with warnings), or -1 with err naming the file; `r` must be freed with
+ * rep_recording_free either way. */
+int rep_recording_load(rep_recording_t *r, const char *path, const char *label, const char *seat, verr_t *err);
+
+/* The seats of a recording: the distinct partitions its ContactFeedback
+ * writers (the servers) wrote in, sorted, at most `max` of 128 bytes each.
+ * Returns how many (0: none known), or -1 with err. */
+int rep_recording_seats(const char *path, char (*seats)[128], int max, verr_t *err);
 void rep_recording_free(rep_recording_t *r);
 
 #endif

@@ -36,12 +36,13 @@ static size_t count_lines(const char *s) {
   return n;
 }
 
-int rep_write_csv(const rep_recording_t *const *recs, int n, const char *path, verr_t *err) {
+int rep_write_csv(const rep_recording_t *const *recs, int n, const rep_limits_t *limits, const char *path,
+                  verr_t *err) {
   FILE *f = fopen(path, "w");
   if (!f) return verr_set(err, "%s: cannot create: %s", path, strerror(errno));
-  fprintf(f, "label,file,scene,partition,start_utc,complete");
+  fprintf(f, "label,file,scene,partition,identity,start_utc,complete");
   for (int m = 0; m < REP_NMEASURES; m++) fprintf(f, ",%s", rep_measure(m)->key);
-  fprintf(f, ",ST_N,MPF_N,SFT_N,crossings_source,tasks,warnings\n");
+  fprintf(f, ",ST_N,MPF_N,SFT_N,crossings_source,tasks,verdict,failed,warnings\n");
   for (int i = 0; i < n; i++) {
     const rep_recording_t *r = recs[i];
     char start[40];
@@ -52,7 +53,9 @@ int rep_write_csv(const rep_recording_t *const *recs, int n, const char *path, v
     fputc(',', f);
     csv_text(f, r->scene[0] ? r->scene : r->session.scene);
     fputc(',', f);
-    csv_text(f, r->session.partition);
+    csv_text(f, r->seat[0] ? r->seat : r->session.partition);
+    fputc(',', f);
+    csv_text(f, r->identity);
     fprintf(f, ",%s,%d", start, r->damaged || !r->session.has_end ? 0 : 1);
     for (int m = 0; m < REP_NMEASURES; m++) {
       fputc(',', f);
@@ -75,6 +78,16 @@ int rep_write_csv(const rep_recording_t *const *recs, int n, const char *path, v
         len += (size_t)snprintf(tasks + len, sizeof tasks - len, "%s%s=incomplete", t ? ";" : "", tk->name);
     }
     csv_text(f, tasks);
+    /* verdict, and the limits that failed as "KEY<=BOUND;..." */
+    char failed[512] = "";
+    size_t fl = 0;
+    for (int k = 0; k < limits->n && fl + 80 < sizeof failed; k++) {
+      double v, b;
+      if (rep_limit_check(&limits->l[k], r, &v, &b) == REP_FAIL)
+        fl += (size_t)snprintf(failed + fl, sizeof failed - fl, "%s%s", fl ? ";" : "", limits->l[k].text);
+    }
+    fprintf(f, ",%s,", rep_outcome_name(rep_verdict(limits, r, NULL)));
+    csv_text(f, failed);
     fprintf(f, ",%zu\n", count_lines(r->warnings));
   }
   if (fclose(f) != 0) return verr_set(err, "%s: write failed: %s", path, strerror(errno));
@@ -144,14 +157,157 @@ static void html_value(FILE *f, const rep_recording_t *r, int m) {
 static const char *STYLE =
     "body{font-family:'DejaVu Sans',Arial,sans-serif;max-width:1000px;margin:24px auto;color:#222;padding:0 12px}"
     "h1{font-size:24px}h2{font-size:19px;border-bottom:2px solid #1f77b4;padding-bottom:3px;margin-top:34px}"
+    "h3{font-size:15px;margin:16px 0 4px}"
+    ".summary td:nth-child(2),.summary th:nth-child(2){text-align:left}.summary td:first-child{white-space:nowrap}"
     "table{border-collapse:collapse;margin:10px 0}td,th{border:1px solid #ccc;padding:4px 10px;text-align:right}"
     "th{background:#eef3f8}td:first-child,th:first-child{text-align:left}td.na{color:#999}"
+    "td.pass{color:#176d2c;font-weight:bold}td.fail{color:#b00020;font-weight:bold}"
+    ".verdict{display:inline-block;padding:2px 10px;border-radius:3px;font-weight:bold;color:#fff}"
+    ".verdict.pass{background:#2e7d32}.verdict.fail{background:#c62828}.verdict.na{background:#888}"
+    ".who{background:#f4f6f9;border-left:4px solid #1f77b4;padding:6px 10px;margin:8px 0}"
     ".warn{background:#fff4e0;border-left:4px solid #e69500;padding:6px 10px;white-space:pre-wrap}"
     ".meta td{text-align:left}.grid{display:flex;flex-wrap:wrap;gap:8px}.grid img{width:440px}"
-    "img{max-width:100%}.note{color:#555;font-size:13px}";
+    "img{max-width:100%}.note{color:#555;font-size:13px}"
+    /* Print (the browser's print to PDF): A4, one section per page, no
+     * table row or chart cut across pages, colours kept. */
+    "@page{size:A4;margin:14mm 12mm}"
+    "@media print{body{max-width:none;margin:0;padding:0;font-size:11px}"
+    "h2{break-before:page;page-break-before:always;margin-top:0}h2.first{break-before:auto;page-break-before:auto}"
+    "table,img,.who,.warn,tr{break-inside:avoid;page-break-inside:avoid}h2,h3{break-after:avoid;page-break-after:avoid}"
+    ".grid img{width:48%}td,th{padding:2px 6px}.note{font-size:9px}"
+    "*{-webkit-print-color-adjust:exact;print-color-adjust:exact}}";
 
-int rep_write_html(const rep_recording_t *const *recs, int n, const char *const *force_png,
-                   const char *const *compare_png, const char *path, verr_t *err) {
+static const char *outcome_class(rep_outcome_t o) { return o == REP_PASS ? "pass" : o == REP_FAIL ? "fail" : "na"; }
+
+static void html_verdict_badge(FILE *f, rep_outcome_t v) {
+  fprintf(f, "<span class=\"verdict %s\">%s</span>", outcome_class(v), rep_outcome_name(v));
+}
+
+static void html_number(FILE *f, int m, double v) {
+  const rep_measure_def_t *d = rep_measure(m);
+  fprintf(f, d->format, v);
+  if (d->unit[0]) fprintf(f, " %s", d->unit);
+}
+
+static void html_verdict(FILE *f, const rep_recording_t *r, const rep_limits_t *ls) {
+  int nfail = 0;
+  rep_outcome_t v = rep_verdict(ls, r, &nfail);
+  fputs("<h3>Verdict ", f);
+  html_verdict_badge(f, v);
+  fputs("</h3>\n<table><tr><th>measure</th><th>value</th><th>limit</th><th>result</th></tr>\n", f);
+  for (int i = 0; i < ls->n; i++) {
+    const rep_limit_t *l = &ls->l[i];
+    double val, b;
+    rep_outcome_t o = rep_limit_check(l, r, &val, &b);
+    fputs("<tr><td>", f);
+    html_text(f, rep_measure(l->measure)->title);
+    fputs("</td><td>", f);
+    if (isfinite(val))
+      html_number(f, l->measure, val);
+    else
+      fputs("n/a", f);
+    fprintf(f, "</td><td>%s ", l->upper ? "&le;" : "&ge;");
+    if (isfinite(b))
+      html_number(f, l->measure, b);
+    else
+      fputs("n/a", f);
+    if (l->level >= 0) fprintf(f, " (%s)", strchr(l->text, l->upper ? '<' : '>') + 3);
+    fprintf(f, "</td><td class=%s>%s</td></tr>\n", outcome_class(o), rep_outcome_name(o));
+  }
+  fputs("</table>\n", f);
+}
+
+/* One row per section: who, the key measures, tasks and the verdict. */
+static void html_summary(FILE *f, const rep_recording_t *const *recs, int n, const rep_layout_t *lay) {
+  fprintf(f, "<h2 class=first id=summary>%s</h2>\n", lay->lab ? "Lab summary" : "Summary");
+  fputs(
+      "<table class=summary><tr><th>trainee</th><th>who</th><th>peak force</th><th>contact time</th><th>above MPF</th>"
+      "<th>tasks completed</th><th>verdict</th></tr>\n",
+      f);
+  for (int i = 0; i < n; i++) {
+    const rep_recording_t *r = recs[i];
+    fprintf(f, "<tr><td><a href=\"#s%d\">", i + 1);
+    html_text(f, r->label);
+    fputs("</a></td><td>", f);
+    html_text(f, r->identity);
+    fputs("</td>", f);
+    html_value(f, r, 0);
+    html_value(f, r, 2);
+    html_value(f, r, 6);
+    size_t done = 0;
+    for (size_t t = 0; t < r->ntasks; t++) done += isfinite(r->tasks[t].end);
+    fprintf(f, "<td>%zu / %zu</td><td>", done, r->ntasks);
+    html_verdict_badge(f, rep_verdict(lay->limits, r, NULL));
+    fputs("</td></tr>\n", f);
+  }
+  fputs("</table>\n", f);
+}
+
+static int html_section(FILE *f, const rep_recording_t *r, int i, const rep_charts_t *ch, const rep_layout_t *lay,
+                        bool first, verr_t *err) {
+  fprintf(f, "<h2 id=s%d%s>", i + 1, first ? " class=first" : "");
+  html_text(f, r->label);
+  fputs("</h2>\n<div class=who><b>Trainee:</b> ", f);
+  html_text(f, r->identity);
+  fputs("</div>\n<table class=meta>", f);
+  char start[40];
+  utc_string(r->session.start_wall_ns, start, sizeof start);
+  fputs("<tr><td>recording</td><td>", f);
+  html_text(f, r->path);
+  fputs("</td></tr><tr><td>scene</td><td>", f);
+  html_text(f, r->scene[0] ? r->scene : r->session.scene);
+  fputs("</td></tr><tr><td>partition</td><td>", f);
+  html_text(f, r->seat[0] ? r->seat : r->session.partition);
+  fprintf(f, "</td></tr><tr><td>started</td><td>%s</td></tr>", start);
+  fprintf(f, "<tr><td>simulated time covered</td><td>%.2f s</td></tr>", r->sum.duration);
+  for (int t = 0; t < r->ntools; t++)
+    if (r->tools[t].present) {
+      fputs("<tr><td>tool ", f);
+      html_text(f, r->tools[t].name);
+      fprintf(f, "</td><td>%zu force samples, %zu commands; ST %.2f N, MPF %.2f N, SFT %.2f N</td></tr>",
+              r->tools[t].nforce, r->tools[t].ncmd, r->tools[t].levels[0], r->tools[t].levels[1],
+              r->tools[t].levels[2]);
+    }
+  fputs("</table>\n", f);
+  if (r->warnings[0]) {
+    fputs("<div class=warn><b>Warnings</b> (the figures cover what was readable):\n", f);
+    html_text(f, r->warnings);
+    fputs("</div>\n", f);
+  }
+  html_verdict(f, r, lay->limits);
+  fputs("<h3>Measures</h3>\n<table><tr><th>measure</th><th>value</th></tr>\n", f);
+  for (int m = 0; m < REP_NMEASURES; m++) {
+    fputs("<tr><td>", f);
+    html_text(f, rep_measure(m)->title);
+    fputs("</td>", f);
+    html_value(f, r, m);
+    fputs("</tr>\n", f);
+  }
+  for (size_t t = 0; t < r->ntasks; t++) {
+    const rep_task_t *tk = &r->tasks[t];
+    fputs("<tr><td>operation time, task ", f);
+    html_text(f, tk->name);
+    if (tk->id >= 0) fprintf(f, " (#%d)", tk->id);
+    if (isfinite(tk->end))
+      fprintf(f, "</td><td>%.3f s%s</td></tr>\n", tk->end - tk->start, tk->started_seen ? "" : " (from session start)");
+    else
+      fputs("</td><td class=na>not completed</td></tr>\n", f);
+  }
+  if (r->have_metrics)
+    fprintf(f,
+            "<tr><td class=note>server's last Metrics (about 1 Hz): above ST / MPF / SFT, contact, mean, peak, "
+            "path</td><td class=note>%.2f / %.2f / %.2f s, %.2f s, %.2f N, %.2f N, %.1f cm</td></tr>\n",
+            r->metrics_time_above[0], r->metrics_time_above[1], r->metrics_time_above[2], r->metrics_contact_time,
+            r->metrics_mean_force, r->metrics_peak, r->metrics_path * 100);
+  fprintf(f, "</table>\n<p class=note>crossings from %s.</p>\n",
+          r->sum.crossings_from_events ? "the server's SessionEvents"
+                                       : "the replayed force trace (no events recorded)");
+  if (ch->force_png && ch->force_png[i]) return html_png(f, ch->force_png[i], "contact force over time", err);
+  return 0;
+}
+
+int rep_write_html(const rep_recording_t *const *recs, int n, const rep_charts_t *ch, const rep_layout_t *lay,
+                   const char *path, verr_t *err) {
   FILE *f = fopen(path, "w");
   if (!f) return verr_set(err, "%s: cannot create: %s", path, strerror(errno));
   int ret = 0;
@@ -160,69 +316,14 @@ int rep_write_html(const rep_recording_t *const *recs, int n, const char *const 
           "<style>%s</style></head><body>\n<h1>Trainee report</h1>\n",
           STYLE);
   fprintf(f,
-          "<p class=note>%d recording(s). Force measures replay the recorded ContactFeedback (force on the tool "
+          "<p class=note>%d section(s)%s. Force measures replay the recorded ContactFeedback (force on the tool "
           "at the server, every physics step) through the server's threshold tracker; times are simulated "
           "time. Thresholds (docs/methods.md B ch. 6): ST sound threshold, MPF maximum palpation force, SFT stopping "
-          "force threshold; crossings are upward crossings.</p>\n",
-          n);
-  for (int i = 0; i < n && ret == 0; i++) {
-    const rep_recording_t *r = recs[i];
-    fputs("<h2>", f);
-    html_text(f, r->label);
-    fputs("</h2>\n<table class=meta>", f);
-    char start[40];
-    utc_string(r->session.start_wall_ns, start, sizeof start);
-    fputs("<tr><td>recording</td><td>", f);
-    html_text(f, r->path);
-    fputs("</td></tr><tr><td>scene</td><td>", f);
-    html_text(f, r->scene[0] ? r->scene : r->session.scene);
-    fputs("</td></tr><tr><td>partition</td><td>", f);
-    html_text(f, r->session.partition);
-    fprintf(f, "</td></tr><tr><td>started</td><td>%s</td></tr>", start);
-    fprintf(f, "<tr><td>simulated time covered</td><td>%.2f s</td></tr>", r->sum.duration);
-    for (int t = 0; t < r->ntools; t++)
-      if (r->tools[t].present) {
-        fputs("<tr><td>tool ", f);
-        html_text(f, r->tools[t].name);
-        fprintf(f, "</td><td>%zu force samples, %zu commands; ST %.2f N, MPF %.2f N, SFT %.2f N</td></tr>",
-                r->tools[t].nforce, r->tools[t].ncmd, r->tools[t].levels[0], r->tools[t].levels[1],
-                r->tools[t].levels[2]);
-      }
-    fputs("</table>\n", f);
-    if (r->warnings[0]) {
-      fputs("<div class=warn><b>Warnings</b> (the figures cover what was readable):\n", f);
-      html_text(f, r->warnings);
-      fputs("</div>\n", f);
-    }
-    fputs("<table><tr><th>measure</th><th>value</th></tr>\n", f);
-    for (int m = 0; m < REP_NMEASURES; m++) {
-      fputs("<tr><td>", f);
-      html_text(f, rep_measure(m)->title);
-      fputs("</td>", f);
-      html_value(f, r, m);
-      fputs("</tr>\n", f);
-    }
-    for (size_t t = 0; t < r->ntasks; t++) {
-      const rep_task_t *tk = &r->tasks[t];
-      fputs("<tr><td>operation time, task ", f);
-      html_text(f, tk->name);
-      if (isfinite(tk->end))
-        fprintf(f, "</td><td>%.2f s%s</td></tr>\n", tk->end - tk->start,
-                tk->started_seen ? "" : " (from session start)");
-      else
-        fputs("</td><td class=na>not completed</td></tr>\n", f);
-    }
-    if (r->have_metrics)
-      fprintf(f,
-              "<tr><td class=note>server's last Metrics (about 1 Hz): above ST / MPF / SFT, contact, mean, peak, "
-              "path</td><td class=note>%.2f / %.2f / %.2f s, %.2f s, %.2f N, %.2f N, %.1f cm</td></tr>\n",
-              r->metrics_time_above[0], r->metrics_time_above[1], r->metrics_time_above[2], r->metrics_contact_time,
-              r->metrics_mean_force, r->metrics_peak, r->metrics_path * 100);
-    fprintf(f, "</table>\n<p class=note>crossings from %s.</p>\n",
-            r->sum.crossings_from_events ? "the server's SessionEvents"
-                                         : "the replayed force trace (no events recorded)");
-    if (force_png && force_png[i]) ret = html_png(f, force_png[i], "contact force over time", err);
-  }
+          "force threshold; crossings are upward crossings. Identities are what each process announced (a claim "
+          "unless the session ran with DDS Security).</p>\n",
+          n, lay->lab ? ", one per seat of the lab" : "");
+  if (n >= 2) html_summary(f, recs, n, lay);
+  for (int i = 0; i < n && ret == 0; i++) ret = html_section(f, recs[i], i, ch, lay, n < 2 && i == 0, err);
   if (n >= 2 && ret == 0) {
     fputs("<h2 id=comparison>Comparison</h2>\n<table><tr><th>measure</th>", f);
     for (int i = 0; i < n; i++) {
@@ -238,9 +339,16 @@ int rep_write_html(const rep_recording_t *const *recs, int n, const char *const 
       for (int i = 0; i < n; i++) html_value(f, recs[i], m);
       fputs("</tr>\n", f);
     }
-    fputs("</table>\n<div class=grid>\n", f);
+    fputs("<tr><td>verdict</td>", f);
+    for (int i = 0; i < n; i++) {
+      rep_outcome_t v = rep_verdict(lay->limits, recs[i], NULL);
+      fprintf(f, "<td class=%s>%s</td>", outcome_class(v), rep_outcome_name(v));
+    }
+    fputs("</tr></table>\n", f);
+    if (ch->overlay_png) ret = html_png(f, ch->overlay_png, "contact force of every trainee on one time axis", err);
+    fputs("<div class=grid>\n", f);
     for (int m = 0; m < REP_NMEASURES && ret == 0; m++)
-      if (compare_png && compare_png[m]) ret = html_png(f, compare_png[m], rep_measure(m)->title, err);
+      if (ch->compare_png && ch->compare_png[m]) ret = html_png(f, ch->compare_png[m], rep_measure(m)->title, err);
     fputs("</div>\n", f);
   }
   fputs("</body></html>\n", f);

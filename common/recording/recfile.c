@@ -372,3 +372,5 @@ int recfile_participants(recfile_t *rf, recfile_participant_cb cb, void *arg) {
   sqlite3_finalize(st);
   return rc == SQLITE_DONE ? n : -2;
 }
+
+void *recfile_sqlite(recfile_t *rf) { return rf->db; }

@@ -80,6 +80,10 @@ const char *recfile_warnings(const recfile_t *rf);
  * reported is a salvage, not the whole recording. */
 bool recfile_damaged(const recfile_t *rf);
 
+/* The open SQLite handle (a `sqlite3 *`), for readers of the tables this
+ * API does not wrap (rec_writers.h, rec_schema.h); read-only, owned by rf. */
+void *recfile_sqlite(recfile_t *rf);
+
 /* Return non-zero to stop the scan. */
 typedef int (*recfile_row_cb)(void *arg, const recfile_row_t *row);
 

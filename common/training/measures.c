@@ -74,13 +74,19 @@ double rep_first_motion(const rep_pos_sample_t *p, size_t n, double eps) {
   return NAN;
 }
 
+/* Two tasks may share a name (a scene names them freely), never an id. */
+static bool same_task(const rep_task_t *t, const rep_task_event_t *e) {
+  if (t->id >= 0 && e->id >= 0) return t->id == e->id;
+  return strcmp(t->name, e->name) == 0;
+}
+
 size_t rep_tasks(const rep_task_event_t *ev, size_t n, double session_start, rep_task_t *out, size_t cap) {
   size_t nt = 0;
   for (size_t i = 0; i < n; i++) {
     rep_task_t *t = NULL;
     /* the latest task of that name: a name can repeat (task done twice) */
     for (size_t k = nt; k-- > 0;)
-      if (strcmp(out[k].name, ev[i].name) == 0) {
+      if (same_task(&out[k], &ev[i])) {
         t = &out[k];
         break;
       }
@@ -93,18 +99,21 @@ size_t rep_tasks(const rep_task_event_t *ev, size_t n, double session_start, rep
       t = &out[nt++];
       memset(t, 0, sizeof *t);
       snprintf(t->name, sizeof t->name, "%s", ev[i].name);
+      t->id = ev[i].id;
       t->start = ev[i].t;
       t->end = NAN;
       t->started_seen = 1;
     } else {
       if (t && isnan(t->end)) {
         t->end = ev[i].t;
+        if (isfinite(ev[i].value) && ev[i].value >= 0) t->start = t->end - ev[i].value;
         continue;
       }
       if (nt >= cap) break;
       t = &out[nt++];
       memset(t, 0, sizeof *t);
       snprintf(t->name, sizeof t->name, "%s", ev[i].name);
+      t->id = ev[i].id;
       t->start = session_start;
       t->end = ev[i].t;
       t->started_seen = 0;

@@ -24,7 +24,9 @@
  *                                the client (not after samples the
  *                                recording lost: command seq tells);
  *   task time                    TASK_STARTED to TASK_COMPLETED of the same
- *                                task (events matched by their text). */
+ *                                task (events matched by the task id the
+ *                                server puts in them; by name for events
+ *                                without one). */
 #ifndef VISCERA_REPORT_MEASURES_H
 #define VISCERA_REPORT_MEASURES_H
 
@@ -76,16 +78,22 @@ typedef enum rep_task_mark { REP_TASK_STARTED, REP_TASK_COMPLETED } rep_task_mar
 typedef struct rep_task_event {
   double t;
   rep_task_mark_t mark;
+  int id; /* the scene's task index, -1 when the event carries none */
   char name[64];
+  double value; /* completion: the operation time the server measured (s), NAN unknown */
 } rep_task_event_t;
 
 typedef struct rep_task {
+  int id; /* -1: unknown, the task is known by name only */
   char name[64];
   double start, end; /* s; end = NAN when not completed */
   int started_seen;  /* 0: completed without a start event, start = session start */
 } rep_task_t;
 
-/* Pairs start and completion events by task name, in time order; a second
+/* Pairs start and completion events by task id (by name when either has
+ * no id), in time order. A completion that carries the server's operation
+ * time (value) sets the start to end - value: the server starts a task's
+ * clock at its tool's first command, a step before the event; a second
  * start of a running task restarts it. `session_start` stands in for a
  * missing start. Writes at most `cap` tasks (in order of first appearance)
  * and returns how many. */

@@ -61,7 +61,10 @@ typedef struct server {
 
 static uint64_t sim_ns(const server_t *s) { return (uint64_t)(s->rt.sim_time * 1e9); }
 
-static void publish_event(server_t *s, viscera_EventKind kind, int organ, int tool, double value, const char *text) {
+/* task: the scene's task index the event is about, -1 for none (its name
+ * goes with it, so a reader pairs a task's events by id, not by text). */
+static void publish_task_event(server_t *s, viscera_EventKind kind, int organ, int tool, double value, const char *text,
+                               int task) {
   viscera_SessionEvent e;
   memset(&e, 0, sizeof e);
   e.source_id = 0;
@@ -72,7 +75,14 @@ static void publish_event(server_t *s, viscera_EventKind kind, int organ, int to
   e.tool_id = tool;
   e.value = value;
   snprintf(e.text, sizeof e.text, "%s", text);
+  e.task_id = task;
+  if (task >= 0 && (size_t)task < s->rt.scene.ntasks)
+    snprintf(e.task_name, sizeof e.task_name, "%s", s->rt.scene.tasks[task].name);
   if (dds_write(s->w_event, &e) >= 0) s->stats->published[VT_SESSION_EVENT]++;
+}
+
+static void publish_event(server_t *s, viscera_EventKind kind, int organ, int tool, double value, const char *text) {
+  publish_task_event(s, kind, organ, tool, value, text, -1);
 }
 
 static void publish_scene_info(server_t *s) {
@@ -429,7 +439,7 @@ static int rebuild_runtime(server_t *s, const scene_t *sc, const scene_t *old, v
  * reported as a TASK_STARTED whose text carries the station tag. */
 static void start_task(server_t *s, int k, const char *text) {
   tasks_start(&s->rt.tasks[k], s->rt.sim_time);
-  publish_event(s, viscera_EVENT_TASK_STARTED, -1, s->rt.scene.tasks[k].tool, 1, text);
+  publish_task_event(s, viscera_EVENT_TASK_STARTED, -1, s->rt.scene.tasks[k].tool, 1, text, k);
 }
 
 /* Applies pending instructor commands (session_control.h); each outcome is
@@ -659,7 +669,8 @@ static void publish_interactions(server_t *s) {
     }
     }
     if (!s->opts->quiet) fprintf(stderr, "server: %s\n", text);
-    publish_event(s, kind, e->organ, e->tool, e->value, text);
+    bool about_task = e->kind == IEV_TASK_STARTED || e->kind == IEV_TASK_COMPLETED;
+    publish_task_event(s, kind, e->organ, e->tool, e->value, text, about_task ? e->task : -1);
   }
   s->rt.events.n = 0;
   /* A refused cut is logged (the first few, then every 100th), never fatal. */

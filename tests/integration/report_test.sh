@@ -80,7 +80,8 @@ awk -v n="$(col novice operation_time_s)" -v e="$(col expert operation_time_s)" 
 
 imgs=$(grep -o 'src="data:image/png;base64,[A-Za-z0-9+/]\{200\}' "$HTML" | wc -l)
 [ "$imgs" -ge 14 ] || fail "report.html has $imgs embedded PNGs, want 2 force charts + 12 comparison charts"
-grep -q '<h2>expert</h2>' "$HTML" && grep -q '<h2>novice</h2>' "$HTML" && grep -q '<h2 id=comparison>Comparison</h2>' "$HTML" \
+grep -q '<h2 id=s[0-9]*[^>]*>expert</h2>' "$HTML" && grep -q '<h2 id=s[0-9]*[^>]*>novice</h2>' "$HTML" &&
+  grep -q '<h2 id=comparison>Comparison</h2>' "$HTML" \
   || fail "report.html lacks a trainee or the comparison section"
 ! grep -q 'src="[^d]' "$HTML" || fail "report.html refers to an external file"
 for f in "$OUT"/report/*.png; do [ "$(head -c 8 "$f" | od -An -tx1 | tr -d ' \n')" = 89504e470d0a1a0a ] || fail "$f is not a PNG"; done
