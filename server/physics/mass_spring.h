@@ -109,6 +109,14 @@ size_t mass_spring_fix_below(mass_spring_t *ms, double z);
  * f_res and f_ext. Forces stay finite for coincident nodes (a zero-length spring
  * has no direction and pushes nothing). */
 void mass_spring_forces(const mass_spring_t *ms, const double *x, const double *v, double *f);
+/* The same through a chosen spring loop: simd 1 the AVX2 loop (when the
+ * processor has AVX2, else the scalar one), 0 the scalar loop. Both give
+ * the same forces bit for bit (same operations in the same order, no fused
+ * multiply-add); mass_spring_forces takes the AVX2 loop whenever
+ * mass_spring_simd_available() (checked at run time, the build needs no
+ * -mavx2). For the tests and benchmarks that compare the two. */
+void mass_spring_forces_path(const mass_spring_t *ms, const double *x, const double *v, double *f, int simd);
+int mass_spring_simd_available(void);
 /* out = (a K(x) + b C(x)) y, as described above. */
 void mass_spring_stiffness_mul(const mass_spring_t *ms, const double *x, double a, double b, const double *y,
                                double *out);
