@@ -250,10 +250,10 @@ size_t mass_spring_fix_below(mass_spring_t *ms, double z) {
  * inline helper is called with scaled = 0 and 1), so the common uniform case
  * carries no branch per spring. */
 static inline void ms_spring_forces(const mass_spring_t *ms, const double *restrict x, const double *restrict v,
-                                    double *restrict f, int scaled) {
+                                    double *restrict f, int scaled, double damping) {
   const ms_spring_t *restrict sp = ms->springs;
   const double *restrict kscale = ms->k_scale;
-  const double stiffness = ms->p.stiffness, damping = ms->p.damping;
+  const double stiffness = ms->p.stiffness;
   const size_t ns = ms->nsprings;
   size_t s = 0;
   while (s < ns) {
@@ -313,11 +313,12 @@ __attribute__((target("avx2"))) static inline void transpose3(const __m256d r[4]
 }
 
 __attribute__((target("avx2"))) static void ms_spring_forces_avx2(const mass_spring_t *ms, const double *restrict x,
-                                                                  const double *restrict v, double *restrict f) {
+                                                                  const double *restrict v, double *restrict f,
+                                                                  double damping) {
   const ms_spring_t *restrict sp = ms->springs;
   const double *restrict kscale = ms->k_scale;
   const size_t ns = ms->nsprings;
-  const __m256d stiff = _mm256_set1_pd(ms->p.stiffness), damp = _mm256_set1_pd(ms->p.damping);
+  const __m256d stiff = _mm256_set1_pd(ms->p.stiffness), damp = _mm256_set1_pd(damping);
   const __m256d one = _mm256_set1_pd(1.0), tiny = _mm256_set1_pd(MS_TINY);
   const __m256i m3 = _mm256_set_epi64x(0, -1, -1, -1);
   uint32_t cur = UINT32_MAX;
@@ -392,7 +393,7 @@ __attribute__((target("avx2"))) static void ms_spring_forces_avx2(const mass_spr
     const double inv = 1.0 / len;
     const double dvd = (vj[0] - vi[0]) * d0 + (vj[1] - vi[1]) * d1 + (vj[2] - vi[2]) * d2;
     const double k = kscale ? ms->p.stiffness * kscale[s] : ms->p.stiffness;
-    const double mag = (k * (len - sp[s].rest) + ms->p.damping * dvd * inv) * inv;
+    const double mag = (k * (len - sp[s].rest) + damping * dvd * inv) * inv;
     fi0 += mag * d0;
     fi1 += mag * d1;
     fi2 += mag * d2;
@@ -430,7 +431,9 @@ void mass_spring_forces_path(const mass_spring_t *ms, const double *x, const dou
   const double *restrict xx = x, *restrict vv = v;
   double *restrict ff = f;
   const double g0 = ms->p.gravity[0], g1 = ms->p.gravity[1], g2 = ms->p.gravity[2];
-  const double hk = ms->p.home_stiffness, hc = ms->p.home_damping;
+  /* With implicit_damping the dampers are left to mass_spring_damp. */
+  const double hk = ms->p.home_stiffness, hc = ms->implicit_damping ? 0.0 : ms->p.home_damping;
+  const double damping = ms->implicit_damping ? 0.0 : ms->p.damping;
   const size_t n = ms->n;
   for (size_t i = 0; i < n; i++) {
     const size_t c = 3 * i;
@@ -442,16 +445,55 @@ void mass_spring_forces_path(const mass_spring_t *ms, const double *x, const dou
     for (size_t c = 0; c < 3 * n; c++) ff[c] += fres[c];
 #ifdef MS_HAVE_AVX2_PATH
   if (simd) {
-    ms_spring_forces_avx2(ms, x, v, f);
+    ms_spring_forces_avx2(ms, x, v, f, damping);
     return;
   }
 #else
   (void)simd;
 #endif
   if (ms->k_scale)
-    ms_spring_forces(ms, x, v, f, 1);
+    ms_spring_forces(ms, x, v, f, 1, damping);
   else
-    ms_spring_forces(ms, x, v, f, 0);
+    ms_spring_forces(ms, x, v, f, 0, damping);
+}
+
+void mass_spring_damp(const mass_spring_t *ms, const double *x, double h, double *v) {
+  const double *restrict im = ms->inv_mass;
+  const double hc = h * ms->p.home_damping, c = h * ms->p.damping;
+  double *restrict vv = v;
+  /* Home dampers: diagonal, solved exactly. */
+  if (hc > 0)
+    for (size_t i = 0; i < ms->n; i++) {
+      const double s = 1.0 / (1.0 + hc * im[i]);
+      vv[3 * i] *= s;
+      vv[3 * i + 1] *= s;
+      vv[3 * i + 2] *= s;
+    }
+  if (!(c > 0)) return;
+  /* Edge dampers: one Gauss-Seidel sweep. The impulse c_h dvn' along the
+   * unit axis u (c_h = h c) with dvn' the relative speed after it gives
+   * dvn' = dvn / (1 + c_h (w_i + w_j)), the implicit solve of this one
+   * damper; it is equal and opposite along the axis (momenta kept) and
+   * never reverses dvn (it dissipates at any h). */
+  const ms_spring_t *restrict sp = ms->springs;
+  for (size_t s = 0; s < ms->nsprings; s++) {
+    const size_t i = sp[s].i, j = sp[s].j;
+    const double wi = im[i], wj = im[j], w = wi + wj;
+    if (w == 0) continue;
+    const double d0 = x[3 * j] - x[3 * i], d1 = x[3 * j + 1] - x[3 * i + 1], d2 = x[3 * j + 2] - x[3 * i + 2];
+    const double l2 = d0 * d0 + d1 * d1 + d2 * d2;
+    if (!(l2 > MS_TINY)) continue;
+    const double dvd =
+        (vv[3 * j] - vv[3 * i]) * d0 + (vv[3 * j + 1] - vv[3 * i + 1]) * d1 + (vv[3 * j + 2] - vv[3 * i + 2]) * d2;
+    /* dvn = dvd / L and the impulse acts along d / L: one factor 1 / L^2. */
+    const double p = c * dvd / (l2 * (1.0 + c * w));
+    vv[3 * i] += wi * p * d0;
+    vv[3 * i + 1] += wi * p * d1;
+    vv[3 * i + 2] += wi * p * d2;
+    vv[3 * j] -= wj * p * d0;
+    vv[3 * j + 1] -= wj * p * d1;
+    vv[3 * j + 2] -= wj * p * d2;
+  }
 }
 
 /* The Jacobian product, walked by runs of equal i like the forces (above).

@@ -95,10 +95,11 @@ static void pre_substep(force_system_t *s) {
   if (mm->m.hook) mm->m.hook(&mm->m, mm->m.hook_ctx);
 }
 
-/* Symplectic Euler, between kick and drift: the declared tool springs
- * implicitly (physics/coupling.h). */
+/* Symplectic Euler, between kick and drift: the dampers (mass_spring.h)
+ * and the declared tool springs (physics/coupling.h) implicitly. */
 static void correct_v(force_system_t *s, double h) {
   ms_model_t *mm = s->ctx;
+  mass_spring_damp(&mm->ms, mm->ms.x, h, mm->ms.v);
   coupling_set_apply(&mm->cpl, mm->ms.inv_mass, h, mm->ms.v);
 }
 
@@ -280,6 +281,7 @@ static int substeps_from(ms_model_t *mm, integrator_kind_t kind, double lk, doub
   const mass_spring_t *ms = &mm->ms;
   double m_node = ms->p.mass / (double)ms->n;
   double lk0 = (ms->p.home_stiffness + mm->tool_stiffness) / m_node, lc0 = ms->p.home_damping / m_node;
+  if (ms->implicit_damping) lc = lc0 = 0; /* the dampers impose no limit */
   return integrator_choose_substeps(kind, mm->dt, mm->requested_substeps, lk, lc, lk0, lc0,
                                     "lower material stiffness, damping or tool stiffness, raise the mass, or use "
                                     "implicit_euler (explicit_euler needs damping)",
@@ -341,6 +343,7 @@ static model_t *ms_create(const model_params_t *p, int tet, verr_t *err) {
   if (kind == INT_SYMPLECTIC_EULER) {
     mm->ms.fs.correct_v = correct_v;
     mm->m.implicit_tools = 1;
+    mm->ms.implicit_damping = 1;
     if (coupling_set_init(&mm->cpl, 256, 8192, err)) {
       ms_destroy(&mm->m);
       return NULL;
