@@ -26,6 +26,10 @@ struct force_system {
    * so it must set the external forces (contact hooks), not add to them;
    * may be NULL. */
   void (*pre_substep)(force_system_t *s);
+  /* Optional (NULL: none), symplectic Euler only: called between the kick
+   * (s->v holds v + h M^-1 F) and the drift, to correct the velocities for
+   * forces integrated implicitly (physics/coupling.h). */
+  void (*correct_v)(force_system_t *s, double h);
   void *ctx; /* the owning model */
 };
 

@@ -98,6 +98,19 @@ static void explicit_euler(integrator_t *it, force_system_t *s, double h) {
 static void symplectic_euler(integrator_t *it, force_system_t *s, double h) {
   double *f = it->buf[0];
   s->forces(s, s->x, s->v, f);
+  if (s->correct_v) { /* kick, implicit correction, drift */
+    for (size_t i = 0; i < s->n; i++) {
+      double w = s->inv_mass[i];
+      if (w == 0) continue;
+      for (int k = 0; k < 3; k++) s->v[3 * i + k] += h * w * f[3 * i + k];
+    }
+    s->correct_v(s, h);
+    for (size_t i = 0; i < s->n; i++) {
+      if (s->inv_mass[i] == 0) continue;
+      for (int k = 0; k < 3; k++) s->x[3 * i + k] += h * s->v[3 * i + k];
+    }
+    return;
+  }
   for (size_t i = 0; i < s->n; i++) {
     double w = s->inv_mass[i];
     if (w == 0) continue;

@@ -250,10 +250,10 @@ size_t mass_spring_fix_below(mass_spring_t *ms, double z) {
  * inline helper is called with scaled = 0 and 1), so the common uniform case
  * carries no branch per spring. */
 static inline void ms_spring_forces(const mass_spring_t *ms, const double *restrict x, const double *restrict v,
-                                    double *restrict f, int scaled) {
+                                    double *restrict f, int scaled, double damping) {
   const ms_spring_t *restrict sp = ms->springs;
   const double *restrict kscale = ms->k_scale;
-  const double stiffness = ms->p.stiffness, damping = ms->p.damping;
+  const double stiffness = ms->p.stiffness;
   const size_t ns = ms->nsprings;
   size_t s = 0;
   while (s < ns) {
@@ -289,7 +289,139 @@ static inline void ms_spring_forces(const mass_spring_t *ms, const double *restr
   }
 }
 
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+#define MS_HAVE_AVX2_PATH 1
+#include <immintrin.h>
+
+/* The spring loop with the arithmetic four springs at a time (AVX2, chosen
+ * at run time): both ends' x and v as masked row loads transposed into one
+ * vector per component (the hardware gathers measured slower), then the
+ * difference, length (one 4-wide square root and divide instead of four
+ * scalar ones), damping projection and force g of each spring, with
+ * exactly the scalar loop's operations in its order (mul and add, no fused
+ * multiply-add), then the scatter of the four g in spring order with the
+ * same runs of equal i as the scalar loop: the forces are bit for bit the
+ * scalar path's (test_ms_forces). */
+/* Rows r[q] = (x, y, z, -) of four springs into c0 = (r0.x .. r3.x), c1, c2. */
+__attribute__((target("avx2"))) static inline void transpose3(const __m256d r[4], __m256d *c0, __m256d *c1,
+                                                              __m256d *c2) {
+  const __m256d t0 = _mm256_unpacklo_pd(r[0], r[1]), t1 = _mm256_unpackhi_pd(r[0], r[1]);
+  const __m256d t2 = _mm256_unpacklo_pd(r[2], r[3]), t3 = _mm256_unpackhi_pd(r[2], r[3]);
+  *c0 = _mm256_permute2f128_pd(t0, t2, 0x20);
+  *c1 = _mm256_permute2f128_pd(t1, t3, 0x20);
+  *c2 = _mm256_permute2f128_pd(t0, t2, 0x31);
+}
+
+__attribute__((target("avx2"))) static void ms_spring_forces_avx2(const mass_spring_t *ms, const double *restrict x,
+                                                                  const double *restrict v, double *restrict f,
+                                                                  double damping) {
+  const ms_spring_t *restrict sp = ms->springs;
+  const double *restrict kscale = ms->k_scale;
+  const size_t ns = ms->nsprings;
+  const __m256d stiff = _mm256_set1_pd(ms->p.stiffness), damp = _mm256_set1_pd(damping);
+  const __m256d one = _mm256_set1_pd(1.0), tiny = _mm256_set1_pd(MS_TINY);
+  const __m256i m3 = _mm256_set_epi64x(0, -1, -1, -1);
+  uint32_t cur = UINT32_MAX;
+  double fi0 = 0, fi1 = 0, fi2 = 0;
+  size_t s = 0;
+  for (; s + 4 <= ns; s += 4) {
+    /* Each end's (x, y, z) as one masked 4-wide load (the fourth lane is
+     * not read: no access past the array), the differences row by row,
+     * then a 4x4 transpose into one vector per component. */
+    __m256d dr[4], dvr[4];
+    for (int q = 0; q < 4; q++) {
+      const size_t i3 = 3 * (size_t)sp[s + q].i, j3 = 3 * (size_t)sp[s + q].j;
+      dr[q] = _mm256_sub_pd(_mm256_maskload_pd(x + j3, m3), _mm256_maskload_pd(x + i3, m3));
+      dvr[q] = _mm256_sub_pd(_mm256_maskload_pd(v + j3, m3), _mm256_maskload_pd(v + i3, m3));
+    }
+    __m256d d0, d1, d2, dv0, dv1, dv2;
+    transpose3(dr, &d0, &d1, &d2);
+    transpose3(dvr, &dv0, &dv1, &dv2);
+    const __m256d len = _mm256_sqrt_pd(
+        _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(d0, d0), _mm256_mul_pd(d1, d1)), _mm256_mul_pd(d2, d2)));
+    /* A zero-length spring pushes nothing; NaN stays live, as in the scalar test. */
+    const __m256d live = _mm256_cmp_pd(len, tiny, _CMP_NLE_UQ);
+    const __m256d inv = _mm256_div_pd(one, len);
+    const __m256d dvd =
+        _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(dv0, d0), _mm256_mul_pd(dv1, d1)), _mm256_mul_pd(dv2, d2));
+    const __m256d rest = _mm256_set_pd(sp[s + 3].rest, sp[s + 2].rest, sp[s + 1].rest, sp[s].rest);
+    const __m256d k = kscale ? _mm256_mul_pd(stiff, _mm256_loadu_pd(kscale + s)) : stiff;
+    const __m256d mag = _mm256_and_pd(live, _mm256_mul_pd(_mm256_add_pd(_mm256_mul_pd(k, _mm256_sub_pd(len, rest)),
+                                                                        _mm256_mul_pd(_mm256_mul_pd(damp, dvd), inv)),
+                                                          inv));
+    double g[3][4];
+    _mm256_storeu_pd(g[0], _mm256_mul_pd(mag, d0));
+    _mm256_storeu_pd(g[1], _mm256_mul_pd(mag, d1));
+    _mm256_storeu_pd(g[2], _mm256_mul_pd(mag, d2));
+    const int lv = _mm256_movemask_pd(live);
+    for (int q = 0; q < 4; q++) {
+      const uint32_t i = sp[s + q].i, j = sp[s + q].j;
+      if (i != cur) {
+        if (cur != UINT32_MAX) {
+          f[3 * (size_t)cur] += fi0;
+          f[3 * (size_t)cur + 1] += fi1;
+          f[3 * (size_t)cur + 2] += fi2;
+        }
+        cur = i;
+        fi0 = fi1 = fi2 = 0;
+      }
+      if (!((lv >> q) & 1)) continue; /* as the scalar loop: skipped, not added as 0 */
+      fi0 += g[0][q];
+      fi1 += g[1][q];
+      fi2 += g[2][q];
+      f[3 * (size_t)j] -= g[0][q];
+      f[3 * (size_t)j + 1] -= g[1][q];
+      f[3 * (size_t)j + 2] -= g[2][q];
+    }
+  }
+  /* The remainder (fewer than four springs), scalar, continuing the run. */
+  for (; s < ns; s++) {
+    const uint32_t i = sp[s].i, j = sp[s].j;
+    if (i != cur) {
+      if (cur != UINT32_MAX) {
+        f[3 * (size_t)cur] += fi0;
+        f[3 * (size_t)cur + 1] += fi1;
+        f[3 * (size_t)cur + 2] += fi2;
+      }
+      cur = i;
+      fi0 = fi1 = fi2 = 0;
+    }
+    const double *xi = x + 3 * (size_t)i, *xj = x + 3 * (size_t)j, *vi = v + 3 * (size_t)i, *vj = v + 3 * (size_t)j;
+    const double d0 = xj[0] - xi[0], d1 = xj[1] - xi[1], d2 = xj[2] - xi[2];
+    const double len = sqrt(d0 * d0 + d1 * d1 + d2 * d2);
+    if (len <= MS_TINY) continue;
+    const double inv = 1.0 / len;
+    const double dvd = (vj[0] - vi[0]) * d0 + (vj[1] - vi[1]) * d1 + (vj[2] - vi[2]) * d2;
+    const double k = kscale ? ms->p.stiffness * kscale[s] : ms->p.stiffness;
+    const double mag = (k * (len - sp[s].rest) + damping * dvd * inv) * inv;
+    fi0 += mag * d0;
+    fi1 += mag * d1;
+    fi2 += mag * d2;
+    f[3 * (size_t)j] -= mag * d0;
+    f[3 * (size_t)j + 1] -= mag * d1;
+    f[3 * (size_t)j + 2] -= mag * d2;
+  }
+  if (cur != UINT32_MAX) {
+    f[3 * (size_t)cur] += fi0;
+    f[3 * (size_t)cur + 1] += fi1;
+    f[3 * (size_t)cur + 2] += fi2;
+  }
+}
+#endif
+
+int mass_spring_simd_available(void) {
+#ifdef MS_HAVE_AVX2_PATH
+  return __builtin_cpu_supports("avx2") ? 1 : 0;
+#else
+  return 0;
+#endif
+}
+
 void mass_spring_forces(const mass_spring_t *ms, const double *x, const double *v, double *f) {
+  mass_spring_forces_path(ms, x, v, f, mass_spring_simd_available());
+}
+
+void mass_spring_forces_path(const mass_spring_t *ms, const double *x, const double *v, double *f, int simd) {
   /* Node terms. The parameters are copied to locals and the arrays are
    * restrict-qualified: through plain pointers every store to f could alias
    * ms->p, so the compiler reloaded gravity and the home coefficients per
@@ -299,7 +431,9 @@ void mass_spring_forces(const mass_spring_t *ms, const double *x, const double *
   const double *restrict xx = x, *restrict vv = v;
   double *restrict ff = f;
   const double g0 = ms->p.gravity[0], g1 = ms->p.gravity[1], g2 = ms->p.gravity[2];
-  const double hk = ms->p.home_stiffness, hc = ms->p.home_damping;
+  /* With implicit_damping the dampers are left to mass_spring_damp. */
+  const double hk = ms->p.home_stiffness, hc = ms->implicit_damping ? 0.0 : ms->p.home_damping;
+  const double damping = ms->implicit_damping ? 0.0 : ms->p.damping;
   const size_t n = ms->n;
   for (size_t i = 0; i < n; i++) {
     const size_t c = 3 * i;
@@ -309,10 +443,57 @@ void mass_spring_forces(const mass_spring_t *ms, const double *x, const double *
   }
   if (fres)
     for (size_t c = 0; c < 3 * n; c++) ff[c] += fres[c];
+#ifdef MS_HAVE_AVX2_PATH
+  if (simd) {
+    ms_spring_forces_avx2(ms, x, v, f, damping);
+    return;
+  }
+#else
+  (void)simd;
+#endif
   if (ms->k_scale)
-    ms_spring_forces(ms, x, v, f, 1);
+    ms_spring_forces(ms, x, v, f, 1, damping);
   else
-    ms_spring_forces(ms, x, v, f, 0);
+    ms_spring_forces(ms, x, v, f, 0, damping);
+}
+
+void mass_spring_damp(const mass_spring_t *ms, const double *x, double h, double *v) {
+  const double *restrict im = ms->inv_mass;
+  const double hc = h * ms->p.home_damping, c = h * ms->p.damping;
+  double *restrict vv = v;
+  /* Home dampers: diagonal, solved exactly. */
+  if (hc > 0)
+    for (size_t i = 0; i < ms->n; i++) {
+      const double s = 1.0 / (1.0 + hc * im[i]);
+      vv[3 * i] *= s;
+      vv[3 * i + 1] *= s;
+      vv[3 * i + 2] *= s;
+    }
+  if (!(c > 0)) return;
+  /* Edge dampers: one Gauss-Seidel sweep. The impulse c_h dvn' along the
+   * unit axis u (c_h = h c) with dvn' the relative speed after it gives
+   * dvn' = dvn / (1 + c_h (w_i + w_j)), the implicit solve of this one
+   * damper; it is equal and opposite along the axis (momenta kept) and
+   * never reverses dvn (it dissipates at any h). */
+  const ms_spring_t *restrict sp = ms->springs;
+  for (size_t s = 0; s < ms->nsprings; s++) {
+    const size_t i = sp[s].i, j = sp[s].j;
+    const double wi = im[i], wj = im[j], w = wi + wj;
+    if (w == 0) continue;
+    const double d0 = x[3 * j] - x[3 * i], d1 = x[3 * j + 1] - x[3 * i + 1], d2 = x[3 * j + 2] - x[3 * i + 2];
+    const double l2 = d0 * d0 + d1 * d1 + d2 * d2;
+    if (!(l2 > MS_TINY)) continue;
+    const double dvd =
+        (vv[3 * j] - vv[3 * i]) * d0 + (vv[3 * j + 1] - vv[3 * i + 1]) * d1 + (vv[3 * j + 2] - vv[3 * i + 2]) * d2;
+    /* dvn = dvd / L and the impulse acts along d / L: one factor 1 / L^2. */
+    const double p = c * dvd / (l2 * (1.0 + c * w));
+    vv[3 * i] += wi * p * d0;
+    vv[3 * i + 1] += wi * p * d1;
+    vv[3 * i + 2] += wi * p * d2;
+    vv[3 * j] -= wj * p * d0;
+    vv[3 * j + 1] -= wj * p * d1;
+    vv[3 * j + 2] -= wj * p * d2;
+  }
 }
 
 /* The Jacobian product, walked by runs of equal i like the forces (above).

@@ -115,6 +115,17 @@ typedef struct model_ops {
   double (*error_estimate)(const model_t *m);
   /* Adds force f (N) at surface vertex i for the current sub-step. */
   void (*add_surface_force)(model_t *m, uint32_t i, const double f[3]);
+  /* Optional (NULL: the model integrates tool forces explicitly and keeps
+   * the stiffest tool in its stability bound). Declares that forces just
+   * added by the hook include a tool spring of stiffness k (N/m) acting
+   * as -w_j f on surface vertices wi[j] (nw of them), with f = k (P - d)
+   * and P = sum_l b_l surf_x[bi[l]] + offset (nb of them), so the model
+   * may integrate its stiffness implicitly (physics/coupling.h) for this
+   * sub-step. A model that does (model_t.implicit_tools set) leaves
+   * tool_stiffness out of its bound, so whoever drives it declares every
+   * stiff spring it adds; the others ignore the call. */
+  void (*add_surface_coupling)(model_t *m, double k, size_t nw, const uint32_t *wi, const double *w, size_t nb,
+                               const uint32_t *bi, const double *b);
   /* Checkpoints of a changed topology (runtime/checkpoint_state.h), optional: a
    * model without them cannot be checkpointed once its topology_version is
    * above 0 (the checkpoint says so and keeps the last one it could write).
@@ -161,8 +172,9 @@ struct model {
   const double *surf_rest;   /* 3 nsurf */
   const uint32_t *surf_tris; /* 3 nsurf_tris */
   /* Stepping. */
-  int substeps;     /* per scene step */
-  double stable_dt; /* s, the bound the sub-steps were chosen from (INFINITY: unconditionally stable) */
+  int substeps;       /* per scene step */
+  int implicit_tools; /* 1: tool springs declared through add_surface_coupling are implicit */
+  double stable_dt;   /* s, the bound the sub-steps were chosen from (INFINITY: unconditionally stable) */
   uint64_t rollbacks;
   /* Topology of the surface: 0 at creation. A model that changes its surface
    * (adaptive refinement, cutting) increments it after it has updated nsurf,
@@ -179,7 +191,8 @@ struct model {
 
 /* Everything a model constructor gets. tool_stiffness (N/m) is the stiffest
  * tool spring that may act on the surface: explicit schemes include it in
- * their stability bound. */
+ * their stability bound unless they integrate tool springs implicitly
+ * (model_ops_t.add_surface_coupling). */
 typedef struct model_params {
   const scene_organ_t *cfg;
   const mesh_t *surface; /* after scale and position; the model copies what it keeps */

@@ -44,6 +44,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "physics/coupling.h"
 #include "physics/integrator.h"
 #include "physics/mass_spring.h"
 #include "physics/model.h"
@@ -77,6 +78,7 @@ typedef struct ms_model {
   double lam_k;
   int refining, refine_count;
   double refine_lambda;
+  coupling_set_t cpl; /* symplectic Euler: the tool springs of the sub-step (implicit) */
 } ms_model_t;
 
 static void embed(ms_model_t *mm) {
@@ -89,8 +91,17 @@ static void embed(ms_model_t *mm) {
 static void pre_substep(force_system_t *s) {
   ms_model_t *mm = s->ctx;
   memset(mm->ms.f_ext, 0, 3 * mm->ms.n * sizeof(double));
+  coupling_set_clear(&mm->cpl);
   embed(mm);
   if (mm->m.hook) mm->m.hook(&mm->m, mm->m.hook_ctx);
+}
+
+/* Symplectic Euler, between kick and drift: the dampers (mass_spring.h)
+ * and the declared tool springs (physics/coupling.h) implicitly. */
+static void correct_v(force_system_t *s, double h) {
+  ms_model_t *mm = s->ctx;
+  mass_spring_damp(&mm->ms, mm->ms.x, h, mm->ms.v);
+  coupling_set_apply(&mm->cpl, mm->ms.inv_mass, h, mm->ms.v);
 }
 
 /* Total energy and the part that measures motion and deformation (kinetic +
@@ -162,6 +173,7 @@ static void ms_destroy(model_t *m) {
     tet_embedding_free(&mm->emb);
   }
   model_guard_free(&mm->guard);
+  coupling_set_free(&mm->cpl);
   free(mm->surf_buf);
   free(mm->surf_rest_buf);
   free(mm->tris);
@@ -200,6 +212,47 @@ static void tet_add_force(model_t *m, uint32_t i, const double f[3]) {
   }
 }
 
+/* A tool spring in node terms: surface vertex i is node i. */
+static void surface_add_coupling(model_t *m, double k, size_t nw, const uint32_t *wi, const double *w, size_t nb,
+                                 const uint32_t *bi, const double *b) {
+  ms_model_t *mm = (ms_model_t *)m;
+  if (!m->implicit_tools) return;
+  coupling_set_t *cs = &mm->cpl;
+  coupling_begin(cs, k);
+  for (size_t j = 0; j < nw; j++)
+    if (wi[j] < mm->ms.n) coupling_push_w(cs, wi[j], w[j]);
+  for (size_t l = 0; l < nb; l++)
+    if (bi[l] < mm->ms.n) coupling_push_b(cs, bi[l], b[l]);
+  coupling_end(cs);
+}
+
+/* The same through the embedding: surface vertex i moves as sum_k e_k x_k
+ * over its tetrahedron's nodes, so both weight sets spread by e. */
+static void tet_add_coupling(model_t *m, double k, size_t nw, const uint32_t *wi, const double *w, size_t nb,
+                             const uint32_t *bi, const double *b) {
+  ms_model_t *mm = (ms_model_t *)m;
+  if (!m->implicit_tools) return;
+  coupling_set_t *cs = &mm->cpl;
+  coupling_begin(cs, k);
+  for (int pass = 0; pass < 2; pass++) {
+    size_t cnt = pass ? nb : nw;
+    const uint32_t *idx = pass ? bi : wi;
+    const double *wt = pass ? b : w;
+    for (size_t j = 0; j < cnt; j++) {
+      if (idx[j] >= mm->emb.nsurf) continue;
+      const uint32_t *q = mm->tm.tets + 4 * (size_t)mm->emb.tet[idx[j]];
+      for (int c = 0; c < 4; c++) {
+        double e = mm->emb.bary[4 * (size_t)idx[j] + c] * wt[j];
+        if (pass)
+          coupling_push_b(cs, q[c], e);
+        else
+          coupling_push_w(cs, q[c], e);
+      }
+    }
+  }
+  coupling_end(cs);
+}
+
 static int surface_save_topology(const model_t *m, state_blob_t *b);
 static int surface_restore_topology(model_t *m, state_blob_t *b, size_t nnodes, const double *x, const double *v,
                                     verr_t *err);
@@ -212,6 +265,7 @@ static const model_ops_t SURFACE_OPS = {.name = "mass_spring_surface",
                                         .energy = ms_energy,
                                         .error_estimate = surface_error,
                                         .add_surface_force = surface_add_force,
+                                        .add_surface_coupling = surface_add_coupling,
                                         .save_topology = surface_save_topology,
                                         .restore_topology = surface_restore_topology,
                                         .edit = &SURFACE_EDIT};
@@ -220,13 +274,15 @@ static const model_ops_t TET_OPS = {.name = "mass_spring_tet",
                                     .destroy = ms_destroy,
                                     .energy = ms_energy,
                                     .error_estimate = tet_error,
-                                    .add_surface_force = tet_add_force};
+                                    .add_surface_force = tet_add_force,
+                                    .add_surface_coupling = tet_add_coupling};
 
 /* Stable dt of the scheme for this system (see the file comment). */
 static int substeps_from(ms_model_t *mm, integrator_kind_t kind, double lk, double lc, verr_t *err) {
   const mass_spring_t *ms = &mm->ms;
   double m_node = ms->p.mass / (double)ms->n;
   double lk0 = (ms->p.home_stiffness + mm->tool_stiffness) / m_node, lc0 = ms->p.home_damping / m_node;
+  if (ms->implicit_damping) lc = lc0 = 0; /* the dampers impose no limit */
   return integrator_choose_substeps(kind, mm->dt, mm->requested_substeps, lk, lc, lk0, lc0,
                                     "lower material stiffness, damping or tool stiffness, raise the mass, or use "
                                     "implicit_euler (explicit_euler needs damping)",
@@ -257,7 +313,9 @@ static model_t *ms_create(const model_params_t *p, int tet, verr_t *err) {
   }
   mm->tet = tet;
   mm->dt = p->dt;
-  mm->tool_stiffness = p->tool_stiffness;
+  /* Symplectic Euler takes the tool springs implicitly (coupling.h): the
+   * sub-steps then follow the tissue alone. */
+  mm->tool_stiffness = kind == INT_SYMPLECTIC_EULER ? 0 : p->tool_stiffness;
   mm->requested_substeps = cfg->solver.substeps;
   const mesh_t *s = p->surface;
   ms_params_t mp = {.mass = cfg->material.mass,
@@ -282,6 +340,15 @@ static model_t *ms_create(const model_params_t *p, int tet, verr_t *err) {
   }
   mm->ms.fs.ctx = mm;
   mm->ms.fs.pre_substep = pre_substep;
+  if (kind == INT_SYMPLECTIC_EULER) {
+    mm->ms.fs.correct_v = correct_v;
+    mm->m.implicit_tools = 1;
+    mm->ms.implicit_damping = 1;
+    if (coupling_set_init(&mm->cpl, 256, 8192, err)) {
+      ms_destroy(&mm->m);
+      return NULL;
+    }
+  }
   /* Conjugate gradients need a definite matrix (see mass_spring.h). */
   mm->ms.definite_jacobian = kind == INT_IMPLICIT_EULER;
   if (cfg->fixed_below_set) mass_spring_fix_below(&mm->ms, cfg->fixed_below);

@@ -192,6 +192,15 @@ static void apply_contacts(model_t *m, void *vctx) {
       v3_scale(fk, f, -tool->patch_w[j]);
       m->ops->add_surface_force(m, tool->patch[j], fk);
     }
+    /* The same spring's stiffness, for a model that takes it implicitly:
+     * the patch takes the force, the proxy's triangle carries the
+     * attachment point. A clamped spring is as stiff as its clamp allows. */
+    if (m->ops->add_surface_coupling && p->tri < m->nsurf_tris) {
+      double k = tool->cfg->stiffness, stretch = k * v3_dist(p->pos, tool->cmd.pos);
+      if (stretch > tool->max_force) k *= tool->max_force / stretch;
+      m->ops->add_surface_coupling(m, k, tool->npatch, tool->patch, tool->patch_w, 3, m->surf_tris + 3 * p->tri,
+                                   p->bary);
+    }
   }
   interact_apply(rt, o, m);
 }

@@ -167,9 +167,22 @@ static int tip_on(const tool_rt_t *tool, size_t organ) {
   return tool->proxy.in_contact && tool->proxy.surface >= 0 && (size_t)tool->proxy.surface == organ;
 }
 
-static void add_force(void *ctx, uint32_t i, const double f[3]) {
-  model_t *m = ctx;
-  m->ops->add_surface_force(m, i, f);
+/* A penalty spring of stiffness k on one vertex: its force, and its
+ * stiffness for a model that takes tool springs implicitly (model.h). */
+typedef struct spring_ctx {
+  model_t *m;
+  double k;
+} spring_ctx_t;
+
+static void declare_spring(model_t *m, uint32_t i, double k) {
+  static const double one = 1;
+  if (m->ops->add_surface_coupling) m->ops->add_surface_coupling(m, k, 1, &i, &one, 1, &i, &one);
+}
+
+static void add_spring_force(void *ctx, uint32_t i, const double f[3]) {
+  spring_ctx_t *sc = ctx;
+  sc->m->ops->add_surface_force(sc->m, i, f);
+  declare_spring(sc->m, i, sc->k);
 }
 
 void interact_apply(runtime_t *rt, organ_rt_t *o, model_t *m) {
@@ -187,7 +200,10 @@ void interact_apply(runtime_t *rt, organ_rt_t *o, model_t *m) {
     }
     double fv[GRASP_MAX_VERTS][3], ft[3];
     grasp_force(&tool->grasp, m->surf_x, tool->cmd.pos, tool->cfg->stiffness, tool->max_force, fv, ft);
-    for (size_t j = 0; j < tool->grasp.n; j++) m->ops->add_surface_force(m, tool->grasp.v[j], fv[j]);
+    for (size_t j = 0; j < tool->grasp.n; j++) {
+      m->ops->add_surface_force(m, tool->grasp.v[j], fv[j]);
+      declare_spring(m, tool->grasp.v[j], tool->cfg->stiffness * tool->grasp.w[j]);
+    }
   }
   /* The shafts' crossing test reads the organ's tree as refit at the start
    * of the step, so the surface may have moved since: the slack (shaft.h)
@@ -199,22 +215,24 @@ void interact_apply(runtime_t *rt, organ_rt_t *o, model_t *m) {
     double p0[3], p1[3], ft[3] = {0, 0, 0};
     if (!shaft_of(rt, t, p0, p1)) continue;
     double radius = SHAFT_RADIUS_FRACTION * tool->cfg->radius;
+    spring_ctx_t sc = {m, tool->cfg->stiffness};
     if (tip_on(tool, o->id)) {
       /* The tip presses this organ: the shaft rises out of the tip's own dent,
        * whose walls its axis can graze when the dent is deep; pushing those
        * triangles aside would open the dent under the god-object (stability
        * case 9 lost its contact that way). Only the node test here. */
-      shaft_push(p0, p1, radius, tool->cfg->stiffness, m->surf_x, m->nsurf, add_force, m, ft);
+      shaft_push(p0, p1, radius, tool->cfg->stiffness, m->surf_x, m->nsurf, add_spring_force, &sc, ft);
       continue;
     }
     shaft_surface_t surf = {m->surf_x, m->nsurf, m->surf_tris, m->nsurf_tris, tree, radius};
-    shaft_contact(p0, p1, radius, tool->cfg->stiffness, &surf, add_force, m, ft, NULL);
+    shaft_contact(p0, p1, radius, tool->cfg->stiffness, &surf, add_spring_force, &sc, ft, NULL);
   }
   for (size_t i = 0; i < rt->nstones; i++) {
     stone_t *s = &rt->stones[i];
     if (s->organ != (int)o->id) continue;
     double k = s->held_by >= 0 ? rt->tools[s->held_by].cfg->stiffness : STONE_REST_STIFFNESS;
-    stone_push(s, m->surf_x, m->nsurf, k, add_force, m);
+    spring_ctx_t sc = {m, k};
+    stone_push(s, m->surf_x, m->nsurf, k, add_spring_force, &sc);
   }
 }
 

@@ -5,7 +5,9 @@
  * (assets/meshes/kidney.obj, 2,000 nodes, 5,994 springs, the classroom
  * scene's organ) with springs as built (sorted by i) and shuffled. Prints a
  * table; the best of several repeats is reported (the machine may be
- * shared). usage: bench_ms_forces [--quick] */
+ * shared). The "forces avx2" rows compare the scalar spring loop (old
+ * column) with the AVX2 one (new column) of mass_spring_forces_path.
+ * usage: bench_ms_forces [--quick] */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -78,6 +80,14 @@ typedef void (*kmul_fn)(const mass_spring_t *, const double *, double, double, c
 
 static double sink;
 
+/* The two spring loops of mass_spring.c, for the scalar / AVX2 rows. */
+static void forces_scalar(const mass_spring_t *ms, const double *x, const double *v, double *f) {
+  mass_spring_forces_path(ms, x, v, f, 0);
+}
+static void forces_simd(const mass_spring_t *ms, const double *x, const double *v, double *f) {
+  mass_spring_forces_path(ms, x, v, f, 1);
+}
+
 /* Best over `repeats` of the mean ns per spring of `calls` calls. */
 static double time_forces(forces_fn fn, const mass_spring_t *ms, const double *x, const double *v, double *f,
                           int repeats, int calls) {
@@ -138,6 +148,11 @@ int main(int argc, char **argv) {
     double fo = time_forces(old_forces, &ms, x, v, f, repeats, calls);
     double fn = time_forces(mass_spring_forces, &ms, x, v, f, repeats, calls);
     printf("%-10s %-14s %8.2f %8.2f %8.2f\n", label, "forces", fo, fn, fn / fo);
+    /* Scalar loop (old column) against the AVX2 loop (new column). */
+    double fs = time_forces(forces_scalar, &ms, x, v, f, repeats, calls);
+    double fv = time_forces(forces_simd, &ms, x, v, f, repeats, calls);
+    printf("%-10s %-14s %8.2f %8.2f %8.2f%s\n", label, "forces avx2", fs, fv, fv / fs,
+           mass_spring_simd_available() ? "" : " (no AVX2 here: scalar twice)");
     double ko = time_kmul(old_stiffness_mul, &ms, x, y, f, repeats, calls);
     double kn = time_kmul(mass_spring_stiffness_mul, &ms, x, y, f, repeats, calls);
     printf("%-10s %-14s %8.2f %8.2f %8.2f\n", label, "stiffness_mul", ko, kn, kn / ko);
