@@ -27,6 +27,8 @@ typedef struct organ_rt {
   aabb_tree_t tree;    /* over the model's contact surface, refit after every step */
   double *vn_rest;     /* unit vertex normals of the rest surface (force shading, proxy.h) */
   uint64_t rollbacks;
+  uint32_t rollback_run; /* consecutive rolled-back steps (scene_runtime.h RUNTIME_ROLLBACK_RESET) */
+  uint64_t rest_resets;  /* times the organ was put back to rest after such a run */
   /* The model topology_version the tree, surface view, proxies and patches
    * were last rebuilt for (topology_follow.h). The server polls it: when it
    * differs from what it last published, a new keyframe is due. */

@@ -310,6 +310,16 @@ static void organ_topology(runtime_t *rt, size_t i, const topo_anchor_t anchors[
     aabb_tree_refit(&o->tree, o->model->surf_x);
 }
 
+/* Puts organ i's nodes back at their rest positions with zero velocity
+ * (and an embedded surface at its rest embedding); the tree is refit by
+ * the topology phase that follows. */
+static void organ_to_rest(organ_rt_t *o) {
+  model_t *m = o->model;
+  if (m->x != m->x_rest) memmove(m->x, m->x_rest, 3 * m->nnodes * sizeof(double));
+  memset(m->v, 0, 3 * m->nnodes * sizeof(double));
+  if (m->surf_x != m->x && m->surf_x != m->surf_rest) memmove(m->surf_x, m->surf_rest, 3 * m->nsurf * sizeof(double));
+}
+
 /* Phase models: each organ that is not asleep steps its model (the hook
  * applies the tools' contact, grasp, shaft and stone forces every
  * sub-step), then, organ by organ, its cut and the topology follow-up run
@@ -343,6 +353,14 @@ static int step_models(runtime_t *rt) {
     if (bad) {
       o->rollbacks++;
       rolled++;
+      if (++o->rollback_run >= RUNTIME_ROLLBACK_RESET) {
+        organ_to_rest(o);
+        o->rest_resets++;
+        o->rollback_run = 0;
+        rt->organs_reset |= 1u << i;
+      }
+    } else {
+      o->rollback_run = 0;
     }
     scalpel_after_organ_step(rt, i); /* phase cut: may change the topology */
     organ_topology(rt, i, anchors);  /* phase topology */
@@ -374,6 +392,7 @@ static void settle_contact(runtime_t *rt) {
  * (settle, proxy spring), outputs (hand force, feedback, events, tasks). */
 int runtime_step(runtime_t *rt) {
   rt->organs_stepped = 0;
+  rt->organs_reset = 0;
   interact_inputs(rt);
   interact_tools(rt);
   step_contact(rt);
