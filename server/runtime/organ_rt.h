@@ -21,7 +21,8 @@ typedef struct organ_rt {
   const scene_organ_t *cfg;
   uint32_t id;
   struct runtime *rt;  /* back pointer for the model's contact hook */
-  mesh_t rest;         /* the imported mesh after scale and position */
+  mesh_t rest;         /* the imported mesh after scale and position (and mesh_admit's repairs) */
+  char mesh_note[200]; /* what mesh_admit repaired, "" when nothing */
   model_t *model;      /* sub-steps and stable dt live in the model */
   double patch_radius; /* m, contact patch radius: max(2 tool radius, 1.5 mean surface edge) */
   aabb_tree_t tree;    /* over the model's contact surface, refit after every step */

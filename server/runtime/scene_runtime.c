@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "interaction/shaft.h"
+#include "mesh_admit.h"
 #include "mesh_import.h"
 #include "runtime/step_cut.h"
 #include "runtime/step_tools.h"
@@ -25,6 +26,17 @@ static int organ_init(organ_rt_t *o, runtime_t *rt, const scene_organ_t *cfg, ui
     return verr_set(err, "%s:%d: organ '%s': %s", sc->path, cfg->line, cfg->name, e.msg);
   for (size_t i = 0; i < o->rest.nverts; i++)
     for (int k = 0; k < 3; k++) o->rest.pos[3 * i + k] = o->rest.pos[3 * i + k] * cfg->scale + cfg->position[k];
+  /* The defects no model can take are refused, the ones with one right
+   * answer repaired (mesh_admit.h); the volume models need a closed
+   * surface, the surface ones also take a sheet. */
+  mesh_admit_opts_t ao = {.allow_open = strcmp(cfg->model, "mass_spring_tet") && strcmp(cfg->model, "pbd") &&
+                                        strcmp(cfg->model, "xpbd"),
+                          .min_size = MESH_ADMIT_MIN_SIZE,
+                          .max_size = MESH_ADMIT_MAX_SIZE};
+  if (mesh_admit(&o->rest, &ao, cfg->mesh, o->mesh_note, sizeof o->mesh_note, &e)) {
+    mesh_free(&o->rest);
+    return verr_set(err, "%s:%d: organ '%s' (model %s): %s", sc->path, cfg->line, cfg->name, cfg->model, e.msg);
+  }
   /* The proxy spring acts on the contact vertices like an extra home
    * spring, so explicit schemes include the stiffest tool in their bound. */
   model_params_t mp = {.cfg = cfg, .surface = &o->rest, .dt = sc->dt, .tool_stiffness = tool_k};

@@ -782,6 +782,7 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
               "%d sub-step(s) per %.3g ms (stable below %.3g ms)\n",
               o->cfg->name, m->ops->name, o->cfg->integrator, m->nnodes, m->ntets, m->nsurf, m->nsurf_tris, m->substeps,
               scene->dt * 1e3, m->stable_dt * 1e3);
+      if (o->mesh_note[0]) fprintf(stderr, "server: organ '%s': mesh repaired: %s\n", o->cfg->name, o->mesh_note);
       if (m->substeps > 0 && scene->dt / m->substeps > m->stable_dt)
         fprintf(stderr,
                 "server: organ '%s': warning: solver.substeps %d gives %.3g ms sub-steps, above the "
