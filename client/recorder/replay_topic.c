@@ -6,6 +6,8 @@
 
 #include <dds/ddsi/ddsi_cdrstream.h>
 
+#include "replay_typecheck.h"
+
 static dds_duration_t col_dur(sqlite3_stmt *st, int col, dds_duration_t dflt) {
   return sqlite3_column_type(st, col) == SQLITE_NULL ? dflt : sqlite3_column_int64(st, col);
 }
@@ -182,6 +184,14 @@ static int setup_topic(const rp_setup_t *r, sqlite3_stmt *st, rp_topic_t *t, ver
   t->st.type.ops.nops = (uint32_t)nops;
   t->st.type.ops.ops = t->ops;
 
+  /* Cyclone trusts a descriptor: a NULL or damaged type mapping crashes
+   * dds_create_topic, a damaged program makes the op counter below loop.
+   * Both are checked first (replay_typecheck.h). */
+  char why[200];
+  if (rp_ops_check(t->ops, (uint32_t)nops, (uint32_t)size, t->nkeys, t->keys, why, sizeof why))
+    return verr_set(err, "topic %s: stored type program is damaged: %s", t->name, why);
+  if (rp_types_check(t->typeinfo, tilen, t->typemap, tmlen, why, sizeof why))
+    return verr_set(err, "topic %s: stored type information is damaged: %s", t->name, why);
   /* A wrong ops length makes dds_create_topic hang (docs/dds.md, "Topic descriptors"): the stored
    * count must be what Cyclone counts in the stored program. */
   uint32_t counted = dds_stream_countops(t->ops, t->nkeys, t->keys);
