@@ -6,6 +6,7 @@
  * even though the error is found after parsing. The tree is freed before
  * returning: the result is plain data. */
 #include "scene.h"
+#include "scene_limits.h"
 
 #include <errno.h>
 #include <math.h>
@@ -29,8 +30,8 @@
 
 /* The accepted names for each choice field, the first being the default.
  * Adding a model, integrator or tool kind means adding it here only. */
-static const char *const scene_models[] = {"mass_spring_surface", "mass_spring_tet", "molecular", "pbd",
-                                           "xpbd", "vertex_based", "adaptive_mass_spring"};
+static const char *const scene_models[] = {"mass_spring_surface", "mass_spring_tet",     "molecular", "pbd", "xpbd",
+                                           "vertex_based",        "adaptive_mass_spring"};
 static const char *const scene_integrators[] = {"symplectic_euler", "explicit_euler", "verlet", "rk4",
                                                 "implicit_euler"};
 static const char *const scene_tool_kinds[] = {"probe", "grasper", "scalpel", "extractor", "syringe"};
@@ -251,19 +252,9 @@ static void list_names(char *dst, size_t size, const char *const *names, size_t 
 
 /* ---- value readers ----------------------------------------------------- */
 
-enum bound { B_NONE, B_INCL, B_EXCL };
-typedef struct range {
-  enum bound lo_kind;
-  double lo;
-  enum bound hi_kind;
-  double hi;
-} range_t;
-
-static const range_t ANY = {B_NONE, 0, B_NONE, 0};
-static const range_t GT0 = {B_EXCL, 0, B_NONE, 0};
-static const range_t GE0 = {B_INCL, 0, B_NONE, 0};
-
-static int get_number(const ctx_t *c, const node_t *n, const char *path, const range_t *r, double *out) {
+/* Every numeric key's range is a row of the one table (scene_limits.h);
+ * `lk` names the row. */
+static int get_number(const ctx_t *c, const node_t *n, const char *path, const char *lk, double *out) {
   if (n->kind != N_SCALAR || is_null(n)) return field_err(c, n, path, "must be a number (got %s)", kind_name(n));
   if (!n->plain) return field_err(c, n, path, "must be a number, not a quoted string (got \"%.*s%s\")", SHOW(n));
   /* YAML spells them .nan and .inf; strtod would also take nan and inf. */
@@ -280,49 +271,44 @@ static int get_number(const ctx_t *c, const node_t *n, const char *path, const r
   double v = strtod(n->text, &end);
   if (end != n->text + n->len) return field_err(c, n, path, "must be a number (got '%.*s%s')", SHOW(n));
   if (!isfinite(v)) return field_err(c, n, path, "must be a finite number (got %.*s%s)", SHOW(n));
-  int ok = 1;
-  if ((r->lo_kind == B_INCL && !(v >= r->lo)) || (r->lo_kind == B_EXCL && !(v > r->lo))) ok = 0;
-  if ((r->hi_kind == B_INCL && !(v <= r->hi)) || (r->hi_kind == B_EXCL && !(v < r->hi))) ok = 0;
-  if (!ok) {
-    char want[96] = "";
-    int k = 0;
-    if (r->lo_kind != B_NONE) k = snprintf(want, sizeof want, "%s %g", r->lo_kind == B_INCL ? ">=" : ">", r->lo);
-    if (r->hi_kind != B_NONE)
-      snprintf(want + k, sizeof want - (size_t)k, "%s%s %g", k ? " and " : "", r->hi_kind == B_INCL ? "<=" : "<",
-               r->hi);
-    return field_err(c, n, path, "must be %s (got %.*s%s)", want, SHOW(n));
+  const scene_limit_t *l = scene_limit(lk);
+  if (!l) return field_err(c, n, path, "no range known for '%s' (a bug in scene.c)", lk);
+  if (!scene_limit_ok(l, v)) {
+    char want[96];
+    scene_limit_describe(l, want, sizeof want);
+    return field_err(c, n, path, "%s (got %.*s%s): %s", want, SHOW(n), l->why);
   }
   *out = v;
   return 0;
 }
 
 /* Optional number field: n == NULL (absent) keeps the default in *out. */
-static int opt_number(const ctx_t *c, const node_t *n, const char *prefix, const char *key, const range_t *r,
+static int opt_number(const ctx_t *c, const node_t *n, const char *prefix, const char *key, const char *lk,
                       double *out) {
   if (!n) return 0;
   char path[128];
   join(path, sizeof path, prefix, key);
-  return get_number(c, n, path, r, out);
+  return get_number(c, n, path, lk, out);
 }
 
 /* A whole number in r (the range is checked first, so the message for 1e9
  * is the range, not the type). */
-static int get_int(const ctx_t *c, const node_t *n, const char *path, const range_t *r, int *out) {
+static int get_int(const ctx_t *c, const node_t *n, const char *path, const char *lk, int *out) {
   double v;
-  if (get_number(c, n, path, r, &v)) return -1;
+  if (get_number(c, n, path, lk, &v)) return -1;
   if (v != floor(v) || fabs(v) > 1e9) return field_err(c, n, path, "must be a whole number (got %.*s%s)", SHOW(n));
   *out = (int)v;
   return 0;
 }
 
-static int opt_int(const ctx_t *c, const node_t *n, const char *prefix, const char *key, const range_t *r, int *out) {
+static int opt_int(const ctx_t *c, const node_t *n, const char *prefix, const char *key, const char *lk, int *out) {
   if (!n) return 0;
   char path[128];
   join(path, sizeof path, prefix, key);
-  return get_int(c, n, path, r, out);
+  return get_int(c, n, path, lk, out);
 }
 
-static int get_vec3(const ctx_t *c, const node_t *n, const char *path, const range_t *r, double out[3]) {
+static int get_vec3(const ctx_t *c, const node_t *n, const char *path, const char *lk, double out[3]) {
   if (n->kind != N_SEQ || n->nkids != 3) {
     if (n->kind == N_SEQ)
       return field_err(c, n, path, "must be a list of 3 numbers [x, y, z] (got %zu items)", n->nkids);
@@ -332,7 +318,7 @@ static int get_vec3(const ctx_t *c, const node_t *n, const char *path, const ran
   for (int i = 0; i < 3; i++) {
     char p[160];
     snprintf(p, sizeof p, "%s[%d]", path, i);
-    if (get_number(c, n->kids[i], p, r, &v[i])) return -1;
+    if (get_number(c, n->kids[i], p, lk, &v[i])) return -1;
   }
   memcpy(out, v, sizeof v);
   return 0;
@@ -410,16 +396,32 @@ static int missing(const ctx_t *c, const node_t *owner, const char *prefix, cons
 /* ---- the schema -------------------------------------------------------- */
 
 enum { P_DT, P_PUBLISH_HZ, P_QUANT_STEP, P_GRAVITY, P_SLEEP_SPEED, P_SLEEP_AFTER, P_PUBLISH_KEEPALIVE, P_NKEYS };
-static const char *const physics_keys[P_NKEYS] = {
-    [P_DT] = "dt", [P_PUBLISH_HZ] = "publish_hz", [P_QUANT_STEP] = "quant_step", [P_GRAVITY] = "gravity",
-    [P_SLEEP_SPEED] = "sleep_speed", [P_SLEEP_AFTER] = "sleep_after", [P_PUBLISH_KEEPALIVE] = "publish_keepalive"};
+static const char *const physics_keys[P_NKEYS] = {[P_DT] = "dt",
+                                                  [P_PUBLISH_HZ] = "publish_hz",
+                                                  [P_QUANT_STEP] = "quant_step",
+                                                  [P_GRAVITY] = "gravity",
+                                                  [P_SLEEP_SPEED] = "sleep_speed",
+                                                  [P_SLEEP_AFTER] = "sleep_after",
+                                                  [P_PUBLISH_KEEPALIVE] = "publish_keepalive"};
 
 enum {
-  M_MASS, M_STIFFNESS, M_DAMPING, M_HOME_STIFFNESS, M_HOME_DAMPING,
-  M_BOND_K, M_ANGLE_K, M_STRETCH_BEND_K,
-  M_DISTANCE_STIFFNESS, M_VOLUME_STIFFNESS, M_DISTANCE_COMPLIANCE, M_VOLUME_COMPLIANCE,
-  M_SLOPE_M1, M_SLOPE_M2, M_SLOPE_M3,
-  M_REFINE_AREA, M_REFINE_LEVELS,
+  M_MASS,
+  M_STIFFNESS,
+  M_DAMPING,
+  M_HOME_STIFFNESS,
+  M_HOME_DAMPING,
+  M_BOND_K,
+  M_ANGLE_K,
+  M_STRETCH_BEND_K,
+  M_DISTANCE_STIFFNESS,
+  M_VOLUME_STIFFNESS,
+  M_DISTANCE_COMPLIANCE,
+  M_VOLUME_COMPLIANCE,
+  M_SLOPE_M1,
+  M_SLOPE_M2,
+  M_SLOPE_M3,
+  M_REFINE_AREA,
+  M_REFINE_LEVELS,
   M_NKEYS
 };
 static const char *const material_keys[M_NKEYS] = {[M_MASS] = "mass",
@@ -448,13 +450,30 @@ static const char *const solver_keys[V_NKEYS] = {[V_SUBSTEPS] = "substeps",
                                                  [V_TET_SIZE] = "tet_size"};
 
 enum {
-  O_NAME, O_MESH, O_MODEL, O_INTEGRATOR, O_SOLVER, O_POSITION, O_SCALE, O_COLOR, O_FIXED_BELOW, O_MATERIAL,
-  O_VOLUME, O_NKEYS
+  O_NAME,
+  O_MESH,
+  O_MODEL,
+  O_INTEGRATOR,
+  O_SOLVER,
+  O_POSITION,
+  O_SCALE,
+  O_COLOR,
+  O_FIXED_BELOW,
+  O_MATERIAL,
+  O_VOLUME,
+  O_NKEYS
 };
-static const char *const organ_keys[O_NKEYS] = {
-    [O_NAME] = "name",         [O_MESH] = "mesh",          [O_MODEL] = "model", [O_INTEGRATOR] = "integrator",
-    [O_SOLVER] = "solver",     [O_POSITION] = "position",  [O_SCALE] = "scale", [O_COLOR] = "color",
-    [O_FIXED_BELOW] = "fixed_below", [O_MATERIAL] = "material", [O_VOLUME] = "volume"};
+static const char *const organ_keys[O_NKEYS] = {[O_NAME] = "name",
+                                                [O_MESH] = "mesh",
+                                                [O_MODEL] = "model",
+                                                [O_INTEGRATOR] = "integrator",
+                                                [O_SOLVER] = "solver",
+                                                [O_POSITION] = "position",
+                                                [O_SCALE] = "scale",
+                                                [O_COLOR] = "color",
+                                                [O_FIXED_BELOW] = "fixed_below",
+                                                [O_MATERIAL] = "material",
+                                                [O_VOLUME] = "volume"};
 
 enum {
   T_NAME,
@@ -490,8 +509,8 @@ static const char *const object_keys[J_NKEYS] = {[J_NAME] = "name",         [J_K
 
 enum { K_NAME, K_KIND, K_TOOL, K_OBJECT, K_TARGET, K_TARGET_RADIUS, K_DISTANCE, K_START, K_NKEYS };
 static const char *const task_keys[K_NKEYS] = {
-    [K_NAME] = "name",        [K_KIND] = "kind",     [K_TOOL] = "tool",
-    [K_OBJECT] = "object",    [K_TARGET] = "target", [K_TARGET_RADIUS] = "target_radius",
+    [K_NAME] = "name",         [K_KIND] = "kind",     [K_TOOL] = "tool",
+    [K_OBJECT] = "object",     [K_TARGET] = "target", [K_TARGET_RADIUS] = "target_radius",
     [K_DISTANCE] = "distance", [K_START] = "start"};
 
 /* In the order they must rise: ST < MPF <= SFT (docs/methods.md B ch. 6). */
@@ -553,21 +572,15 @@ static void tool_defaults(scene_tool_t *t) {
 
 static int parse_physics(const ctx_t *c, const node_t *n, scene_t *s) {
   const node_t *v[P_NKEYS];
-  static const range_t dt_range = {B_EXCL, 0, B_INCL, 0.05};
-  static const range_t hz_range = {B_INCL, 1, B_INCL, 240};
-  static const range_t quant_range = {B_INCL, 1e-7, B_INCL, 1e-2};
-  static const range_t g_range = {B_INCL, -100, B_INCL, 100};
-  static const range_t sleep_speed_range = {B_INCL, 0, B_INCL, 0.1};
-  static const range_t sleep_after_range = {B_EXCL, 0, B_INCL, 60};
-  static const range_t keepalive_range = {B_INCL, 0, B_INCL, 60};
   if (get_fields(c, n, "physics", physics_keys, P_NKEYS, v)) return -1;
-  if (opt_number(c, v[P_DT], "physics", "dt", &dt_range, &s->dt)) return -1;
-  if (opt_number(c, v[P_PUBLISH_HZ], "physics", "publish_hz", &hz_range, &s->publish_hz)) return -1;
-  if (opt_number(c, v[P_QUANT_STEP], "physics", "quant_step", &quant_range, &s->quant_step)) return -1;
-  if (v[P_GRAVITY] && get_vec3(c, v[P_GRAVITY], "physics.gravity", &g_range, s->gravity)) return -1;
-  if (opt_number(c, v[P_SLEEP_SPEED], "physics", "sleep_speed", &sleep_speed_range, &s->sleep_speed)) return -1;
-  if (opt_number(c, v[P_SLEEP_AFTER], "physics", "sleep_after", &sleep_after_range, &s->sleep_after)) return -1;
-  if (opt_number(c, v[P_PUBLISH_KEEPALIVE], "physics", "publish_keepalive", &keepalive_range, &s->publish_keepalive))
+  if (opt_number(c, v[P_DT], "physics", "dt", "physics.dt", &s->dt)) return -1;
+  if (opt_number(c, v[P_PUBLISH_HZ], "physics", "publish_hz", "physics.publish_hz", &s->publish_hz)) return -1;
+  if (opt_number(c, v[P_QUANT_STEP], "physics", "quant_step", "physics.quant_step", &s->quant_step)) return -1;
+  if (v[P_GRAVITY] && get_vec3(c, v[P_GRAVITY], "physics.gravity", "physics.gravity", s->gravity)) return -1;
+  if (opt_number(c, v[P_SLEEP_SPEED], "physics", "sleep_speed", "physics.sleep_speed", &s->sleep_speed)) return -1;
+  if (opt_number(c, v[P_SLEEP_AFTER], "physics", "sleep_after", "physics.sleep_after", &s->sleep_after)) return -1;
+  if (opt_number(c, v[P_PUBLISH_KEEPALIVE], "physics", "publish_keepalive", "physics.publish_keepalive",
+                 &s->publish_keepalive))
     return -1;
   /* Fewer than two steps of stillness is no evidence of rest. */
   if (v[P_SLEEP_AFTER] && s->sleep_after < 2 * s->dt)
@@ -577,47 +590,53 @@ static int parse_physics(const ctx_t *c, const node_t *n, scene_t *s) {
 
 /* v[] receives the value nodes so the model-specific checks in parse_organ
  * can point at the line of the value they complain about. */
-static int parse_material(const ctx_t *c, const node_t *n, const char *path, scene_material_t *m,
-                          const node_t **v) {
-  static const range_t unit = {B_INCL, 0, B_INCL, 1};
-  static const range_t levels = {B_INCL, 1, B_INCL, 4};
+static int parse_material(const ctx_t *c, const node_t *n, const char *path, scene_material_t *m, const node_t **v) {
   if (get_fields(c, n, path, material_keys, M_NKEYS, v)) return -1;
-  if (opt_number(c, v[M_MASS], path, "mass", &GT0, &m->mass)) return -1;
-  if (opt_number(c, v[M_STIFFNESS], path, "stiffness", &GE0, &m->stiffness)) return -1;
-  if (opt_number(c, v[M_DAMPING], path, "damping", &GE0, &m->damping)) return -1;
-  if (opt_number(c, v[M_HOME_STIFFNESS], path, "home_stiffness", &GE0, &m->home_stiffness)) return -1;
-  if (opt_number(c, v[M_HOME_DAMPING], path, "home_damping", &GE0, &m->home_damping)) return -1;
-  if (opt_number(c, v[M_BOND_K], path, "bond_k", &GE0, &m->bond_k)) return -1;
-  if (opt_number(c, v[M_ANGLE_K], path, "angle_k", &GE0, &m->angle_k)) return -1;
+  if (opt_number(c, v[M_MASS], path, "mass", "organs.material.mass", &m->mass)) return -1;
+  if (opt_number(c, v[M_STIFFNESS], path, "stiffness", "organs.material.stiffness", &m->stiffness)) return -1;
+  if (opt_number(c, v[M_DAMPING], path, "damping", "organs.material.damping", &m->damping)) return -1;
+  if (opt_number(c, v[M_HOME_STIFFNESS], path, "home_stiffness", "organs.material.home_stiffness", &m->home_stiffness))
+    return -1;
+  if (opt_number(c, v[M_HOME_DAMPING], path, "home_damping", "organs.material.home_damping", &m->home_damping))
+    return -1;
+  if (opt_number(c, v[M_BOND_K], path, "bond_k", "organs.material.bond_k", &m->bond_k)) return -1;
+  if (opt_number(c, v[M_ANGLE_K], path, "angle_k", "organs.material.angle_k", &m->angle_k)) return -1;
   /* The coupling may have either sign; only its square enters the
    * definiteness condition checked in parse_organ. */
-  if (opt_number(c, v[M_STRETCH_BEND_K], path, "stretch_bend_k", &ANY, &m->stretch_bend_k)) return -1;
-  if (opt_number(c, v[M_DISTANCE_STIFFNESS], path, "distance_stiffness", &unit, &m->distance_stiffness)) return -1;
-  if (opt_number(c, v[M_VOLUME_STIFFNESS], path, "volume_stiffness", &unit, &m->volume_stiffness)) return -1;
-  if (opt_number(c, v[M_DISTANCE_COMPLIANCE], path, "distance_compliance", &GE0, &m->distance_compliance)) return -1;
-  if (opt_number(c, v[M_VOLUME_COMPLIANCE], path, "volume_compliance", &GE0, &m->volume_compliance)) return -1;
-  if (opt_number(c, v[M_SLOPE_M1], path, "slope_m1", &GT0, &m->slope_m1)) return -1;
-  if (opt_number(c, v[M_SLOPE_M2], path, "slope_m2", &GT0, &m->slope_m2)) return -1;
-  if (opt_number(c, v[M_SLOPE_M3], path, "slope_m3", &GT0, &m->slope_m3)) return -1;
-  if (opt_number(c, v[M_REFINE_AREA], path, "refine_area", &GT0, &m->refine_area)) return -1;
-  if (opt_int(c, v[M_REFINE_LEVELS], path, "refine_levels", &levels, &m->refine_levels)) return -1;
+  if (opt_number(c, v[M_STRETCH_BEND_K], path, "stretch_bend_k", "organs.material.stretch_bend_k", &m->stretch_bend_k))
+    return -1;
+  if (opt_number(c, v[M_DISTANCE_STIFFNESS], path, "distance_stiffness", "organs.material.distance_stiffness",
+                 &m->distance_stiffness))
+    return -1;
+  if (opt_number(c, v[M_VOLUME_STIFFNESS], path, "volume_stiffness", "organs.material.volume_stiffness",
+                 &m->volume_stiffness))
+    return -1;
+  if (opt_number(c, v[M_DISTANCE_COMPLIANCE], path, "distance_compliance", "organs.material.distance_compliance",
+                 &m->distance_compliance))
+    return -1;
+  if (opt_number(c, v[M_VOLUME_COMPLIANCE], path, "volume_compliance", "organs.material.volume_compliance",
+                 &m->volume_compliance))
+    return -1;
+  if (opt_number(c, v[M_SLOPE_M1], path, "slope_m1", "organs.material.slope_m1", &m->slope_m1)) return -1;
+  if (opt_number(c, v[M_SLOPE_M2], path, "slope_m2", "organs.material.slope_m2", &m->slope_m2)) return -1;
+  if (opt_number(c, v[M_SLOPE_M3], path, "slope_m3", "organs.material.slope_m3", &m->slope_m3)) return -1;
+  if (opt_number(c, v[M_REFINE_AREA], path, "refine_area", "organs.material.refine_area", &m->refine_area)) return -1;
+  if (opt_int(c, v[M_REFINE_LEVELS], path, "refine_levels", "organs.material.refine_levels", &m->refine_levels))
+    return -1;
   return 0;
 }
 
 static int parse_solver(const ctx_t *c, const node_t *n, const char *path, scene_solver_t *sv) {
   const node_t *v[V_NKEYS];
-  static const range_t substeps = {B_INCL, 0, B_INCL, 256};
-  static const range_t iterations = {B_INCL, 1, B_INCL, 1000};
-  static const range_t tolerance = {B_INCL, 1e-12, B_INCL, 1e-1};
-  static const range_t cg_iterations = {B_INCL, 1, B_INCL, 10000};
-  static const range_t tet_size = {B_INCL, 0, B_INCL, 0.1};
   if (get_fields(c, n, path, solver_keys, V_NKEYS, v)) return -1;
-  if (opt_int(c, v[V_SUBSTEPS], path, "substeps", &substeps, &sv->substeps)) return -1;
-  if (opt_int(c, v[V_ITERATIONS], path, "iterations", &iterations, &sv->iterations)) return -1;
-  if (opt_number(c, v[V_CG_TOLERANCE], path, "cg_tolerance", &tolerance, &sv->cg_tolerance)) return -1;
-  if (opt_int(c, v[V_CG_MAX_ITERATIONS], path, "cg_max_iterations", &cg_iterations, &sv->cg_max_iterations))
+  if (opt_int(c, v[V_SUBSTEPS], path, "substeps", "organs.solver.substeps", &sv->substeps)) return -1;
+  if (opt_int(c, v[V_ITERATIONS], path, "iterations", "organs.solver.iterations", &sv->iterations)) return -1;
+  if (opt_number(c, v[V_CG_TOLERANCE], path, "cg_tolerance", "organs.solver.cg_tolerance", &sv->cg_tolerance))
     return -1;
-  if (opt_number(c, v[V_TET_SIZE], path, "tet_size", &tet_size, &sv->tet_size)) return -1;
+  if (opt_int(c, v[V_CG_MAX_ITERATIONS], path, "cg_max_iterations", "organs.solver.cg_max_iterations",
+              &sv->cg_max_iterations))
+    return -1;
+  if (opt_number(c, v[V_TET_SIZE], path, "tet_size", "organs.solver.tet_size", &sv->tet_size)) return -1;
   /* 0 asks for the automatic size; anything else below 0.1 mm would build
    * millions of tetrahedra for an organ. */
   if (sv->tet_size != 0 && sv->tet_size < 1e-4) {
@@ -689,7 +708,6 @@ static int parse_organ(const ctx_t *c, const node_t *n, size_t idx, const char *
   scene_organ_t *o = &s->organs[idx];
   const node_t *v[O_NKEYS];
   char path[64], fp[128];
-  static const range_t unit = {B_INCL, 0, B_INCL, 1};
   snprintf(path, sizeof path, "organs[%zu]", idx);
   organ_defaults(o);
   o->line = n->line;
@@ -726,16 +744,16 @@ static int parse_organ(const ctx_t *c, const node_t *n, size_t idx, const char *
     if (parse_solver(c, v[O_SOLVER], fp, &o->solver)) return -1;
   }
   join(fp, sizeof fp, path, "position");
-  if (v[O_POSITION] && get_vec3(c, v[O_POSITION], fp, &ANY, o->position)) return -1;
-  if (opt_number(c, v[O_SCALE], path, "scale", &GT0, &o->scale)) return -1;
+  if (v[O_POSITION] && get_vec3(c, v[O_POSITION], fp, "organs.position", o->position)) return -1;
+  if (opt_number(c, v[O_SCALE], path, "scale", "organs.scale", &o->scale)) return -1;
   if (v[O_COLOR]) {
     double rgb[3];
     join(fp, sizeof fp, path, "color");
-    if (get_vec3(c, v[O_COLOR], fp, &unit, rgb)) return -1;
+    if (get_vec3(c, v[O_COLOR], fp, "organs.color", rgb)) return -1;
     for (int k = 0; k < 3; k++) o->color[k] = (float)rgb[k];
   }
   if (v[O_FIXED_BELOW]) {
-    if (opt_number(c, v[O_FIXED_BELOW], path, "fixed_below", &ANY, &o->fixed_below)) return -1;
+    if (opt_number(c, v[O_FIXED_BELOW], path, "fixed_below", "organs.fixed_below", &o->fixed_below)) return -1;
     o->fixed_below_set = 1;
   }
   const node_t *mv[M_NKEYS] = {0};
@@ -748,13 +766,12 @@ static int parse_organ(const ctx_t *c, const node_t *n, size_t idx, const char *
  * other and against the tool's max_force (already parsed). */
 static int parse_thresholds(const ctx_t *c, const node_t *n, const char *path, scene_tool_t *t) {
   const node_t *hv[H_NKEYS];
-  static const range_t thr_range = {B_EXCL, 0, B_INCL, 100};
   double *dst[H_NKEYS] = {[H_ST] = &t->st, [H_MPF] = &t->mpf, [H_SFT] = &t->sft};
   char fp[160];
   if (get_fields(c, n, path, threshold_keys, H_NKEYS, hv)) return -1;
   for (int k = 0; k < H_NKEYS; k++) {
     if (!hv[k]) continue;
-    if (opt_number(c, hv[k], path, threshold_keys[k], &thr_range, dst[k])) return -1;
+    if (opt_number(c, hv[k], path, threshold_keys[k], "tools.thresholds", dst[k])) return -1;
     join(fp, sizeof fp, path, threshold_keys[k]);
     if (*dst[k] > t->max_force)
       return field_err(c, hv[k], fp, "must be <= the tool's max_force %g N (got %g)", t->max_force, *dst[k]);
@@ -779,11 +796,8 @@ static int parse_thresholds(const ctx_t *c, const node_t *n, const char *path, s
  * that have jaws: a key a kind cannot use is refused, not ignored, so a
  * scene never promises a capability the tool does not have. */
 static int parse_capability(const ctx_t *c, const node_t *const *v, const char *path, scene_tool_t *t) {
-  static const range_t mu_range = {B_INCL, 0, B_INCL, 2};
-  static const range_t grasp_range = {B_EXCL, 0, B_INCL, 0.05};
-  static const range_t blade_range = {B_EXCL, 0, B_INCL, 0.2};
   char fp[128];
-  if (opt_number(c, v[T_FRICTION], path, "friction", &mu_range, &t->friction)) return -1;
+  if (opt_number(c, v[T_FRICTION], path, "friction", "tools.friction", &t->friction)) return -1;
   int jaws = !strcmp(t->kind, "grasper") || !strcmp(t->kind, "extractor");
   if (v[T_GRASP_RADIUS] && !jaws) {
     join(fp, sizeof fp, path, "grasp_radius");
@@ -798,11 +812,11 @@ static int parse_capability(const ctx_t *c, const node_t *const *v, const char *
     return field_err(c, v[T_BLADE_LENGTH], fp, "only a scalpel has a blade (this tool is a %s)", t->kind);
   }
   if (!strcmp(t->kind, "scalpel")) t->blade_length = 0.02;
-  if (opt_number(c, v[T_BLADE_LENGTH], path, "blade_length", &blade_range, &t->blade_length)) return -1;
+  if (opt_number(c, v[T_BLADE_LENGTH], path, "blade_length", "tools.blade_length", &t->blade_length)) return -1;
   if (jaws) t->grasp_radius = 2 * t->radius;
   if (!strcmp(t->kind, "grasper")) t->jaw_opening = 4 * t->radius;
-  if (opt_number(c, v[T_GRASP_RADIUS], path, "grasp_radius", &grasp_range, &t->grasp_radius)) return -1;
-  if (opt_number(c, v[T_JAW_OPENING], path, "jaw_opening", &grasp_range, &t->jaw_opening)) return -1;
+  if (opt_number(c, v[T_GRASP_RADIUS], path, "grasp_radius", "tools.grasp_radius", &t->grasp_radius)) return -1;
+  if (opt_number(c, v[T_JAW_OPENING], path, "jaw_opening", "tools.jaw_opening", &t->jaw_opening)) return -1;
   return 0;
 }
 
@@ -810,9 +824,6 @@ static int parse_tool(const ctx_t *c, const node_t *n, size_t idx, scene_t *s) {
   scene_tool_t *t = &s->tools[idx];
   const node_t *v[T_NKEYS];
   char path[64], fp[128];
-  static const range_t radius_range = {B_EXCL, 0, B_INCL, 0.05};
-  static const range_t stiffness_range = {B_EXCL, 0, B_INCL, 1e5};
-  static const range_t force_range = {B_EXCL, 0, B_INCL, 100};
   snprintf(path, sizeof path, "tools[%zu]", idx);
   tool_defaults(t);
   t->line = n->line;
@@ -827,10 +838,10 @@ static int parse_tool(const ctx_t *c, const node_t *n, size_t idx, scene_t *s) {
   join(fp, sizeof fp, path, "kind");
   if (v[T_KIND] && get_choice(c, v[T_KIND], fp, scene_tool_kinds, COUNT(scene_tool_kinds), t->kind, sizeof t->kind))
     return -1;
-  if (opt_number(c, v[T_RADIUS], path, "radius", &radius_range, &t->radius)) return -1;
-  if (opt_number(c, v[T_LENGTH], path, "length", &GT0, &t->length)) return -1;
-  if (opt_number(c, v[T_STIFFNESS], path, "stiffness", &stiffness_range, &t->stiffness)) return -1;
-  if (opt_number(c, v[T_MAX_FORCE], path, "max_force", &force_range, &t->max_force)) return -1;
+  if (opt_number(c, v[T_RADIUS], path, "radius", "tools.radius", &t->radius)) return -1;
+  if (opt_number(c, v[T_LENGTH], path, "length", "tools.length", &t->length)) return -1;
+  if (opt_number(c, v[T_STIFFNESS], path, "stiffness", "tools.stiffness", &t->stiffness)) return -1;
+  if (opt_number(c, v[T_MAX_FORCE], path, "max_force", "tools.max_force", &t->max_force)) return -1;
   if (v[T_THRESHOLDS]) {
     join(fp, sizeof fp, path, "thresholds");
     if (parse_thresholds(c, v[T_THRESHOLDS], fp, t)) return -1;
@@ -871,8 +882,6 @@ static int parse_object(const ctx_t *c, const node_t *n, size_t idx, scene_t *s)
   scene_object_t *o = &s->objects[idx];
   const node_t *v[J_NKEYS];
   char path[64], fp[128];
-  static const range_t radius_range = {B_EXCL, 0, B_INCL, 0.05};
-  static const range_t unit = {B_INCL, 0, B_INCL, 1};
   snprintf(path, sizeof path, "objects[%zu]", idx);
   memset(o, 0, sizeof *o);
   snprintf(o->kind, sizeof o->kind, "%s", scene_object_kinds[0]);
@@ -894,15 +903,15 @@ static int parse_object(const ctx_t *c, const node_t *n, size_t idx, scene_t *s)
   join(fp, sizeof fp, path, "kind");
   if (v[J_KIND] && get_choice(c, v[J_KIND], fp, scene_object_kinds, COUNT(scene_object_kinds), o->kind, sizeof o->kind))
     return -1;
-  if (opt_number(c, v[J_RADIUS], path, "radius", &radius_range, &o->radius)) return -1;
+  if (opt_number(c, v[J_RADIUS], path, "radius", "objects.radius", &o->radius)) return -1;
   join(fp, sizeof fp, path, "position");
-  if (get_vec3(c, v[J_POSITION], fp, &ANY, o->position)) return -1;
+  if (get_vec3(c, v[J_POSITION], fp, "objects.position", o->position)) return -1;
   join(fp, sizeof fp, path, "organ");
   if (find_name(c, v[J_ORGAN], fp, "organ", s->organs[0].name, sizeof s->organs[0], s->norgans, &o->organ)) return -1;
   if (v[J_COLOR]) {
     double rgb[3];
     join(fp, sizeof fp, path, "color");
-    if (get_vec3(c, v[J_COLOR], fp, &unit, rgb)) return -1;
+    if (get_vec3(c, v[J_COLOR], fp, "objects.color", rgb)) return -1;
     for (int k = 0; k < 3; k++) o->color[k] = (float)rgb[k];
   }
   return 0;
@@ -920,8 +929,6 @@ static int parse_task(const ctx_t *c, const node_t *n, size_t idx, scene_t *s) {
   scene_task_t *t = &s->tasks[idx];
   const node_t *v[K_NKEYS];
   char path[64], fp[128];
-  static const range_t radius_range = {B_EXCL, 0, B_INCL, 0.1};
-  static const range_t distance_range = {B_EXCL, 0, B_INCL, 0.5};
   snprintf(path, sizeof path, "tasks[%zu]", idx);
   memset(t, 0, sizeof *t);
   t->object = -1;
@@ -968,14 +975,14 @@ static int parse_task(const ctx_t *c, const node_t *n, size_t idx, scene_t *s) {
                        s->tools[t->tool].name);
     if (!v[K_TARGET]) return missing(c, n, path, "target");
     join(fp, sizeof fp, path, "target");
-    if (get_vec3(c, v[K_TARGET], fp, &ANY, t->target)) return -1;
-    if (opt_number(c, v[K_TARGET_RADIUS], path, "target_radius", &radius_range, &t->target_radius)) return -1;
+    if (get_vec3(c, v[K_TARGET], fp, "tasks.target", t->target)) return -1;
+    if (opt_number(c, v[K_TARGET_RADIUS], path, "target_radius", "tasks.target_radius", &t->target_radius)) return -1;
     if (task_key_unused(c, v, K_OBJECT, path, t->kind) || task_key_unused(c, v, K_DISTANCE, path, t->kind)) return -1;
   } else { /* grasp_pull */
     if (strcmp(tk, "grasper"))
       return field_err(c, v[K_TOOL], fp, "a grasp_pull task needs a grasper (tool '%s' is a %s)",
                        s->tools[t->tool].name, tk);
-    if (opt_number(c, v[K_DISTANCE], path, "distance", &distance_range, &t->distance)) return -1;
+    if (opt_number(c, v[K_DISTANCE], path, "distance", "tasks.distance", &t->distance)) return -1;
     if (task_key_unused(c, v, K_OBJECT, path, t->kind) || task_key_unused(c, v, K_TARGET, path, t->kind) ||
         task_key_unused(c, v, K_TARGET_RADIUS, path, t->kind))
       return -1;

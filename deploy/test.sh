@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs what is missing, builds with warnings as errors, and runs the whole
 # test suite (unit, integration over DDS on loopback, stability, fuzz), then
-# the unit, integration and stability tests again under AddressSanitizer +
+# the unit, integration, stability and fuzz tests again under AddressSanitizer +
 # UndefinedBehaviorSanitizer. Build trees: build-test/ and build-asan/.
 # Set VISCERA_SKIP_ASAN=1 to skip the sanitizer pass.
 set -euo pipefail
@@ -25,6 +25,6 @@ if [ "${VISCERA_SKIP_ASAN:-0}" != "1" ]; then
   # Two at a time like the first pass, except the tests that judge loss
   # detection or real-time coupling: sanitized 1 kHz processes need about
   # twice the CPU, so those run alone (RUN_SERIAL, tests/integration/CMakeLists.txt).
-  (cd "$ROOT/build-asan" && ctest --output-on-failure -j"$JOBS" --timeout 300 --repeat until-pass:2 -L "unit|integration|stability")
+  (cd "$ROOT/build-asan" && ctest --output-on-failure -j"$JOBS" --timeout 300 --repeat until-pass:2 -L "unit|integration|stability|fuzz")
 fi
 echo "test: all passed"

@@ -27,10 +27,13 @@ typedef struct replay {
   size_t ntopics;
   dds_entity_t pp, pub;
   int64_t t0, t_end;
+  /* The recording's own span (find_time_range): a source timestamp outside
+   * [span_lo, span_hi] is garbled and never moves the schedule. */
+  int64_t span_lo, span_hi;
   /* per pass */
   int64_t start_mono, sched_ts, last_progress;
   uint64_t pass_rows;
-  uint64_t total_written, total_bad, total_skipped;
+  uint64_t total_written, total_bad, total_skipped, total_out_of_span;
   rp_buf_t buf; /* rp_topic_write's scratch copy */
 } replay_t;
 
@@ -121,7 +124,17 @@ static int on_row(void *arg, const recfile_row_t *row) {
   /* Only data rows are guaranteed monotonic (recording.h): the schedule
    * never goes backwards; rows older than the session start go at once. */
   int64_t ts = row->source_ts_ns;
-  if (ts > r->sched_ts) r->sched_ts = ts;
+  if (ts < r->span_lo || ts > r->span_hi) {
+    /* INT64_MAX would have made the replay wait for ever: the sample goes
+     * out at the current schedule time, counted. */
+    if (r->total_out_of_span++ == 0)
+      fprintf(stderr,
+              "replay: %s: sample %lld: source time %lld ns outside the recording's span; sent without "
+              "waiting\n",
+              r->o.path, (long long)row->id, (long long)ts);
+  } else if (ts > r->sched_ts) {
+    r->sched_ts = ts;
+  }
   int64_t rel = r->sched_ts - r->t0;
   int64_t seek_ns = (int64_t)(r->o.seek * 1e9);
   if (rel < seek_ns) {
@@ -155,21 +168,54 @@ static int on_row(void *arg, const recfile_row_t *row) {
   return 0;
 }
 
-static void find_time_range(replay_t *r) {
-  const recfile_session_t *s = recfile_session(r->rf);
+/* A recording spans at most this long (s): a damaged end time cannot make
+ * the replay wait longer. */
+#define REPLAY_MAX_SPAN_S (7 * 24 * 3600)
+
+static int64_t query_i64(sqlite3 *db, const char *sql, int64_t lo, int64_t hi, int64_t dflt) {
   sqlite3_stmt *st = NULL;
-  int64_t first = 0, last = 0;
-  if (sqlite3_prepare_v2(r->db, "SELECT min(source_ts_ns), max(source_ts_ns) FROM samples WHERE kind = 0", -1, &st,
-                         NULL) == SQLITE_OK &&
-      sqlite3_step(st) == SQLITE_ROW) {
-    first = sqlite3_column_int64(st, 0);
-    last = sqlite3_column_int64(st, 1);
+  int64_t v = dflt;
+  if (sqlite3_prepare_v2(db, sql, -1, &st, NULL) == SQLITE_OK) {
+    sqlite3_bind_int64(st, 1, lo);
+    sqlite3_bind_int64(st, 2, hi);
+    if (sqlite3_step(st) == SQLITE_ROW && sqlite3_column_type(st, 0) != SQLITE_NULL) v = sqlite3_column_int64(st, 0);
   }
   sqlite3_finalize(st);
+  return v;
+}
+
+/* The recording's own span from the recorder's clock (the session row's
+ * start and end, else the samples' receive times, at most
+ * REPLAY_MAX_SPAN_S), widened by an hour before (keyframes a late joiner
+ * took) and a minute after (writers' clocks). Sim time 0 is the session
+ * start, or the first data sample inside the span. */
+static void find_time_range(replay_t *r) {
+  const recfile_session_t *s = recfile_session(r->rf);
+  const int64_t big = INT64_MAX / 4;
+  int64_t lo = s->valid && s->start_wall_ns > 0 ? s->start_wall_ns
+                                                : query_i64(r->db,
+                                                            "SELECT min(recv_wall_ns) FROM samples WHERE "
+                                                            "recv_wall_ns BETWEEN ?1 AND ?2",
+                                                            1, big, 1);
+  int64_t hi = s->valid && s->has_end && s->end_wall_ns >= lo ? s->end_wall_ns
+                                                              : query_i64(r->db,
+                                                                          "SELECT max(recv_wall_ns) FROM samples "
+                                                                          "WHERE recv_wall_ns BETWEEN ?1 AND ?2",
+                                                                          lo, big, lo);
+  if (hi - lo > DDS_SECS(REPLAY_MAX_SPAN_S)) hi = lo + DDS_SECS(REPLAY_MAX_SPAN_S);
+  r->span_lo = lo > DDS_SECS(3600) ? lo - DDS_SECS(3600) : 1;
+  r->span_hi = hi + DDS_SECS(60);
+  const char *q = "SELECT %s(source_ts_ns) FROM samples WHERE kind = 0 AND source_ts_ns BETWEEN ?1 AND ?2";
+  char sql[160];
+  snprintf(sql, sizeof sql, q, "min");
+  int64_t first = query_i64(r->db, sql, r->span_lo, r->span_hi, 0);
+  snprintf(sql, sizeof sql, q, "max");
+  int64_t last = query_i64(r->db, sql, r->span_lo, r->span_hi, 0);
   /* Sim time 0 is the session start (keyframes taken as a late joiner are
    * older and go out at once); without a session row, the first sample. */
   r->t0 = s->valid && s->start_wall_ns > 0 ? s->start_wall_ns : first;
   if (first > 0 && (r->t0 <= 0 || first > r->t0 + DDS_SECS(3600))) r->t0 = first;
+  if (r->t0 <= 0) r->t0 = r->span_lo;
   r->t_end = last;
 }
 
@@ -275,6 +321,9 @@ static int publish_all(replay_t *r) {
           stop_flag ? "interrupted after" : "wrote", (unsigned long long)r->total_written, r->ntopics,
           (unsigned long long)r->total_skipped, (unsigned long long)r->total_bad,
           passes > 1 ? " over several passes" : "");
+  if (r->total_out_of_span)
+    fprintf(stderr, "replay: %llu sample(s) with a source time outside the recording's span sent without waiting\n",
+            (unsigned long long)r->total_out_of_span);
   printf("SUMMARY written=%llu topics=%zu bad=%llu skipped=%llu\n", (unsigned long long)r->total_written, r->ntopics,
          (unsigned long long)r->total_bad, (unsigned long long)r->total_skipped);
 out:

@@ -6,6 +6,8 @@
 
 #include <dds/ddsi/ddsi_cdrstream.h>
 
+#include "replay_typecheck.h"
+
 static dds_duration_t col_dur(sqlite3_stmt *st, int col, dds_duration_t dflt) {
   return sqlite3_column_type(st, col) == SQLITE_NULL ? dflt : sqlite3_column_int64(st, col);
 }
@@ -33,6 +35,38 @@ static dds_duration_t scaled(const rp_setup_t *r, dds_duration_t d) {
   if (d == DDS_INFINITY || r->speed >= 1.0) return d;
   double v = (double)d / r->speed;
   return v > 9e18 ? DDS_INFINITY : (dds_duration_t)v;
+}
+
+/* Durations of the recorded QoS (untrusted, issue 15: a deadline of 0 made
+ * the writer spin): NULL or DDS_INFINITY-like "not set" is fine, else at
+ * least 1 ms and finite. Returns NULL or what is wrong. */
+static const char *qos_values_ok(sqlite3_stmt *st, char *why, size_t n) {
+  static const struct {
+    int col;
+    const char *name;
+  } durs[] = {{13, "max_blocking"}, {19, "deadline"}, {21, "liveliness lease"}};
+  for (size_t i = 0; i < sizeof durs / sizeof durs[0]; i++) {
+    if (sqlite3_column_type(st, durs[i].col) == SQLITE_NULL) continue;
+    int64_t d = sqlite3_column_int64(st, durs[i].col);
+    if (d == DDS_INFINITY) continue;
+    if (d < DDS_MSECS(1) && !(durs[i].col == 13 && d >= 0)) {
+      snprintf(why, n, "recorded %s %lld ns out of range (>= 1 ms or infinite)", durs[i].name, (long long)d);
+      return why;
+    }
+  }
+  for (int col = 16; col <= 18; col += 2)
+    if (sqlite3_column_type(st, col) != SQLITE_NULL &&
+        (sqlite3_column_int64(st, col) < 0 || sqlite3_column_int64(st, col) > 100000)) {
+      snprintf(why, n, "recorded history depth %lld out of range (0..100000)",
+               (long long)sqlite3_column_int64(st, col));
+      return why;
+    }
+  if (sqlite3_column_type(st, 23) != SQLITE_NULL &&
+      (sqlite3_column_int64(st, 23) < INT32_MIN || sqlite3_column_int64(st, 23) > INT32_MAX)) {
+    snprintf(why, n, "recorded ownership strength out of range");
+    return why;
+  }
+  return NULL;
 }
 
 static dds_qos_t *qos_from_row(const rp_setup_t *r, sqlite3_stmt *st, bool *tl) {
@@ -182,6 +216,14 @@ static int setup_topic(const rp_setup_t *r, sqlite3_stmt *st, rp_topic_t *t, ver
   t->st.type.ops.nops = (uint32_t)nops;
   t->st.type.ops.ops = t->ops;
 
+  /* Cyclone trusts a descriptor: a NULL or damaged type mapping crashes
+   * dds_create_topic, a damaged program makes the op counter below loop.
+   * Both are checked first (replay_typecheck.h). */
+  char why[200];
+  if (rp_ops_check(t->ops, (uint32_t)nops, (uint32_t)size, t->nkeys, t->keys, why, sizeof why))
+    return verr_set(err, "topic %s: stored type program is damaged: %s", t->name, why);
+  if (rp_types_check(t->typeinfo, tilen, t->typemap, tmlen, why, sizeof why))
+    return verr_set(err, "topic %s: stored type information is damaged: %s", t->name, why);
   /* A wrong ops length makes dds_create_topic hang (docs/dds.md, "Topic descriptors"): the stored
    * count must be what Cyclone counts in the stored program. */
   uint32_t counted = dds_stream_countops(t->ops, t->nkeys, t->keys);
@@ -192,6 +234,8 @@ static int setup_topic(const rp_setup_t *r, sqlite3_stmt *st, rp_topic_t *t, ver
   if (t->topic < 0)
     return verr_set(err, "topic %s (type %s): cannot create from the stored descriptor: %s", t->name, t->type_name,
                     dds_strretcode(t->topic));
+  const char *qbad = qos_values_ok(st, why, sizeof why);
+  if (qbad) return verr_set(err, "topic %s: %s", t->name, qbad);
   dds_qos_t *q = qos_from_row(r, st, &t->transient_local);
   if (!q) return verr_set(err, "out of memory");
   t->writer = dds_create_writer(r->pub, t->topic, q, NULL);

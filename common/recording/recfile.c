@@ -201,12 +201,19 @@ int recfile_open(recfile_t **out, const char *path, verr_t *err) {
   int64_t user_version = 0;
   pragma_int(rf->db, "PRAGMA user_version", &user_version);
   if (app_id != REC_APPLICATION_ID) warn(rf, "%s", "identification pragma missing (file rewritten by another tool?)");
-  if (user_version > REC_FORMAT_VERSION) {
-    char v[32];
-    snprintf(v, sizeof v, "%lld", (long long)user_version);
-    warn(rf, "format version %s is newer than this tool knows; reading what it can", v);
+  /* A format this tool does not know is refused, not guessed at: its
+   * tables may mean something else (0: the pragma was lost, see above). */
+  if (user_version < 0 || user_version > REC_FORMAT_VERSION) {
+    verr_set(err, "%s: recording format version %lld is not one this tool reads (1..%d)", path, (long long)user_version,
+             REC_FORMAT_VERSION);
+    goto fail;
   }
   read_session(rf);
+  if (rf->session.valid && (rf->session.format_version < 1 || rf->session.format_version > REC_FORMAT_VERSION)) {
+    verr_set(err, "%s: recording format version %d (session row) is not one this tool reads (1..%d)", path,
+             rf->session.format_version, REC_FORMAT_VERSION);
+    goto fail;
+  }
   read_topics(rf);
   *out = rf;
   return 0;

@@ -18,6 +18,7 @@ typedef struct load_ctx {
   resim_recording_t *rec;
   caps_t caps; /* allocated lengths of the arrays in rec */
   int oom;
+  int64_t scene_ts; /* source timestamp of the earliest SceneInfo: the server's sim time 0 (0 unknown) */
 } load_ctx_t;
 
 static void skip(resim_recording_t *rec, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
@@ -41,11 +42,21 @@ static int grow(void **arr, size_t *cap, size_t n, size_t size) {
   return 0;
 }
 
-/* The server step of a sim time; UINT64_MAX beyond RESIM_MAX_SIM_S (a
- * garbled time must not size the schedule). */
-static uint64_t step_of(const resim_recording_t *rec, uint64_t sim_time_ns) {
+/* The server step of a sim time; UINT64_MAX beyond RESIM_MAX_SIM_S, or
+ * beyond the recording's own span: the server stamps a sample of sim time
+ * t no earlier than t after it wrote its SceneInfo (sim time 0; it never
+ * runs ahead of the wall clock), so a sim time later than the sample's own
+ * source timestamp minus the SceneInfo's, plus RESIM_SPAN_SLACK_S, is
+ * garbled (one flipped bit in a MeshDelta header planned 17.6 million
+ * steps). Both timestamps come from the server's clock. */
+static uint64_t step_of(const load_ctx_t *ctx, const recfile_row_t *row, uint64_t sim_time_ns) {
+  const resim_recording_t *rec = ctx->rec;
   double s = (double)sim_time_ns * 1e-9;
   if (s > RESIM_MAX_SIM_S) return UINT64_MAX;
+  if (ctx->scene_ts > 0 && row->source_ts_ns > 0) {
+    double span = (double)(row->source_ts_ns - ctx->scene_ts) * 1e-9 + RESIM_SPAN_SLACK_S;
+    if (s > span) return UINT64_MAX;
+  }
   return (uint64_t)llround(s / rec->dt);
 }
 
@@ -54,10 +65,15 @@ static int on_scene(void *arg, const void *sample, const recfile_row_t *row) {
   const viscera_SceneInfo *si = sample;
   if (!(si->physics_dt > 0 && si->physics_dt < 1) || si->organs._length > SCENE_MAX_ORGANS ||
       si->tools._length > SCENE_MAX_TOOLS || !(si->quant_step > 0)) {
-    skip(rec, "SceneInfo sample %lld: dt %g, %u organs, %u tools, quant_step %g out of range", (long long)row->id,
-         si->physics_dt, si->organs._length, si->tools._length, (double)si->quant_step);
+    skip(rec,
+         "SceneInfo sample %lld: dt %g, %u organs, %u tools, quant_step %g beyond the recording (RESIM_MAX_SIM_S or "
+         "its own span)",
+         (long long)row->id, si->physics_dt, si->organs._length, si->tools._length, (double)si->quant_step);
   } else {
     rec->have_scene = 1;
+    load_ctx_t *ctx = arg;
+    if (row->source_ts_ns > 0 && (ctx->scene_ts == 0 || row->source_ts_ns < ctx->scene_ts))
+      ctx->scene_ts = row->source_ts_ns;
     snprintf(rec->scene, sizeof rec->scene, "%s", si->scene);
     rec->dt = si->physics_dt;
     rec->publish_hz = si->publish_hz;
@@ -99,10 +115,10 @@ static int on_feedback(void *arg, const void *sample, const recfile_row_t *row) 
     skip(rec, "ContactFeedback sample %lld: tool %u not in the scene", (long long)row->id, f->tool_id);
     return 0;
   }
-  uint64_t step = step_of(rec, f->sim_time_ns);
+  uint64_t step = step_of(ctx, row, f->sim_time_ns);
   if (step == UINT64_MAX) {
-    skip(rec, "ContactFeedback sample %lld: sim time %llu ns out of range", (long long)row->id,
-         (unsigned long long)f->sim_time_ns);
+    skip(rec, "ContactFeedback sample %lld: sim time %llu ns beyond the recording (RESIM_MAX_SIM_S or its own span)",
+         (long long)row->id, (unsigned long long)f->sim_time_ns);
     return 0;
   }
   resim_tool_input_t *t = &rec->tools[f->tool_id];
@@ -121,10 +137,10 @@ static int on_event(void *arg, const void *sample, const recfile_row_t *row) {
          (int)e->tool_id);
     return 0;
   }
-  uint64_t step = step_of(rec, e->sim_time_ns);
+  uint64_t step = step_of(ctx, row, e->sim_time_ns);
   if (step == UINT64_MAX) {
-    skip(rec, "SessionEvent sample %lld: sim time %llu ns out of range", (long long)row->id,
-         (unsigned long long)e->sim_time_ns);
+    skip(rec, "SessionEvent sample %lld: sim time %llu ns beyond the recording (RESIM_MAX_SIM_S or its own span)",
+         (long long)row->id, (unsigned long long)e->sim_time_ns);
     return 0;
   }
   resim_tool_input_t *t = &rec->tools[e->tool_id];
@@ -138,9 +154,9 @@ static int on_state(void *arg, const void *sample, const recfile_row_t *row) {
   resim_recording_t *rec = ctx->rec;
   const viscera_MeshState *s = sample;
   int rc = 0;
-  if (step_of(rec, s->sim_time_ns) == UINT64_MAX) {
-    skip(rec, "MeshState sample %lld: sim time %llu ns out of range", (long long)row->id,
-         (unsigned long long)s->sim_time_ns);
+  if (step_of(ctx, row, s->sim_time_ns) == UINT64_MAX) {
+    skip(rec, "MeshState sample %lld: sim time %llu ns beyond the recording (RESIM_MAX_SIM_S or its own span)",
+         (long long)row->id, (unsigned long long)s->sim_time_ns);
   } else if (s->organ_id >= rec->norgans) {
     skip(rec, "MeshState sample %lld: organ %u not in the scene", (long long)row->id, s->organ_id);
   } else if (s->positions._length != 3ull * rec->organs[s->organ_id].nverts) {
@@ -157,7 +173,7 @@ static int on_state(void *arg, const void *sample, const recfile_row_t *row) {
       rec->keys[rec->nkeys++] = (resim_keyframe_t){.organ = s->organ_id,
                                                    .keyframe_seq = s->keyframe_seq,
                                                    .topology_version = s->topology_version,
-                                                   .step = step_of(rec, s->sim_time_ns),
+                                                   .step = step_of(ctx, row, s->sim_time_ns),
                                                    .pos = pos};
     }
   }
@@ -169,9 +185,9 @@ static int on_delta(void *arg, const void *sample, const recfile_row_t *row) {
   resim_recording_t *rec = ctx->rec;
   const viscera_MeshDelta *d = sample;
   int rc = 0;
-  if (step_of(rec, d->sim_time_ns) == UINT64_MAX) {
-    skip(rec, "MeshDelta sample %lld: sim time %llu ns out of range", (long long)row->id,
-         (unsigned long long)d->sim_time_ns);
+  if (step_of(ctx, row, d->sim_time_ns) == UINT64_MAX) {
+    skip(rec, "MeshDelta sample %lld: sim time %llu ns beyond the recording (RESIM_MAX_SIM_S or its own span)",
+         (long long)row->id, (unsigned long long)d->sim_time_ns);
   } else if (d->organ_id >= rec->norgans) {
     skip(rec, "MeshDelta sample %lld: organ %u not in the scene", (long long)row->id, d->organ_id);
   } else if (grow((void **)&rec->deltas, &ctx->caps.deltas, rec->ndeltas, sizeof *rec->deltas)) {
@@ -192,7 +208,7 @@ static int on_delta(void *arg, const void *sample, const recfile_row_t *row) {
                                                     .keyframe_seq = d->keyframe_seq,
                                                     .topology_version = d->topology_version,
                                                     .frame_seq = d->frame_seq,
-                                                    .step = step_of(rec, d->sim_time_ns),
+                                                    .step = step_of(ctx, row, d->sim_time_ns),
                                                     .quant = d->quant_step,
                                                     .count = d->indices._length,
                                                     .idx = idx,

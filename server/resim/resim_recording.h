@@ -22,6 +22,10 @@
 /* Samples stamped later than this (s of simulated time) are skipped: a
  * garbled time must not size the schedule. */
 #define RESIM_MAX_SIM_S 21600.0
+/* ... and so are samples whose sim time lies more than this (s) beyond the
+ * wall time the server had run when it wrote them (resim_recording.c
+ * step_of: the recording's own span bounds the schedule). */
+#define RESIM_SPAN_SLACK_S 10.0
 
 typedef struct resim_organ_info {
   char name[65];

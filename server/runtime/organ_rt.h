@@ -21,12 +21,15 @@ typedef struct organ_rt {
   const scene_organ_t *cfg;
   uint32_t id;
   struct runtime *rt;  /* back pointer for the model's contact hook */
-  mesh_t rest;         /* the imported mesh after scale and position */
+  mesh_t rest;         /* the imported mesh after scale and position (and mesh_admit's repairs) */
+  char mesh_note[200]; /* what mesh_admit repaired, "" when nothing */
   model_t *model;      /* sub-steps and stable dt live in the model */
   double patch_radius; /* m, contact patch radius: max(2 tool radius, 1.5 mean surface edge) */
   aabb_tree_t tree;    /* over the model's contact surface, refit after every step */
   double *vn_rest;     /* unit vertex normals of the rest surface (force shading, proxy.h) */
   uint64_t rollbacks;
+  uint32_t rollback_run; /* consecutive rolled-back steps (scene_runtime.h RUNTIME_ROLLBACK_RESET) */
+  uint64_t rest_resets;  /* times the organ was put back to rest after such a run */
   /* The model topology_version the tree, surface view, proxies and patches
    * were last rebuilt for (topology_follow.h). The server polls it: when it
    * differs from what it last published, a new keyframe is due. */

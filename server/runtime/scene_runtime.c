@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "interaction/shaft.h"
+#include "mesh_admit.h"
 #include "runtime/organ_geometry.h"
 #include "runtime/step_cut.h"
 #include "runtime/step_tools.h"
@@ -24,6 +25,18 @@ static int organ_init(organ_rt_t *o, runtime_t *rt, const scene_organ_t *cfg, ui
   tet_mesh_t volume = {0};
   if (organ_geometry_load(cfg, &o->rest, &volume, &e))
     return verr_set(err, "%s:%d: organ '%s': %s", sc->path, cfg->line, cfg->name, e.msg);
+  /* The defects no model can take are refused, the ones with one right
+   * answer repaired (mesh_admit.h); the volume models need a closed
+   * surface, the surface ones also take a sheet. */
+  mesh_admit_opts_t ao = {.allow_open = strcmp(cfg->model, "mass_spring_tet") && strcmp(cfg->model, "pbd") &&
+                                        strcmp(cfg->model, "xpbd"),
+                          .min_size = MESH_ADMIT_MIN_SIZE,
+                          .max_size = MESH_ADMIT_MAX_SIZE};
+  if (mesh_admit(&o->rest, &ao, cfg->mesh[0] ? cfg->mesh : cfg->volume, o->mesh_note, sizeof o->mesh_note, &e)) {
+    mesh_free(&o->rest);
+    tet_mesh_free(&volume);
+    return verr_set(err, "%s:%d: organ '%s' (model %s): %s", sc->path, cfg->line, cfg->name, cfg->model, e.msg);
+  }
   /* The proxy spring acts on the contact vertices like an extra home
    * spring, so explicit schemes include the stiffest tool in their bound. */
   model_params_t mp = {
@@ -320,6 +333,16 @@ static void organ_topology(runtime_t *rt, size_t i, const topo_anchor_t anchors[
     aabb_tree_refit(&o->tree, o->model->surf_x);
 }
 
+/* Puts organ i's nodes back at their rest positions with zero velocity
+ * (and an embedded surface at its rest embedding); the tree is refit by
+ * the topology phase that follows. */
+static void organ_to_rest(organ_rt_t *o) {
+  model_t *m = o->model;
+  if (m->x != m->x_rest) memmove(m->x, m->x_rest, 3 * m->nnodes * sizeof(double));
+  memset(m->v, 0, 3 * m->nnodes * sizeof(double));
+  if (m->surf_x != m->x && m->surf_x != m->surf_rest) memmove(m->surf_x, m->surf_rest, 3 * m->nsurf * sizeof(double));
+}
+
 /* Phase models: each organ that is not asleep steps its model (the hook
  * applies the tools' contact, grasp, shaft and stone forces every
  * sub-step), then, organ by organ, its cut and the topology follow-up run
@@ -353,6 +376,14 @@ static int step_models(runtime_t *rt) {
     if (bad) {
       o->rollbacks++;
       rolled++;
+      if (++o->rollback_run >= RUNTIME_ROLLBACK_RESET) {
+        organ_to_rest(o);
+        o->rest_resets++;
+        o->rollback_run = 0;
+        rt->organs_reset |= 1u << i;
+      }
+    } else {
+      o->rollback_run = 0;
     }
     scalpel_after_organ_step(rt, i); /* phase cut: may change the topology */
     organ_topology(rt, i, anchors);  /* phase topology */
@@ -384,6 +415,7 @@ static void settle_contact(runtime_t *rt) {
  * (settle, proxy spring), outputs (hand force, feedback, events, tasks). */
 int runtime_step(runtime_t *rt) {
   rt->organs_stepped = 0;
+  rt->organs_reset = 0;
   interact_inputs(rt);
   interact_tools(rt);
   step_contact(rt);

@@ -38,7 +38,19 @@ typedef struct runtime {
   uint64_t steps;
   double sim_time;       /* s */
   size_t organs_stepped; /* organs stepped by the last runtime_step (the others slept) */
+  /* Bit i: organ i was put back to rest by the last runtime_step, after
+   * RUNTIME_ROLLBACK_RESET consecutive rolled-back steps (organ_rt.h
+   * rollback_run); the server says so (event and log). */
+  uint32_t organs_reset;
 } runtime_t;
+
+/* Consecutive rolled-back steps after which an organ is put back to rest
+ * (nodes at their rest positions, velocities zero): a state the guard
+ * restores but that can never step (a velocity that overflows, a contact
+ * the material cannot take) would otherwise freeze the organ for good. 200
+ * steps is 0.2 s at the default 1 kHz: long enough that a passing spike
+ * never triggers it. */
+#define RUNTIME_ROLLBACK_RESET 200
 
 /* Imports every organ mesh and builds its model (model_create: the model
  * chooses its sub-steps from the scene's dt and the stiffest tool). Errors
@@ -70,7 +82,8 @@ void runtime_topology_restored(runtime_t *rt, size_t organ);
  * Returns the number of organs whose step was rolled back because it
  * produced NaN/Inf. With the scene's sleep_speed > 0 an organ at rest with
  * nothing within reach is skipped (organ_sleep.h; organs_stepped tells how
- * many were stepped). */
+ * many were stepped). An organ rolled back RUNTIME_ROLLBACK_RESET steps in a
+ * row is put back to rest in that step (organs_reset). */
 int runtime_step(runtime_t *rt);
 
 #endif

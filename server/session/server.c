@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include "mesh.h"
+#include "runtime/rollback_report.h"
 #include "runtime/step_cut.h"
 #include "session/checkpoint.h"
 #include "session/command_intake.h"
@@ -49,6 +50,7 @@ typedef struct server {
   command_gate_t cmd_check;
   uint64_t gate_seen[VDDS_GATE_REASONS], gate_seen_range, gate_seen_blocked;
   session_control_t control;
+  rollback_report_t rb; /* rolled-back steps: reported at most once per simulated second */
   uint64_t event_seq;
   uint64_t feedback_seq;     /* ContactFeedback.seq of the last sample written */
   double *step_us;           /* ring of recent step times */
@@ -159,6 +161,7 @@ static dds_entity_t control_reader(server_t *s, verr_t *err) {
 static int setup(server_t *s, const scene_t *scene, verr_t *err) {
   liveliness_watch_init(&s->lw); /* first: teardown always destroys them */
   vdds_gate_init(&s->cmd_gate, 0, command_gate_check, &s->cmd_check);
+  rollback_report_init(&s->rb, (uint64_t)fmax(1.0, floor(1.0 / scene->dt + 0.5)));
   if (runtime_init(&s->rt, scene, err)) return -1;
   if (vdds_open(&s->dds, s->opts->domain, s->opts->partition, err)) return -1;
   s->w_scene = vdds_writer(&s->dds, VT_SCENE_INFO, err);
@@ -777,6 +780,29 @@ static void record_step_time(server_t *s, uint64_t t0, uint64_t c0, uint64_t t1)
   s->step_us[s->nstep_us++ % STEP_RING] = (double)(t1 - t0) * 1e-3;
 }
 
+/* Rolled-back steps (runtime_step): an event and a log line at most once
+ * per simulated second, counting the ones held back (rollback_report.h);
+ * an organ put back to rest after a run of them is always said. */
+static void report_rollbacks(server_t *s, int rolled) {
+  s->stats->rollbacks += (uint64_t)rolled;
+  uint64_t n = 0;
+  if (rollback_report_note(&s->rb, s->rt.steps, rolled, &n)) {
+    char text[160];
+    snprintf(text, sizeof text, "non-finite state: %" PRIu64 " organ step(s) rolled back since the last report", n);
+    publish_event(s, viscera_EVENT_STEP_ROLLED_BACK, -1, -1, (double)n, text);
+    if (!s->opts->quiet) fprintf(stderr, "server: step %" PRIu64 ": %s\n", s->rt.steps, text);
+  }
+  for (size_t i = 0; i < s->rt.norgans; i++) {
+    if (!(s->rt.organs_reset & (1u << i))) continue;
+    char text[200];
+    snprintf(text, sizeof text,
+             "organ '%.60s' reset to rest after %d consecutive rolled-back steps (%" PRIu64 " so far)",
+             s->rt.organs[i].cfg->name, RUNTIME_ROLLBACK_RESET, s->rt.organs[i].rest_resets);
+    publish_event(s, viscera_EVENT_STEP_ROLLED_BACK, (int)i, -1, RUNTIME_ROLLBACK_RESET, text);
+    fprintf(stderr, "server: step %" PRIu64 ": %s\n", s->rt.steps, text);
+  }
+}
+
 /* One step of the session, started at t0 (monotonic ns; c0 the thread's
  * CPU time then): the walk of a ToolCommand from the DDS take to the
  * ContactFeedback write. t1 is when the step's work was done (before the
@@ -800,11 +826,7 @@ static int session_step(server_t *s, uint64_t t0, uint64_t c0, uint64_t *t1) {
   /* Step: paused, the organs and the measures freeze; commands are still
    * read (so nothing queues up) and the last contact model keeps going out. */
   int rolled = s->control.paused ? 0 : runtime_step(&s->rt);
-  if (rolled) {
-    s->stats->rollbacks += (uint64_t)rolled;
-    publish_event(s, viscera_EVENT_STEP_ROLLED_BACK, -1, -1, rolled, "non-finite state: step rolled back");
-    if (!s->opts->quiet) fprintf(stderr, "server: step %" PRIu64 ": non-finite state, rolled back\n", s->rt.steps);
-  }
+  if (rolled) report_rollbacks(s, rolled);
   /* Out: keyframes after a topology change, the ContactFeedback of every
    * driven tool (its force, tip and normal from the core record), the
    * trainee measures, the step's events, frames and metrics. */
@@ -848,6 +870,7 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
               "%d sub-step(s) per %.3g ms (stable below %.3g ms)\n",
               o->cfg->name, m->ops->name, o->cfg->integrator, m->nnodes, m->ntets, m->nsurf, m->nsurf_tris, m->substeps,
               scene->dt * 1e3, m->stable_dt * 1e3);
+      if (o->mesh_note[0]) fprintf(stderr, "server: organ '%s': mesh repaired: %s\n", o->cfg->name, o->mesh_note);
       if (m->substeps > 0 && scene->dt / m->substeps > m->stable_dt)
         fprintf(stderr,
                 "server: organ '%s': warning: solver.substeps %d gives %.3g ms sub-steps, above the "

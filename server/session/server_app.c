@@ -34,6 +34,7 @@ static int check_scene(const scene_t *scene) {
            "%d sub-step(s), stable dt %.3g ms\n",
            o->cfg->name, m->ops->name, o->cfg->integrator, m->nnodes, m->ntets, m->nsurf, m->nsurf_tris, m->substeps,
            m->stable_dt * 1e3);
+    if (o->mesh_note[0]) printf("  organ '%s': mesh repaired: %s\n", o->cfg->name, o->mesh_note);
   }
   runtime_destroy(&rt);
   return 0;

@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "scene_limits.h"
 #include "session/tool_roles.h"
 
 /* Every answer ends with the command's origin, so the station that sent it
@@ -22,11 +23,13 @@ static int refuse(session_control_t *sc, const viscera_SessionControl *c, char *
 }
 
 /* Thresholds as the scene file accepts them (common/scene.c): each either 0
- * (not set) or positive and finite, the set ones ordered st < mpf <= sft, none
- * above the tool's clamp (a level the tool can never reach is a mistake). */
-static const char *check_levels(const double v[3], double max_force) {
+ * (not set) or inside the table's tools.thresholds range (scene_limits.h),
+ * the set ones ordered st < mpf <= sft, none above the tool's clamp (a level
+ * the tool can never reach is a mistake). */
+static const char *check_levels(const double v[3], double max_force, char *why, size_t n) {
   for (int k = 0; k < 3; k++) {
-    if (!isfinite(v[k]) || v[k] < 0) return "threshold not a finite non-negative force";
+    if (v[k] == 0) continue;
+    if (scene_limit_check("tools.thresholds", v[k], why, n)) return why;
     if (v[k] > max_force) return "threshold above the tool's max_force";
   }
   if (v[0] > 0 && v[1] > 0 && !(v[0] < v[1])) return "need st < mpf";
@@ -57,17 +60,21 @@ int session_control_duplicate(session_control_t *sc, const viscera_SessionContro
   return 0;
 }
 
-/* New material values as the scene file accepts them (common/scene.c);
- * negative = keep. Returns NULL or what is wrong. */
-static const char *edit_material(scene_material_t *m, const double v[4]) {
-  for (int k = 0; k < 4; k++)
-    if (!isfinite(v[k])) return "material value not finite";
-  if (v[3] == 0 || (v[3] > 0 && v[3] > 1000)) return "mass must be > 0 and at most 1000 kg";
-  if (v[0] > 1e7 || v[1] > 1e4 || v[2] > 1e7) return "material value out of range";
+/* New material values (stiffness, damping, home stiffness, mass), each
+ * negative = keep, else inside the same range a scene file must respect
+ * (scene_limits.h: a mass of 1e-300 kg is refused here as in the file).
+ * Returns NULL or what is wrong (in why). */
+static const char *edit_material(scene_material_t *m, const double v[4], char *why, size_t n) {
+  static const char *const keys[4] = {"organs.material.stiffness", "organs.material.damping",
+                                      "organs.material.home_stiffness", "organs.material.mass"};
+  for (int k = 0; k < 4; k++) {
+    if (isfinite(v[k]) && v[k] < 0) continue; /* keep */
+    if (scene_limit_check(keys[k], v[k], why, n)) return why;
+  }
   if (v[0] >= 0) m->stiffness = v[0];
   if (v[1] >= 0) m->damping = v[1];
   if (v[2] >= 0) m->home_stiffness = v[2];
-  if (v[3] > 0) m->mass = v[3];
+  if (v[3] >= 0) m->mass = v[3];
   return NULL;
 }
 
@@ -119,7 +126,8 @@ int session_control_apply(session_control_t *sc, const viscera_SessionControl *c
   case viscera_CONTROL_SET_THRESHOLDS: {
     if (c->tool_id < 0 || (size_t)c->tool_id >= ntools) return refuse(sc, c, text, n, "tool id out of range");
     const double v[3] = {c->values[0], c->values[1], c->values[2]};
-    const char *bad = check_levels(v, tool_max_force[c->tool_id]);
+    char why[200];
+    const char *bad = check_levels(v, tool_max_force[c->tool_id], why, sizeof why);
     if (bad) return refuse(sc, c, text, n, bad);
     /* New levels, same history: time above, contact time and path so far
      * stay with the trainee. The hysteretic state restarts below every
@@ -143,7 +151,8 @@ int session_control_apply(session_control_t *sc, const viscera_SessionControl *c
     if (c->organ_id < 0 || (size_t)c->organ_id >= scene->norgans)
       return refuse(sc, c, text, n, "organ id out of range");
     scene_organ_t *o = &scene->organs[c->organ_id];
-    const char *bad = edit_material(&o->material, c->values);
+    char why[200];
+    const char *bad = edit_material(&o->material, c->values, why, sizeof why);
     if (bad) return refuse(sc, c, text, n, bad);
     snprintf(text, n,
              "organ '%s' material: stiffness %.4g N/m, damping %.4g N s/m, home stiffness %.4g N/m, mass %.4g kg",

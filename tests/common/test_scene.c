@@ -256,21 +256,23 @@ static void test_not_finite(void) {
 static void test_out_of_range(void) {
   /* The exact message, once, for the whole format. */
   CHECK(fails_with(HEAD "    material:\n      mass: 0.2\n      stiffness: -3\n", "", NULL));
-  CHECK(!strcmp(e.msg, "t.yaml:7: field 'organs[0].material.stiffness': must be >= 0 (got -3)"));
-  CHECK(fails_with(HEAD "    material: {mass: 0}\n", "t.yaml:5:", "organs[0].material.mass': must be > 0 (got 0)"));
+  CHECK(!strcmp(e.msg, "t.yaml:7: field 'organs[0].material.stiffness': must be >= 0 and <= 1e+07 N/m (got -3): "
+                       "stiffer than 1e7 N/m is rigid at haptic rates and overflows the stable-step estimate"));
+  CHECK(fails_with(HEAD "    material: {mass: 0}\n",
+                   "t.yaml:5:", "organs[0].material.mass': must be >= 0.001 and <= 20 kg (got 0)"));
   CHECK(fails_with(HEAD "    material: {damping: -0.1}\n", "organs[0].material.damping': must be >= 0", NULL));
   CHECK(fails_with(HEAD "    material: {home_stiffness: -1}\n", "organs[0].material.home_stiffness'", NULL));
   CHECK(fails_with(HEAD "    material: {home_damping: -1}\n", "organs[0].material.home_damping'", NULL));
-  CHECK(fails_with(HEAD "physics:\n  dt: 0.1\n", "t.yaml:6: field 'physics.dt': must be > 0 and <= 0.05 (got 0.1)",
-                   NULL));
-  CHECK(fails_with(HEAD "physics:\n  dt: 0\n", "physics.dt': must be > 0", NULL));
+  CHECK(fails_with(HEAD "physics:\n  dt: 0.1\n",
+                   "t.yaml:6: field 'physics.dt': must be >= 1e-05 and <= 0.05 s (got 0.1)", NULL));
+  CHECK(fails_with(HEAD "physics:\n  dt: 0\n", "physics.dt': must be >= 1e-05", NULL));
   CHECK(fails_with(HEAD "physics: {publish_hz: 0.5}\n", "physics.publish_hz': must be >= 1 and <= 240", NULL));
   CHECK(fails_with(HEAD "physics: {publish_hz: 241}\n", "physics.publish_hz'", "(got 241)"));
   CHECK(fails_with(HEAD "physics: {quant_step: 1e-8}\n", "physics.quant_step': must be >= 1e-07 and <= 0.01", NULL));
   CHECK(fails_with(HEAD "physics: {quant_step: 0.1}\n", "physics.quant_step'", NULL));
   CHECK(fails_with(HEAD "physics:\n  gravity:\n    - 0\n    - 200\n    - 0\n",
-                   "t.yaml:8:", "physics.gravity[1]': must be >= -100 and <= 100 (got 200)"));
-  CHECK(fails_with(HEAD "    scale: 0\n", "organs[0].scale': must be > 0", NULL));
+                   "t.yaml:8:", "physics.gravity[1]': must be >= -100 and <= 100 m/s^2 (got 200)"));
+  CHECK(fails_with(HEAD "    scale: 0\n", "organs[0].scale': must be >= 1e-06", NULL));
   CHECK(fails_with(HEAD "    color: [1.5, 0, 0]\n", "t.yaml:5:", "organs[0].color[0]': must be >= 0 and <= 1"));
   CHECK(fails_with(HEAD "    color: [0, 0, -0.1]\n", "organs[0].color[2]'", NULL));
   CHECK(fails_with(HEAD "tools:\n  - name: p\n    radius: 0.06\n", "t.yaml:7: field 'tools[0].radius'",
@@ -597,7 +599,10 @@ static void test_files(void) {
   /* Errors in a file name the file path, not a stand-in. */
   CHECK(write_file(path, HEAD "    scale: -1\n", strlen(HEAD "    scale: -1\n")) == 0);
   CHECK(scene_load(path, &s, &e) == -1);
-  snprintf(want, sizeof want, "%s:5: field 'organs[0].scale': must be > 0 (got -1)", path);
+  snprintf(want, sizeof want,
+           "%s:5: field 'organs[0].scale': must be >= 1e-06 and <= 1e+06 (got -1): a unit conversion (um, mm, cm to m) "
+           "with room; the scaled mesh is checked too",
+           path);
   CHECK(!strcmp(e.msg, want));
 
   size_t n = (1u << 20) + 1;

@@ -115,7 +115,10 @@ static void test_rebuild_commands(void) {
   CHECK_NEAR(scene.organs[0].material.home_stiffness, 30, 0);
   CHECK_NEAR(scene.organs[0].material.mass, 0.3, 0);
   /* Refused, material unchanged: bad organ, NaN, zero mass, absurd stiffness. */
-  const double bad[][4] = {{NAN, -1, -1, -1}, {-1, -1, -1, 0}, {1e9, -1, -1, -1}, {-1, INFINITY, -1, -1}};
+  /* Issue 15: 1e-300 kg and 1e300 N/m passed and rolled back every contact
+   * step; the scene file's ranges (scene_limits.h) now apply. */
+  const double bad[][4] = {{NAN, -1, -1, -1},    {-1, -1, -1, 0},     {1e9, -1, -1, -1},   {-1, INFINITY, -1, -1},
+                           {-1, -1, -1, 1e-300}, {1e300, -1, -1, -1}, {-1, -1, 1e300, -1}, {-1, 1e6, -1, -1}};
   for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
     c = cmd(1, 3 + i, viscera_CONTROL_SET_MATERIAL, -1, 0, 0, 0);
     c.organ_id = 0;
@@ -124,7 +127,12 @@ static void test_rebuild_commands(void) {
     CHECK_NEAR(scene.organs[0].material.stiffness, 90, 0);
     CHECK_NEAR(scene.organs[0].material.mass, 0.3, 0);
   }
-  c = cmd(1, 9, viscera_CONTROL_SET_MATERIAL, -1, 50, -1, -1);
+  c = cmd(1, 20, viscera_CONTROL_SET_MATERIAL, -1, -1, -1, -1);
+  c.organ_id = 0;
+  c.values[3] = 1e-300;
+  CHECK(session_control_apply(&sc, &c, tools, 1, maxf, &scene, text, sizeof text) == -1);
+  CHECK(strstr(text, "organs.material.mass = 1e-300: must be >= 0.001 and <= 20 kg") != NULL);
+  c = cmd(1, 21, viscera_CONTROL_SET_MATERIAL, -1, 50, -1, -1);
   c.organ_id = 1; /* no such organ */
   CHECK(session_control_apply(&sc, &c, tools, 1, maxf, &scene, text, sizeof text) == -1);
   CHECK(strstr(text, "organ id out of range") != NULL);
