@@ -60,7 +60,7 @@ async function main() {
     }
   }
   const perTopic = new Map(), indexedCount = new Map();
-  let decoded = 0, total = 0, peak = 0, inContact = 0, sceneUpdates = 0;
+  let decoded = 0, total = 0, peak = 0, inContact = 0, sceneUpdates = 0, lastT;
   for await (const m of indexed.readMessages({ validateCrcs: true })) {
     const ch = indexed.channelsById.get(m.channelId);
     if (ch.topic === "/viscera/scene") { // Foxglove scene primitives: one organ surface per message
@@ -87,7 +87,12 @@ async function main() {
     if (ch.metadata.get("dds_topic") === "viscera_ContactFeedback" && msg.tool_id === 0) {
       const f = Math.hypot(msg.force[0], msg.force[1], msg.force[2]);
       if (f > peak) peak = f;
-      if (msg.in_contact) inContact++;
+      // each sample stands for the simulated time since the previous one
+      // (as the report counts), so samples a loaded recorder lost do not count
+      const t = Number(msg.sim_time_ns) * 1e-9;
+      const dt = lastT !== undefined && t > lastT && t - lastT <= 0.5 ? t - lastT : 0.001;
+      if (msg.in_contact) inContact += dt;
+      lastT = t;
     }
     decoded++;
     total++;
@@ -114,7 +119,7 @@ async function main() {
   if (hasScene) console.log(`scene_updates=${sceneUpdates}`);
   if (bad) fail(`${bad} topic(s) differ`);
   // decoded values, for the caller to compare with the server's figures
-  console.log(`tool0_peak_force=${peak.toFixed(4)} tool0_contact_time=${(inContact * 0.001).toFixed(3)}`);
+  console.log(`tool0_peak_force=${peak.toFixed(4)} tool0_contact_time=${inContact.toFixed(3)}`);
   console.log(`ok: ${total} messages in ${indexed.channelsById.size} channels, ${indexed.chunkIndexes.length} chunks, ` +
               `all ${decoded} DDS samples decoded with their OMG IDL schema`);
 }

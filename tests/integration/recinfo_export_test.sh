@@ -5,7 +5,8 @@
 # against what the server printed:
 #  - ContactFeedback CSV: one row per recorded sample (recinfo's count), the
 #    decoded columns named from the IDL (force[0..2], in_contact, ...); the
-#    probe's peak |force| and its time in contact (1 ms per in-contact row)
+#    probe's peak |force| and its time in contact (each row counting the
+#    simulated time since the previous one, as the report does)
 #    equal its PALPATION line (peak within 0.02 N, contact within 0.05 s or
 #    3 %: ContactFeedback is best-effort);
 #  - SceneInfo JSONL: the probe's ST/MPF/SFT equal the PALPATION levels;
@@ -40,7 +41,8 @@ head -1 "$OUT/fb.csv" | grep -q '^source_time_ns,partition,tool_id,cmd_seq,.*,in
 [ "$(tail -n +2 "$OUT/fb.csv" | wc -l)" = "$(count viscera_ContactFeedback)" ] || fail "CSV rows differ from recinfo's count"
 read -r peak contact < <(awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next }
   $c["tool_id"] == 0 { f = sqrt($c["force[0]"]^2 + $c["force[1]"]^2 + $c["force[2]"]^2); if (f > p) p = f;
-    if ($c["in_contact"] == "true") n++ } END { printf "%.4f %.3f\n", p, n * 0.001 }' "$OUT/fb.csv")
+    t = $c["sim_time_ns"] * 1e-9; dt = (seen && t > last && t - last <= 0.5) ? t - last : 0.001
+    if ($c["in_contact"] == "true") n += dt; last = t; seen = 1 } END { printf "%.4f %.3f\n", p, n }' "$OUT/fb.csv")
 near "probe peak force (N)" "$peak" "$(srv peak_force)" 0.02 0
 near "probe contact time (s)" "$contact" "$(srv contact_time)" 0.05 0.03
 

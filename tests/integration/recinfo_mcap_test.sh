@@ -31,14 +31,15 @@ REC="$OUT/demo/session.db"
 "$RECINFO" "$REC" --export mcap --foxglove-scene "$OUT/demo.mcap" 2> "$OUT/export.err" \
   || { cat "$OUT/export.err"; fail "export failed"; }
 cat "$OUT/export.err"
-# recinfo's own table: topic and data samples
-"$RECINFO" "$REC" | awk '/^topic /{ t = 1; next } /^total:/{ t = 0 } t && NF > 3 { print $1, $3 }' > "$OUT/counts.txt"
+# recinfo's own table: topic and data samples (notes under a topic are indented)
+"$RECINFO" "$REC" | awk '/^topic /{ t = 1; next } /^total:/{ t = 0 } t && NF > 3 && $0 !~ /^ / { print $1, $3 }' > "$OUT/counts.txt"
 [ "$(wc -l < "$OUT/counts.txt")" -ge 8 ] || fail "recinfo listed too few topics: $(cat "$OUT/counts.txt")"
 NODE_PATH="$NPM/node_modules" node "$SRC/tests/integration/mcap_read.js" "$OUT/demo.mcap" "$OUT/counts.txt" \
   > "$OUT/read.out" || { cat "$OUT/read.out"; fail "the MCAP reader rejected the export (above)"; }
 cat "$OUT/read.out"
 # The decoded values are the session's: the probe's peak force and time in
-# contact (1 ms per in-contact sample) against the server's PALPATION line.
+# contact (each sample counting the simulated time since the previous one)
+# against the server's PALPATION line.
 srv() { grep '^PALPATION tool=probe ' "$OUT/demo/server.out" | tr ' ' '\n' | sed -n "s/^$1=//p"; }
 got() { tr ' ' '\n' < "$OUT/read.out" | sed -n "s/^$1=//p"; }
 awk -v g="$(got tool0_peak_force)" -v w="$(srv peak_force)" 'BEGIN { d = g - w; exit !(g != "" && d < 0.02 && d > -0.02) }' \
