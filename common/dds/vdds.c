@@ -1,9 +1,9 @@
 #include "dds/vdds.h"
 
-
 #include <stdlib.h>
 #include <string.h>
 
+#include "dds/vdds_config.h"
 #include "dds/vdds_ident.h"
 #include "viscera.h"
 
@@ -75,6 +75,7 @@ static dds_qos_t *make_qos(qos_kind_t k, int lease_ms) {
 
 int vdds_open(vdds_t *v, dds_domainid_t domain, const char *partition, verr_t *err) {
   memset(v, 0, sizeof *v);
+  vdds_config_default(); /* no CYCLONEDDS_URI: the loopback configuration, like the scripts */
   /* USER_DATA announces role, host and pid (vdds_ident.h), so recorders
    * and operators can tell the participants of a session apart. */
   dds_qos_t *pq = vdds_participant_qos();
