@@ -66,7 +66,7 @@ SRV_RT=() HAP_RT=()
 [ "$HRTPRIO" -gt 0 ] && HAP_RT=(--rt-priority "$HRTPRIO")
 [ -x "$BUILD/tests/bench/delta_sub" ] || { echo "load_bench.sh: $BUILD/tests/bench/delta_sub missing (build with -DVISCERA_BUILD_BENCH=ON)" >&2; exit 1; }
 export CYCLONEDDS_URI="${CYCLONEDDS_URI:-file://$ROOT/deploy/cyclonedds-loopback.xml}"
-export VISCERA_DOMAIN="${VISCERA_DOMAIN:-8}"
+export VISCERA_DOMAIN="${VISCERA_DOMAIN:-0}"
 rm -rf "$OUT"; mkdir -p "$OUT"
 SCENE="$ROOT/assets/scenes/classroom_kidney.yaml"
 # Press 8 mm, hold, release, every 4 s, for the whole run.
