@@ -37,7 +37,9 @@ void haptic_usage(FILE *f) {
           "                      a warning naming the reason, normal priority)\n"
           "  --quiet             only the summary\n"
           "  --help              this text\n"
-          "  --version           print the version and exit\n",
+          "  --version           print the version and exit\n"
+          "Exit status: 0 done (trajectory ended, --duration or SIGINT/SIGTERM), 1 device, DDS or\n"
+          "output error (or no server within --wait-server), 2 usage error.\n",
           device_names());
 }
 

@@ -61,8 +61,9 @@ void options_usage(FILE *f, const char *prog) {
           "towards +x) and %g degrees above, far enough that all of them are in view.\n"
           "\n"
           "On exit prints 'viewer: N frames written to DIR' and 'SUMMARY frames=N\n"
-          "rejected=M' (M: samples refused as malformed). Exit status: 0 on success or\n"
-          "SIGINT/SIGTERM, 1 when OSMesa, DDS or output setup fails, 2 on bad usage.\n"
+          "rejected=M' (M: samples refused as malformed).\n"
+          "Exit status: 0 on success or SIGINT/SIGTERM, 1 when OSMesa, DDS or output setup\n"
+          "fails, 2 on bad usage.\n"
           "DDS configuration comes from CYCLONEDDS_URI.\n",
           prog, RENDER_MAX_SIZE, RENDER_MAX_SIZE,
 #ifdef VISCERA_HAVE_WINDOW
@@ -187,6 +188,7 @@ int options_parse(viewer_opts_t *o, int argc, char **argv) {
                            .common = CLI_DOMAIN | CLI_DOMAIN_ENV | CLI_PARTITION | CLI_QUIET,
                            .options = longopts,
                            .option = viewer_option,
+                           .shortopts = "h",
                            .usage = usage_text,
                            .domain_error = "--domain '%s': expected an integer 0..230",
                            .partition_error = "--partition: empty partition name"};
