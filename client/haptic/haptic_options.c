@@ -213,6 +213,10 @@ int haptic_options_parse(haptic_options_t *o, int argc, char **argv) {
     fprintf(stderr, "viscera-haptic: --rate must be 10..10000 Hz and --max-force > 0\n");
     return 2;
   }
+  if (o->trajectory) { /* "palpate_kidney.traj" finds the installed one from any directory */
+    data_path_resolve(o->trajectory, "assets/trajectories", o->trajectory_path, sizeof o->trajectory_path);
+    o->trajectory = o->trajectory_path;
+  }
   o->dcfg.trajectory = o->trajectory;
   o->dcfg.max_force = o->max_force;
   o->dcfg.max_stiffness = o->max_stiffness;

@@ -6,7 +6,9 @@
 #include <inttypes.h>
 #include <signal.h>
 #include <stdio.h>
+#include <string.h>
 
+#include "data_path.h"
 #include "dds/vdds.h"
 #include "scene.h"
 #include "vsignal.h"
@@ -115,7 +117,13 @@ static void print_summary(const scene_t *scene, const server_stats_t *s) {
 int server_app_run(const server_app_options_t *o) {
   static scene_t scene;
   verr_t err;
-  if (scene_load(o->scene_path, &scene, &err)) {
+  /* Installed data (data_path.h): "--scene default.yaml" works from any
+   * directory; a path that exists as given is used as given. */
+  char scene_path[DATA_PATH_MAX];
+  if (data_path_resolve(o->scene_path, "assets/scenes", scene_path, sizeof scene_path) == 0 &&
+      strcmp(scene_path, o->scene_path) && !o->opts.quiet)
+    fprintf(stderr, "viscera-server: scene %s found as %s\n", o->scene_path, scene_path);
+  if (scene_load(scene_path, &scene, &err)) {
     fprintf(stderr, "viscera-server: %s\n", err.msg);
     return 1;
   }
