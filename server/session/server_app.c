@@ -11,6 +11,7 @@
 #include "data_path.h"
 #include "dds/vdds.h"
 #include "scene.h"
+#include "session/scene_check.h"
 #include "vsignal.h"
 
 static volatile sig_atomic_t g_stop = 0;
@@ -37,6 +38,9 @@ static int check_scene(const scene_t *scene) {
            o->cfg->name, m->ops->name, o->cfg->integrator, m->nnodes, m->ntets, m->nsurf, m->nsurf_tris, m->substeps,
            m->stable_dt * 1e3);
   }
+  /* Warnings only (scene_check.h): real time at this dt, organ sizes. */
+  scene_check_sizes(&rt, stderr);
+  scene_check_cost(&rt, stdout, stderr);
   runtime_destroy(&rt);
   return 0;
 }
