@@ -9,3 +9,8 @@ if(NOT VISCERA_SANITIZE)
   viscera_integration_test(package_deb 214 package_test.sh)
   set_tests_properties(package_deb PROPERTIES SKIP_RETURN_CODE 77)
 endif()
+# Like the lab launcher tests: a whole sanitized lab (3 servers, viewers and
+# trainees) fills the 2 cores by itself.
+if(VISCERA_SANITIZE)
+  set_tests_properties(readme_classroom PROPERTIES RUN_SERIAL TRUE)
+endif()
