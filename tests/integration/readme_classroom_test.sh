@@ -54,7 +54,7 @@ done
 echo "readme block: every seat seen by the dashboard, pause applied, report written"
 
 # --secure: the printed dashboard command, pasted (with --duration added).
-(cd "$OUT/root" && exec setsid bash deploy/lab.sh --seats 2 --secure --viewers 0 --no-record --duration 20 \
+(cd "$OUT/root" && exec setsid bash deploy/lab.sh --seats 2 --secure --viewers 0 --no-record --duration 14 \
   --out "$OUT/secure") > "$OUT/secure.log" 2>&1 &
 LAB=$!
 PIDS+=("$LAB")
@@ -64,10 +64,13 @@ line="$(grep -- "viscera-dashboard .*--out .*/dashboard$" "$OUT/secure.log" | he
 echo "pasted: $line"
 case "$line" in *identities/instructor/security.xml*) ;; *) fail "the printed command has no instructor identity" ;; esac
 sleep 3
+# The same without identity, at the same time: nothing, and the explanation.
+(cd "$OUT/root" && exec build/client/dashboard/viscera-dashboard --seats 2 --out "$OUT/plain_dash" --duration 7) \
+  > "$OUT/plain_dashboard.log" 2>&1 &
+PLAIN=$!
+PIDS+=("$PLAIN")
 (cd "$OUT/root" && eval "$line --duration 8") > "$OUT/secure_dashboard.log" 2>&1 || fail "the pasted dashboard failed"
-# The same without identity: nothing, and the explanation.
-(cd "$OUT/root" && build/client/dashboard/viscera-dashboard --seats 2 --out "$OUT/plain_dash" --duration 7) \
-  > "$OUT/plain_dashboard.log" 2>&1 || fail "the dashboard without identity failed"
+wait "$PLAIN" || fail "the dashboard without identity failed"
 wait "$LAB" || fail "lab.sh --secure failed"
 PIDS=()
 for s in 01 02; do
