@@ -10,9 +10,9 @@ set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/prelude.sh"
 TRAJ="$SRC/assets/trajectories/palpate_kidney.traj"
 "$BUILD/server/viscera-server" --scene "$SRC/assets/scenes/default.yaml" --partition lab/seat01 --duration 20 \
-  > "$OUT/server.log" 2>&1 & PIDS+=($!)
+  > "$OUT/server.log" 2>&1 & PIDS+=("$!")
 "$BUILD/client/dashboard/viscera-dashboard" --seats 1 --out "$OUT/dash" --interval-ms 250 --duration 19 \
-  > "$OUT/dashboard.log" 2>&1 & DASH=$!; PIDS+=($DASH)
+  > "$OUT/dashboard.log" 2>&1 & DASH=$!; PIDS+=("$DASH")
 sleep 2
 "$BUILD/client/haptic/viscera-haptic" --partition lab/seat01 --trajectory "$TRAJ" --wait-server 10 --quiet \
   > "$OUT/haptic1.log" 2>&1 || fail "the first trainee did not exit cleanly"
@@ -28,7 +28,7 @@ row="$(last_row)"
 grep -q "haptic client left" "$OUT/server.log" || fail "the server did not see the client leave"
 
 "$BUILD/client/haptic/viscera-haptic" --partition lab/seat01 --trajectory "$TRAJ" --quiet > "$OUT/haptic2.log" 2>&1 &
-H=$!; PIDS+=($H)
+H=$!; PIDS+=("$H")
 for ((t = 0; t < 100; t++)); do [ "$(last_row | cut -d, -f13)" = 0 ] && break; sleep 0.1; done
 [ "$(last_row | cut -d, -f13)" = 0 ] || fail "a new trainee did not clear 'left'"
 sleep 1

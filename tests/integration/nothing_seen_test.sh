@@ -11,13 +11,13 @@ source "$(dirname "${BASH_SOURCE[0]}")/prelude.sh"
 unset CYCLONEDDS_URI
 P=empty/seat01
 "$BUILD/client/viewer/viscera-viewer" --partition $P --out "$OUT/frames" --duration 7 > "$OUT/viewer.log" 2>&1 &
-PIDS+=($!)
+PIDS+=("$!")
 "$BUILD/client/dashboard/viscera-dashboard" --prefix empty --seats 1 --out "$OUT/dash" --duration 7 \
-  > "$OUT/dashboard.log" 2>&1 & PIDS+=($!)
+  > "$OUT/dashboard.log" 2>&1 & PIDS+=("$!")
 # The recorder alone in its partition (viscera-control's writer would be a
 # writer to record).
 "$BUILD/client/recorder/viscera-recorder" --partition empty/rec --out "$OUT/rec.db" --duration 7 > "$OUT/recorder.log" 2>&1 &
-PIDS+=($!)
+PIDS+=("$!")
 st=0
 "$BUILD/client/control/viscera-control" --partition $P --wait 7 pause > "$OUT/control.log" 2>&1 || st=$?
 [ $st = 1 ] || fail "viscera-control without a server exited $st, expected 1"
@@ -39,7 +39,7 @@ done
 
 # With a server there: no explanation.
 "$BUILD/server/viscera-server" --scene "$SRC/assets/scenes/default.yaml" --partition $P --duration 9 --quiet \
-  > "$OUT/server.log" 2>&1 & PIDS+=($!)
+  > "$OUT/server.log" 2>&1 & PIDS+=("$!")
 "$BUILD/client/viewer/viscera-viewer" --partition $P --out "$OUT/frames2" --duration 7 > "$OUT/viewer2.log" 2>&1 ||
   fail "viewer with a server failed"
 grep -q "viewer: scene" "$OUT/viewer2.log" || fail "the viewer did not see the server"

@@ -54,9 +54,9 @@ grep -q "^\.TH VISCERA-SERVER" <(zcat -f "$R"/usr/share/man/man1/viscera-server.
 mkdir -p "$OUT/elsewhere"
 cd "$OUT/elsewhere"
 "$R/usr/bin/viscera-server" --scene default.yaml --partition pkg/seat01 --duration 9 > "$OUT/server.log" 2>&1 &
-SRV=$!; PIDS+=($SRV)
+SRV=$!; PIDS+=("$SRV")
 "$R/usr/bin/viscera-recorder" --partition pkg/seat01 --out "$OUT/session.db" --duration 8 --quiet \
-  > "$OUT/recorder.log" 2>&1 & REC=$!; PIDS+=($REC)
+  > "$OUT/recorder.log" 2>&1 & REC=$!; PIDS+=("$REC")
 "$R/usr/bin/viscera-haptic" --partition pkg/seat01 --trajectory palpate_kidney.traj --quiet > "$OUT/haptic.log" 2>&1 ||
   fail "the installed haptic client failed"
 wait $SRV || fail "the installed server failed"
