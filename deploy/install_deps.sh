@@ -17,7 +17,7 @@ PKGS=(
   xvfb xauth                                # headless X server for the window test
   systemd                                   # systemd-analyze verify of the service units (test)
   help2man                                  # man pages generated at build time from --help
-  dpkg-dev                                  # dpkg-shlibdeps: the .deb's computed Depends (cpack)
+  dpkg-dev file                             # dpkg-shlibdeps and file: the .deb's computed Depends (cpack)
 )
 
 missing=()

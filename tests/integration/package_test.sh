@@ -15,7 +15,7 @@
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/prelude.sh"
 unset CYCLONEDDS_URI VISCERA_DATA_DIR
-for t in dpkg-deb dpkg-shlibdeps cpack; do
+for t in dpkg-deb dpkg-shlibdeps file cpack; do
   command -v $t > /dev/null || { echo "SKIP: $t not installed"; exit 77; }
 done
 (cd "$BUILD" && nice cpack -G DEB -B "$OUT/pkg") > "$OUT/cpack.log" 2>&1 || fail "cpack failed: $(tail -5 "$OUT/cpack.log")"
