@@ -76,7 +76,8 @@ int cli_parse_domain(const char *s);
 /* $VISCERA_DOMAIN if set and non-empty, else 0; -1 with err when the
  * variable is not a domain id. */
 int cli_env_domain(verr_t *err);
-/* The project version (CMake project(VERSION)), "0.1.0". */
+/* The project version: CMake project(VERSION) plus git describe when the
+ * build had git, "0.1.0 (git a69fab4)" (cmake/version.cmake). */
 const char *cli_version(void);
 
 #endif

@@ -13,8 +13,8 @@ echo "== server step time and MeshDelta size (one core, Release build)"
 "$ROOT/build-bench/tests/bench/bench_server" "$ROOT/assets" "$OUT/server_steps.csv"
 echo
 echo "== haptic tick and command->feedback latency on loopback (server + scripted haptic client, 60 s, SCHED_FIFO when allowed)"
-export CYCLONEDDS_URI="file://$ROOT/deploy/cyclonedds-loopback.xml"
-D="${VISCERA_DOMAIN:-9}"
+export CYCLONEDDS_URI="${CYCLONEDDS_URI:-file://$ROOT/deploy/cyclonedds-loopback.xml}"
+D="${VISCERA_DOMAIN:-0}"
 "$ROOT/build-bench/server/viscera-server" --scene "$ROOT/assets/scenes/default.yaml" --domain "$D" \
   --partition bench/latency >"$OUT/latency/server.out" 2>"$OUT/latency/server.log" & S=$!
 "$ROOT/build-bench/client/haptic/viscera-haptic" --trajectory "$ROOT/assets/trajectories/palpate_kidney.traj" \

@@ -16,6 +16,8 @@ PKGS=(
   libsdl2-dev                               # window viewer (--window, --drive)
   xvfb xauth                                # headless X server for the window test
   systemd                                   # systemd-analyze verify of the service units (test)
+  help2man                                  # man pages generated at build time from --help
+  dpkg-dev file                             # dpkg-shlibdeps and file: the .deb's computed Depends (cpack)
 )
 
 missing=()

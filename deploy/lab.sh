@@ -29,7 +29,11 @@
 # SIGTERM (SIGKILL if still running 10 s later), then the summary is printed.
 # Exit status: 0 when every process ended cleanly, 1 when one failed (named
 # with its log), 2 on bad usage.
-# env: VISCERA_DOMAIN (default 9), CYCLONEDDS_URI (default the loopback config),
+# At start it prints ready-to-paste commands for the instructor's dashboard,
+# viscera-control and the report of this lab (with --secure, each with the
+# instructor's or recorder's identity in CYCLONEDDS_URI).
+# env: VISCERA_DOMAIN (default 0, like every binary), CYCLONEDDS_URI (default the
+#   loopback config, like every binary),
 #   VISCERA_LAB_STOP_GRACE (seconds before SIGKILL, default 10)
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -74,7 +78,7 @@ SRV_RT=() HAP_RT=()
 [[ "$PREFIX" =~ ^[A-Za-z0-9_-]+$ ]] || { echo "lab.sh: --prefix: letters, digits, '-' and '_' only" >&2; exit 2; }
 [ -f "$SCENE" ] || { echo "lab.sh: scene file not found: $SCENE" >&2; exit 2; }
 [ -x "$BUILD/server/viscera-server" ] || bash "$ROOT/deploy/build.sh" "$BUILD"
-export VISCERA_DOMAIN="${VISCERA_DOMAIN:-9}"
+export VISCERA_DOMAIN="${VISCERA_DOMAIN:-0}"
 NET="${CYCLONEDDS_URI:-file://$ROOT/deploy/cyclonedds-loopback.xml}"
 mkdir -p "$OUT"
 OUT="$(cd "$OUT" && pwd)" # children get absolute paths
@@ -142,6 +146,23 @@ pause() { # a sleep that SIGINT/SIGTERM cut short
 
 echo "lab: seats $FIRST..$LAST on domain $VISCERA_DOMAIN, partitions $PREFIX/seatNN, $VIEWERS viewer(s) per seat," \
   "secure=$SECURE, $([ "$DURATION" -gt 0 ] && echo "$DURATION s" || echo "until stopped"); output in $OUT"
+# Ready-to-paste commands for this lab (the same domain and configuration,
+# and the instructor's identity when secure).
+paste_env() { # the environment a pasted command needs, as shell words
+  local e=""
+  [ "$VISCERA_DOMAIN" = 0 ] || e="VISCERA_DOMAIN=$VISCERA_DOMAIN "
+  if [ $SECURE = 1 ] || [ -n "${CYCLONEDDS_URI:-}" ]; then
+    local u
+    u="$(as "$1" 2>/dev/null)" || u="$NET"
+    e+="CYCLONEDDS_URI='$u' "
+  fi
+  printf '%s' "$e"
+}
+echo "lab: paste these to follow the lab:"
+echo "  $(paste_env instructor)$BUILD/client/dashboard/viscera-dashboard --prefix $PREFIX --first $FIRST --seats $SEATS --window"
+echo "  $(paste_env instructor)$BUILD/client/dashboard/viscera-dashboard --prefix $PREFIX --first $FIRST --seats $SEATS --out $OUT/dashboard"
+echo "  $(paste_env instructor)$BUILD/client/control/viscera-control --partition $PREFIX/$(printf 'seat%02d' "$FIRST") pause"
+[ $RECORD = 0 ] || echo "  $BUILD/client/report/viscera-report --out $OUT/report $OUT/lab.db    # after the lab"
 if [ $RECORD = 1 ]; then
   rm -f "$OUT/lab.db" "$OUT/lab.db-wal" "$OUT/lab.db-shm"
   # shellcheck disable=SC2046 # dur prints nothing or two words

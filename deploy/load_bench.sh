@@ -75,7 +75,7 @@ SRV_RT=() HAP_RT=()
 [ "$HRTPRIO" -gt 0 ] && HAP_RT=(--rt-priority "$HRTPRIO")
 [ -x "$BUILD/tests/bench/delta_sub" ] || { echo "load_bench.sh: $BUILD/tests/bench/delta_sub missing (build with -DVISCERA_BUILD_BENCH=ON)" >&2; exit 1; }
 export CYCLONEDDS_URI="${CYCLONEDDS_URI:-file://$ROOT/deploy/cyclonedds-loopback.xml}"
-export VISCERA_DOMAIN="${VISCERA_DOMAIN:-8}"
+export VISCERA_DOMAIN="${VISCERA_DOMAIN:-0}"
 [ -r "$SCENE" ] || { echo "load_bench.sh: cannot read the scene '$SCENE'" >&2; exit 2; }
 SCENE_NAME=$(basename "$SCENE" .yaml)
 rm -rf "$OUT"; mkdir -p "$OUT"

@@ -4,7 +4,7 @@
 # Cyclone DDS. Used by demo.sh and by the integration tests.
 #
 # usage: deploy/session.sh BUILD_DIR OUT_DIR [SCENE] [TRAJECTORY]
-# env:   VISCERA_DOMAIN (default 7), VISCERA_PARTITION (default demo/seat01),
+# env:   VISCERA_DOMAIN (default 0, like every binary), VISCERA_PARTITION (default demo/seat01),
 #        VIEWER_ARGS, SERVER_ARGS (extra options)
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -12,7 +12,7 @@ BUILD="$1"
 OUT="$2"
 SCENE="${3:-$ROOT/assets/scenes/default.yaml}"
 TRAJ="${4:-$ROOT/assets/trajectories/palpate_kidney.traj}"
-DOMAIN="${VISCERA_DOMAIN:-7}"
+DOMAIN="${VISCERA_DOMAIN:-0}"
 PART="${VISCERA_PARTITION:-demo/seat01}"
 export CYCLONEDDS_URI="${CYCLONEDDS_URI:-file://$ROOT/deploy/cyclonedds-loopback.xml}"
 

@@ -538,7 +538,8 @@ static void usage(FILE *f) {
              "       viscera-organ-gen --help | --version\n"
              "Writes tissue_block, spleen, kidney, gallbladder and liver_large (.obj, metres, z up)\n"
              "into OUTDIR (created if missing) and prints their sizes. The repository copies live\n"
-             "in assets/meshes/; regenerate them with this tool rather than editing them.\n");
+             "in assets/meshes/; regenerate them with this tool rather than editing them.\n"
+             "Exit status: 0 written, 1 cannot write OUTDIR, 2 usage error.\n");
 }
 
 int main(int argc, char **argv) {

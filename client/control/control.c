@@ -205,7 +205,7 @@ int main(int argc, char **argv) {
                                        {0, 0, 0, 0}};
   const cli_spec_t spec = {.program = "viscera-control",
                            .common = CLI_DOMAIN | CLI_DOMAIN_ENV | CLI_PARTITION,
-                           .shortopts = "+", /* stop at the command, so "-1" values are not options */
+                           .shortopts = "+h", /* stop at the command, so "-1" values are not options */
                            .options = opts,
                            .option = on_option,
                            .usage = usage,

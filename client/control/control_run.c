@@ -6,6 +6,7 @@
 
 #include "dds/seat_server.h"
 #include "dds/vdds.h"
+#include "dds/vdds_config.h"
 #include "dds/vdds_gate.h"
 #include "vtime.h"
 
@@ -43,9 +44,12 @@ int control_run(const control_options_t *o) {
     fprintf(stderr, "viscera-control: %s\n", err.msg);
     goto out;
   }
-  uint64_t deadline = vtime_mono_ns() + (uint64_t)(o->wait_s * 1e9);
-  int have_server = 0;
+  uint64_t start = vtime_mono_ns(), deadline = start + (uint64_t)(o->wait_s * 1e9);
+  int have_server = 0, told = 0;
+  const char *part = o->partition ? o->partition : VDDS_DEFAULT_PARTITION;
   while (!have_server && vtime_mono_ns() < deadline) {
+    if (vdds_nothing_seen_due(&told, vdds_matched_writers(r_scene), start, vtime_mono_ns()))
+      vdds_explain_nothing_seen(stderr, "viscera-control", "no server found", o->domain, part, VDDS_NOTHING_SEEN_S);
     void *samples[1] = {0};
     dds_sample_info_t info;
     int n = dds_take(r_scene, samples, &info, 1, 1);
@@ -57,8 +61,10 @@ int control_run(const control_options_t *o) {
     }
   }
   if (!have_server) {
-    fprintf(stderr, "viscera-control: no server on domain %d partition '%s' within %.1f s\n", o->domain,
-            o->partition ? o->partition : VDDS_DEFAULT_PARTITION, o->wait_s);
+    fprintf(stderr, "viscera-control: no server on domain %d partition '%s' within %.1f s\n", o->domain, part,
+            o->wait_s);
+    if (!told) /* a --wait shorter than VDDS_NOTHING_SEEN_S: explain now */
+      vdds_explain_nothing_seen(stderr, "viscera-control", "no server found", o->domain, part, o->wait_s);
     rc = 1;
     goto out;
   }

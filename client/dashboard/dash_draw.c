@@ -190,7 +190,9 @@ static void draw_tile(dash_t *d, int i, cairo_t *cr, int x, int y, verr_t *err) 
   double f = seat_force(s, &st, &mpf, &sft, &maxf);
   char head[200];
   snprintf(head, sizeof head, "%.60s  %.64s  %.2f N%s", s->partition, s->sv.have_scene ? s->sv.scene_name : "-", f,
-           s->client_lost ? "  trainee lost" : "");
+           s->client_lost   ? "  trainee lost"
+           : s->client_left ? "  trainee left"
+                            : "");
   cairo_set_source_rgb(cr, 0.9, 0.9, 0.92);
   text_fit(cr, x + 6, y + 15, 12, head, tw - 12);
   if (s->alert != SEAT_OK) {
@@ -372,6 +374,8 @@ static void draw_panel(const seat_t *s, cairo_t *cr, double x, double y, double 
                 : strncmp(e->text, "MPF", 3) == 0 ? SEAT_ABOVE_MPF
                                                   : SEAT_ABOVE_ST,
                 ec);
+    else if (e->kind == viscera_EVENT_CLIENT_LOST && strstr(e->text, "client left"))
+      ec[0] = ec[1] = ec[2] = 0.6; /* a clean exit: grey, not an alarm */
     else if (e->kind == viscera_EVENT_CLIENT_LOST)
       ec[0] = 0.95, ec[1] = 0.35, ec[2] = 0.3;
     /* The server's texts mostly say what happened ("MPF crossed up: ..."):
@@ -399,15 +403,19 @@ int dash_draw_focus(dash_t *d, int i, cairo_t *cr, int w, int h, verr_t *err) {
   cairo_set_source_rgb(cr, 0.93, 0.93, 0.95);
   int bx, by, bw, bh;
   dash_focus_badge_rect(w, h, &bx, &by, &bw, &bh);
-  if (s->client_lost) {
+  if (s->client_lost || s->client_left) {
     /* Next to the seat's name, where the instructor looks first. */
     cairo_set_font_size(cr, 20);
     cairo_text_extents_t tt;
     cairo_text_extents(cr, b, &tt);
     double room = bx - 2 * M - 190;
     text_fit(cr, M, 31, 20, b, room);
-    cairo_set_source_rgb(cr, 0.95, 0.35, 0.3);
-    text(cr, M + fmin(tt.x_advance, room) + 14, 31, 15, "trainee's client lost");
+    if (s->client_lost)
+      cairo_set_source_rgb(cr, 0.95, 0.35, 0.3);
+    else
+      cairo_set_source_rgb(cr, 0.6, 0.6, 0.6);
+    text(cr, M + fmin(tt.x_advance, room) + 14, 31, 15,
+         s->client_lost ? "trainee's client lost" : "trainee's client left");
   } else {
     text_fit(cr, M, 31, 20, b, bx - 2 * M);
   }

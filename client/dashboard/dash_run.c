@@ -14,6 +14,7 @@
 #include "dash_draw.h"
 #include "plot/plot_cleanup.h"
 #include "seat.h"
+#include "dds/vdds_config.h"
 #include "dds/vdds_ident.h"
 #include "vsignal.h"
 #include "vtime.h"
@@ -49,6 +50,26 @@ static void log_roles(seat_t *s) {
   }
 }
 
+/* Once, VDDS_NOTHING_SEEN_S after the start: when no seat has a server,
+ * why that may be (vdds_config.h); when only some have none, which. */
+static void tell_empty_seats(const seat_t *seats, int n, const dash_options_t *o, int *told, uint64_t t0,
+                             uint64_t now) {
+  int seen = 0;
+  for (int i = 0; i < n; i++) seen += seats[i].sv.have_scene || vdds_matched_writers(seats[i].sv.rd_scene) > 0;
+  if (!vdds_nothing_seen_due(told, seen == n, t0, now)) return;
+  if (seen == 0) {
+    char parts[160];
+    snprintf(parts, sizeof parts, "%s/seat%02d..seat%02d", o->prefix, o->first, o->first + n - 1);
+    vdds_explain_nothing_seen(stderr, "viscera-dashboard", "no seat has a server", o->domain, parts,
+                              VDDS_NOTHING_SEEN_S);
+    return;
+  }
+  for (int i = 0; i < n; i++)
+    if (!seats[i].sv.have_scene && vdds_matched_writers(seats[i].sv.rd_scene) == 0)
+      fprintf(stderr, "viscera-dashboard: no server seen in %s after %.0f s (%d other seat(s) live)\n",
+              seats[i].partition, VDDS_NOTHING_SEEN_S, seen);
+}
+
 int dash_run(const dash_options_t *o) {
   const char *prefix = o->prefix, *out = o->out, *script = o->script;
   int nseats = o->nseats, first = o->first, tw = o->tw, th = o->th, cols = o->cols, interval_ms = o->interval_ms;
@@ -76,7 +97,7 @@ int dash_run(const dash_options_t *o) {
       return 1;
     }
     fprintf(csv, "frame,wall_s,seat,have_scene,force_n,peak_n,alert,crossings_st,crossings_mpf,crossings_sft,"
-                 "client_lost,focused\n");
+                 "client_lost,focused,client_left\n");
   }
 
   static seat_t seats[MAX_SEATS];
@@ -126,11 +147,12 @@ int dash_run(const dash_options_t *o) {
   const uint64_t tick_ns = window ? (uint64_t)(1e9 / refresh_hz) : sample_ns;
   uint64_t t0 = vtime_mono_ns(), next_tick = t0, next_sample = t0, last_sample = t0;
   uint64_t next_frame = t0 + (uint64_t)interval_ms * 1000000ull;
-  int frame = 0;
+  int frame = 0, told_empty = 0;
   while (!g_stop) {
     uint64_t now_ns = vtime_mono_ns();
     double now = (double)(now_ns - t0) * 1e-9;
     if (duration > 0 && now >= duration) break;
+    tell_empty_seats(seats, nseats, o, &told_empty, t0, now_ns);
     for (int i = 0; i < nseats; i++) {
       if (seat_poll(&seats[i], now, &err)) fprintf(stderr, "viscera-dashboard: %s: %s\n", seats[i].partition, err.msg);
       log_roles(&seats[i]);
@@ -182,9 +204,9 @@ int dash_run(const dash_options_t *o) {
         seat_t *s = &seats[i];
         float st, mpf, sft, maxf;
         double f = seat_force(s, &st, &mpf, &sft, &maxf);
-        fprintf(csv, "%d,%.3f,%s,%d,%.4f,%.4f,%s,%u,%u,%u,%d,%d\n", frame, now, s->partition, s->sv.have_scene, f,
+        fprintf(csv, "%d,%.3f,%s,%d,%.4f,%.4f,%s,%u,%u,%u,%d,%d,%d\n", frame, now, s->partition, s->sv.have_scene, f,
                 s->peak, seat_level_name(s->alert), s->crossings[0], s->crossings[1], s->crossings[2], s->client_lost,
-                i == focused);
+                i == focused, s->client_left);
       }
       fflush(csv);
       frame++;

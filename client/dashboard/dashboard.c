@@ -44,7 +44,9 @@ static void usage(FILE *f) {
           "  --help              this text\n"
           "  --version           print the version and exit\n"
           "window keys: 1-9 or a click on a tile: focus that seat; Tab / Shift+Tab: next / previous\n"
-          "  seat; Esc or a click: back to the grid; Q or closing the window: quit\n",
+          "  seat; Esc or a click: back to the grid; Q or closing the window: quit\n"
+          "Exit status: 0 done (--duration, Q or SIGINT/SIGTERM), 1 DDS, window or output error,\n"
+          "2 usage error.\n",
           MAX_SEATS, FOCUS_W, FOCUS_H);
 }
 
@@ -180,6 +182,7 @@ int main(int argc, char **argv) {
                            .common = CLI_DOMAIN | CLI_DOMAIN_ENV,
                            .options = opts,
                            .option = on_option,
+                           .shortopts = "h",
                            .usage = usage};
   dash_options_t o = {.prefix = "lab",
                       .out = "dashboard",

@@ -20,7 +20,8 @@ int seat_open(seat_t *s, int domain, const char *partition, verr_t *err) {
     s->rd_role = vdds_reader_gated(&s->sv.dds, VT_TOOL_ROLE, &s->gate_role, 0, viscera_MAX_TOOLS, NULL, err);
   if (s->rd_event >= 0 && s->rd_role >= 0)
     s->rd_measures = vdds_reader_gated(&s->sv.dds, VT_TOOL_METRICS, &s->gate_measures, 0, viscera_MAX_TOOLS, NULL, err);
-  if (s->rd_event < 0 || s->rd_role < 0 || s->rd_measures < 0) {
+  if (s->rd_measures >= 0) s->rd_presence = vdds_reader(&s->sv.dds, VT_TOOL_COMMAND, err);
+  if (s->rd_event < 0 || s->rd_role < 0 || s->rd_measures < 0 || s->rd_presence < 0) {
     scene_view_close(&s->sv);
     return -1;
   }
@@ -121,18 +122,47 @@ static void on_event(seat_t *s, const void *x, double now) {
     break;
   }
   case viscera_EVENT_CLIENT_LOST:
-    s->client_lost = 1;
+    /* The server says "left" for a deleted writer; a dispose already seen
+     * means the same. */
+    if (strstr(e->text, "client left"))
+      s->client_left = 1, s->client_lost = 0;
+    else if (!s->client_left)
+      s->client_lost = 1;
     break;
   case viscera_EVENT_CONTACT_BEGIN:
-    s->client_lost = 0;
+    s->client_lost = s->client_left = 0;
     break;
   default:
     break;
   }
 }
 
+/* The trainee's ToolCommand writers: present, left or lost (seat.h). A new
+ * command clears both; then the reader's liveliness status since the last
+ * poll: a writer deleted while alive (alive count down, no not-alive rise)
+ * left; a lease that expired (not-alive count up) was lost. The samples
+ * themselves are dropped. */
+static void seat_presence(seat_t *s) {
+  for (;;) {
+    void *samples[16] = {0};
+    dds_sample_info_t infos[16];
+    int n = dds_take(s->rd_presence, samples, infos, 16, 16);
+    if (n <= 0) break;
+    for (int i = 0; i < n; i++)
+      if (infos[i].valid_data) s->client_left = s->client_lost = 0;
+    dds_return_loan(s->rd_presence, samples, n);
+  }
+  dds_liveliness_changed_status_t st;
+  if (dds_get_liveliness_changed_status(s->rd_presence, &st) != DDS_RETCODE_OK) return;
+  if (st.not_alive_count_change > 0 && !s->client_left)
+    s->client_lost = 1;
+  else if (st.alive_count_change < 0 && st.not_alive_count_change <= 0)
+    s->client_left = 1, s->client_lost = 0;
+}
+
 int seat_poll(seat_t *s, double now, verr_t *err) {
   if (scene_view_poll(&s->sv, err) < 0) return -1;
+  seat_presence(s);
   take_all(s, s->rd_event, &s->gate_event, on_event, now);
   take_all(s, s->rd_role, &s->gate_role, on_role, now);
   take_all(s, s->rd_measures, &s->gate_measures, on_measures, now);

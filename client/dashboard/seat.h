@@ -50,6 +50,7 @@ typedef struct seat {
   scene_view_t sv;
   dds_entity_t rd_event, rd_role, rd_measures;      /* believed from the seat's server only (sv.server) */
   vdds_gate_t gate_event, gate_role, gate_measures; /* bounded: source 0, the tools */
+  dds_entity_t rd_presence; /* ToolCommand, read for its instance states only (seat_presence) */
   int have_camera;
   camera_t cam;
   float history[SEAT_HISTORY]; /* N, newest at (nhist - 1) % SEAT_HISTORY */
@@ -58,7 +59,8 @@ typedef struct seat {
   seat_alert_t alert;               /* highest level crossed up within SEAT_ALERT_HOLD_S, or the force's level now */
   double alert_until;               /* dashboard time (s) the alert shows until */
   uint32_t crossings[3];            /* upward crossings seen: ST, MPF, SFT */
-  int client_lost;                  /* a CLIENT_LOST event since the last contact */
+  int client_lost;                  /* the trainee's client is gone without a goodbye (see below) */
+  int client_left;                  /* it exited cleanly: its ToolCommand instance was disposed */
   seat_event_t events[SEAT_EVENTS]; /* newest at (nevents - 1) % SEAT_EVENTS */
   uint64_t nevents;
   seat_role_t roles[SCENE_VIEW_MAX_TOOLS];
@@ -67,6 +69,16 @@ typedef struct seat {
   unsigned long rejected;
 } seat_t;
 
+/* Left or lost: a client that exits cleanly deletes its ToolCommand writer
+ * while the writer is alive (it unregisters and disposes its instance): the
+ * seat's reader sees the alive count drop with no not-alive rise, and the
+ * seat shows "left", in grey. A client that dies (kill, crash, cable) stops
+ * asserting liveliness: its lease expires (the not-alive count rises) and
+ * the server's CLIENT_LOST event follows: the seat shows "lost", in red. (The
+ * instance state cannot tell them apart: Cyclone auto-disposes a lost
+ * writer's instances too.) A clean exit seen before or after the server's
+ * event wins (the server's event for a deleted writer says "left" as well);
+ * a new command or contact clears both. */
 int seat_open(seat_t *s, int domain, const char *partition, verr_t *err);
 void seat_close(seat_t *s);
 /* Takes what arrived; `now` is the dashboard's clock in s. */

@@ -37,7 +37,9 @@ void haptic_usage(FILE *f) {
           "                      a warning naming the reason, normal priority)\n"
           "  --quiet             only the summary\n"
           "  --help              this text\n"
-          "  --version           print the version and exit\n",
+          "  --version           print the version and exit\n"
+          "Exit status: 0 done (trajectory ended, --duration or SIGINT/SIGTERM), 1 device, DDS or\n"
+          "output error (or no server within --wait-server), 2 usage error.\n",
           device_names());
 }
 
@@ -210,6 +212,10 @@ int haptic_options_parse(haptic_options_t *o, int argc, char **argv) {
   if (!(o->rate >= 10 && o->rate <= 10000) || !(o->max_force > 0)) {
     fprintf(stderr, "viscera-haptic: --rate must be 10..10000 Hz and --max-force > 0\n");
     return 2;
+  }
+  if (o->trajectory) { /* "palpate_kidney.traj" finds the installed one from any directory */
+    data_path_resolve(o->trajectory, "assets/trajectories", o->trajectory_path, sizeof o->trajectory_path);
+    o->trajectory = o->trajectory_path;
   }
   o->dcfg.trajectory = o->trajectory;
   o->dcfg.max_force = o->max_force;

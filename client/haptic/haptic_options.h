@@ -5,6 +5,7 @@
 
 #include <stdio.h>
 
+#include "data_path.h"
 #include "device.h"
 
 typedef struct haptic_options {
@@ -15,12 +16,13 @@ typedef struct haptic_options {
   const char *station;    /* --station NAME, or NULL */
   device_config_t dcfg;   /* --device-index, --workspace-scale/-offset, and the fields below once parsed */
   int domain, quiet, rt_priority;
-  unsigned tool;        /* --tool N */
-  double rate;          /* --rate HZ, loop rate */
-  double max_force;     /* --max-force N */
-  double max_stiffness; /* --max-stiffness K, N/m; 0 = no stated limit */
-  double wait_server;   /* --wait-server S */
-  double duration;      /* --duration S; < 0: end of the trajectory + 0.5 s */
+  unsigned tool;                       /* --tool N */
+  double rate;                         /* --rate HZ, loop rate */
+  double max_force;                    /* --max-force N */
+  double max_stiffness;                /* --max-stiffness K, N/m; 0 = no stated limit */
+  double wait_server;                  /* --wait-server S */
+  double duration;                     /* --duration S; < 0: end of the trajectory + 0.5 s */
+  char trajectory_path[DATA_PATH_MAX]; /* --trajectory found (data_path_resolve: installed ones by name) */
 } haptic_options_t;
 
 /* Defaults, $VISCERA_DOMAIN, then argv. Returns CLI_RUN (cli.h) to run, or

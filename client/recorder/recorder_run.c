@@ -5,6 +5,7 @@
 #include <stdio.h>
 
 #include "cli.h"
+#include "dds/vdds_config.h"
 #include "vsignal.h"
 #include "vtime.h"
 
@@ -39,10 +40,17 @@ int recorder_run(const recorder_options_t *ro) {
   const uint64_t t0 = vtime_mono_ns();
   const uint64_t t_end = ro->duration > 0 ? t0 + (uint64_t)(ro->duration * 1e9) : UINT64_MAX;
   uint64_t next_progress = t0 + 1000000000u, last_samples = 0, last_progress = t0;
-  int status = 0;
+  int status = 0, told = 0;
   while (!stop_requested) {
     uint64_t now = vtime_mono_ns();
     if (now >= t_end) break;
+    if (!told) { /* no writer in the partition yet: say why that may be, once */
+      rec_session_stats_t st;
+      rec_session_get_stats(s, &st);
+      if (vdds_nothing_seen_due(&told, (int)(st.topics + st.failed_topics), t0, now))
+        vdds_explain_nothing_seen(stderr, "recorder", "no writer in this partition", ro->session.domain,
+                                  ro->session.partition, VDDS_NOTHING_SEEN_S);
+    }
     /* Short waits: the loop also commits batches on time and notices
      * signals, which cannot wake a DDS waitset safely. */
     dds_duration_t wait = DDS_MSECS(50);

@@ -36,7 +36,8 @@ static void usage(FILE *f) {
              "  --help          this text\n"
              "  --version       print the version and exit\n"
              "SIGUSR1 toggles pause/resume; after a resume the original timing goes on\n"
-             "(the schedule is shifted by the paused time, no burst of missed samples).\n");
+             "(the schedule is shifted by the paused time, no burst of missed samples).\n"
+             "Exit status: 0 done, 1 unreadable recording, DDS error or usage error.\n");
 }
 
 enum { OPT_SPEED = 's', OPT_SEEK = 'k', OPT_LOOP = 'l', OPT_PAUSE_AT = 'P' };
@@ -82,6 +83,7 @@ static int parse_args(replay_options_t *r, int argc, char **argv) {
                            .common = CLI_DOMAIN | CLI_PARTITION | CLI_QUIET,
                            .options = opts,
                            .option = on_option,
+                           .shortopts = "h",
                            .usage = usage,
                            .domain_error = "--domain '%s': expected an integer 0..230",
                            .partition_error = "--partition: empty or too long",

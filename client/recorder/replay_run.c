@@ -9,6 +9,7 @@
 #include <dds/dds.h>
 #include <sqlite3.h>
 
+#include "dds/vdds_config.h"
 #include "dds/vdds_ident.h"
 #include "recording/recfile.h"
 #include "replay_pause.h"
@@ -262,6 +263,7 @@ static int open_recording(replay_t *r) {
 static int publish_all(replay_t *r) {
   verr_t err;
   int status = 0;
+  vdds_config_default(); /* no CYCLONEDDS_URI: the loopback configuration */
   dds_qos_t *ppq = vdds_participant_qos();
   r->pp = dds_create_participant((dds_domainid_t)r->o.domain, ppq, NULL);
   if (ppq) dds_delete_qos(ppq);

@@ -7,6 +7,7 @@
 #include "capture.h"
 #include "discovery.h"
 #include "participants.h"
+#include "dds/vdds_config.h"
 #include "dds/vdds_ident.h"
 #include "recording/store.h"
 #include "topic_type.h"
@@ -179,6 +180,7 @@ int rec_session_open(rec_session_t **out, const rec_session_opts_t *opts, const 
     free(s);
     return -1;
   }
+  vdds_config_default(); /* no CYCLONEDDS_URI: the loopback configuration */
   dds_qos_t *pq = vdds_participant_qos();
   s->participant = dds_create_participant((dds_domainid_t)opts->domain, pq, NULL);
   if (pq) dds_delete_qos(pq);

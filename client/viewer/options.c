@@ -189,6 +189,7 @@ int options_parse(viewer_opts_t *o, int argc, char **argv) {
                            .common = CLI_DOMAIN | CLI_DOMAIN_ENV | CLI_PARTITION | CLI_QUIET,
                            .options = longopts,
                            .option = viewer_option,
+                           .shortopts = "h",
                            .usage = usage_text,
                            .domain_error = "--domain '%s': expected an integer 0..230",
                            .partition_error = "--partition: empty partition name"};

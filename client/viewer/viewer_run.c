@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "dds/vdds_config.h"
 #include "view/camera.h"
 #include "view/frame_log.h"
 #include "mesh_dump.h"
@@ -119,7 +120,7 @@ int viewer_run(const viewer_opts_t *o) {
   const uint64_t interval_ns = (uint64_t)o->interval_ms * 1000000ull;
   const uint64_t duration_ns = (uint64_t)(o->duration_s * 1e9);
   uint64_t first_key_ns = 0, next_due = 0;
-  int have_cam = 0, status = 0;
+  int have_cam = 0, status = 0, told_nothing = 0;
   camera_t cam;
   while (!g_stop) {
     uint64_t now = vtime_mono_ns();
@@ -129,6 +130,9 @@ int viewer_run(const viewer_opts_t *o) {
       status = 1;
       break;
     }
+    if (vdds_nothing_seen_due(&told_nothing, sv.have_scene || vdds_matched_writers(sv.rd_scene), t0, now))
+      vdds_explain_nothing_seen(stderr, "viewer", "no server publishes a scene here", o->domain, o->partition,
+                                VDDS_NOTHING_SEEN_S);
     if (!have_cam && scene_view_any_keyframe(&sv)) {
       if (!first_key_ns) first_key_ns = now;
       double bmin[3], bmax[3];

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "dds/vdds_config.h"
 #include "view/camera.h"
 #include "view/frame_log.h"
 #include "input_drive.h"
@@ -193,6 +194,7 @@ static int run(win_t *w, volatile sig_atomic_t *stop) {
   const uint64_t interval_ns = (uint64_t)o->interval_ms * 1000000ull;
   uint64_t first_key_ns = 0, cam_ns = 0, last_ns = t0, next_png = 0, next_title = 0;
   long presented = 0;
+  int told_nothing = 0;
   const uint8_t *last_img = NULL;
   while (!*stop) {
     uint64_t now = vtime_mono_ns();
@@ -204,6 +206,9 @@ static int run(win_t *w, volatile sig_atomic_t *stop) {
       fprintf(stderr, "viscera-viewer: %s\n", err.msg);
       return 1;
     }
+    if (vdds_nothing_seen_due(&told_nothing, w->sv.have_scene || vdds_matched_writers(w->sv.rd_scene), t0, now))
+      vdds_explain_nothing_seen(stderr, "viewer", "no server publishes a scene here", o->domain, o->partition,
+                                VDDS_NOTHING_SEEN_S);
     if (!w->have_cam && scene_view_any_keyframe(&w->sv)) {
       if (!first_key_ns) first_key_ns = now;
       double bmin[3], bmax[3];

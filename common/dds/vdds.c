@@ -1,9 +1,9 @@
 #include "dds/vdds.h"
 
-
 #include <stdlib.h>
 #include <string.h>
 
+#include "dds/vdds_config.h"
 #include "dds/vdds_ident.h"
 #include "viscera.h"
 
@@ -79,6 +79,7 @@ dds_qos_t *vdds_topic_qos(vdds_topic_id_t t) { return make_qos(TOPICS[t].qos, TO
 
 int vdds_open(vdds_t *v, dds_domainid_t domain, const char *partition, verr_t *err) {
   memset(v, 0, sizeof *v);
+  vdds_config_default(); /* no CYCLONEDDS_URI: the loopback configuration, like the scripts */
   /* USER_DATA announces role, host and pid (vdds_ident.h), so recorders
    * and operators can tell the participants of a session apart. */
   dds_qos_t *pq = vdds_participant_qos();

@@ -23,7 +23,8 @@ static void usage(FILE *f) {
              "  --help            this text\n"
              "  --version         print the version and exit\n"
              "Re-runs the recorded tool commands in a fresh server runtime and compares every recorded\n"
-             "MeshState/MeshDelta frame. Exit 0 within tolerance, 1 beyond, 2 on an error.\n");
+             "MeshState/MeshDelta frame.\n"
+             "Exit status: 0 within tolerance, 1 beyond, 2 on an error or a usage error.\n");
 }
 
 enum { OPT_SCENE = 's', OPT_TOLERANCE = 't', OPT_CSV = 'c' };

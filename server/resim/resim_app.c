@@ -6,7 +6,9 @@
 #include <inttypes.h>
 #include <math.h>
 #include <stdio.h>
+#include <string.h>
 
+#include "data_path.h"
 #include "resim/resim_recording.h"
 #include "resim/resim_run.h"
 #include "runtime/scene_runtime.h"
@@ -99,8 +101,10 @@ static int print_organs(const runtime_t *rt, const resim_recording_t *rec, const
 
 int resim_app_run(const resim_options_t *o) {
   verr_t err;
-  static scene_t scene; /* large; static keeps it off the stack */
-  if (scene_load(o->scene_path, &scene, &err)) {
+  static scene_t scene;           /* large; static keeps it off the stack */
+  char scene_path[DATA_PATH_MAX]; /* installed scenes from any directory (data_path.h) */
+  data_path_resolve(o->scene_path, "assets/scenes", scene_path, sizeof scene_path);
+  if (scene_load(scene_path, &scene, &err)) {
     fprintf(stderr, "viscera-resim: %s\n", err.msg);
     return 2;
   }

@@ -28,7 +28,8 @@ static void usage(FILE *f) {
              "  --quiet             only errors and warnings on stderr\n"
              "  --help              this text\n"
              "  --version           print the version and exit\n"
-             "DDS configuration comes from CYCLONEDDS_URI (deploy/cyclonedds-loopback.xml for one machine).\n");
+             "DDS configuration comes from CYCLONEDDS_URI (unset: deploy/cyclonedds-loopback.xml, one machine).\n"
+             "Exit status: 0 done (or --check passed), 1 bad scene or runtime error, 2 usage error.\n");
 }
 
 enum {

@@ -6,9 +6,12 @@
 #include <inttypes.h>
 #include <signal.h>
 #include <stdio.h>
+#include <string.h>
 
+#include "data_path.h"
 #include "dds/vdds.h"
 #include "scene.h"
+#include "session/scene_check.h"
 #include "vsignal.h"
 
 static volatile sig_atomic_t g_stop = 0;
@@ -36,6 +39,9 @@ static int check_scene(const scene_t *scene) {
            m->stable_dt * 1e3);
     if (o->mesh_note[0]) printf("  organ '%s': mesh repaired: %s\n", o->cfg->name, o->mesh_note);
   }
+  /* Warnings only (scene_check.h): real time at this dt, organ sizes. */
+  scene_check_sizes(&rt, stderr);
+  scene_check_cost(&rt, stdout, stderr);
   runtime_destroy(&rt);
   return 0;
 }
@@ -128,7 +134,13 @@ static void print_summary(const scene_t *scene, const server_stats_t *s) {
 int server_app_run(const server_app_options_t *o) {
   static scene_t scene;
   verr_t err;
-  if (scene_load(o->scene_path, &scene, &err)) {
+  /* Installed data (data_path.h): "--scene default.yaml" works from any
+   * directory; a path that exists as given is used as given. */
+  char scene_path[DATA_PATH_MAX];
+  if (data_path_resolve(o->scene_path, "assets/scenes", scene_path, sizeof scene_path) == 0 &&
+      strcmp(scene_path, o->scene_path) && !o->opts.quiet)
+    fprintf(stderr, "viscera-server: scene %s found as %s\n", o->scene_path, scene_path);
+  if (scene_load(scene_path, &scene, &err)) {
     fprintf(stderr, "viscera-server: %s\n", err.msg);
     return 1;
   }

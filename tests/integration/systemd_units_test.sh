@@ -11,7 +11,8 @@
 #      as one word; User= and the sandboxing options are not applied) for
 #      instance seat01 on domain 164: the server serves PARTITION from the
 #      env file, the recorder records it into STATE/seat01-<UTC time>.db, and
-#      SIGTERM (what `systemctl stop` sends) ends both cleanly.
+#      SIGTERM (what `systemctl stop` sends) ends both cleanly; the server
+#      leaves its checkpoint in the state directory.
 # Exit 77 (skipped) only when systemd-analyze is not installed.
 # usage: systemd_units_test.sh BUILD SRC OUT
 set -euo pipefail
@@ -121,4 +122,5 @@ echo "recorder unit: $(basename "${dbs[0]}"), scene '$scene', partition '$part',
 [ "$scene" = seat01 ] && [ "$part" = unit/seat01 ] || fail "recording metadata: scene '$scene', partition '$part'"
 [ "$closed" = 1 ] || fail "the recording has no end time"
 [ "${deltas:-0}" -gt 10 ] || fail "the recorder unit recorded ${deltas:-0} MeshDelta samples"
+[ -s "$OUT/state/seat01.ckpt" ] || fail "the server unit wrote no checkpoint into its state directory"
 echo PASS

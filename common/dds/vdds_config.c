@@ -1,0 +1,93 @@
+#include "dds/vdds_config.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "data_path.h"
+
+int vdds_config_default(void) {
+  const char *uri = getenv("CYCLONEDDS_URI");
+  if (uri && *uri) return 0;
+  char path[DATA_PATH_MAX], value[DATA_PATH_MAX + 16];
+  if (data_path_find(VDDS_LOOPBACK_CONFIG, path, sizeof path)) return -1;
+  snprintf(value, sizeof value, "file://%s", path);
+  return setenv("CYCLONEDDS_URI", value, 1) ? -1 : 0;
+}
+
+/* 1 when the text configures security. */
+static int text_secure(const char *t) { return strstr(t, "<Security") || strstr(t, "<DDSSecurity"); }
+
+/* 1 when the file at `path` configures security (first 64 kB read). */
+static int file_secure(const char *path) {
+  FILE *f = fopen(path, "r");
+  if (!f) return 0;
+  static const size_t cap = 65536;
+  char *buf = malloc(cap + 1);
+  int secure = 0;
+  if (buf) {
+    size_t n = fread(buf, 1, cap, f);
+    buf[n] = 0;
+    secure = text_secure(buf);
+    free(buf);
+  }
+  fclose(f);
+  return secure;
+}
+
+int vdds_config_secure(void) {
+  const char *uri = getenv("CYCLONEDDS_URI");
+  if (!uri || !*uri) return 0;
+  char *copy = strdup(uri);
+  if (!copy) return 0;
+  int secure = 0;
+  /* Cyclone takes a comma-separated list of file:// URIs and inline XML. */
+  char *save = NULL;
+  for (char *e = strtok_r(copy, ",", &save); e && !secure; e = strtok_r(NULL, ",", &save)) {
+    while (*e == ' ' || *e == '\t' || *e == '\n') e++;
+    secure = strncmp(e, "file://", 7) == 0 ? file_secure(e + 7) : text_secure(e);
+  }
+  free(copy);
+  return secure;
+}
+
+int vdds_matched_writers(dds_entity_t reader) {
+  dds_subscription_matched_status_t st;
+  return dds_get_subscription_matched_status(reader, &st) == DDS_RETCODE_OK ? (int)st.current_count : 0;
+}
+
+int vdds_matched_readers(dds_entity_t writer) {
+  dds_publication_matched_status_t st;
+  return dds_get_publication_matched_status(writer, &st) == DDS_RETCODE_OK ? (int)st.current_count : 0;
+}
+
+int vdds_nothing_seen_due(int *reported, int matched, uint64_t start_ns, uint64_t now_ns) {
+  if (*reported || matched > 0 || now_ns < start_ns || (double)(now_ns - start_ns) < VDDS_NOTHING_SEEN_S * 1e9)
+    return 0;
+  *reported = 1;
+  return 1;
+}
+
+void vdds_explain_nothing_seen(FILE *f, const char *tag, const char *what, int domain, const char *partition,
+                               double waited_s) {
+  const char *uri = getenv("CYCLONEDDS_URI");
+  int secure = vdds_config_secure();
+  fprintf(f, "%s: nothing seen after %.0f s: %s\n", tag, waited_s, what);
+  fprintf(f, "%s:   listening on domain %d, partition '%s'\n", tag, domain, partition ? partition : "");
+  fprintf(f, "%s:   configuration: %s, DDS Security %s\n", tag, uri && *uri ? uri : "(Cyclone DDS defaults)",
+          secure ? "on" : "off");
+  fprintf(f,
+          "%s:   likely cause: no server runs on this domain and partition (start it, or check --domain / "
+          "$VISCERA_DOMAIN and --partition against the server's)\n",
+          tag);
+  if (secure)
+    fprintf(f,
+            "%s:   or: the peers do not accept this identity (another PKI, or permissions that do not cover "
+            "this domain and partition)\n",
+            tag);
+  else
+    fprintf(f,
+            "%s:   or: the peers run with DDS Security and refuse a participant without identity (add your "
+            "identity: CYCLONEDDS_URI=\"file://.../cyclonedds-loopback.xml,file://PKI/identities/NAME/"
+            "security.xml\")\n",
+            tag);
+}
