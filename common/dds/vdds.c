@@ -1,13 +1,12 @@
 #include "dds/vdds.h"
 
-
 #include <stdlib.h>
 #include <string.h>
 
 #include "dds/vdds_ident.h"
 #include "viscera.h"
 
-typedef enum qos_kind { QOS_STATE, QOS_STREAM, QOS_EVENTS, QOS_METRICS, QOS_CONTROL } qos_kind_t;
+typedef enum qos_kind { QOS_STATE, QOS_STREAM, QOS_EVENTS, QOS_METRICS, QOS_CONTROL, QOS_LOG } qos_kind_t;
 
 static const struct {
   const char *name;
@@ -29,6 +28,8 @@ static const struct {
     [VT_OBJECT_STATE] = {"viscera_ObjectState", &viscera_ObjectState_desc, QOS_STATE},
     [VT_TOOL_METRICS] = {"viscera_ToolMetrics", &viscera_ToolMetrics_desc, QOS_METRICS},
     [VT_TOOL_ROLE] = {"viscera_ToolRole", &viscera_ToolRole_desc, QOS_STATE},
+    [VT_APPLIED_INPUT] = {"viscera_AppliedInput", &viscera_AppliedInput_desc, QOS_LOG},
+    [VT_SCENE_SOURCE] = {"viscera_SceneSource", &viscera_SceneSource_desc, QOS_STATE},
 };
 
 const char *vdds_topic_name(vdds_topic_id_t t) { return t < VT_COUNT ? TOPICS[t].name : "?"; }
@@ -68,6 +69,14 @@ static dds_qos_t *make_qos(qos_kind_t k, int lease_ms) {
     dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
     dds_qset_durability(q, DDS_DURABILITY_VOLATILE);
     dds_qset_history(q, DDS_HISTORY_KEEP_LAST, 16);
+    break;
+  case QOS_LOG:
+    /* Every sample counts (a recording must hold each applied input to
+     * re-simulate), at up to 1 kHz: reliable, with room for a reader's
+     * acknowledgements to lag 64 samples without the writer blocking. */
+    dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
+    dds_qset_durability(q, DDS_DURABILITY_VOLATILE);
+    dds_qset_history(q, DDS_HISTORY_KEEP_LAST, 64);
     break;
   }
   return q;

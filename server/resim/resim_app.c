@@ -71,8 +71,9 @@ static int print_organs(const runtime_t *rt, const resim_recording_t *rec, const
     const resim_organ_result_t *r = &res->organs[i];
     double rms = r->nsq ? sqrt(r->sum_sq / (double)r->nsq) : 0;
     printf("ORGAN %s frames=%" PRIu64 " keyframes=%" PRIu64 " exact=%" PRIu64 " unmatched=%" PRIu64
-           " max_err_m=%.3g rms_err_m=%.3g worst_step=%" PRIu64 "\n",
-           rt->organs[i].cfg->name, r->frames, r->keyframes, r->exact, r->unmatched, r->max_err, rms, r->worst_step);
+           " unreached=%" PRIu64 " max_err_m=%.3g rms_err_m=%.3g worst_step=%" PRIu64 "\n",
+           rt->organs[i].cfg->name, r->frames, r->keyframes, r->exact, r->unmatched, r->unreached, r->max_err, rms,
+           r->worst_step);
     /* MeshDelta frame_seq counts every published frame of the organ. */
     uint64_t dfirst = 0, dlast = 0, ddistinct = 0, dprev = 0;
     for (size_t j = 0; j < rec->ndeltas; j++) {
@@ -86,6 +87,14 @@ static int print_organs(const runtime_t *rt, const resim_recording_t *rec, const
     printf("STREAM organ=%s delta_first_seq=%" PRIu64 " delta_last_seq=%" PRIu64 " delta_seq_gaps=%" PRIu64 "\n",
            rt->organs[i].cfg->name, dfirst, dlast, ddistinct ? dlast - dfirst + 1 - ddistinct : 0);
     if (r->frames) *compared = 1;
+    if (res->applied && (r->unmatched || r->unreached)) {
+      beyond = 1;
+      fprintf(stderr,
+              "viscera-resim: organ '%s': %" PRIu64
+              " recorded frame(s) do not fit the re-simulated surface and %" PRIu64
+              " were never reached (another topology or end): the re-simulation does not reproduce the session\n",
+              rt->organs[i].cfg->name, r->unmatched, r->unreached);
+    }
     if (r->max_err > tolerance) {
       beyond = 1;
       fprintf(stderr,
@@ -95,6 +104,54 @@ static int print_organs(const runtime_t *rt, const resim_recording_t *rec, const
     }
   }
   return beyond;
+}
+
+/* INPUTS, OBJECTS and EVENTS lines; returns whether they fail the run
+ * (applied inputs only: an older recording knows no buttons or controls,
+ * so only its meshes are judged). */
+static int print_others(const resim_recording_t *rec, const resim_result_t *res, double tolerance) {
+  int bad = 0;
+  if (res->applied)
+    printf("INPUTS mode=applied commands=%" PRIu64 " releases=%" PRIu64 " controls=%" PRIu64 " rebuilds=%" PRIu64
+           " steps=%" PRIu64 "\n",
+           res->commands, res->releases, res->controls, res->rebuilds, res->steps);
+  else
+    printf("INPUTS mode=schedule (no AppliedInput recorded: tool positions only, from ToolCommand and "
+           "ContactFeedback)\n");
+  const resim_object_result_t *o = &res->objects;
+  printf("OBJECTS compared=%" PRIu64 " exact=%" PRIu64 " mismatched=%" PRIu64 " unreached=%" PRIu64
+         " max_err_m=%.3g worst_step=%" PRIu64 "\n",
+         o->compared, o->exact, o->mismatched, o->unreached, o->max_err, o->worst_step);
+  const resim_event_result_t *e = &res->events;
+  printf("EVENTS recorded=%zu resim=%zu equal=%zu\n", e->recorded, e->resim, e->equal);
+  if (res->diverged) {
+    bad = 1;
+    fprintf(stderr, "viscera-resim: the re-simulation diverged from the recording: %s\n", res->divergence);
+  }
+  if (!res->applied) return bad;
+  if (o->mismatched || o->unreached || o->max_err > tolerance) {
+    bad = 1;
+    fprintf(stderr,
+            "viscera-resim: objects differ from the recording: %" PRIu64 " with another holder or state (first at "
+            "step %" PRIu64 "), %" PRIu64 " not reached, position error %.3g m at step %" PRIu64 "\n",
+            o->mismatched, o->first_mismatch_step, o->unreached, o->max_err, o->worst_step);
+  }
+  if (e->first_difference[0]) {
+    bad = 1;
+    fprintf(stderr, "viscera-resim: interaction events differ from the recording: %s\n", e->first_difference);
+  }
+  (void)rec;
+  return bad;
+}
+
+/* Every compared frame and object reproduced bit for bit, every event equal. */
+static int bit_exact(const runtime_t *rt, const resim_result_t *res) {
+  for (size_t i = 0; i < rt->norgans; i++) {
+    const resim_organ_result_t *r = &res->organs[i];
+    if (r->exact != r->frames || r->unmatched || r->unreached) return 0;
+  }
+  return res->objects.exact == res->objects.compared && !res->objects.unreached && !res->events.first_difference[0] &&
+         !res->diverged;
 }
 
 int resim_app_run(const resim_options_t *o) {
@@ -152,14 +209,15 @@ int resim_app_run(const resim_options_t *o) {
 
   print_schedules(&rt, &rec, &res);
   int compared = 0, beyond = print_organs(&rt, &rec, &res, &scene, tolerance, &compared);
+  beyond |= print_others(&rec, &res, tolerance);
   if (res.first_unmatched[0])
     fprintf(stderr, "viscera-resim: warning: frames not compared; first: %s\n", res.first_unmatched);
   if (!compared) {
     fprintf(stderr, "viscera-resim: %s: no mesh frame recorded: nothing to compare\n", o->rec_path);
     goto out;
   }
-  printf("RESIM %s steps=%" PRIu64 " rollbacks=%" PRIu64 " tolerance_m=%.3g wall_s=%.2f\n", beyond ? "FAIL" : "PASS",
-         res.steps, res.rollbacks, tolerance, wall);
+  printf("RESIM %s steps=%" PRIu64 " rollbacks=%" PRIu64 " tolerance_m=%.3g bit_exact=%d wall_s=%.2f\n",
+         beyond ? "FAIL" : "PASS", res.steps, res.rollbacks, tolerance, bit_exact(&rt, &res), wall);
   rc = beyond ? 1 : 0;
 out:
   if (csv && fclose(csv) != 0) {
