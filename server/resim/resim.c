@@ -1,8 +1,8 @@
 /* viscera-resim: deterministic re-simulation of a recorded session.
  *
- * Feeds the recorded ToolCommands, step by step as the server applied them
- * (schedule rebuilt from the recorded ContactFeedback, resim_schedule.h),
- * into a fresh runtime of the scene and compares every recorded mesh frame
+ * Feeds the inputs the server applied (AppliedInput; in older recordings
+ * the ToolCommands scheduled from the recorded ContactFeedback,
+ * resim_schedule.h) into a fresh runtime of the recorded scene and compares every recorded mesh frame
  * with the re-simulated surface (resim_run.h). Exit 0 when every organ's
  * largest per-coordinate error is within the tolerance, 1 beyond it, 2 on
  * a usage error, an unreadable recording or a scene that is not the
@@ -15,15 +15,17 @@
 #include "resim/resim_app.h"
 
 static void usage(FILE *f) {
-  fprintf(f, "usage: viscera-resim --scene SCENE.yaml REC.db [options]\n"
-             "  --scene FILE      the scene the session ran (must match the recording's SceneInfo)\n"
+  fprintf(f, "usage: viscera-resim REC.db [options]\n"
+             "  --scene FILE      re-simulate with this scene file instead of the recording's own (names what\n"
+             "                    differs; must match the recording's SceneInfo)\n"
              "  --tolerance M     largest per-coordinate error allowed, m (default: quant_step/2 + 5e-8)\n"
              "  --csv FILE        one line per compared frame: step,sim_time_s,organ,kind,max_err_m,rms_err_m,exact\n"
              "  --quiet           no progress lines\n"
              "  --help            this text\n"
              "  --version         print the version and exit\n"
-             "Re-runs the recorded tool commands in a fresh server runtime and compares every recorded\n"
-             "MeshState/MeshDelta frame. Exit 0 within tolerance, 1 beyond, 2 on an error.\n");
+             "Re-applies every input the server applied (AppliedInput: tool commands, releases, controls) in a\n"
+             "fresh server runtime and compares every recorded MeshState/MeshDelta frame, ObjectState and\n"
+             "interaction event. Exit 0 within tolerance, 1 beyond, 2 on an error.\n");
 }
 
 enum { OPT_SCENE = 's', OPT_TOLERANCE = 't', OPT_CSV = 'c' };
@@ -65,9 +67,8 @@ int main(int argc, char **argv) {
   int rc = cli_parse(&spec, argc, argv, &common, &o);
   if (rc != CLI_RUN) return rc;
   o.quiet = common.quiet;
-  if (!o.scene_path || optind != argc - 1) {
-    fprintf(stderr, "viscera-resim: %s\n",
-            !o.scene_path ? "--scene FILE is required" : "expected one recording REC.db");
+  if (optind != argc - 1) {
+    fprintf(stderr, "viscera-resim: expected one recording REC.db\n");
     usage(stderr);
     return 2;
   }

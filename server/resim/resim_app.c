@@ -6,9 +6,14 @@
 #include <inttypes.h>
 #include <math.h>
 #include <stdio.h>
+#include <string.h>
+
+#include "build_id.h"
+#include "cli.h"
 
 #include "resim/resim_recording.h"
 #include "resim/resim_run.h"
+#include "resim/resim_scene.h"
 #include "runtime/scene_runtime.h"
 #include "scene.h"
 #include "vtime.h"
@@ -154,18 +159,40 @@ static int bit_exact(const runtime_t *rt, const resim_result_t *res) {
          !res->diverged;
 }
 
+/* BUILD line: the build that recorded and this one. Bit-exact reproduction
+ * is a property of one build; another one is judged the same way, against
+ * the recording, and told. */
+static void print_build(const resim_recording_t *rec) {
+  const resim_source_t *s = &rec->source;
+  if (!s->have) {
+    printf("BUILD recorded=unknown this=\"%s %s %s\"\n", cli_version(), build_compiler(), build_flags());
+    return;
+  }
+  int same = !strcmp(s->version, cli_version()) && !strcmp(s->compiler, build_compiler()) &&
+             !strcmp(s->build_flags, build_flags());
+  printf("BUILD same=%d recorded=\"%s %s %s\" this=\"%s %s %s\"\n", same, s->version, s->compiler, s->build_flags,
+         cli_version(), build_compiler(), build_flags());
+  if (!same)
+    fprintf(stderr,
+            "viscera-resim: note: the session ran on another build (%s, %s, %s): bit-exact reproduction is "
+            "not expected, the errors below are against the recording\n",
+            s->version, s->compiler, s->build_flags);
+}
+
 int resim_app_run(const resim_options_t *o) {
   verr_t err;
   static scene_t scene; /* large; static keeps it off the stack */
-  if (scene_load(o->scene_path, &scene, &err)) {
-    fprintf(stderr, "viscera-resim: %s\n", err.msg);
-    return 2;
-  }
   static resim_recording_t rec;
   if (resim_recording_load(&rec, o->rec_path, &err)) {
     fprintf(stderr, "viscera-resim: %s\n", err.msg);
     return 2;
   }
+  if (resim_scene_load(&scene, o->scene_path, &rec, stdout, &err)) {
+    fprintf(stderr, "viscera-resim: %s: %s\n", o->rec_path, err.msg);
+    resim_recording_free(&rec);
+    return 2;
+  }
+  print_build(&rec);
   if (rec.warnings[0]) fprintf(stderr, "viscera-resim: warning: %s\n", rec.warnings);
   if (rec.skipped)
     fprintf(stderr, "viscera-resim: warning: %" PRIu64 " sample(s) skipped; first: %s\n", rec.skipped, rec.first_skip);

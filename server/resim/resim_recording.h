@@ -119,7 +119,7 @@ typedef struct resim_source {
   char text_sha256[65];
   size_t nmeshes;
   struct {
-    char path[257], sha256[65];
+    char path[1025], sha256[65];
     uint64_t size;
   } meshes[SCENE_MAX_ORGANS];
   char version[65], compiler[129], build_flags[257], station[65];

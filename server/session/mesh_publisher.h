@@ -52,13 +52,13 @@ typedef struct mesh_publisher {
   uint64_t frames, keyframes, delta_payload_bytes, keyframe_payload_bytes, retopos;
   long last_count; /* vertices in the last delta */
   /* Quiet frames (above). */
-  uint64_t keepalive_ns;  /* 0: write every frame */
-  uint64_t skipped;       /* frames not written: equal to the last written delta */
-  int have_written;       /* written_idx/dq hold the last written delta of the current keyframe */
-  long written_count;     /* vertices in it */
-  uint64_t written_ns;    /* vtime_mono_ns() of its write */
-  uint32_t *written_idx;  /* cap_verts */
-  int16_t *written_dq;    /* 3 cap_verts */
+  uint64_t keepalive_ns; /* 0: write every frame */
+  uint64_t skipped;      /* frames not written: equal to the last written delta */
+  int have_written;      /* written_idx/dq hold the last written delta of the current keyframe */
+  long written_count;    /* vertices in it */
+  uint64_t written_ns;   /* vtime_mono_ns() of its write */
+  uint32_t *written_idx; /* cap_verts */
+  int16_t *written_dq;   /* 3 cap_verts */
 } mesh_publisher_t;
 
 int mesh_publisher_init(mesh_publisher_t *mp, uint32_t organ_id, size_t nverts, const uint32_t *tris, size_t ntris,

@@ -10,6 +10,7 @@
 #include "runtime/step_cut.h"
 #include "session/applied_input.h"
 #include "session/checkpoint.h"
+#include "session/scene_source.h"
 #include "session/command_intake.h"
 #include "session/liveliness_watch.h"
 #include "session/session_control.h"
@@ -110,6 +111,15 @@ static void publish_scene_info(server_t *s) {
   si.tools._buffer = tools;
   si.tools._length = si.tools._maximum = (uint32_t)s->rt.ntools;
   if (dds_write(s->w_scene, &si) >= 0) s->stats->published[VT_SCENE_INFO]++;
+}
+
+/* The scene's text, mesh digests and the build (scene_source.h), once. */
+static void publish_scene_source(server_t *s) {
+  viscera_SceneSource src;
+  verr_t e;
+  if (scene_source_fill(&src, &s->rt.scene, NULL, &e)) fprintf(stderr, "server: warning: %s\n", e.msg);
+  if (dds_write(s->w_source, &src) >= 0) s->stats->published[VT_SCENE_SOURCE]++;
+  scene_source_free(&src);
 }
 
 /* The ToolCommand reader. Its topic keeps the last sample per tool, but two
@@ -826,6 +836,7 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
   }
   uint64_t ckpt_every = (uint64_t)fmax(1.0, floor(opts->checkpoint_every / scene->dt + 0.5));
   publish_scene_info(&s);
+  publish_scene_source(&s);
   publish_roles(&s);
   for (size_t i = 0; i < s.rt.norgans; i++) mesh_publisher_keyframe(&s.pubs[i], s.rt.organs[i].model->surf_x, 0);
   publish_event(&s, viscera_EVENT_SESSION_STARTED, -1, -1, stats->resumed, resumed[0] ? resumed : scene->name);
