@@ -9,3 +9,11 @@ if(TARGET viscera-resim)
     set_tests_properties(resim_scenes PROPERTIES RUN_SERIAL TRUE)
   endif()
 endif()
+
+# Issue 16: SessionControls, a guided tool and two rebuilds re-simulate bit
+# for bit; without the controls' AppliedInput they do not. Domain 198.
+if(TARGET viscera-resim)
+  add_executable(rec_applied ${CMAKE_CURRENT_LIST_DIR}/rec_applied.c)
+  target_link_libraries(rec_applied PRIVATE viscera_test_recording viscera_recording)
+  viscera_integration_test(resim_controls 198 resim_controls_test.sh)
+endif()
