@@ -129,6 +129,9 @@ static int print_others(const resim_recording_t *rec, const resim_result_t *res,
          o->compared, o->exact, o->mismatched, o->unreached, o->max_err, o->worst_step);
   const resim_event_result_t *e = &res->events;
   printf("EVENTS recorded=%zu resim=%zu equal=%zu\n", e->recorded, e->resim, e->equal);
+  const resim_metrics_result_t *m = &res->metrics;
+  printf("TOOLMETRICS compared=%" PRIu64 " differ=%" PRIu64 " unreached=%" PRIu64 "\n", m->compared, m->differ,
+         m->unreached);
   if (res->diverged) {
     bad = 1;
     fprintf(stderr, "viscera-resim: the re-simulation diverged from the recording: %s\n", res->divergence);
@@ -145,6 +148,12 @@ static int print_others(const resim_recording_t *rec, const resim_result_t *res,
     bad = 1;
     fprintf(stderr, "viscera-resim: interaction events differ from the recording: %s\n", e->first_difference);
   }
+  if (m->differ || m->unreached) {
+    bad = 1;
+    fprintf(stderr,
+            "viscera-resim: ToolMetrics differ from the recording: %" PRIu64 " differ, %" PRIu64 " not reached%s%s\n",
+            m->differ, m->unreached, m->first_difference[0] ? "; first: " : "", m->first_difference);
+  }
   (void)rec;
   return bad;
 }
@@ -156,7 +165,7 @@ static int bit_exact(const runtime_t *rt, const resim_result_t *res) {
     if (r->exact != r->frames || r->unmatched || r->unreached) return 0;
   }
   return res->objects.exact == res->objects.compared && !res->objects.unreached && !res->events.first_difference[0] &&
-         !res->diverged;
+         !res->metrics.differ && !res->metrics.unreached && !res->diverged;
 }
 
 /* BUILD line: the build that recorded and this one. Bit-exact reproduction

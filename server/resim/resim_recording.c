@@ -24,7 +24,21 @@ typedef struct load_ctx {
    * restarts simulated time). */
   uint64_t obj_ns[SCENE_MAX_OBJECTS], met_ns[SCENE_MAX_TOOLS];
   uint32_t obj_epoch[SCENE_MAX_OBJECTS], met_epoch[SCENE_MAX_TOOLS];
+  /* Source timestamps (the server's clock) of the AppliedInput samples
+   * that carried a rebuild, one entry per rebuild, in recording order. */
+  int64_t *rebuild_ts;
+  size_t nrebuild, caprebuild;
 } load_ctx_t;
+
+/* The epoch of a sample the server wrote at source time ts: the rebuilds
+ * written before it (the AppliedInput of a rebuild is written after the
+ * rebuild, before the step; every later sample is of the new epoch). */
+static uint32_t epoch_at(const load_ctx_t *ctx, int64_t ts) {
+  uint32_t e = 0;
+  for (size_t i = 0; i < ctx->nrebuild; i++)
+    if (ctx->rebuild_ts[i] <= ts) e++;
+  return e;
+}
 
 static void skip(resim_recording_t *rec, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 static void skip(resim_recording_t *rec, const char *fmt, ...) {
@@ -299,6 +313,12 @@ static int on_applied(void *arg, const void *sample, const recfile_row_t *row) {
     memcpy(in->values, c->values, sizeof in->values);
     in->result = c->result;
     in->task = c->task;
+    if ((c->kind == viscera_CONTROL_RESET || c->kind == viscera_CONTROL_SET_MATERIAL) &&
+        (c->result == 1 || c->result == 2)) {
+      if (grow((void **)&ctx->rebuild_ts, &ctx->caprebuild, ctx->nrebuild, sizeof *ctx->rebuild_ts))
+        return ctx->oom = 1;
+      ctx->rebuild_ts[ctx->nrebuild++] = row->source_ts_ns;
+    }
   }
   return 0;
 }
@@ -312,8 +332,11 @@ static int on_object(void *arg, const void *sample, const recfile_row_t *row) {
     skip(rec, "ObjectState sample %lld: object %u or sim time out of range", (long long)row->id, o->object_id);
     return 0;
   }
+  /* Without recorded inputs (an older recording), a rebuild shows as the
+   * object's simulated time going back. */
   if (o->sim_time_ns < ctx->obj_ns[o->object_id]) ctx->obj_epoch[o->object_id]++;
   ctx->obj_ns[o->object_id] = o->sim_time_ns;
+  if (rec->ninputs) ctx->obj_epoch[o->object_id] = epoch_at(ctx, row->source_ts_ns);
   if (grow((void **)&rec->objects, &ctx->caps.objects, rec->nobjects, sizeof *rec->objects)) return ctx->oom = 1;
   rec->objects[rec->nobjects++] = (resim_object_t){.object = o->object_id,
                                                    .epoch = ctx->obj_epoch[o->object_id],
@@ -335,6 +358,7 @@ static int on_metrics(void *arg, const void *sample, const recfile_row_t *row) {
   }
   if (m->sim_time_ns < ctx->met_ns[m->tool_id]) ctx->met_epoch[m->tool_id]++;
   ctx->met_ns[m->tool_id] = m->sim_time_ns;
+  if (rec->ninputs) ctx->met_epoch[m->tool_id] = epoch_at(ctx, row->source_ts_ns);
   if (grow((void **)&rec->metrics, &ctx->caps.metrics, rec->nmetrics, sizeof *rec->metrics)) return ctx->oom = 1;
   rec->metrics[rec->nmetrics++] =
       (resim_tool_metrics_t){.tool = m->tool_id,
@@ -446,6 +470,7 @@ int resim_recording_load(resim_recording_t *rec, const char *path, verr_t *err) 
                     rep.scan.damaged ? "; the file is damaged: " : "", rep.scan.damaged ? rep.scan.first_error : "");
   }
   recfile_close(rf);
+  free(ctx.rebuild_ts);
   if (rc) {
     resim_recording_free(rec);
     return -1;

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "mesh_delta.h"
+#include "resim/resim_measures.h"
 
 int resim_check_scene(const runtime_t *rt, const resim_recording_t *rec, verr_t *err) {
   const scene_t *sc = &rt->scene;
@@ -69,6 +70,7 @@ typedef struct run_ctx {
   uint32_t pubver[SCENE_MAX_ORGANS], modelver[SCENE_MAX_ORGANS];
   uint32_t epoch; /* rebuilds so far */
   int paused;
+  resim_measures_t measures; /* the ToolMetrics the server computes */
   size_t nev, capev;
   resim_event_t *ev; /* the interaction events the re-simulation reported */
   verr_t *err;
@@ -201,6 +203,47 @@ static int cmp_delta_otp(const void *a, const void *b) {
   if (x->step != y->step) return x->step < y->step ? -1 : 1;
   return x->frame_seq < y->frame_seq ? -1 : x->frame_seq > y->frame_seq;
 }
+static int cmp_metrics(const void *a, const void *b) {
+  const resim_tool_metrics_t *x = a, *y = b;
+  if (x->epoch != y->epoch) return x->epoch < y->epoch ? -1 : 1;
+  if (x->step != y->step) return x->step < y->step ? -1 : 1;
+  return x->tool < y->tool ? -1 : x->tool > y->tool;
+}
+
+/* A recorded ToolMetrics against the re-simulated measures: every field bit
+ * for bit. */
+static void compare_metrics(run_ctx_t *c, resim_tool_metrics_t *m) {
+  m->done = 1;
+  resim_metrics_result_t *r = &c->res->metrics;
+  r->compared++;
+  if (m->tool >= c->rt->ntools) {
+    r->differ++;
+    return;
+  }
+  resim_tool_metrics_t x;
+  resim_measures_fill(&c->measures, c->rt, m->tool, &x);
+  const char *field = NULL;
+  double a = 0, b = 0;
+#define FIELD(f)                                                                                                       \
+  if (!field && x.f != m->f) field = #f, a = (double)m->f, b = (double)x.f;
+  FIELD(peak_force)
+  FIELD(time_above[0])
+  FIELD(time_above[1])
+  FIELD(time_above[2])
+  FIELD(contact_time)
+  FIELD(path_length)
+  FIELD(grasps)
+  FIELD(grasp_time)
+  FIELD(tasks_completed)
+  FIELD(operation_time)
+#undef FIELD
+  if (!field) return;
+  if (r->differ++ == 0)
+    snprintf(r->first_difference, sizeof r->first_difference,
+             "tool %u at step %llu: %s recorded %.9g, re-simulated %.9g", m->tool, (unsigned long long)m->step, field,
+             a, b);
+}
+
 static int cmp_object(const void *a, const void *b) {
   const resim_object_t *x = a, *y = b;
   if (x->epoch != y->epoch) return x->epoch < y->epoch ? -1 : 1;
@@ -246,6 +289,11 @@ static void compare_now(run_ctx_t *c) {
   }
   uint32_t e = c->epoch;
 #define OBJ_LT(p) ((p)->epoch < e || ((p)->epoch == e && (p)->step < k))
+  {
+    LOWER_BOUND(rec->metrics, rec->nmetrics, OBJ_LT)
+    for (size_t j = lo; j < rec->nmetrics && rec->metrics[j].epoch == e && rec->metrics[j].step == k; j++)
+      if (!rec->metrics[j].done) compare_metrics(c, &rec->metrics[j]);
+  }
   LOWER_BOUND(rec->objects, rec->nobjects, OBJ_LT)
 #undef OBJ_LT
   for (size_t j = lo; j < rec->nobjects && rec->objects[j].epoch == e && rec->objects[j].step == k; j++) {
@@ -308,6 +356,7 @@ static void step(run_ctx_t *c) {
     push_event(c, (int)e->kind, e->tool, e->organ, e->value);
   }
   c->rt->events.n = 0;
+  resim_measures_step(&c->measures, c->rt);
   compare_now(c);
 }
 
@@ -322,6 +371,7 @@ static int rebuild(run_ctx_t *c, const scene_t *sc, const scene_t *old) {
   }
   c->epoch++;
   c->res->rebuilds++;
+  resim_measures_init(&c->measures, c->rt);
   for (size_t i = 0; i < c->rt->norgans; i++) {
     c->modelver[i] = c->rt->organs[i].topology_version;
     c->pubver[i]++;
@@ -373,7 +423,10 @@ static int apply_control(run_ctx_t *c, const resim_input_t *in) {
     free(old);
     return rc;
   }
-  default: /* thresholds, roles: the session's, not the simulation's (the effective commands are recorded) */
+  case RESIM_CTL_SET_THRESHOLDS:
+    if (in->ctl_tool >= 0) resim_measures_levels(&c->measures, (size_t)in->ctl_tool, in->values);
+    return 0;
+  default: /* roles: the effective commands they lead to are recorded */
     return 0;
   }
 }
@@ -410,6 +463,8 @@ static uint64_t end_step(const run_ctx_t *c) {
       end = rec->deltas[j].step;
   for (size_t j = 0; j < rec->nobjects; j++)
     if (rec->objects[j].epoch == c->epoch && rec->objects[j].step > end) end = rec->objects[j].step;
+  for (size_t j = 0; j < rec->nmetrics; j++)
+    if (rec->metrics[j].epoch == c->epoch && rec->metrics[j].step > end) end = rec->metrics[j].step;
   return end;
 }
 
@@ -522,6 +577,9 @@ int resim_run(runtime_t *rt, resim_recording_t *rec, const resim_hooks_t *hooks,
   if (rec->nkeys) qsort(rec->keys, rec->nkeys, sizeof *rec->keys, cmp_key_otp);
   if (rec->ndeltas) qsort(rec->deltas, rec->ndeltas, sizeof *rec->deltas, cmp_delta_otp);
   if (rec->nobjects) qsort(rec->objects, rec->nobjects, sizeof *rec->objects, cmp_object);
+  if (rec->nmetrics) qsort(rec->metrics, rec->nmetrics, sizeof *rec->metrics, cmp_metrics);
+  for (size_t i = 0; i < rec->nmetrics; i++) rec->metrics[i].done = 0;
+  resim_measures_init(&c->measures, rt);
   for (size_t i = 0; i < rec->nkeys; i++) rec->keys[i].done = 0;
   for (size_t i = 0; i < rec->ndeltas; i++) rec->deltas[i].done = 0;
   for (size_t i = 0; i < rec->nobjects; i++) rec->objects[i].done = 0;
@@ -549,6 +607,8 @@ int resim_run(runtime_t *rt, resim_recording_t *rec, const resim_hooks_t *hooks,
     if (!rec->deltas[i].done && rec->deltas[i].organ < rt->norgans) res->organs[rec->deltas[i].organ].unreached++;
   for (size_t i = 0; i < rec->nobjects; i++)
     if (!rec->objects[i].done) res->objects.unreached++;
+  for (size_t i = 0; i < rec->nmetrics; i++)
+    if (!rec->metrics[i].done) res->metrics.unreached++;
   compare_events(c);
   res->epochs = c->epoch;
   for (size_t i = 0; i < SCENE_MAX_ORGANS; i++) {

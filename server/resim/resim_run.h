@@ -50,6 +50,11 @@ typedef struct resim_event_result {
   char first_difference[320];
 } resim_event_result_t;
 
+typedef struct resim_metrics_result {
+  uint64_t compared, differ, unreached; /* ToolMetrics samples */
+  char first_difference[256];
+} resim_metrics_result_t;
+
 typedef struct resim_result {
   uint64_t steps;
   uint64_t rollbacks;
@@ -61,6 +66,7 @@ typedef struct resim_result {
   resim_organ_result_t organs[SCENE_MAX_ORGANS];
   resim_object_result_t objects;
   resim_event_result_t events;
+  resim_metrics_result_t metrics;
   resim_schedule_stats_t sched[SCENE_MAX_TOOLS];
   char first_unmatched[VERR_MSG_LEN + 128];
 } resim_result_t;
