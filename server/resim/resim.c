@@ -18,6 +18,8 @@ static void usage(FILE *f) {
   fprintf(f, "usage: viscera-resim REC.db [options]\n"
              "  --scene FILE      re-simulate with this scene file instead of the recording's own (names what\n"
              "                    differs; must match the recording's SceneInfo)\n"
+             "  --mesh-dir DIR    look here, by file name, for a recorded mesh that is not where the server\n"
+             "                    read it (taken only with the recorded sha256)\n"
              "  --tolerance M     largest per-coordinate error allowed, m (default: quant_step/2 + 5e-8)\n"
              "  --csv FILE        one line per compared frame: step,sim_time_s,organ,kind,max_err_m,rms_err_m,exact\n"
              "  --quiet           no progress lines\n"
@@ -28,7 +30,7 @@ static void usage(FILE *f) {
              "interaction event. Exit 0 within tolerance, 1 beyond, 2 on an error.\n");
 }
 
-enum { OPT_SCENE = 's', OPT_TOLERANCE = 't', OPT_CSV = 'c' };
+enum { OPT_SCENE = 's', OPT_TOLERANCE = 't', OPT_CSV = 'c', OPT_MESH_DIR = 'm' };
 
 static int on_option(void *ctx, int code, const char *arg) {
   resim_options_t *o = ctx;
@@ -39,6 +41,9 @@ static int on_option(void *ctx, int code, const char *arg) {
     return 0;
   case OPT_CSV:
     o->csv_path = arg;
+    return 0;
+  case OPT_MESH_DIR:
+    o->mesh_dir = arg;
     return 0;
   case OPT_TOLERANCE:
     o->tolerance = strtod(arg, &end);
@@ -55,10 +60,11 @@ int main(int argc, char **argv) {
   static const struct option lo[] = {{"scene", required_argument, 0, OPT_SCENE},
                                      {"tolerance", required_argument, 0, OPT_TOLERANCE},
                                      {"csv", required_argument, 0, OPT_CSV},
+                                     {"mesh-dir", required_argument, 0, OPT_MESH_DIR},
                                      {0, 0, 0, 0}};
   const cli_spec_t spec = {.program = "viscera-resim",
                            .common = CLI_QUIET,
-                           .shortopts = "s:t:c:qh",
+                           .shortopts = "s:t:c:m:qh",
                            .options = lo,
                            .option = on_option,
                            .usage = usage};

@@ -196,7 +196,7 @@ int resim_app_run(const resim_options_t *o) {
     fprintf(stderr, "viscera-resim: %s\n", err.msg);
     return 2;
   }
-  if (resim_scene_load(&scene, o->scene_path, &rec, stdout, &err)) {
+  if (resim_scene_load(&scene, o->scene_path, o->mesh_dir, &rec, stdout, &err)) {
     fprintf(stderr, "viscera-resim: %s: %s\n", o->rec_path, err.msg);
     resim_recording_free(&rec);
     return 2;

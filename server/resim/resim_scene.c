@@ -58,7 +58,27 @@ static int check_meshes(const scene_t *sc, const resim_source_t *src, FILE *out,
   return bad;
 }
 
-int resim_scene_load(scene_t *sc, const char *path, const resim_recording_t *rec, FILE *report, verr_t *err) {
+/* A mesh not at the path the server read it from, looked for by its file
+ * name in mesh_dir and taken only when its digest is the recorded one. */
+static void relocate_meshes(scene_t *sc, const resim_source_t *src, const char *mesh_dir, FILE *out) {
+  for (size_t i = 0; mesh_dir && i < sc->norgans && i < src->nmeshes; i++) {
+    char hex[SHA256_HEX_LEN];
+    uint64_t size;
+    verr_t e;
+    if (!sha256_file(sc->organs[i].mesh, hex, &size, &e) && !strcmp(hex, src->meshes[i].sha256)) continue;
+    const char *base = strrchr(sc->organs[i].mesh, '/');
+    base = base ? base + 1 : sc->organs[i].mesh;
+    char cand[sizeof sc->organs[i].mesh];
+    int n = snprintf(cand, sizeof cand, "%s/%s", mesh_dir, base);
+    if (n <= 0 || (size_t)n >= sizeof cand) continue;
+    if (sha256_file(cand, hex, &size, &e) || strcmp(hex, src->meshes[i].sha256)) continue;
+    fprintf(out, "SCENE mesh organ=%s found=%s (not at %s)\n", sc->organs[i].name, cand, sc->organs[i].mesh);
+    memcpy(sc->organs[i].mesh, cand, sizeof cand);
+  }
+}
+
+int resim_scene_load(scene_t *sc, const char *path, const char *mesh_dir, const resim_recording_t *rec, FILE *report,
+                     verr_t *err) {
   const resim_source_t *src = &rec->source;
   char first[600] = "";
   if (path) {
@@ -106,6 +126,7 @@ int resim_scene_load(scene_t *sc, const char *path, const resim_recording_t *rec
     dir[0] = 0;
   if (scene_load_string(src->text, src->path, dir, sc, err)) return -1;
   snprintf(sc->path, sizeof sc->path, "%.1000s", src->path);
+  relocate_meshes(sc, src, mesh_dir, report);
   if (check_meshes(sc, src, report, first, sizeof first))
     return verr_set(err, "the recorded scene's meshes are not the ones the session ran: %s", first);
   fprintf(report, "SCENE source=recording %s sha256=%.16s meshes=%zu verified\n", src->path, src->text_sha256,

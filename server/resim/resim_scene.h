@@ -17,7 +17,11 @@
 #include "scene.h"
 #include "verr.h"
 
-/* Differences go to `report` (SCENE lines); returns 0 or -1 with err. */
-int resim_scene_load(scene_t *sc, const char *path, const resim_recording_t *rec, FILE *report, verr_t *err);
+/* Differences go to `report` (SCENE lines); returns 0 or -1 with err.
+ * mesh_dir (may be NULL): where to look, by file name, for a recorded mesh
+ * that is not where the server read it (a recording moved to another
+ * machine or checkout); a file there counts only with the recorded digest. */
+int resim_scene_load(scene_t *sc, const char *path, const char *mesh_dir, const resim_recording_t *rec, FILE *report,
+                     verr_t *err);
 
 #endif
