@@ -128,7 +128,9 @@ int resim_scene_load(scene_t *sc, const char *path, const char *mesh_dir, const 
   snprintf(sc->path, sizeof sc->path, "%.1000s", src->path);
   relocate_meshes(sc, src, mesh_dir, report);
   if (check_meshes(sc, src, report, first, sizeof first))
-    return verr_set(err, "the recorded scene's meshes are not the ones the session ran: %s", first);
+    return verr_set(
+        err, "the recorded scene's meshes are not the ones the session ran: %s (--mesh-dir DIR names where copies are)",
+        first);
   fprintf(report, "SCENE source=recording %s sha256=%.16s meshes=%zu verified\n", src->path, src->text_sha256,
           sc->norgans);
   return 0;
