@@ -72,11 +72,12 @@ static dds_qos_t *make_qos(qos_kind_t k, int lease_ms) {
     break;
   case QOS_LOG:
     /* Every sample counts (a recording must hold each applied input to
-     * re-simulate), at up to 1 kHz: reliable, with room for a reader's
-     * acknowledgements to lag 64 samples without the writer blocking. */
+     * re-simulate), at up to 1 kHz: reliable, keep-last 1000 (a second), so
+     * neither a recorder stalled by a disk commit loses one nor the writer
+     * ever blocks the physics loop (a loss shows as a seq gap). */
     dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
     dds_qset_durability(q, DDS_DURABILITY_VOLATILE);
-    dds_qset_history(q, DDS_HISTORY_KEEP_LAST, 64);
+    dds_qset_history(q, DDS_HISTORY_KEEP_LAST, 1000);
     break;
   }
   return q;

@@ -118,8 +118,8 @@ static int print_others(const resim_recording_t *rec, const resim_result_t *res,
   int bad = 0;
   if (res->applied)
     printf("INPUTS mode=applied commands=%" PRIu64 " releases=%" PRIu64 " controls=%" PRIu64 " rebuilds=%" PRIu64
-           " steps=%" PRIu64 "\n",
-           res->commands, res->releases, res->controls, res->rebuilds, res->steps);
+           " steps=%" PRIu64 " lost=%" PRIu64 "\n",
+           res->commands, res->releases, res->controls, res->rebuilds, res->steps, rec->applied_lost);
   else
     printf("INPUTS mode=schedule (no AppliedInput recorded: tool positions only, from ToolCommand and "
            "ContactFeedback)\n");
@@ -137,6 +137,13 @@ static int print_others(const resim_recording_t *rec, const resim_result_t *res,
     fprintf(stderr, "viscera-resim: the re-simulation diverged from the recording: %s\n", res->divergence);
   }
   if (!res->applied) return bad;
+  if (rec->applied_lost) {
+    bad = 1;
+    fprintf(stderr,
+            "viscera-resim: %" PRIu64 " AppliedInput sample(s) are missing from the recording (the recorder lost "
+            "them): the inputs of those steps are unknown\n",
+            rec->applied_lost);
+  }
   if (o->mismatched || o->unreached || o->max_err > tolerance) {
     bad = 1;
     fprintf(stderr,
@@ -154,7 +161,6 @@ static int print_others(const resim_recording_t *rec, const resim_result_t *res,
             "viscera-resim: ToolMetrics differ from the recording: %" PRIu64 " differ, %" PRIu64 " not reached%s%s\n",
             m->differ, m->unreached, m->first_difference[0] ? "; first: " : "", m->first_difference);
   }
-  (void)rec;
   return bad;
 }
 

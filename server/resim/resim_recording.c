@@ -24,6 +24,7 @@ typedef struct load_ctx {
    * restarts simulated time). */
   uint64_t obj_ns[SCENE_MAX_OBJECTS], met_ns[SCENE_MAX_TOOLS];
   uint32_t obj_epoch[SCENE_MAX_OBJECTS], met_epoch[SCENE_MAX_TOOLS];
+  uint64_t seq_min, seq_max, seq_n; /* AppliedInput seqs seen (> 0) */
   /* Source timestamps (the server's clock) of the AppliedInput samples
    * that carried a rebuild, one entry per rebuild, in recording order. */
   int64_t *rebuild_ts;
@@ -279,6 +280,11 @@ static int on_applied(void *arg, const void *sample, const recfile_row_t *row) {
   resim_recording_t *rec = ctx->rec;
   const viscera_AppliedInput *a = sample;
   resim_input_t h = {.tick = a->tick, .step = a->step, .epoch = a->epoch};
+  if (a->seq > 0) {
+    if (!ctx->seq_n || a->seq < ctx->seq_min) ctx->seq_min = a->seq;
+    if (!ctx->seq_n || a->seq > ctx->seq_max) ctx->seq_max = a->seq;
+    ctx->seq_n++;
+  }
   if ((double)a->step * rec->dt > RESIM_MAX_SIM_S) {
     skip(rec, "AppliedInput sample %lld: step %llu out of range", (long long)row->id, (unsigned long long)a->step);
     return 0;
@@ -471,6 +477,9 @@ int resim_recording_load(resim_recording_t *rec, const char *path, verr_t *err) 
   }
   recfile_close(rf);
   free(ctx.rebuild_ts);
+  /* The server numbers its samples from 1: a missing one is a lost input
+   * (duplicates, which a reliable reader does not deliver, would hide one). */
+  if (ctx.seq_n) rec->applied_lost = ctx.seq_max - ctx.seq_n;
   if (rc) {
     resim_recording_free(rec);
     return -1;

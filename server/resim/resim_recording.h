@@ -145,6 +145,7 @@ typedef struct resim_recording {
    * schedule is then rebuilt from ToolCommand and ContactFeedback). */
   resim_input_t *inputs;
   size_t ninputs;
+  uint64_t applied_lost; /* AppliedInput samples missing (seq gaps; format-1 samples carry no seq) */
   resim_event_t *events; /* recorded interaction events, in recording order */
   size_t nevents;
   resim_object_t *objects;

@@ -15,6 +15,7 @@ void applied_input_flush(applied_input_t *ai) {
   ai->cur.tools._maximum = ai->cur.tools._length;
   ai->cur.controls._buffer = ai->controls;
   ai->cur.controls._maximum = ai->cur.controls._length;
+  ai->cur.seq = ++ai->seq;
   if (ai->writer > 0) {
     if (dds_write(ai->writer, &ai->cur) >= 0)
       ai->published++;

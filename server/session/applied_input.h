@@ -33,6 +33,7 @@ typedef struct applied_input {
   viscera_AppliedInput cur; /* header of the open sample */
   viscera_AppliedTool tools[APPLIED_MAX_TOOLS];
   viscera_AppliedControl controls[APPLIED_MAX_CONTROLS];
+  uint64_t seq;               /* samples closed (the last one's AppliedInput.seq) */
   uint64_t published, failed; /* samples written, writes that failed */
 } applied_input_t;
 

@@ -3,7 +3,7 @@
  * exactly the effective command's fields; the header is the state when the
  * first entry came, so a control's rebuild does not move it (begin_control
  * first) and the next sample carries the new epoch and step; a full buffer
- * starts a new sample. */
+ * starts a new sample; samples are numbered from 1 (a gap is a lost one). */
 #include <string.h>
 
 #include "check.h"
@@ -41,7 +41,7 @@ int main(void) {
   CHECK(ai.cur.step == 5 && ai.cur.epoch == 0 && ai.cur.controls._length == 1);
   CHECK(ai.controls[0].kind == viscera_CONTROL_RESET && ai.controls[0].result == 1 && ai.controls[0].task == -1);
   applied_input_tick(&ai); /* publishes (nothing to write to) and closes */
-  CHECK(!ai.open && ai.tick == 2);
+  CHECK(!ai.open && ai.tick == 2 && ai.seq == 1 && ai.cur.seq == 1);
   paused = 1;
   applied_input_command(&ai, 0, &in);
   CHECK(ai.cur.step == 0 && ai.cur.epoch == 1 && ai.cur.paused && ai.cur.tick == 2);
@@ -52,6 +52,6 @@ int main(void) {
   applied_input_release(&ai, 1);
   CHECK(ai.cur.tools._length == 1 && ai.tools[0].released && ai.cur.step == 3);
   applied_input_flush(&ai);
-  CHECK(!ai.open && ai.published == 0 && ai.failed == 0);
+  CHECK(!ai.open && ai.published == 0 && ai.failed == 0 && ai.seq == 3);
   return check_report("test_applied_input");
 }
