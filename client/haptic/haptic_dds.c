@@ -30,6 +30,7 @@ static void on_scene(dds_entity_t reader, void *arg) {
 int haptic_dds_open(haptic_dds_t *h, const haptic_options_t *o, size_t latency_capacity) {
   verr_t err;
   vdds_set_tool((int)o->tool);
+  vdds_set_station(o->station); /* in the participant's USER_DATA too: recordings name who drove */
   if (vdds_open(&h->dds, o->domain, o->partition, &err)) {
     fprintf(stderr, "viscera-haptic: %s\n", err.msg);
     return 1;

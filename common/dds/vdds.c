@@ -7,7 +7,7 @@
 #include "dds/vdds_ident.h"
 #include "viscera.h"
 
-typedef enum qos_kind { QOS_STATE, QOS_STREAM, QOS_EVENTS, QOS_METRICS, QOS_CONTROL } qos_kind_t;
+typedef enum qos_kind { QOS_STATE, QOS_STREAM, QOS_EVENTS, QOS_METRICS, QOS_CONTROL, QOS_LOG } qos_kind_t;
 
 static const struct {
   const char *name;
@@ -29,6 +29,8 @@ static const struct {
     [VT_OBJECT_STATE] = {"viscera_ObjectState", &viscera_ObjectState_desc, QOS_STATE},
     [VT_TOOL_METRICS] = {"viscera_ToolMetrics", &viscera_ToolMetrics_desc, QOS_METRICS},
     [VT_TOOL_ROLE] = {"viscera_ToolRole", &viscera_ToolRole_desc, QOS_STATE},
+    [VT_APPLIED_INPUT] = {"viscera_AppliedInput", &viscera_AppliedInput_desc, QOS_LOG},
+    [VT_SCENE_SOURCE] = {"viscera_SceneSource", &viscera_SceneSource_desc, QOS_STATE},
 };
 
 const char *vdds_topic_name(vdds_topic_id_t t) { return t < VT_COUNT ? TOPICS[t].name : "?"; }
@@ -68,6 +70,15 @@ static dds_qos_t *make_qos(qos_kind_t k, int lease_ms) {
     dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
     dds_qset_durability(q, DDS_DURABILITY_VOLATILE);
     dds_qset_history(q, DDS_HISTORY_KEEP_LAST, 16);
+    break;
+  case QOS_LOG:
+    /* Every sample counts (a recording must hold each applied input to
+     * re-simulate), at up to 1 kHz: reliable, keep-last 1000 (a second), so
+     * neither a recorder stalled by a disk commit loses one nor the writer
+     * ever blocks the physics loop (a loss shows as a seq gap). */
+    dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
+    dds_qset_durability(q, DDS_DURABILITY_VOLATILE);
+    dds_qset_history(q, DDS_HISTORY_KEEP_LAST, 1000);
     break;
   }
   return q;

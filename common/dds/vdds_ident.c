@@ -6,6 +6,7 @@
 
 static char g_role[VDDS_ROLE_MAX] = "unknown";
 static int g_tool = -1;
+static char g_station[VDDS_ROLE_MAX] = "";
 
 void vdds_set_role(const char *role) {
   if (!role || !*role) role = "unknown";
@@ -22,6 +23,15 @@ void vdds_set_tool(int tool) { g_tool = tool < 0 ? -1 : tool; }
 
 const char *vdds_role(void) { return g_role; }
 
+void vdds_set_station(const char *station) {
+  size_t i = 0;
+  for (; station && station[i] && i + 1 < sizeof g_station; i++) {
+    unsigned char c = (unsigned char)station[i];
+    g_station[i] = (c > 0x20 && c < 0x7f && c != '=') ? (char)c : '_';
+  }
+  g_station[i] = 0;
+}
+
 size_t vdds_ident_format(char *out, size_t cap, const char *role, int tool, const char *host, long pid) {
   if (!cap) return 0;
   char tool_s[24] = "";
@@ -37,7 +47,13 @@ size_t vdds_ident_self(char *out, size_t cap) {
   char host[128] = "";
   if (gethostname(host, sizeof host - 1) != 0) host[0] = 0;
   host[sizeof host - 1] = 0;
-  return vdds_ident_format(out, cap, g_role, g_tool, host, (long)getpid());
+  size_t n = vdds_ident_format(out, cap, g_role, g_tool, host, (long)getpid());
+  /* The station last, so readers that know the fields above are unchanged. */
+  if (g_station[0] && n < cap) {
+    int k = snprintf(out + n, cap - n, " station=%s", g_station);
+    if (k > 0) n = n + (size_t)k < cap ? n + (size_t)k : cap - 1;
+  }
+  return n;
 }
 
 dds_qos_t *vdds_participant_qos(void) {

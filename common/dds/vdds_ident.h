@@ -3,7 +3,7 @@
  * text.
  *
  * Format (one line, at most VDDS_IDENT_MAX-1 bytes, printable ASCII):
- *   "viscera role=<role> [tool=<n> ]host=<hostname> pid=<pid>"
+ *   "viscera role=<role> [tool=<n> ]host=<hostname> pid=<pid>[ station=<name>]"
  * Every main calls vdds_set_role() (and the haptic client vdds_set_tool())
  * before creating its participant; vdds_open() and the recorder/replay,
  * which create participants themselves, use vdds_participant_qos().
@@ -35,6 +35,10 @@ void vdds_set_role(const char *role);
 /* The tool index this process drives, announced as tool=<n>; < 0: none. */
 void vdds_set_tool(int tool);
 const char *vdds_role(void);
+/* The station (person or seat, idl ToolRole) this process acts for,
+ * announced last as " station=<name>" (issue 16: a recording names who drove
+ * each tool); NULL or "": none. A claim like the role. */
+void vdds_set_station(const char *station);
 
 /* Formats the announcement into out[cap] (always NUL-terminated, truncated
  * to fit); returns its length. Pure: host and pid are arguments. */

@@ -9,6 +9,45 @@
 #include <dds/ddsi/ddsi_xt_impl.h>
 
 #include "recording/recording.h"
+#include "viscera_format1.h"
+
+/* The frozen format-1 twin of a compiled-in type (idl/viscera_format1.idl),
+ * by the type's name after its module; NULL when there is none. */
+static const dds_topic_descriptor_t *format1_twin(const dds_topic_descriptor_t *desc) {
+  static const dds_topic_descriptor_t *const twins[] = {
+      &viscera_format1_SceneInfo_desc,   &viscera_format1_MeshState_desc,       &viscera_format1_MeshDelta_desc,
+      &viscera_format1_ToolCommand_desc, &viscera_format1_ContactFeedback_desc, &viscera_format1_SessionEvent_desc,
+      &viscera_format1_Metrics_desc,     &viscera_format1_SessionControl_desc,  &viscera_format1_ToolRole_desc,
+      &viscera_format1_ObjectState_desc, &viscera_format1_ToolMetrics_desc,     &viscera_format1_AppliedInput_desc,
+      &viscera_format1_SceneSource_desc};
+  const char *name = desc->m_typename ? strrchr(desc->m_typename, ':') : NULL;
+  if (!name) return NULL;
+  for (size_t i = 0; i < sizeof twins / sizeof twins[0]; i++) {
+    const char *t = strrchr(twins[i]->m_typename, ':');
+    if (twins[i] != desc && !strcmp(t, name) && twins[i]->m_size <= desc->m_size) return twins[i];
+  }
+  return NULL;
+}
+
+/* Normalizes a copy of the payload against `ops` and reads it into out. */
+static bool decode_with(const unsigned char *payload, uint32_t size, bool bswap, uint32_t xcdrv, const uint32_t *ops,
+                        void *out) {
+  /* normalize works in place (byte swap), so on a copy: the caller's bytes
+   * may be SQLite's own buffer. */
+  char *buf = malloc(size ? size : 1);
+  if (!buf) return false;
+  memcpy(buf, payload, size);
+  uint32_t off = 0;
+  bool ok = dds_stream_normalize_data(buf, &off, size, bswap, xcdrv, ops) != NULL;
+  if (ok) {
+    dds_istream_t is;
+    dds_istream_init(&is, size, buf, xcdrv);
+    dds_stream_read(&is, out, ops);
+    dds_istream_fini(&is);
+  }
+  free(buf);
+  return ok;
+}
 
 bool rec_decode_cdr(const void *cdr, size_t len, const dds_topic_descriptor_t *desc, void *out) {
   memset(out, 0, desc->m_size); /* dds_stream_read would free or reuse garbage pointers */
@@ -28,22 +67,14 @@ bool rec_decode_cdr(const void *cdr, size_t len, const dds_topic_descriptor_t *d
   bool le = (id & 1u) != 0;
   uint32_t xcdrv = id <= 3 ? 1 : 2;
   uint32_t size = (uint32_t)(len - 4);
-  /* normalize works in place (byte swap), so on a copy: the caller's bytes
-   * may be SQLite's own buffer. */
-  char *buf = malloc(size ? size : 1);
-  if (!buf) return false;
-  memcpy(buf, b + 4, size);
-  uint32_t off = 0;
   bool bswap = le != (DDSRT_ENDIAN == DDSRT_LITTLE_ENDIAN);
-  bool ok = dds_stream_normalize_data(buf, &off, size, bswap, xcdrv, desc->m_ops) != NULL;
-  if (ok) {
-    dds_istream_t is;
-    dds_istream_init(&is, size, buf, xcdrv);
-    dds_stream_read(&is, out, desc->m_ops);
-    dds_istream_fini(&is);
-  }
-  free(buf);
-  return ok;
+  if (decode_with(b + 4, size, bswap, xcdrv, desc->m_ops, out)) return true;
+  /* A format-1 sample of a type that has grown since (fields appended at
+   * its end): the frozen twin reads it into the prefix of `out`. */
+  const dds_topic_descriptor_t *twin = xcdrv == 1 ? format1_twin(desc) : NULL;
+  if (twin && decode_with(b + 4, size, bswap, xcdrv, twin->m_ops, out)) return true;
+  memset(out, 0, desc->m_size);
+  return false;
 }
 
 void rec_decode_free(void *sample, const dds_topic_descriptor_t *desc) {

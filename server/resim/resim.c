@@ -1,8 +1,8 @@
 /* viscera-resim: deterministic re-simulation of a recorded session.
  *
- * Feeds the recorded ToolCommands, step by step as the server applied them
- * (schedule rebuilt from the recorded ContactFeedback, resim_schedule.h),
- * into a fresh runtime of the scene and compares every recorded mesh frame
+ * Feeds the inputs the server applied (AppliedInput; in older recordings
+ * the ToolCommands scheduled from the recorded ContactFeedback,
+ * resim_schedule.h) into a fresh runtime of the recorded scene and compares every recorded mesh frame
  * with the re-simulated surface (resim_run.h). Exit 0 when every organ's
  * largest per-coordinate error is within the tolerance, 1 beyond it, 2 on
  * a usage error, an unreadable recording or a scene that is not the
@@ -15,19 +15,22 @@
 #include "resim/resim_app.h"
 
 static void usage(FILE *f) {
-  fprintf(f, "usage: viscera-resim --scene SCENE.yaml REC.db [options]\n"
-             "  --scene FILE      the scene the session ran (must match the recording's SceneInfo)\n"
+  fprintf(f, "usage: viscera-resim REC.db [options]\n"
+             "  --scene FILE      re-simulate with this scene file instead of the recording's own (names what\n"
+             "                    differs; must match the recording's SceneInfo)\n"
+             "  --mesh-dir DIR    look here, by file name, for a recorded mesh that is not where the server\n"
+             "                    read it (taken only with the recorded sha256)\n"
              "  --tolerance M     largest per-coordinate error allowed, m (default: quant_step/2 + 5e-8)\n"
              "  --csv FILE        one line per compared frame: step,sim_time_s,organ,kind,max_err_m,rms_err_m,exact\n"
              "  --quiet           no progress lines\n"
              "  --help            this text\n"
              "  --version         print the version and exit\n"
-             "Re-runs the recorded tool commands in a fresh server runtime and compares every recorded\n"
-             "MeshState/MeshDelta frame.\n"
-             "Exit status: 0 within tolerance, 1 beyond, 2 on an error or a usage error.\n");
+             "Re-applies every input the server applied (AppliedInput: tool commands, releases, controls) in a\n"
+             "fresh server runtime and compares every recorded MeshState/MeshDelta frame, ObjectState and\n"
+             "interaction event.\nExit status: 0 within tolerance, 1 beyond, 2 on an error or a usage error.\n");
 }
 
-enum { OPT_SCENE = 's', OPT_TOLERANCE = 't', OPT_CSV = 'c' };
+enum { OPT_SCENE = 's', OPT_TOLERANCE = 't', OPT_CSV = 'c', OPT_MESH_DIR = 'm' };
 
 static int on_option(void *ctx, int code, const char *arg) {
   resim_options_t *o = ctx;
@@ -38,6 +41,9 @@ static int on_option(void *ctx, int code, const char *arg) {
     return 0;
   case OPT_CSV:
     o->csv_path = arg;
+    return 0;
+  case OPT_MESH_DIR:
+    o->mesh_dir = arg;
     return 0;
   case OPT_TOLERANCE:
     o->tolerance = strtod(arg, &end);
@@ -54,10 +60,11 @@ int main(int argc, char **argv) {
   static const struct option lo[] = {{"scene", required_argument, 0, OPT_SCENE},
                                      {"tolerance", required_argument, 0, OPT_TOLERANCE},
                                      {"csv", required_argument, 0, OPT_CSV},
+                                     {"mesh-dir", required_argument, 0, OPT_MESH_DIR},
                                      {0, 0, 0, 0}};
   const cli_spec_t spec = {.program = "viscera-resim",
                            .common = CLI_QUIET,
-                           .shortopts = "s:t:c:qh",
+                           .shortopts = "s:t:c:m:qh",
                            .options = lo,
                            .option = on_option,
                            .usage = usage};
@@ -66,9 +73,8 @@ int main(int argc, char **argv) {
   int rc = cli_parse(&spec, argc, argv, &common, &o);
   if (rc != CLI_RUN) return rc;
   o.quiet = common.quiet;
-  if (!o.scene_path || optind != argc - 1) {
-    fprintf(stderr, "viscera-resim: %s\n",
-            !o.scene_path ? "--scene FILE is required" : "expected one recording REC.db");
+  if (optind != argc - 1) {
+    fprintf(stderr, "viscera-resim: expected one recording REC.db\n");
     usage(stderr);
     return 2;
   }

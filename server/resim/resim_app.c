@@ -8,9 +8,13 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "build_id.h"
+#include "cli.h"
+
 #include "data_path.h"
 #include "resim/resim_recording.h"
 #include "resim/resim_run.h"
+#include "resim/resim_scene.h"
 #include "runtime/scene_runtime.h"
 #include "scene.h"
 #include "vtime.h"
@@ -73,8 +77,9 @@ static int print_organs(const runtime_t *rt, const resim_recording_t *rec, const
     const resim_organ_result_t *r = &res->organs[i];
     double rms = r->nsq ? sqrt(r->sum_sq / (double)r->nsq) : 0;
     printf("ORGAN %s frames=%" PRIu64 " keyframes=%" PRIu64 " exact=%" PRIu64 " unmatched=%" PRIu64
-           " max_err_m=%.3g rms_err_m=%.3g worst_step=%" PRIu64 "\n",
-           rt->organs[i].cfg->name, r->frames, r->keyframes, r->exact, r->unmatched, r->max_err, rms, r->worst_step);
+           " unreached=%" PRIu64 " max_err_m=%.3g rms_err_m=%.3g worst_step=%" PRIu64 "\n",
+           rt->organs[i].cfg->name, r->frames, r->keyframes, r->exact, r->unmatched, r->unreached, r->max_err, rms,
+           r->worst_step);
     /* MeshDelta frame_seq counts every published frame of the organ. */
     uint64_t dfirst = 0, dlast = 0, ddistinct = 0, dprev = 0;
     for (size_t j = 0; j < rec->ndeltas; j++) {
@@ -88,6 +93,14 @@ static int print_organs(const runtime_t *rt, const resim_recording_t *rec, const
     printf("STREAM organ=%s delta_first_seq=%" PRIu64 " delta_last_seq=%" PRIu64 " delta_seq_gaps=%" PRIu64 "\n",
            rt->organs[i].cfg->name, dfirst, dlast, ddistinct ? dlast - dfirst + 1 - ddistinct : 0);
     if (r->frames) *compared = 1;
+    if (res->applied && (r->unmatched || r->unreached)) {
+      beyond = 1;
+      fprintf(stderr,
+              "viscera-resim: organ '%s': %" PRIu64
+              " recorded frame(s) do not fit the re-simulated surface and %" PRIu64
+              " were never reached (another topology or end): the re-simulation does not reproduce the session\n",
+              rt->organs[i].cfg->name, r->unmatched, r->unreached);
+    }
     if (r->max_err > tolerance) {
       beyond = 1;
       fprintf(stderr,
@@ -99,20 +112,110 @@ static int print_organs(const runtime_t *rt, const resim_recording_t *rec, const
   return beyond;
 }
 
+/* INPUTS, OBJECTS and EVENTS lines; returns whether they fail the run
+ * (applied inputs only: an older recording knows no buttons or controls,
+ * so only its meshes are judged). */
+static int print_others(const resim_recording_t *rec, const resim_result_t *res, double tolerance) {
+  int bad = 0;
+  if (res->applied)
+    printf("INPUTS mode=applied commands=%" PRIu64 " releases=%" PRIu64 " controls=%" PRIu64 " rebuilds=%" PRIu64
+           " steps=%" PRIu64 " lost=%" PRIu64 "\n",
+           res->commands, res->releases, res->controls, res->rebuilds, res->steps, rec->applied_lost);
+  else
+    printf("INPUTS mode=schedule (no AppliedInput recorded: tool positions only, from ToolCommand and "
+           "ContactFeedback)\n");
+  const resim_object_result_t *o = &res->objects;
+  printf("OBJECTS compared=%" PRIu64 " exact=%" PRIu64 " mismatched=%" PRIu64 " unreached=%" PRIu64
+         " max_err_m=%.3g worst_step=%" PRIu64 "\n",
+         o->compared, o->exact, o->mismatched, o->unreached, o->max_err, o->worst_step);
+  const resim_event_result_t *e = &res->events;
+  printf("EVENTS recorded=%zu resim=%zu equal=%zu\n", e->recorded, e->resim, e->equal);
+  const resim_metrics_result_t *m = &res->metrics;
+  printf("TOOLMETRICS compared=%" PRIu64 " differ=%" PRIu64 " unreached=%" PRIu64 "\n", m->compared, m->differ,
+         m->unreached);
+  if (res->diverged) {
+    bad = 1;
+    fprintf(stderr, "viscera-resim: the re-simulation diverged from the recording: %s\n", res->divergence);
+  }
+  if (!res->applied) return bad;
+  if (rec->applied_lost) {
+    bad = 1;
+    fprintf(stderr,
+            "viscera-resim: %" PRIu64 " AppliedInput sample(s) are missing from the recording (the recorder lost "
+            "them): the inputs of those steps are unknown\n",
+            rec->applied_lost);
+  }
+  if (o->mismatched || o->unreached || o->max_err > tolerance) {
+    bad = 1;
+    fprintf(stderr,
+            "viscera-resim: objects differ from the recording: %" PRIu64 " with another holder or state (first at "
+            "step %" PRIu64 "), %" PRIu64 " not reached, position error %.3g m at step %" PRIu64 "\n",
+            o->mismatched, o->first_mismatch_step, o->unreached, o->max_err, o->worst_step);
+  }
+  if (e->first_difference[0]) {
+    bad = 1;
+    fprintf(stderr, "viscera-resim: interaction events differ from the recording: %s\n", e->first_difference);
+  }
+  if (m->differ || m->unreached) {
+    bad = 1;
+    fprintf(stderr,
+            "viscera-resim: ToolMetrics differ from the recording: %" PRIu64 " differ, %" PRIu64 " not reached%s%s\n",
+            m->differ, m->unreached, m->first_difference[0] ? "; first: " : "", m->first_difference);
+  }
+  return bad;
+}
+
+/* Every compared frame and object reproduced bit for bit, every event equal. */
+static int bit_exact(const runtime_t *rt, const resim_result_t *res) {
+  for (size_t i = 0; i < rt->norgans; i++) {
+    const resim_organ_result_t *r = &res->organs[i];
+    if (r->exact != r->frames || r->unmatched || r->unreached) return 0;
+  }
+  return res->objects.exact == res->objects.compared && !res->objects.unreached && !res->events.first_difference[0] &&
+         !res->metrics.differ && !res->metrics.unreached && !res->diverged;
+}
+
+/* BUILD line: the build that recorded and this one. Bit-exact reproduction
+ * is a property of one build; another one is judged the same way, against
+ * the recording, and told. */
+static void print_build(const resim_recording_t *rec) {
+  const resim_source_t *s = &rec->source;
+  if (!s->have) {
+    printf("BUILD recorded=unknown this=\"%s %s %s\"\n", cli_version(), build_compiler(), build_flags());
+    return;
+  }
+  int same = !strcmp(s->version, cli_version()) && !strcmp(s->compiler, build_compiler()) &&
+             !strcmp(s->build_flags, build_flags());
+  printf("BUILD same=%d recorded=\"%s %s %s\" this=\"%s %s %s\"\n", same, s->version, s->compiler, s->build_flags,
+         cli_version(), build_compiler(), build_flags());
+  if (!same)
+    fprintf(stderr,
+            "viscera-resim: note: the session ran on another build (%s, %s, %s): bit-exact reproduction is "
+            "not expected, the errors below are against the recording\n",
+            s->version, s->compiler, s->build_flags);
+}
+
 int resim_app_run(const resim_options_t *o) {
   verr_t err;
-  static scene_t scene;           /* large; static keeps it off the stack */
-  char scene_path[DATA_PATH_MAX]; /* installed scenes from any directory (data_path.h) */
-  data_path_resolve(o->scene_path, "assets/scenes", scene_path, sizeof scene_path);
-  if (scene_load(scene_path, &scene, &err)) {
-    fprintf(stderr, "viscera-resim: %s\n", err.msg);
-    return 2;
+  static scene_t scene; /* large; static keeps it off the stack */
+  /* An installed scene by name from any directory (data_path.h). */
+  char scene_buf[DATA_PATH_MAX];
+  const char *scene_path = o->scene_path;
+  if (scene_path) {
+    data_path_resolve(scene_path, "assets/scenes", scene_buf, sizeof scene_buf);
+    scene_path = scene_buf;
   }
   static resim_recording_t rec;
   if (resim_recording_load(&rec, o->rec_path, &err)) {
     fprintf(stderr, "viscera-resim: %s\n", err.msg);
     return 2;
   }
+  if (resim_scene_load(&scene, scene_path, o->mesh_dir, &rec, stdout, &err)) {
+    fprintf(stderr, "viscera-resim: %s: %s\n", o->rec_path, err.msg);
+    resim_recording_free(&rec);
+    return 2;
+  }
+  print_build(&rec);
   if (rec.warnings[0]) fprintf(stderr, "viscera-resim: warning: %s\n", rec.warnings);
   if (rec.skipped)
     fprintf(stderr, "viscera-resim: warning: %" PRIu64 " sample(s) skipped; first: %s\n", rec.skipped, rec.first_skip);
@@ -156,14 +259,15 @@ int resim_app_run(const resim_options_t *o) {
 
   print_schedules(&rt, &rec, &res);
   int compared = 0, beyond = print_organs(&rt, &rec, &res, &scene, tolerance, &compared);
+  beyond |= print_others(&rec, &res, tolerance);
   if (res.first_unmatched[0])
     fprintf(stderr, "viscera-resim: warning: frames not compared; first: %s\n", res.first_unmatched);
   if (!compared) {
     fprintf(stderr, "viscera-resim: %s: no mesh frame recorded: nothing to compare\n", o->rec_path);
     goto out;
   }
-  printf("RESIM %s steps=%" PRIu64 " rollbacks=%" PRIu64 " tolerance_m=%.3g wall_s=%.2f\n", beyond ? "FAIL" : "PASS",
-         res.steps, res.rollbacks, tolerance, wall);
+  printf("RESIM %s steps=%" PRIu64 " rollbacks=%" PRIu64 " tolerance_m=%.3g bit_exact=%d wall_s=%.2f\n",
+         beyond ? "FAIL" : "PASS", res.steps, res.rollbacks, tolerance, bit_exact(&rt, &res), wall);
   rc = beyond ? 1 : 0;
 out:
   if (csv && fclose(csv) != 0) {

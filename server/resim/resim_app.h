@@ -3,7 +3,8 @@
 #define VISCERA_RESIM_APP_H
 
 typedef struct resim_options {
-  const char *scene_path; /* --scene FILE */
+  const char *scene_path; /* --scene FILE, or NULL: the recording's own scene */
+  const char *mesh_dir;   /* --mesh-dir DIR, or NULL */
   const char *csv_path;   /* --csv FILE, or NULL */
   const char *rec_path;   /* the recording */
   double tolerance;       /* --tolerance, m; < 0: quant_step/2 + float slack */

@@ -8,10 +8,12 @@
 
 #include "recording/recfile.h"
 #include "recording/rec_decode.h"
+#include "interaction/events.h"
 #include "viscera.h"
 
 typedef struct caps {
   size_t fb[SCENE_MAX_TOOLS], cmd[SCENE_MAX_TOOLS], rel[SCENE_MAX_TOOLS], keys, deltas;
+  size_t inputs, events, objects, metrics;
 } caps_t;
 
 typedef struct load_ctx {
@@ -19,7 +21,26 @@ typedef struct load_ctx {
   caps_t caps; /* allocated lengths of the arrays in rec */
   int oom;
   int64_t scene_ts; /* source timestamp of the earliest SceneInfo: the server's sim time 0 (0 unknown) */
+  /* Per object / tool: the last sample's sim time and epoch (a rebuild
+   * restarts simulated time). */
+  uint64_t obj_ns[SCENE_MAX_OBJECTS], met_ns[SCENE_MAX_TOOLS];
+  uint32_t obj_epoch[SCENE_MAX_OBJECTS], met_epoch[SCENE_MAX_TOOLS];
+  uint64_t seq_min, seq_max, seq_n; /* AppliedInput seqs seen (> 0) */
+  /* Source timestamps (the server's clock) of the AppliedInput samples
+   * that carried a rebuild, one entry per rebuild, in recording order. */
+  int64_t *rebuild_ts;
+  size_t nrebuild, caprebuild;
 } load_ctx_t;
+
+/* The epoch of a sample the server wrote at source time ts: the rebuilds
+ * written before it (the AppliedInput of a rebuild is written after the
+ * rebuild, before the step; every later sample is of the new epoch). */
+static uint32_t epoch_at(const load_ctx_t *ctx, int64_t ts) {
+  uint32_t e = 0;
+  for (size_t i = 0; i < ctx->nrebuild; i++)
+    if (ctx->rebuild_ts[i] <= ts) e++;
+  return e;
+}
 
 static void skip(resim_recording_t *rec, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 static void skip(resim_recording_t *rec, const char *fmt, ...) {
@@ -127,10 +148,50 @@ static int on_feedback(void *arg, const void *sample, const recfile_row_t *row) 
   return 0;
 }
 
+/* The interaction events (grasp, task, cut) a re-simulated runtime reports
+ * too, with their step. 0, or -1 out of memory. */
+static int collect_event(load_ctx_t *ctx, const viscera_SessionEvent *e, const recfile_row_t *row) {
+  resim_recording_t *rec = ctx->rec;
+  int kind;
+  switch (e->kind) {
+  case viscera_EVENT_GRASP_BEGIN:
+    kind = IEV_GRASP_BEGIN;
+    break;
+  case viscera_EVENT_GRASP_END:
+    kind = IEV_GRASP_END;
+    break;
+  case viscera_EVENT_TASK_STARTED:
+    kind = IEV_TASK_STARTED;
+    break;
+  case viscera_EVENT_TASK_COMPLETED:
+    kind = IEV_TASK_COMPLETED;
+    break;
+  case viscera_EVENT_CUT_BEGIN:
+    kind = IEV_CUT_BEGIN;
+    break;
+  case viscera_EVENT_CUT_END:
+    kind = IEV_CUT_END;
+    break;
+  default:
+    return 0;
+  }
+  uint64_t step = step_of(ctx, row, e->sim_time_ns);
+  if (step == UINT64_MAX) {
+    skip(rec, "SessionEvent sample %lld: sim time %llu ns out of range", (long long)row->id,
+         (unsigned long long)e->sim_time_ns);
+    return 0;
+  }
+  if (grow((void **)&rec->events, &ctx->caps.events, rec->nevents, sizeof *rec->events)) return -1;
+  rec->events[rec->nevents++] =
+      (resim_event_t){.kind = kind, .tool = e->tool_id, .organ = e->organ_id, .value = e->value, .step = step};
+  return 0;
+}
+
 static int on_event(void *arg, const void *sample, const recfile_row_t *row) {
   load_ctx_t *ctx = arg;
   resim_recording_t *rec = ctx->rec;
   const viscera_SessionEvent *e = sample;
+  if (e->source_id == 0 && collect_event(ctx, e, row)) return ctx->oom = 1;
   if (e->kind != viscera_EVENT_CLIENT_LOST) return 0;
   if (e->tool_id < 0 || (size_t)e->tool_id >= rec->ntools) {
     skip(rec, "SessionEvent sample %lld: CLIENT_LOST for tool %d not in the scene", (long long)row->id,
@@ -159,22 +220,31 @@ static int on_state(void *arg, const void *sample, const recfile_row_t *row) {
          (long long)row->id, (unsigned long long)s->sim_time_ns);
   } else if (s->organ_id >= rec->norgans) {
     skip(rec, "MeshState sample %lld: organ %u not in the scene", (long long)row->id, s->organ_id);
-  } else if (s->positions._length != 3ull * rec->organs[s->organ_id].nverts) {
-    skip(rec, "MeshState sample %lld: organ %u has %u coordinates, SceneInfo says %u vertices", (long long)row->id,
-         s->organ_id, s->positions._length, rec->organs[s->organ_id].nverts);
+  } else if (s->positions._length % 3 || s->triangles._length % 3 || s->positions._length > 3u * RESIM_MAX_VERTS) {
+    skip(rec,
+         "MeshState sample %lld: organ %u has %u coordinates and %u triangle indices, not whole vertices and "
+         "triangles",
+         (long long)row->id, s->organ_id, s->positions._length, s->triangles._length);
   } else if (grow((void **)&rec->keys, &ctx->caps.keys, rec->nkeys, sizeof *rec->keys)) {
     rc = ctx->oom = 1;
   } else {
     float *pos = malloc(s->positions._length * sizeof(float) + 1);
-    if (!pos) {
+    uint32_t *tris = malloc(s->triangles._length * sizeof(uint32_t) + 1);
+    if (!pos || !tris) {
+      free(pos);
+      free(tris);
       rc = ctx->oom = 1;
     } else {
-      memcpy(pos, s->positions._buffer, s->positions._length * sizeof(float));
+      if (s->positions._length) memcpy(pos, s->positions._buffer, s->positions._length * sizeof(float));
+      if (s->triangles._length) memcpy(tris, s->triangles._buffer, s->triangles._length * sizeof(uint32_t));
       rec->keys[rec->nkeys++] = (resim_keyframe_t){.organ = s->organ_id,
                                                    .keyframe_seq = s->keyframe_seq,
                                                    .topology_version = s->topology_version,
                                                    .step = step_of(ctx, row, s->sim_time_ns),
-                                                   .pos = pos};
+                                                   .nverts = s->positions._length / 3,
+                                                   .ntris = s->triangles._length / 3,
+                                                   .pos = pos,
+                                                   .tris = tris};
     }
   }
   return rc;
@@ -217,6 +287,139 @@ static int on_delta(void *arg, const void *sample, const recfile_row_t *row) {
     }
   }
   return rc;
+}
+
+/* One AppliedInput sample: its tool entries, then its controls, each with
+ * the sample's header. */
+static int on_applied(void *arg, const void *sample, const recfile_row_t *row) {
+  load_ctx_t *ctx = arg;
+  resim_recording_t *rec = ctx->rec;
+  const viscera_AppliedInput *a = sample;
+  resim_input_t h = {.tick = a->tick, .step = a->step, .epoch = a->epoch};
+  if (a->seq > 0) {
+    if (!ctx->seq_n || a->seq < ctx->seq_min) ctx->seq_min = a->seq;
+    if (!ctx->seq_n || a->seq > ctx->seq_max) ctx->seq_max = a->seq;
+    ctx->seq_n++;
+  }
+  if ((double)a->step * rec->dt > RESIM_MAX_SIM_S) {
+    skip(rec, "AppliedInput sample %lld: step %llu out of range", (long long)row->id, (unsigned long long)a->step);
+    return 0;
+  }
+  for (uint32_t i = 0; i < a->tools._length; i++) {
+    const viscera_AppliedTool *t = &a->tools._buffer[i];
+    if (t->tool_id >= rec->ntools) {
+      skip(rec, "AppliedInput sample %lld: tool %u not in the scene", (long long)row->id, t->tool_id);
+      continue;
+    }
+    if (grow((void **)&rec->inputs, &ctx->caps.inputs, rec->ninputs, sizeof *rec->inputs)) return ctx->oom = 1;
+    resim_input_t *in = &rec->inputs[rec->ninputs++];
+    *in = h;
+    in->kind = t->released ? RESIM_IN_RELEASE : RESIM_IN_COMMAND;
+    in->tool = t->tool_id;
+    for (int k = 0; k < 3; k++) in->cmd.pos[k] = t->position[k];
+    for (int k = 0; k < 4; k++) in->cmd.q[k] = t->orientation[k];
+    in->cmd.buttons = t->buttons;
+    in->cmd.max_force = t->max_force;
+    in->cmd.seq = t->cmd_seq;
+    in->cmd.echo = t->cmd_client_mono_ns;
+  }
+  for (uint32_t i = 0; i < a->controls._length; i++) {
+    const viscera_AppliedControl *c = &a->controls._buffer[i];
+    if (grow((void **)&rec->inputs, &ctx->caps.inputs, rec->ninputs, sizeof *rec->inputs)) return ctx->oom = 1;
+    resim_input_t *in = &rec->inputs[rec->ninputs++];
+    *in = h;
+    in->kind = RESIM_IN_CONTROL;
+    in->control = (int)c->kind;
+    in->ctl_tool = c->tool_id;
+    in->ctl_organ = c->organ_id;
+    memcpy(in->values, c->values, sizeof in->values);
+    in->result = c->result;
+    in->task = c->task;
+    if ((c->kind == viscera_CONTROL_RESET || c->kind == viscera_CONTROL_SET_MATERIAL) &&
+        (c->result == 1 || c->result == 2)) {
+      if (grow((void **)&ctx->rebuild_ts, &ctx->caprebuild, ctx->nrebuild, sizeof *ctx->rebuild_ts))
+        return ctx->oom = 1;
+      ctx->rebuild_ts[ctx->nrebuild++] = row->source_ts_ns;
+    }
+  }
+  return 0;
+}
+
+static int on_object(void *arg, const void *sample, const recfile_row_t *row) {
+  load_ctx_t *ctx = arg;
+  resim_recording_t *rec = ctx->rec;
+  const viscera_ObjectState *o = sample;
+  uint64_t step = step_of(ctx, row, o->sim_time_ns);
+  if (o->object_id >= SCENE_MAX_OBJECTS || step == UINT64_MAX) {
+    skip(rec, "ObjectState sample %lld: object %u or sim time out of range", (long long)row->id, o->object_id);
+    return 0;
+  }
+  /* Without recorded inputs (an older recording), a rebuild shows as the
+   * object's simulated time going back. */
+  if (o->sim_time_ns < ctx->obj_ns[o->object_id]) ctx->obj_epoch[o->object_id]++;
+  ctx->obj_ns[o->object_id] = o->sim_time_ns;
+  if (rec->ninputs) ctx->obj_epoch[o->object_id] = epoch_at(ctx, row->source_ts_ns);
+  if (grow((void **)&rec->objects, &ctx->caps.objects, rec->nobjects, sizeof *rec->objects)) return ctx->oom = 1;
+  rec->objects[rec->nobjects++] = (resim_object_t){.object = o->object_id,
+                                                   .epoch = ctx->obj_epoch[o->object_id],
+                                                   .step = step,
+                                                   .pos = {o->position[0], o->position[1], o->position[2]},
+                                                   .held_by = o->held_by,
+                                                   .removed = o->removed};
+  return 0;
+}
+
+static int on_metrics(void *arg, const void *sample, const recfile_row_t *row) {
+  load_ctx_t *ctx = arg;
+  resim_recording_t *rec = ctx->rec;
+  const viscera_ToolMetrics *m = sample;
+  uint64_t step = step_of(ctx, row, m->sim_time_ns);
+  if (m->tool_id >= rec->ntools || step == UINT64_MAX) {
+    skip(rec, "ToolMetrics sample %lld: tool %u or sim time out of range", (long long)row->id, m->tool_id);
+    return 0;
+  }
+  if (m->sim_time_ns < ctx->met_ns[m->tool_id]) ctx->met_epoch[m->tool_id]++;
+  ctx->met_ns[m->tool_id] = m->sim_time_ns;
+  if (rec->ninputs) ctx->met_epoch[m->tool_id] = epoch_at(ctx, row->source_ts_ns);
+  if (grow((void **)&rec->metrics, &ctx->caps.metrics, rec->nmetrics, sizeof *rec->metrics)) return ctx->oom = 1;
+  rec->metrics[rec->nmetrics++] =
+      (resim_tool_metrics_t){.tool = m->tool_id,
+                             .epoch = ctx->met_epoch[m->tool_id],
+                             .step = step,
+                             .peak_force = m->peak_force,
+                             .time_above = {m->time_above_st, m->time_above_mpf, m->time_above_sft},
+                             .contact_time = m->contact_time,
+                             .path_length = m->path_length,
+                             .grasp_time = m->grasp_time,
+                             .operation_time = m->operation_time,
+                             .grasps = m->grasps,
+                             .tasks_completed = m->tasks_completed};
+  return 0;
+}
+
+static int on_source(void *arg, const void *sample, const recfile_row_t *row) {
+  (void)row;
+  resim_source_t *src = &((load_ctx_t *)arg)->rec->source;
+  const viscera_SceneSource *s = sample;
+  char *text = strdup(s->text ? s->text : "");
+  if (!text) return ((load_ctx_t *)arg)->oom = 1;
+  free(src->text);
+  memset(src, 0, sizeof *src);
+  src->have = 1;
+  src->text = text;
+  snprintf(src->path, sizeof src->path, "%s", s->path);
+  snprintf(src->text_sha256, sizeof src->text_sha256, "%s", s->text_sha256);
+  for (uint32_t i = 0; i < s->meshes._length && i < SCENE_MAX_ORGANS; i++) {
+    snprintf(src->meshes[i].path, sizeof src->meshes[i].path, "%s", s->meshes._buffer[i].path);
+    snprintf(src->meshes[i].sha256, sizeof src->meshes[i].sha256, "%s", s->meshes._buffer[i].sha256);
+    src->meshes[i].size = s->meshes._buffer[i].size;
+    src->nmeshes = i + 1;
+  }
+  snprintf(src->version, sizeof src->version, "%s", s->version);
+  snprintf(src->compiler, sizeof src->compiler, "%s", s->compiler);
+  snprintf(src->build_flags, sizeof src->build_flags, "%s", s->build_flags);
+  snprintf(src->station, sizeof src->station, "%s", s->station);
+  return 0;
 }
 
 static int cmp_key(const void *a, const void *b) {
@@ -264,6 +467,10 @@ int resim_recording_load(resim_recording_t *rec, const char *path, verr_t *err) 
       {"viscera_SessionEvent", &viscera_SessionEvent_desc, on_event, &rec->n_events},
       {"viscera_MeshState", &viscera_MeshState_desc, on_state, &rec->n_states},
       {"viscera_MeshDelta", &viscera_MeshDelta_desc, on_delta, &rec->n_deltas},
+      {"viscera_AppliedInput", &viscera_AppliedInput_desc, on_applied, &rec->n_applied},
+      {"viscera_ObjectState", &viscera_ObjectState_desc, on_object, &rec->n_objects},
+      {"viscera_ToolMetrics", &viscera_ToolMetrics_desc, on_metrics, &rec->n_metrics},
+      {"viscera_SceneSource", &viscera_SceneSource_desc, on_source, NULL},
   };
   int rc = 0;
   for (size_t p = 0; p < sizeof passes / sizeof passes[0] && !rc; p++) {
@@ -285,6 +492,10 @@ int resim_recording_load(resim_recording_t *rec, const char *path, verr_t *err) 
                     rep.scan.damaged ? "; the file is damaged: " : "", rep.scan.damaged ? rep.scan.first_error : "");
   }
   recfile_close(rf);
+  free(ctx.rebuild_ts);
+  /* The server numbers its samples from 1: a missing one is a lost input
+   * (duplicates, which a reliable reader does not deliver, would hide one). */
+  if (ctx.seq_n) rec->applied_lost = ctx.seq_max - ctx.seq_n;
   if (rc) {
     resim_recording_free(rec);
     return -1;
@@ -304,7 +515,15 @@ void resim_recording_free(resim_recording_t *rec) {
     free(rec->tools[t].cmd);
     free(rec->tools[t].release);
   }
-  for (size_t i = 0; i < rec->nkeys; i++) free(rec->keys[i].pos);
+  for (size_t i = 0; i < rec->nkeys; i++) {
+    free(rec->keys[i].pos);
+    free(rec->keys[i].tris);
+  }
+  free(rec->inputs);
+  free(rec->events);
+  free(rec->objects);
+  free(rec->metrics);
+  free(rec->source.text);
   for (size_t i = 0; i < rec->ndeltas; i++) {
     free(rec->deltas[i].idx);
     free(rec->deltas[i].dq);

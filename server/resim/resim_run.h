@@ -27,17 +27,46 @@ typedef struct resim_organ_result {
   uint64_t frames;     /* frames compared (keyframes included) */
   uint64_t keyframes;  /* of which MeshState keyframes */
   uint64_t exact;      /* frames reproduced bit for bit */
-  uint64_t unmatched;  /* deltas whose keyframe was not recorded or that do not apply: not compared */
+  uint64_t unmatched;  /* frames that do not fit the re-simulated surface (another topology) or whose keyframe was
+                          not recorded: not compared */
+  uint64_t unreached;  /* frames of a topology version, epoch or step the re-simulation never reached */
   double max_err;      /* m, largest per-coordinate difference */
   uint64_t worst_step; /* where */
   double sum_sq;       /* sum over compared vertices of the squared distance */
   uint64_t nsq;        /* vertices in sum_sq */
 } resim_organ_result_t;
 
+typedef struct resim_object_result {
+  uint64_t compared, exact; /* ObjectState samples compared, reproduced bit for bit (float position, holder, removed) */
+  uint64_t mismatched;      /* holder or removed differ, or no such object */
+  uint64_t first_mismatch_step;
+  uint64_t unreached;
+  double max_err; /* m, largest per-coordinate position difference */
+  uint64_t worst_step;
+} resim_object_result_t;
+
+typedef struct resim_event_result {
+  size_t recorded, resim, equal; /* interaction events (grasp, task, cut) */
+  char first_difference[320];
+} resim_event_result_t;
+
+typedef struct resim_metrics_result {
+  uint64_t compared, differ, unreached; /* ToolMetrics samples */
+  char first_difference[256];
+} resim_metrics_result_t;
+
 typedef struct resim_result {
   uint64_t steps;
   uint64_t rollbacks;
+  int applied;                                     /* re-simulated from AppliedInput (else the rebuilt schedule) */
+  uint64_t commands, releases, controls, rebuilds; /* applied inputs replayed */
+  uint32_t epochs;                                 /* rebuilds the run went through */
+  int diverged;                                    /* the recording asked for a state the run could not reach */
+  char divergence[VERR_MSG_LEN];
   resim_organ_result_t organs[SCENE_MAX_ORGANS];
+  resim_object_result_t objects;
+  resim_event_result_t events;
+  resim_metrics_result_t metrics;
   resim_schedule_stats_t sched[SCENE_MAX_TOOLS];
   char first_unmatched[VERR_MSG_LEN + 128];
 } resim_result_t;
@@ -51,8 +80,18 @@ typedef struct resim_hooks {
 } resim_hooks_t;
 
 int resim_check_scene(const runtime_t *rt, const resim_recording_t *rec, verr_t *err);
-/* rt fresh from runtime_init; rec from resim_recording_load (its tool
- * arrays are sorted in place). Returns 0, or -1 with err. */
+/* rt fresh from runtime_init; rec from resim_recording_load (its arrays
+ * are sorted in place). With applied inputs (idl AppliedInput, issue 16)
+ * every recorded tool command, release and SessionControl is re-applied
+ * before the step the server took it (pause, rebuilds for RESET and
+ * SET_MATERIAL, START_TASK; thresholds and roles do not move the
+ * simulation), frames are matched by organ, MeshState topology version (the
+ * run counts them as the server's publisher does: +1 per cut or rebuild) and
+ * step, ObjectState by epoch and step, and the interaction events (grasp,
+ * task, cut) in order. Without them (an older recording) the schedule of
+ * resim_schedule.h drives the tool positions only. Returns 0 (a run that
+ * could not follow the recording sets res->diverged), or -1 with err when
+ * an older recording's schedule cannot be built. */
 int resim_run(runtime_t *rt, resim_recording_t *rec, const resim_hooks_t *hooks, resim_result_t *res, verr_t *err);
 
 #endif

@@ -10,7 +10,9 @@
 #include "mesh.h"
 #include "runtime/rollback_report.h"
 #include "runtime/step_cut.h"
+#include "session/applied_input.h"
 #include "session/checkpoint.h"
+#include "session/scene_source.h"
 #include "session/command_intake.h"
 #include "session/liveliness_watch.h"
 #include "session/session_control.h"
@@ -32,7 +34,7 @@ typedef struct server {
   runtime_t rt;
   vdds_t dds;
   dds_entity_t w_scene, w_state, w_delta, w_feedback, w_event, w_metrics, r_cmd, r_control;
-  dds_entity_t w_objects, w_tool_metrics, w_role;
+  dds_entity_t w_objects, w_tool_metrics, w_role, w_applied, w_source;
   mesh_publisher_t pubs[SCENE_MAX_ORGANS];
   /* Each tool's session record (session_tool.h: measures, intake,
    * feedback), by its index in the core's rt.tools. */
@@ -51,6 +53,8 @@ typedef struct server {
   uint64_t gate_seen[VDDS_GATE_REASONS], gate_seen_range, gate_seen_blocked;
   session_control_t control;
   rollback_report_t rb; /* rolled-back steps: reported at most once per simulated second */
+  /* What each loop iteration applied, for the recording (applied_input.h). */
+  applied_input_t ai;
   uint64_t event_seq;
   uint64_t feedback_seq;     /* ContactFeedback.seq of the last sample written */
   double *step_us;           /* ring of recent step times */
@@ -130,6 +134,15 @@ static void publish_scene_info(server_t *s) {
   if (dds_write(s->w_scene, &si) >= 0) s->stats->published[VT_SCENE_INFO]++;
 }
 
+/* The scene's text, mesh digests and the build (scene_source.h), once. */
+static void publish_scene_source(server_t *s) {
+  viscera_SceneSource src;
+  verr_t e;
+  if (scene_source_fill(&src, &s->rt.scene, NULL, &e)) fprintf(stderr, "server: warning: %s\n", e.msg);
+  if (dds_write(s->w_source, &src) >= 0) s->stats->published[VT_SCENE_SOURCE]++;
+  scene_source_free(&src);
+}
+
 /* The ToolCommand reader, behind the intake gate. Its topic keeps the last
  * sample per tool, but two writers share a tool when it is guided
  * (tool_roles.h): with depth 1 one station's sample would overwrite the
@@ -178,12 +191,16 @@ static int setup(server_t *s, const scene_t *scene, verr_t *err) {
   s->w_objects = vdds_writer(&s->dds, VT_OBJECT_STATE, err);
   s->w_tool_metrics = vdds_writer(&s->dds, VT_TOOL_METRICS, err);
   s->w_role = vdds_writer(&s->dds, VT_TOOL_ROLE, err);
+  s->w_applied = vdds_writer(&s->dds, VT_APPLIED_INPUT, err);
+  s->w_source = vdds_writer(&s->dds, VT_SCENE_SOURCE, err);
   if (s->w_scene < 0 || s->w_state < 0 || s->w_delta < 0 || s->w_feedback < 0 || s->w_event < 0 || s->w_metrics < 0 ||
-      s->r_cmd < 0 || s->r_control < 0 || s->w_objects < 0 || s->w_tool_metrics < 0 || s->w_role < 0)
+      s->r_cmd < 0 || s->r_control < 0 || s->w_objects < 0 || s->w_tool_metrics < 0 || s->w_role < 0 ||
+      s->w_applied < 0 || s->w_source < 0)
     return -1;
   tool_roles_init(&s->roles, &s->rt.scene);
   writer_stations_init(&s->stations);
   s->control.roles = &s->roles;
+  applied_input_init(&s->ai, s->w_applied, &s->rt, &s->control.paused);
   for (size_t i = 0; i < s->rt.norgans; i++) {
     organ_rt_t *o = &s->rt.organs[i];
     if (mesh_publisher_init(&s->pubs[i], o->id, o->model->nsurf, o->model->surf_tris, o->model->nsurf_tris,
@@ -246,6 +263,7 @@ static void release_lost_writers(server_t *s, uint64_t now) {
         continue;
       }
       runtime_release_tool(&s->rt, t);
+      applied_input_release(&s->ai, t);
       s->tool[t].lost = 1;
       /* From the last command taken to the listener's report, and to this
        * release (which adds the confirmation delay and the step). */
@@ -275,6 +293,7 @@ static void drive_tool(server_t *s, size_t t, uint64_t now) {
     if (!s->opts->quiet) fprintf(stderr, "server: tool %zu: haptic client back\n", t);
   }
   runtime_command_tool(&s->rt, t, &eff.cmd);
+  applied_input_command(&s->ai, t, &eff.cmd);
 }
 
 /* Publishes the ToolRole of every tool whose role changed (or all, after
@@ -390,6 +409,7 @@ static void release_lost_tools(server_t *s, uint64_t now) {
   for (size_t t = 0; t < s->rt.ntools; t++) {
     if (s->rt.tools[t].active && now - s->tool[t].last_cmd_mono > (uint64_t)(s->opts->tool_timeout * 1e9)) {
       runtime_release_tool(&s->rt, t);
+      applied_input_release(&s->ai, t);
       s->tool[t].lost = 1;
       if (!s->opts->quiet)
         fprintf(stderr, "server: tool %zu: no commands for %.1f s, released\n", t, s->opts->tool_timeout);
@@ -459,7 +479,8 @@ static int read_controls(server_t *s) {
       /* The scene lives in the runtime, which a rebuild destroys: work on
        * copies (heap: a scene is tens of kB). */
       scene_t *edit = malloc(sizeof *edit), *old = malloc(sizeof *old);
-      int r = -1;
+      int r = -1, result = -1, task = -1;
+      applied_input_begin_control(&s->ai); /* the state before any rebuild */
       if (edit && old) {
         *edit = s->rt.scene;
         *old = s->rt.scene;
@@ -470,6 +491,8 @@ static int read_controls(server_t *s) {
       if (r == SESSION_CONTROL_REBUILD) {
         verr_t e;
         int b = rebuild_runtime(s, edit, old, &e);
+        applied_input_rebuilt(&s->ai);
+        result = b == 0 ? 1 : 2;
         if (b == -2) {
           free(edit);
           free(old);
@@ -498,8 +521,11 @@ static int read_controls(server_t *s) {
       }
       if (r == SESSION_CONTROL_START_TASK) {
         r = 0;
-        start_task(s, s->control.start_task, text);
+        task = s->control.start_task;
+        start_task(s, task, text);
       }
+      if (r == 0 && result < 0) result = 0;
+      applied_input_control(&s->ai, c, result, task);
       free(edit);
       free(old);
       if (!s->opts->quiet) fprintf(stderr, "server: %s\n", text);
@@ -809,6 +835,7 @@ static void report_rollbacks(server_t *s, int rolled) {
  * metrics). -1 when the scene could not be rebuilt after a control. */
 static int session_step(server_t *s, uint64_t t0, uint64_t c0, uint64_t *t1) {
   /* In: take and convert the commands, check them, note each side's latest. */
+  applied_input_tick(&s->ai);
   uint32_t fresh = take_commands(s, t0);
   /* Once per step, after every side's latest command is in: each tool with
    * a new one takes its effective command (owner, guide or their mix) into
@@ -823,6 +850,7 @@ static int session_step(server_t *s, uint64_t t0, uint64_t c0, uint64_t *t1) {
       if (s->roles.changed & (1u << t)) vdds_gate_unblock_key(&s->cmd_gate, (uint32_t)t);
     publish_roles(s);
   }
+  applied_input_flush(&s->ai); /* before the step it precedes */
   /* Step: paused, the organs and the measures freeze; commands are still
    * read (so nothing queues up) and the last contact model keeps going out. */
   int rolled = s->control.paused ? 0 : runtime_step(&s->rt);
@@ -919,6 +947,7 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
   }
   uint64_t ckpt_every = (uint64_t)fmax(1.0, floor(opts->checkpoint_every / scene->dt + 0.5));
   publish_scene_info(&s);
+  publish_scene_source(&s);
   publish_roles(&s);
   for (size_t i = 0; i < s.rt.norgans; i++) mesh_publisher_keyframe(&s.pubs[i], s.rt.organs[i].model->surf_x, 0);
   publish_event(&s, viscera_EVENT_SESSION_STARTED, -1, -1, stats->resumed, resumed[0] ? resumed : scene->name);
