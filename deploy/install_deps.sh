@@ -16,6 +16,7 @@ PKGS=(
   libsdl2-dev                               # window viewer (--window, --drive)
   xvfb xauth                                # headless X server for the window test
   systemd                                   # systemd-analyze verify of the service units (test)
+  iproute2 ethtool                          # network tests: namespaces, veths, checksum offload off
 )
 
 missing=()
