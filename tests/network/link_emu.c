@@ -183,8 +183,7 @@ static void admit(dir_t *d, const opts_t *o, const unsigned char *buf, int len, 
   uint64_t seq = d->next_seq++;
   /* Every random draw happens for every frame, in the same order, so one
    * decision never shifts the stream of another. */
-  double u_ge = rng_unit(&d->rng), u_loss = rng_unit(&d->rng), u_jit = rng_unit(&d->rng),
-         u_dup = rng_unit(&d->rng);
+  double u_ge = rng_unit(&d->rng), u_loss = rng_unit(&d->rng), u_jit = rng_unit(&d->rng), u_dup = rng_unit(&d->rng);
   if (o->ge_p > 0 || o->ge_r > 0) d->bad = d->bad ? !(u_ge * 100.0 < o->ge_r) : (u_ge * 100.0 < o->ge_p);
   if (link_down(o, (double)(t - t0) * 1e-9)) {
     d->drop_down++;
@@ -266,15 +265,24 @@ static int parse_opts(int argc, char **argv, opts_t *o) {
     }
     i++;
     int bad = 0;
-    if (!strcmp(a, "--a")) o->ifa = v;
-    else if (!strcmp(a, "--b")) o->ifb = v;
-    else if (!strcmp(a, "--ready")) o->ready = v;
-    else if (!strcmp(a, "--delay")) bad = parse_num(v, 0, 10000, &o->delay_ms, a);
-    else if (!strcmp(a, "--jitter")) bad = parse_num(v, 0, 10000, &o->jitter_ms, a);
-    else if (!strcmp(a, "--loss")) bad = parse_num(v, 0, 100, &o->loss, a);
-    else if (!strcmp(a, "--dup")) bad = parse_num(v, 0, 100, &o->dup, a);
-    else if (!strcmp(a, "--rate")) bad = parse_num(v, 0, 1e8, &o->rate_kbit, a);
-    else if (!strcmp(a, "--duration")) bad = parse_num(v, 0.001, 86400, &o->duration_s, a);
+    if (!strcmp(a, "--a"))
+      o->ifa = v;
+    else if (!strcmp(a, "--b"))
+      o->ifb = v;
+    else if (!strcmp(a, "--ready"))
+      o->ready = v;
+    else if (!strcmp(a, "--delay"))
+      bad = parse_num(v, 0, 10000, &o->delay_ms, a);
+    else if (!strcmp(a, "--jitter"))
+      bad = parse_num(v, 0, 10000, &o->jitter_ms, a);
+    else if (!strcmp(a, "--loss"))
+      bad = parse_num(v, 0, 100, &o->loss, a);
+    else if (!strcmp(a, "--dup"))
+      bad = parse_num(v, 0, 100, &o->dup, a);
+    else if (!strcmp(a, "--rate"))
+      bad = parse_num(v, 0, 1e8, &o->rate_kbit, a);
+    else if (!strcmp(a, "--duration"))
+      bad = parse_num(v, 0.001, 86400, &o->duration_s, a);
     else if (!strcmp(a, "--queue")) {
       bad = parse_num(v, 1500, 1e9, &x, a);
       o->queue_bytes = (long)x;
@@ -286,8 +294,7 @@ static int parse_opts(int argc, char **argv, opts_t *o) {
             o->ge_r < 0 || o->ge_r > 100 || o->ge_h < 0 || o->ge_h > 100;
       if (bad) fprintf(stderr, "link_emu: --burst: '%s' is not P,R,H (percent each)\n", v);
     } else if (!strcmp(a, "--down")) {
-      bad = o->ndown >= MAX_DOWN ||
-            sscanf(v, "%lf:%lf", &o->down_at[o->ndown], &o->down_for[o->ndown]) != 2 ||
+      bad = o->ndown >= MAX_DOWN || sscanf(v, "%lf:%lf", &o->down_at[o->ndown], &o->down_for[o->ndown]) != 2 ||
             o->down_at[o->ndown] < 0 || o->down_for[o->ndown] <= 0;
       if (bad) fprintf(stderr, "link_emu: --down: '%s' is not AT:FOR seconds (at most %d)\n", v, MAX_DOWN);
       o->ndown++;
@@ -305,11 +312,11 @@ static int parse_opts(int argc, char **argv, opts_t *o) {
 }
 
 static void report(const dir_t *d) {
-  printf("link %s: in=%" PRIu64 " out=%" PRIu64 " dropped=%" PRIu64 " loss=%" PRIu64 " queue=%" PRIu64
-         " down=%" PRIu64 " duplicated=%" PRIu64 " reordered=%" PRIu64 " flushed=%zu tx_errors=%" PRIu64
-         " bytes_in=%" PRIu64 " bytes_out=%" PRIu64 "\n",
-         d->name, d->in, d->out, d->drop_loss + d->drop_queue + d->drop_down, d->drop_loss, d->drop_queue,
-         d->drop_down, d->dups, d->reordered, d->n, d->tx_err, d->bytes_in, d->bytes_out);
+  printf("link %s: in=%" PRIu64 " out=%" PRIu64 " dropped=%" PRIu64 " loss=%" PRIu64 " queue=%" PRIu64 " down=%" PRIu64
+         " duplicated=%" PRIu64 " reordered=%" PRIu64 " flushed=%zu tx_errors=%" PRIu64 " bytes_in=%" PRIu64
+         " bytes_out=%" PRIu64 "\n",
+         d->name, d->in, d->out, d->drop_loss + d->drop_queue + d->drop_down, d->drop_loss, d->drop_queue, d->drop_down,
+         d->dups, d->reordered, d->n, d->tx_err, d->bytes_in, d->bytes_out);
 }
 
 /* Forwards until --duration or a signal; 0, or 1 on a socket error. */
@@ -368,8 +375,8 @@ int main(int argc, char **argv) {
   signal(SIGTERM, on_sig);
   printf("link_emu: %s <-> %s delay=%.1fms jitter=%.1fms reorder=%s loss=%.2f%% burst=%.1f,%.1f,%.1f "
          "rate=%.0fkbit dup=%.2f%% down=%d seed=%" PRIu64 " duration=%.1fs\n",
-         o.ifa, o.ifb, o.delay_ms, o.jitter_ms, o.reorder ? "yes" : "no", o.loss, o.ge_p, o.ge_r, o.ge_h,
-         o.rate_kbit, o.dup, o.ndown, o.seed, o.duration_s);
+         o.ifa, o.ifb, o.delay_ms, o.jitter_ms, o.reorder ? "yes" : "no", o.loss, o.ge_p, o.ge_r, o.ge_h, o.rate_kbit,
+         o.dup, o.ndown, o.seed, o.duration_s);
   fflush(stdout);
   if (o.ready) {
     FILE *f = fopen(o.ready, "w");

@@ -77,7 +77,9 @@ sites_down() {
   [ "${1:-}" = quiet ] || echo "sites: $SITES_PFX-{a,b,link} removed"
 }
 
-# run_in_site a|b|link COMMAND...: runs COMMAND in that site with its network variables.
+# run_in_site a|b|link COMMAND...: runs COMMAND in that site with its network variables
+# (run_in_site ... & gives in $! the pid of COMMAND itself: in any subshell it execs,
+# so do not call it inside ( ... ) with commands after it).
 run_in_site() {
   local site="$1" ifc peer self
   shift
@@ -87,6 +89,11 @@ run_in_site() {
     link) ifc="" self="" peer="" ;;
     *) echo "run_in_site: no site '$site'" >&2; return 2 ;;
   esac
+  # In a subshell (run_in_site ... &, $(...)) exec, so that $! is the program itself
+  # and a signal sent to it reaches it.
+  if [ "$BASHPID" != "$$" ]; then
+    exec ip netns exec "$SITES_PFX-$site" env VISCERA_IFACE="$ifc" VISCERA_PEER="$peer" VISCERA_SITE_ADDR="$self" "$@"
+  fi
   ip netns exec "$SITES_PFX-$site" env VISCERA_IFACE="$ifc" VISCERA_PEER="$peer" VISCERA_SITE_ADDR="$self" "$@"
 }
 
