@@ -54,9 +54,12 @@ int main(int argc, char **argv) {
   const char *partition = NULL;
   double duration = 10;
   for (int c; (c = getopt_long(argc, argv, "", opts, NULL)) != -1;) {
-    if (c == 'p') partition = optarg;
-    else if (c == 'd') duration = atof(optarg);
-    else return 2;
+    if (c == 'p')
+      partition = optarg;
+    else if (c == 'd')
+      duration = atof(optarg);
+    else
+      return 2;
   }
   verr_t err;
   int domain = cli_env_domain(&err);
