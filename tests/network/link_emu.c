@@ -26,6 +26,11 @@
  *   --duration S      stop by itself after S seconds (required, > 0)
  *   --a IF --b IF     the two interfaces (required)
  *   --ready FILE      written once both sockets are bound (tests wait on it)
+ *   --port-stats      also count forwarded IPv4 UDP frames per destination port
+ *                     (DDS: one unicast port pair per participant, so per
+ *                     process), printed as
+ *                       link a->b port=P frames=N bytes=N
+ *                     (port 0: IP fragments after the first, without a UDP header)
  *
  * SIGINT / SIGTERM stop it early. On exit it prints one line per direction:
  *   link a->b: in=N out=N dropped=N loss=N queue=N down=N duplicated=N
@@ -57,11 +62,12 @@
 #define MAX_FRAME 9216
 #define MAX_DOWN 8
 #define MAX_QUEUED 65536
+#define MAX_PORTS 64
 
 typedef struct opts {
   double delay_ms, jitter_ms, loss, ge_p, ge_r, ge_h, rate_kbit, dup, duration_s;
   double down_at[MAX_DOWN], down_for[MAX_DOWN];
-  int ndown, reorder;
+  int ndown, reorder, port_stats;
   long queue_bytes;
   uint64_t seed;
   const char *ifa, *ifb, *ready;
@@ -84,7 +90,32 @@ typedef struct dir {
   frame_t *heap;
   size_t n;
   uint64_t in, out, drop_loss, drop_queue, drop_down, dups, reordered, bytes_in, bytes_out, tx_err;
+  uint16_t port[MAX_PORTS]; /* --port-stats: forwarded frames per UDP destination port */
+  uint64_t port_frames[MAX_PORTS], port_bytes[MAX_PORTS];
+  int nports;
 } dir_t;
+
+/* The UDP destination port of an IPv4 frame (0 for a later fragment), -1 if not UDP over IPv4. */
+static int udp_dst_port(const unsigned char *f, int len) {
+  if (len < 14 + 20 || f[12] != 0x08 || f[13] != 0x00 || (f[14] >> 4) != 4 || f[23] != 17) return -1;
+  int ihl = (f[14] & 15) * 4, frag_off = ((f[20] & 0x1f) << 8) | f[21];
+  if (frag_off != 0) return 0;
+  if (len < 14 + ihl + 4) return -1;
+  return (f[14 + ihl + 2] << 8) | f[14 + ihl + 3];
+}
+
+static void count_port(dir_t *d, const unsigned char *f, int len) {
+  int p = udp_dst_port(f, len), i;
+  if (p < 0) return;
+  for (i = 0; i < d->nports && d->port[i] != p; i++) {
+  }
+  if (i == d->nports) {
+    if (d->nports == MAX_PORTS) return;
+    d->port[d->nports++] = (uint16_t)p;
+  }
+  d->port_frames[i]++;
+  d->port_bytes[i] += (uint64_t)len;
+}
 
 static volatile sig_atomic_t g_stop;
 static void on_sig(int s) {
@@ -222,7 +253,7 @@ static void admit(dir_t *d, const opts_t *o, const unsigned char *buf, int len, 
   }
 }
 
-static void release_due(dir_t *d, int64_t t) {
+static void release_due(dir_t *d, int64_t t, int port_stats) {
   while (d->n > 0 && d->heap[0].release_ns <= t) {
     frame_t f = heap_pop(d);
     if (d->sent_any && f.seq < d->max_sent_seq) d->reordered++;
@@ -231,6 +262,7 @@ static void release_due(dir_t *d, int64_t t) {
     if (send(d->out_fd, f.data, (size_t)f.len, 0) == f.len) {
       d->out++;
       d->bytes_out += (uint64_t)f.len;
+      if (port_stats) count_port(d, f.data, f.len);
     } else {
       d->tx_err++;
     }
@@ -257,6 +289,10 @@ static int parse_opts(int argc, char **argv, opts_t *o) {
     double x;
     if (!strcmp(a, "--no-reorder")) {
       o->reorder = 0;
+      continue;
+    }
+    if (!strcmp(a, "--port-stats")) {
+      o->port_stats = 1;
       continue;
     }
     if (!v) {
@@ -317,6 +353,9 @@ static void report(const dir_t *d) {
          " bytes_out=%" PRIu64 "\n",
          d->name, d->in, d->out, d->drop_loss + d->drop_queue + d->drop_down, d->drop_loss, d->drop_queue, d->drop_down,
          d->dups, d->reordered, d->n, d->tx_err, d->bytes_in, d->bytes_out);
+  for (int i = 0; i < d->nports; i++)
+    printf("link %s port=%u frames=%" PRIu64 " bytes=%" PRIu64 "\n", d->name, d->port[i], d->port_frames[i],
+           d->port_bytes[i]);
 }
 
 /* Forwards until --duration or a signal; 0, or 1 on a socket error. */
@@ -329,8 +368,8 @@ static int forward(dir_t d[2], const opts_t *op) {
   while (!g_stop) {
     int64_t t = now_ns();
     if (t >= end) break;
-    release_due(&d[0], t);
-    release_due(&d[1], t);
+    release_due(&d[0], t, o.port_stats);
+    release_due(&d[1], t, o.port_stats);
     int64_t wake = end;
     for (int k = 0; k < 2; k++)
       if (d[k].n > 0 && d[k].heap[0].release_ns < wake) wake = d[k].heap[0].release_ns;
