@@ -62,7 +62,7 @@
 #define MAX_FRAME 9216
 #define MAX_DOWN 8
 #define MAX_QUEUED 65536
-#define MAX_PORTS 64
+#define MAX_PORTS 512
 
 typedef struct opts {
   double delay_ms, jitter_ms, loss, ge_p, ge_r, ge_h, rate_kbit, dup, duration_s;

@@ -71,7 +71,7 @@ sites_down() {
   [ -z "$LINK_PID" ] || link_stop >/dev/null 2>&1 || true
   local ns p
   for ns in a b link; do
-    ip netns pids "$SITES_PFX-$ns" 2>/dev/null | while read -r p; do kill -9 "$p" 2>/dev/null || true; done
+    { ip netns pids "$SITES_PFX-$ns" 2>/dev/null || true; } | while read -r p; do kill -9 "$p" 2>/dev/null || true; done
     ip netns del "$SITES_PFX-$ns" 2>/dev/null || true
   done
   [ "${1:-}" = quiet ] || echo "sites: $SITES_PFX-{a,b,link} removed"
