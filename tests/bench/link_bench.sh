@@ -16,10 +16,13 @@
 # Figures, not pass/fail. Needs root (network namespaces).
 # usage: link_bench.sh [--build DIR] [--out DIR] [--quick] [--delays "0 25 ..."] [--losses "0 2 ..."]
 #   --quick: delays 0 50 200, losses 0 5 10 (about 1.5 min)
+#   --config FILE: the Cyclone configuration of the sites (default
+#     deploy/cyclonedds-site.xml; e.g. deploy/cyclonedds-lan.xml to compare)
 # Output: OUT/link.csv, OUT/link_table.md, OUT/*.png (default out/link).
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 BUILD="$ROOT/build" OUT="$ROOT/out/link" DELAYS="0 25 50 100 200" LOSSES="0 2 5 10"
+CONFIG="$ROOT/deploy/cyclonedds-site.xml"
 while [ $# -gt 0 ]; do
   case "$1" in
     --build) BUILD="$2"; shift 2 ;;
@@ -27,6 +30,7 @@ while [ $# -gt 0 ]; do
     --quick) DELAYS="0 50 200" LOSSES="0 5 10"; shift ;;
     --delays) DELAYS="$2"; shift 2 ;;
     --losses) LOSSES="$2"; shift 2 ;;
+    --config) CONFIG="$(cd "$(dirname "$2")" && pwd)/$(basename "$2")"; shift 2 ;;
     *) echo "link_bench: unknown option '$1'" >&2; exit 2 ;;
   esac
 done
@@ -64,7 +68,7 @@ run() {
   local n="$1" lo="$2" delay="$3" loss="$4" reorder="$5" jitter srv hap kw site=b uri ro=()
   jitter=$(awk -v d="$delay" 'BEGIN { printf "%g", d / 5 }')
   [ "$reorder" = yes ] || ro=(--no-reorder)
-  uri="file://$ROOT/deploy/cyclonedds-site.xml"
+  uri="file://$CONFIG"
   if [ "$lo" = 1 ]; then site=a uri="file://$ROOT/deploy/cyclonedds-loopback.xml"; fi
   link_start --duration 120 --seed 23 --port-stats --delay "$delay" --jitter "$jitter" --loss "$loss" "${ro[@]}" \
     || { echo "link_bench: emulator did not start" >&2; exit 1; }
@@ -113,9 +117,9 @@ for d in $DELAYS; do
   done
 done
 load=$(uptime | sed 's/.*load average: //')
-awk -F, -v load="$load" 'NR == 1 { print "| one way (ms) | jitter | loss % | reorder | peak force (N) | vs loopback | largest step (N) | energy (J) | commands applied | keyframe (ms) | seat kbit/s | viewer kbit/s |";
+awk -F, -v load="$load" -v cfg="$(basename "$CONFIG")" 'NR == 1 { print "| one way (ms) | jitter | loss % | reorder | peak force (N) | vs loopback | largest step (N) | energy (J) | commands applied | keyframe (ms) | seat kbit/s | viewer kbit/s |";
     print "|---|---|---|---|---|---|---|---|---|---|---|---|"; next }
   { printf "| %s | %s | %s | %s | %s | %+.0f %% | %s | %s | %s %% | %s | %.0f | %.0f |\n", $1, $2, $3, $4, $5, $6, $7, ($8 == "nan" ? "-" : $8), $9, $10, $11, $12 }
-  END { printf "\nload average at the end: %s\n", load }' "$OUT/link.csv" > "$OUT/link_table.md"
+  END { printf "\nconfiguration %s; load average at the end: %s\n", cfg, load }' "$OUT/link.csv" > "$OUT/link_table.md"
 cat "$OUT/link_table.md"
 "$BUILD/tests/bench/link_plot" "$OUT/link.csv" "$OUT" || echo "link_bench: no plots (link_plot failed)" >&2
