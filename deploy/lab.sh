@@ -84,16 +84,9 @@ NET="${CYCLONEDDS_URI:-file://$ROOT/deploy/cyclonedds-loopback.xml}"
 # Off loopback, secure by default (issue 14): a network configuration runs
 # with DDS Security, or only behind an explicit --insecure that says so.
 [ $SECURE = 1 ] && [ $INSECURE = 1 ] && { echo "lab.sh: --secure and --insecure exclude each other" >&2; exit 2; }
-if [ $SECURE = 0 ] && [ "$NET" != "file://$ROOT/deploy/cyclonedds-loopback.xml" ] &&
-  [[ ! "$NET" =~ ^file://.*/cyclonedds-loopback\.xml$ ]]; then
-  if [ $INSECURE = 0 ]; then
-    echo "lab.sh: CYCLONEDDS_URI=$NET is not the loopback configuration: run with --secure" \
-      "(DDS Security, PKI from deploy/pki.sh), or with --insecure to run without it" >&2
-    exit 2
-  fi
-  echo "lab.sh: WARNING: --insecure: DDS Security is off on $NET; anyone on that network can read" \
-    "every seat and drive its tools" >&2
-fi
+# shellcheck source=net_guard.sh
+source "$ROOT/deploy/net_guard.sh"
+net_guard lab.sh "$NET" $SECURE $INSECURE || exit 2
 mkdir -p "$OUT"
 OUT="$(cd "$OUT" && pwd)" # children get absolute paths
 LAST=$((FIRST + SEATS - 1))

@@ -45,7 +45,7 @@ split() { # split NAME EMULATOR-OPTIONS...
   wait "$lb" || fail "$n: lab.sh in site b failed: $(tail -5 "$OUT/$n-lab-b.txt")"
   PIDS=()
   link_stop > "$OUT/$n-link.txt"
-  grep -q "WARNING: --insecure: DDS Security is off" "$OUT/$n-lab-a.txt" || fail "$n: lab.sh --insecure did not warn"
+  grep -q "WARNING: insecure: DDS Security is off" "$OUT/$n-lab-a.txt" || fail "$n: lab.sh --insecure did not warn"
   q() { sqlite3 "$OUT/$n-a/lab.db" "SELECT count(*) FROM samples s JOIN writers w ON s.writer_id = w.id
     JOIN topics t ON t.id = s.topic_id WHERE t.name = '$1' AND w.partitions = '$2' AND s.kind = 0"; }
   for seat in lab/seat01 lab/seat02 lab/seat03 lab/seat04; do
