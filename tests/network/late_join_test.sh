@@ -31,9 +31,9 @@ late_join() { # late_join NAME EMULATOR-OPTIONS...
   run_in_site b "$BUILD/client/viewer/viscera-viewer" --partition $SEAT --out "$OUT/$n-frames" --interval-ms 0 \
     --dump-mesh "$OUT/$n-viewer.obj" > "$OUT/$n-viewer.out" 2> "$OUT/$n-viewer.log" &
   vw=$!; PIDS+=("$vw")
-  run_in_site b "$BUILD/tests/network/keyframe_wait" --partition $SEAT --duration 3 > "$OUT/$n-keyframe.out" 2>&1 &
+  run_in_site b "$BUILD/tests/network/keyframe_wait" --partition $SEAT --duration 6 > "$OUT/$n-keyframe.out" 2>&1 &
   kw=$!; PIDS+=("$kw")
-  sleep 3
+  sleep 6 # discovery over the lossy link can take a lost announcement or two (1 s each)
   kill -INT "$srv"; wait "$srv" || fail "$n: server exited with an error"
   sleep 1.5 # the last frame's retransmissions
   kill -INT "$vw"; wait "$vw" || fail "$n: viewer exited with an error"
