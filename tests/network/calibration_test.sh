@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Calibration of the two-site harness (issue 14): a server in site a and a
 # scripted trainee (palpate_kidney.traj) in site b on deploy/cyclonedds-site.xml,
-# through link_emu, at two link settings:
+# through link_emu, at three link settings:
 #   1. 0 ms, 0 % loss: the emulator forwards every frame both ways (out = in,
 #      nothing dropped) and the server applies >= 99 % of the trainee's
 #      commands (its own counter against the client's ticks); contact is felt.
@@ -12,7 +12,9 @@
 #      cores: 98.7 % at 1 kHz, 95 % at 500 Hz);
 #   2. 25 ms one way, 5 % random loss: the emulator drops 2-10 % of the frames
 #      each way, the client's command -> feedback latency median is at least
-#      the 50 ms round trip, contact is still felt.
+#      the 50 ms round trip, contact is still felt;
+#   3. 0 ms, 20 % of the frames duplicated: nothing is applied twice (the
+#      server applied at most as many commands as were sent, and still >= 99 %).
 # usage: calibration_test.sh BUILD SRC OUT
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/prelude.sh"
@@ -48,6 +50,14 @@ done
 awk -v a="${app:-0}" -v t="${ticks:-0}" 'BEGIN { exit !(t > 500 && a >= 0.99 * t) }' \
   || fail "ideal link: $app of $ticks commands applied (< 99 %)"
 awk -v f="${peak:-0}" 'BEGIN { exit !(f > 0.3) }' || fail "ideal link: no contact force"
+
+# 3. Duplicated frames: DDS drops the copies, the server applies each command once.
+palpate dup --delay 0 --dup 20
+ticks=$(field "$OUT/dup-haptic.out" ticks); app=$(applied dup)
+echo "0 ms, 20 % duplicated: $app of $ticks commands applied; $(link_count 'b->a' duplicated) frames duplicated b->a"
+[ "$(link_count 'b->a' duplicated)" -gt 100 ] || fail "dup: the emulator duplicated $(link_count 'b->a' duplicated) frames"
+awk -v a="${app:-0}" -v t="${ticks:-0}" 'BEGIN { exit !(t > 500 && a <= t && a >= 0.99 * t) }' \
+  || fail "duplicated frames: $app commands applied of $ticks sent"
 
 # 2. Delay and loss, as configured.
 palpate lossy --delay 25 --loss 5
