@@ -16,7 +16,9 @@
 # and runs link_emu between them. The sites are one Ethernet segment (ARP and
 # multicast cross the emulator like any frame). Transmit checksum and
 # segmentation offloads are off on all four veths: a forwarded frame keeps the
-# checksum its sender wrote. Nothing is created outside these namespaces.
+# checksum its sender wrote. IPv6 is off and the two addresses are static
+# neighbours, so the link carries only the programs' own frames (and their
+# multicast). Nothing is created outside these namespaces.
 #
 # Inside a site, run_in_site exports VISCERA_IFACE (the site's interface),
 # VISCERA_PEER (the other site's address) and VISCERA_SITE_ADDR (its own), which
@@ -55,11 +57,23 @@ sites_up() {
   sites_down quiet
   local ns
   for ns in a b link; do ip netns add "$SITES_PFX-$ns" || return 1; done
-  for ns in a b link; do ip -n "$SITES_PFX-$ns" link set lo up || return 1; done
+  for ns in a b link; do
+    ip -n "$SITES_PFX-$ns" link set lo up || return 1
+    # No IPv6 on the sites: its autoconfiguration and MLD frames would cross the
+    # link at times of their own and shift the emulator's seeded decisions.
+    ip netns exec "$SITES_PFX-$ns" sysctl -qw net.ipv6.conf.all.disable_ipv6=1 net.ipv6.conf.default.disable_ipv6=1 \
+      >/dev/null 2>&1 || true
+  done
   _sites_veth "${SITES_PFX}a0" "$SITES_PFX-a" "${SITES_PFX}la" || return 1
   _sites_veth "${SITES_PFX}b0" "$SITES_PFX-b" "${SITES_PFX}lb" || return 1
   ip -n "$SITES_PFX-a" addr add "$SITE_A_ADDR/24" dev "${SITES_PFX}a0" || return 1
   ip -n "$SITES_PFX-b" addr add "$SITE_B_ADDR/24" dev "${SITES_PFX}b0" || return 1
+  # Static neighbours: no ARP frames on the link either.
+  local mac_a mac_b
+  mac_a=$(ip netns exec "$SITES_PFX-a" cat "/sys/class/net/${SITES_PFX}a0/address") || return 1
+  mac_b=$(ip netns exec "$SITES_PFX-b" cat "/sys/class/net/${SITES_PFX}b0/address") || return 1
+  ip -n "$SITES_PFX-a" neigh replace "$SITE_B_ADDR" lladdr "$mac_b" dev "${SITES_PFX}a0" nud permanent || return 1
+  ip -n "$SITES_PFX-b" neigh replace "$SITE_A_ADDR" lladdr "$mac_a" dev "${SITES_PFX}b0" nud permanent || return 1
   # Multicast (Cyclone's SPDP in the LAN configuration) leaves by the site's interface.
   ip -n "$SITES_PFX-a" route add 224.0.0.0/4 dev "${SITES_PFX}a0" || return 1
   ip -n "$SITES_PFX-b" route add 224.0.0.0/4 dev "${SITES_PFX}b0" || return 1
