@@ -26,6 +26,7 @@
  *   --duration S      stop by itself after S seconds (required, > 0)
  *   --a IF --b IF     the two interfaces (required)
  *   --ready FILE      written once both sockets are bound (tests wait on it)
+ *   --help            a usage summary
  *   --port-stats      also count forwarded IPv4 UDP frames per destination port
  *                     (DDS: one unicast port pair per participant, so per
  *                     process), printed as
@@ -282,11 +283,23 @@ static int parse_num(const char *s, double lo, double hi, double *v, const char 
   return 0;
 }
 
+static void usage(FILE *f) {
+  fprintf(f, "usage: link_emu --a IF --b IF --duration S [--delay MS] [--jitter MS] [--no-reorder] [--loss PCT]\n"
+             "                [--burst P,R,H] [--rate KBIT] [--queue BYTES] [--dup PCT] [--down AT:FOR]...\n"
+             "                [--seed N] [--ready FILE] [--port-stats]\n"
+             "Forwards Ethernet frames between IF a and IF b with the given impairments, per direction;\n"
+             "prints per direction what it did at the end (tests/network/link_emu.c explains each option).\n");
+}
+
 static int parse_opts(int argc, char **argv, opts_t *o) {
   *o = (opts_t){.reorder = 1, .queue_bytes = 256000, .seed = 1};
   for (int i = 1; i < argc; i++) {
     const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
     double x;
+    if (!strcmp(a, "--help")) {
+      usage(stdout);
+      exit(0);
+    }
     if (!strcmp(a, "--no-reorder")) {
       o->reorder = 0;
       continue;
@@ -342,6 +355,7 @@ static int parse_opts(int argc, char **argv, opts_t *o) {
   }
   if (!o->ifa || !o->ifb || o->duration_s <= 0) {
     fprintf(stderr, "link_emu: --a IF, --b IF and --duration S are required\n");
+    usage(stderr);
     return -1;
   }
   return 0;
