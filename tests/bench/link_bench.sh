@@ -102,8 +102,8 @@ run() {
   awk -v d="$delay" -v j="$jitter" -v l="$loss" -v r="$reorder" -v p="${peak:-nan}" -v ref="${REF_PEAK:-nan}" \
     -v s="$step" -v e="${energy:-nan}" -v a="${app:-0}" -v t="${ticks:-0}" -v k="${kf:--1}" -v sb="$seat_b" \
     -v vb="$view_b" -v du="$dur" -v lo="$lo" 'BEGIN {
-      printf "%s,%s,%s,%s,%.3f,%.1f,%s,%s,%.1f,%s,%.1f,%.1f\n", (lo ? "loopback" : d), j, l, r, p, 100 * (p - ref) / ref, s, e,
-        (t > 0 ? 100 * a / t : 0), k, (lo || du <= 0 ? 0 : sb * 8 / 1000 / du), (lo ? 0 : vb * 8 / 1000 / 4) }' >> "$OUT/link.csv"
+      printf "%s,%s,%s,%s,%.3f,%.1f,%s,%s,%.1f,%s,%s,%s\n", (lo ? "loopback" : d), j, l, r, p, 100 * (p - ref) / ref, s, e,
+        (t > 0 ? 100 * a / t : 0), k, (lo || du <= 0 ? "nan" : sprintf("%.1f", sb * 8 / 1000 / du)), (lo ? "nan" : sprintf("%.1f", vb * 8 / 1000 / 4)) }' >> "$OUT/link.csv"
   tail -1 "$OUT/link.csv"
 }
 
@@ -119,7 +119,7 @@ done
 load=$(uptime | sed 's/.*load average: //')
 awk -F, -v load="$load" -v cfg="$(basename "$CONFIG")" 'NR == 1 { print "| one way (ms) | jitter | loss % | reorder | peak force (N) | vs loopback | largest step (N) | energy (J) | commands applied | keyframe (ms) | seat kbit/s | viewer kbit/s |";
     print "|---|---|---|---|---|---|---|---|---|---|---|---|"; next }
-  { printf "| %s | %s | %s | %s | %s | %+.0f %% | %s | %s | %s %% | %s | %.0f | %.0f |\n", $1, $2, $3, $4, $5, $6, $7, ($8 == "nan" ? "-" : $8), $9, $10, $11, $12 }
+  { printf "| %s | %s | %s | %s | %s | %+.0f %% | %s | %s | %s %% | %s | %s | %s |\n", $1, $2, $3, $4, $5, $6, $7, ($8 == "nan" ? "-" : $8), $9, $10, ($11 == "nan" ? "-" : sprintf("%.0f", $11)), ($12 == "nan" ? "-" : sprintf("%.0f", $12)) }
   END { printf "\nconfiguration %s; load average at the end: %s\n", cfg, load }' "$OUT/link.csv" > "$OUT/link_table.md"
 cat "$OUT/link_table.md"
 "$BUILD/tests/bench/link_plot" "$OUT/link.csv" "$OUT" || echo "link_bench: no plots (link_plot failed)" >&2
