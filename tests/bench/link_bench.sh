@@ -8,11 +8,12 @@
 # reference (both in site a on deploy/cyclonedds-loopback.xml).
 # Per setting (CSV and a table):
 #   peak force and its error against loopback, largest one-tick force change
-#   (from the client's force log), passivity energy (the haptic client's
-#   summary field *energy*=, when it has one), commands applied (server's
-#   counter / client's ticks), keyframe wait (from the writer's match), bytes
-#   per second per seat (trainee's traffic both ways) and per viewer (what
-#   the link carried to the late subscriber's ports: link_emu --port-stats).
+#   (from the client's force log), passivity energy (the largest energy of the
+#   haptic client's passivity observer, its energy_max_j=, when it reports
+#   one), commands applied (server's counter / client's ticks), keyframe
+#   wait (from the writer's match), bytes per second per seat (trainee's
+#   traffic both ways) and per viewer (what the link carried to the late
+#   subscriber's ports: link_emu --port-stats).
 # Figures, not pass/fail. Needs root (network namespaces).
 # usage: link_bench.sh [--build DIR] [--out DIR] [--quick] [--delays "0 25 ..."] [--losses "0 2 ..."]
 #   --quick: delays 0 50 200, losses 0 5 10 (about 1.5 min)
@@ -90,7 +91,9 @@ run() {
   local ticks rate peak app energy step kf dur seat_b view_b
   ticks=$(field "$OUT/run/$n-haptic.out" ticks); rate=$(field "$OUT/run/$n-haptic.out" rate_hz)
   peak=$(field "$OUT/run/$n-haptic.out" peak_force)
-  energy=$(sed -n 's/.*[ _]energy[a-z_]*=\([-0-9.e+]*\).*/\1/p' "$OUT/run/$n-haptic.out" | tail -1)
+  # The passivity observer's largest energy over the run (<= 0: passive), when the client reports one.
+  energy=$(field "$OUT/run/$n-haptic.out" energy_max_j)
+  [ -n "$energy" ] || energy=$(field "$OUT/run/$n-haptic.out" energy_j)
   app=$(sed -n 's/^server: \([0-9]*\) tool commands applied.*/\1/p' "$OUT/run/$n-server.log")
   step=$(force_step "$OUT/run/$n-force.csv")
   kf=$(field "$OUT/run/$n-keyframe.out" wait_ms)
@@ -117,7 +120,7 @@ for d in $DELAYS; do
   done
 done
 load=$(uptime | sed 's/.*load average: //')
-awk -F, -v load="$load" -v cfg="$(basename "$CONFIG")" 'NR == 1 { print "| one way (ms) | jitter | loss % | reorder | peak force (N) | vs loopback | largest step (N) | energy (J) | commands applied | keyframe (ms) | seat kbit/s | viewer kbit/s |";
+awk -F, -v load="$load" -v cfg="$(basename "$CONFIG")" 'NR == 1 { print "| one way (ms) | jitter | loss % | reorder | peak force (N) | vs loopback | largest step (N) | observer energy max (J) | commands applied | keyframe (ms) | seat kbit/s | viewer kbit/s |";
     print "|---|---|---|---|---|---|---|---|---|---|---|---|"; next }
   { printf "| %s | %s | %s | %s | %s | %+.0f %% | %s | %s | %s %% | %s | %s | %s |\n", $1, $2, $3, $4, $5, $6, $7, ($8 == "nan" ? "-" : $8), $9, $10, ($11 == "nan" ? "-" : sprintf("%.0f", $11)), ($12 == "nan" ? "-" : sprintf("%.0f", $12)) }
   END { printf "\nconfiguration %s; load average at the end: %s\n", cfg, load }' "$OUT/link.csv" > "$OUT/link_table.md"
