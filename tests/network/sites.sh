@@ -2,7 +2,8 @@
 #
 #   source tests/network/sites.sh
 #   sites_require || exit $?      # 77 (skip) without root, ip, ethtool or namespaces
-#   sites_up lk3 "$OUT"           # namespaces lk3-a, lk3-b, lk3-link; trap removes them
+#   sites_up lk3 "$OUT"           # namespaces lk3-a, lk3-b, lk3-link; an EXIT trap removes
+#                                 # them (it replaces yours: call sites_down from your own)
 #   link_start --delay 50 --loss 10 --duration 60   # link_emu options (top of link_emu.c)
 #   run_in_site a  "$BUILD/server/viscera-server" ... &   # VISCERA_IFACE etc. already set
 #   run_in_site b  "$BUILD/client/haptic/viscera-haptic" ... &
