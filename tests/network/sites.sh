@@ -8,7 +8,7 @@
 #   run_in_site a  "$BUILD/server/viscera-server" ... &   # VISCERA_IFACE etc. already set
 #   run_in_site b  "$BUILD/client/haptic/viscera-haptic" ... &
 #   link_stop                     # stops the emulator, prints its per-direction counts
-#   link_count a->b out           # one of those counts
+#   link_count 'a->b' out         # one of those counts (quote the direction)
 #   sites_down                    # also run by the EXIT trap sites_up installs
 #
 # Layout: site a (namespace PFX-a) has interface PFXa0 = 10.231.0.1/24 and lo;
