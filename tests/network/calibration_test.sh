@@ -5,11 +5,12 @@
 #   1. 0 ms, 0 % loss: the emulator forwards every frame both ways (out = in,
 #      nothing dropped) and the server applies >= 99 % of the trainee's
 #      commands (its own counter against the client's ticks); contact is felt.
-#      The client runs at 200 Hz, a fifth of the server's step rate: the
+#      The client runs at 100 Hz, a tenth of the server's step rate: the
 #      command reader keeps the newest sample only, so at 1 kHz a busy
 #      machine's late server steps overwrite commands in the reader, a loss
-#      that is not the link's (seen with a lossless link at load 12 on 2
-#      cores: 98.7 % at 1 kHz, 95 % at 500 Hz);
+#      that is not the link's (seen with a lossless link on 2 cores: 98.7 %
+#      at 1 kHz and 95 % at 500 Hz at load 12, 94.8 % at 200 Hz at load 18
+#      with the server at 0.83 simulated s per wall s);
 #   2. 25 ms one way, 5 % random loss: the emulator drops 2-10 % of the frames
 #      each way, the client's command -> feedback latency median is at least
 #      the 50 ms round trip, contact is still felt;
@@ -30,7 +31,7 @@ palpate() { # palpate NAME EMULATOR-OPTIONS...: one session through the link
     > "$OUT/$name-server.out" 2> "$OUT/$name-server.log" &
   srv=$!; PIDS+=("$srv")
   run_in_site b timeout 60 "$BUILD/client/haptic/viscera-haptic" --trajectory "$SRC/assets/trajectories/palpate_kidney.traj" \
-    --partition $SEAT --rate 200 --wait-server 15 --quiet > "$OUT/$name-haptic.out" 2> "$OUT/$name-haptic.log" \
+    --partition $SEAT --rate 100 --wait-server 15 --quiet > "$OUT/$name-haptic.out" 2> "$OUT/$name-haptic.log" \
     || fail "$name: haptic client failed"
   kill -INT "$srv"; wait "$srv" || fail "$name: server exited with an error"
   link_stop > "$OUT/$name-link.txt"
@@ -43,11 +44,11 @@ palpate ideal --delay 0
 ticks=$(field "$OUT/ideal-haptic.out" ticks); app=$(applied ideal); peak=$(field "$OUT/ideal-haptic.out" peak_force)
 echo "0 ms, 0 %: $app of $ticks commands applied, peak force $peak N"
 for d in 'a->b' 'b->a'; do
-  [ "$(link_count "$d" in)" -gt 1000 ] || fail "ideal: only $(link_count "$d" in) frames $d"
+  [ "$(link_count "$d" in)" -gt 400 ] || fail "ideal: only $(link_count "$d" in) frames $d"
   [ "$(link_count "$d" out)" = "$(link_count "$d" in)" ] || fail "ideal: the emulator lost frames $d"
   [ "$(link_count "$d" dropped)" = 0 ] || fail "ideal: the emulator dropped frames $d"
 done
-awk -v a="${app:-0}" -v t="${ticks:-0}" 'BEGIN { exit !(t > 500 && a >= 0.99 * t) }' \
+awk -v a="${app:-0}" -v t="${ticks:-0}" 'BEGIN { exit !(t > 400 && a >= 0.99 * t) }' \
   || fail "ideal link: $app of $ticks commands applied (< 99 %)"
 awk -v f="${peak:-0}" 'BEGIN { exit !(f > 0.3) }' || fail "ideal link: no contact force"
 
@@ -55,8 +56,8 @@ awk -v f="${peak:-0}" 'BEGIN { exit !(f > 0.3) }' || fail "ideal link: no contac
 palpate dup --delay 0 --dup 20
 ticks=$(field "$OUT/dup-haptic.out" ticks); app=$(applied dup)
 echo "0 ms, 20 % duplicated: $app of $ticks commands applied; $(link_count 'b->a' duplicated) frames duplicated b->a"
-[ "$(link_count 'b->a' duplicated)" -gt 100 ] || fail "dup: the emulator duplicated $(link_count 'b->a' duplicated) frames"
-awk -v a="${app:-0}" -v t="${ticks:-0}" 'BEGIN { exit !(t > 500 && a <= t && a >= 0.99 * t) }' \
+[ "$(link_count 'b->a' duplicated)" -gt 50 ] || fail "dup: the emulator duplicated $(link_count 'b->a' duplicated) frames"
+awk -v a="${app:-0}" -v t="${ticks:-0}" 'BEGIN { exit !(t > 400 && a <= t && a >= 0.99 * t) }' \
   || fail "duplicated frames: $app commands applied of $ticks sent"
 
 # 2. Delay and loss, as configured.
@@ -65,7 +66,7 @@ ticks=$(field "$OUT/lossy-haptic.out" ticks); app=$(applied lossy); peak=$(field
 lat=$(field "$OUT/lossy-haptic.out" latency_us_median)
 echo "25 ms, 5 %: $app of $ticks commands applied, peak force $peak N, latency median $lat us"
 for d in 'a->b' 'b->a'; do
-  awk -v l="$(link_count "$d" loss)" -v n="$(link_count "$d" in)" 'BEGIN { exit !(n > 1000 && l >= 0.02 * n && l <= 0.10 * n) }' \
+  awk -v l="$(link_count "$d" loss)" -v n="$(link_count "$d" in)" 'BEGIN { exit !(n > 400 && l >= 0.02 * n && l <= 0.10 * n) }' \
     || fail "lossy: $(link_count "$d" loss) of $(link_count "$d" in) frames dropped $d (5 % asked)"
 done
 awk -v l="${lat:-0}" 'BEGIN { exit !(l >= 50000) }' || fail "lossy: latency median $lat us is below the 50 ms round trip"

@@ -8,7 +8,7 @@
 # link settings (20 ms, 2 % loss; 50 +- 10 ms without reordering, 5 % loss and
 # 5 % duplicated frames):
 #   - the viewer ends on the server's last published frame, within q/2 of the
-#     server's exact positions;
+#     server's exact positions (a mesh at least 0.1 mm from the rest shape);
 #   - the recording, rebuilt as a viewer would (rec_mesh), ends on the same
 #     frame and mesh;
 #   - nothing is applied twice: the server applied at most as many commands as
@@ -65,7 +65,7 @@ partition() { # partition NAME EMULATOR-OPTIONS...
   echo "$n: server: $s_head / viewer: $v_head / recording: $r_head"
   [ "$s_head" = "$v_head" ] || fail "$n: viewer is not at the server's last frame"
   [ "$s_head" = "$r_head" ] || fail "$n: recording is not at the server's last frame"
-  "$BUILD/tests/integration/obj_compare" "$OUT/$n-server.obj" "$SRC/assets/meshes/kidney.obj" 1e-3 \
+  "$BUILD/tests/integration/obj_compare" "$OUT/$n-server.obj" "$SRC/assets/meshes/kidney.obj" 1e-4 \
     && fail "$n: organ was not deformed at the end"
   "$BUILD/tests/integration/obj_compare" "$OUT/$n-server.obj" "$OUT/$n-viewer.obj" 5.2e-6 \
     || fail "$n: viewer mesh differs from the server's"
