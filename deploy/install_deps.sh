@@ -18,6 +18,7 @@ PKGS=(
   systemd                                   # systemd-analyze verify of the service units (test)
   help2man                                  # man pages generated at build time from --help
   dpkg-dev file                             # dpkg-shlibdeps and file: the .deb's computed Depends (cpack)
+  iproute2 ethtool                          # network tests: namespaces, veths, checksum offload off
 )
 
 missing=()

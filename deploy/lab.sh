@@ -20,6 +20,10 @@
 #   --viewers K         offscreen viewers per seat (default 1; 0 for none)
 #   --duration S        seconds the lab runs (default 20; 0: until SIGINT/SIGTERM)
 #   --secure            DDS Security on (PKI in --pki DIR)
+#   --insecure          allow a network configuration without DDS Security
+#                       (prints a warning; anyone on the network can then read
+#                       and drive every seat). Without it, a CYCLONEDDS_URI
+#                       other than the loopback file needs --secure.
 #   --pki DIR           the lab's PKI (default OUT/pki; made by pki.sh when missing)
 #   --no-record         no lab recorder
 #   --rt-priority N     every server's physics loop SCHED_FIFO at N (1..99; default 0: normal
@@ -38,7 +42,7 @@
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD="$ROOT/build" OUT="$ROOT/out/lab" SEATS=3 FIRST=1 PREFIX=lab SCENE="$ROOT/assets/scenes/default.yaml"
-TRAINEES=0 VIEWERS=1 DURATION=20 SECURE=0 RECORD=1 PKI="" RTPRIO=0 HRTPRIO=0
+TRAINEES=0 VIEWERS=1 DURATION=20 SECURE=0 INSECURE=0 RECORD=1 PKI="" RTPRIO=0 HRTPRIO=0
 STOP_GRACE_S="${VISCERA_LAB_STOP_GRACE:-10}"
 usage() { awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"; }
 while [ $# -gt 0 ]; do
@@ -53,6 +57,7 @@ while [ $# -gt 0 ]; do
     --viewers) VIEWERS="$2"; shift 2 ;;
     --duration) DURATION="$2"; shift 2 ;;
     --secure) SECURE=1; shift ;;
+    --insecure) INSECURE=1; shift ;;
     --pki) PKI="$2"; shift 2 ;;
     --no-record) RECORD=0; shift ;;
     --rt-priority) RTPRIO="$2"; shift 2 ;;
@@ -80,6 +85,12 @@ SRV_RT=() HAP_RT=()
 [ -x "$BUILD/server/viscera-server" ] || bash "$ROOT/deploy/build.sh" "$BUILD"
 export VISCERA_DOMAIN="${VISCERA_DOMAIN:-0}"
 NET="${CYCLONEDDS_URI:-file://$ROOT/deploy/cyclonedds-loopback.xml}"
+# Off loopback, secure by default (issue 14): a network configuration runs
+# with DDS Security, or only behind an explicit --insecure that says so.
+[ $SECURE = 1 ] && [ $INSECURE = 1 ] && { echo "lab.sh: --secure and --insecure exclude each other" >&2; exit 2; }
+# shellcheck source=net_guard.sh
+source "$ROOT/deploy/net_guard.sh"
+net_guard lab.sh "$NET" $SECURE $INSECURE || exit 2
 mkdir -p "$OUT"
 OUT="$(cd "$OUT" && pwd)" # children get absolute paths
 LAST=$((FIRST + SEATS - 1))

@@ -75,6 +75,11 @@ SRV_RT=() HAP_RT=()
 [ "$HRTPRIO" -gt 0 ] && HAP_RT=(--rt-priority "$HRTPRIO")
 [ -x "$BUILD/tests/bench/delta_sub" ] || { echo "load_bench.sh: $BUILD/tests/bench/delta_sub missing (build with -DVISCERA_BUILD_BENCH=ON)" >&2; exit 1; }
 export CYCLONEDDS_URI="${CYCLONEDDS_URI:-file://$ROOT/deploy/cyclonedds-loopback.xml}"
+# Another configuration than loopback: with a security fragment, or VISCERA_INSECURE=1 (warns).
+# shellcheck source=net_guard.sh
+source "$ROOT/deploy/net_guard.sh"
+net_guard load_bench.sh "$CYCLONEDDS_URI" 0 "${VISCERA_INSECURE:-0}" \
+  "add an identity fragment from deploy/pki.sh to it, or set VISCERA_INSECURE=1 to run without DDS Security" || exit 2
 export VISCERA_DOMAIN="${VISCERA_DOMAIN:-0}"
 [ -r "$SCENE" ] || { echo "load_bench.sh: cannot read the scene '$SCENE'" >&2; exit 2; }
 SCENE_NAME=$(basename "$SCENE" .yaml)

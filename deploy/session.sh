@@ -5,7 +5,9 @@
 #
 # usage: deploy/session.sh BUILD_DIR OUT_DIR [SCENE] [TRAJECTORY]
 # env:   VISCERA_DOMAIN (default 0, like every binary), VISCERA_PARTITION (default demo/seat01),
-#        VIEWER_ARGS, SERVER_ARGS (extra options)
+#        VIEWER_ARGS, SERVER_ARGS (extra options), CYCLONEDDS_URI (default the
+#        loopback configuration; another one needs a security fragment in it, or
+#        VISCERA_INSECURE=1, which warns: deploy/net_guard.sh)
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD="$1"
@@ -15,6 +17,10 @@ TRAJ="${4:-$ROOT/assets/trajectories/palpate_kidney.traj}"
 DOMAIN="${VISCERA_DOMAIN:-0}"
 PART="${VISCERA_PARTITION:-demo/seat01}"
 export CYCLONEDDS_URI="${CYCLONEDDS_URI:-file://$ROOT/deploy/cyclonedds-loopback.xml}"
+# shellcheck source=net_guard.sh
+source "$ROOT/deploy/net_guard.sh"
+net_guard session.sh "$CYCLONEDDS_URI" 0 "${VISCERA_INSECURE:-0}" \
+  "add an identity fragment from deploy/pki.sh to it, or set VISCERA_INSECURE=1 to run without DDS Security" || exit 2
 
 mkdir -p "$OUT"
 rm -rf "$OUT/frames" "$OUT/session.db" "$OUT/session.db-wal" "$OUT/session.db-shm"
