@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "contact_model.h"
+#include "contact_render.h"
 #include "guide_force.h"
 #include "viscera.h"
 #include "vtime.h"
@@ -18,6 +19,9 @@ typedef struct tick_state {
   uint64_t seq;
   int server_lost_reported;
   uint64_t live_lost_reported_ns;
+  int cut;            /* this tick: the server is lost, zero the force at once */
+  int stale;          /* no feedback for CONTACT_RENDER_HOLD_S: the model ramps out */
+  contact_render_t render; /* re-anchoring, ramp, passivity (contact_render.h) */
 } tick_state_t;
 
 /* The device's pose as this tick's ToolCommand. */
@@ -33,22 +37,26 @@ static void send_command(const haptic_loop_t *l, tick_state_t *s, uint64_t now, 
   cmd.buttons = buttons;
   cmd.max_force = (float)l->dev->max_force;
   feedback_slot_sent(&l->h->slot, cmd.seq, cmd.client_mono_ns); /* before the write: the echo may beat it back */
+  contact_render_sent(&s->render, cmd.seq, pos);
   dds_write(l->h->w_cmd, &cmd);
 }
 
-/* The latest contact model, cleared (and said once) when the server is lost.
+/* The latest contact model, and whether to render it (contact_render.h):
+ * cut when the server is lost by liveliness (its process is gone or
+ * unreachable for a whole lease, vdds.h), stale when it is alive but has
+ * sent nothing for CONTACT_RENDER_HOLD_S (a slow or lossy link, a stalled
+ * server: the model is held, then ramped out, never a "server lost").
  * Returns the monotonic time of the last feedback (0: none yet). */
 static uint64_t read_feedback(const haptic_loop_t *l, tick_state_t *s, uint64_t now) {
   uint64_t last_fb_mono = feedback_slot_read(&l->h->slot, &s->model);
   uint64_t lost_ns = 0, lost_last = 0;
   int lost_live = feedback_slot_server_lost(&l->h->slot, &lost_ns, &lost_last);
-  if (last_fb_mono && s->server_lost_reported && !lost_live && now - last_fb_mono < 50000000ull) {
-    fprintf(stderr, "haptic: server back\n");
+  int fresh = last_fb_mono && now - last_fb_mono < (uint64_t)(CONTACT_RENDER_HOLD_S * 1e9);
+  if (s->server_lost_reported && !lost_live && fresh && last_fb_mono > lost_ns) {
+    fprintf(stderr, "haptic: server back, force ramps back to the tissue's\n");
     s->server_lost_reported = 0;
   }
-  /* The server process is gone (its feedback writer's liveliness lapsed):
-   * the listener already cleared the slot; say so once per loss, even when
-   * the feedback timeout happened to notice first on a loaded machine. */
+  s->cut = lost_live;
   if (lost_live) {
     s->model.in_contact = 0;
     if (lost_ns != s->live_lost_reported_ns) {
@@ -58,17 +66,18 @@ static uint64_t read_feedback(const haptic_loop_t *l, tick_state_t *s, uint64_t 
               "zero\n",
               lost_last ? (double)(lost_ns - lost_last) * 1e-6 : -1.0, VDDS_FEEDBACK_LEASE_MS);
       s->server_lost_reported = 1;
+      l->st->server_lost++;
     }
   }
-  /* No feedback for 50 ms while the server is alive (stalled, or not
-   * answering this tool): render nothing rather than a stale wall. */
-  if (last_fb_mono && now > last_fb_mono + 50000000ull) {
-    s->model.in_contact = 0;
-    if (!s->server_lost_reported) {
-      fprintf(stderr, "haptic: server lost (no feedback for 50 ms), force set to zero\n");
-      s->server_lost_reported = 1;
-    }
+  int stale = last_fb_mono && !fresh && !lost_live;
+  if (stale && !s->stale) {
+    l->st->feedback_stale++;
+    if (!l->o->quiet)
+      fprintf(stderr, "haptic: no feedback for %.0f ms from a live server, force ramps out\n",
+              CONTACT_RENDER_HOLD_S * 1e3);
   }
+  s->stale = stale;
+  if (stale) s->model.in_contact = 0;
   return last_fb_mono;
 }
 
@@ -105,6 +114,14 @@ static void render_force(const haptic_loop_t *l, tick_state_t *s, double t, uint
   memcpy(gin.v, vel, sizeof gin.v);
   memcpy(gin.peer, gv.peer, sizeof gin.peer);
   guide_force(&gin, gout);
+  /* Uncoupled, the contact model re-anchored at our own position; coupled,
+   * the guiding law's force. Either way ramped and observed. */
+  double target[3];
+  if (gout->coupled)
+    memcpy(target, gout->f, sizeof target);
+  else
+    contact_render_target(&s->render, s->cut ? NULL : &s->model, pos, vel, target);
+  gout->magnitude = contact_render_output(&s->render, target, s->cut, vel, gout->f);
   guide_report_tick(l->guide, t, &gv.role, gv.peer_station, gv.peer_age_s, gout, o->quiet ? NULL : stderr);
 }
 
@@ -121,15 +138,21 @@ static void record_force(const haptic_loop_t *l, const tick_state_t *s, double t
     st->force_sum += mag;
   }
   if (mag > st->peak_force) st->peak_force = mag;
+  st->energy_max_j = s->render.pc.energy_max;
+  st->step_max_n = s->render.step_max;
   if (l->csv)
-    fprintf(l->csv, "%.4f,%.6f,%.6f,%.6f,%.5f,%.5f,%.5f,%d\n", t, pos[0], pos[1], pos[2], f[0], f[1], f[2],
-            s->model.in_contact);
+    fprintf(l->csv, "%.4f,%.6f,%.6f,%.6f,%.5f,%.5f,%.5f,%d,%.7f,%.5f\n", t, pos[0], pos[1], pos[2], f[0], f[1], f[2],
+            s->model.in_contact, s->render.pc.energy, s->render.step_tick);
 }
 
 void haptic_loop_run(const haptic_loop_t *l) {
   const haptic_options_t *o = l->o;
   haptic_stats_t *st = l->st;
-  tick_state_t s = {.own_station = o->station ? o->station : ""};
+  static tick_state_t s; /* the renderer's position ring is 32 kB */
+  memset(&s, 0, sizeof s);
+  s.own_station = o->station ? o->station : "";
+  contact_render_init(&s.render, 1.0 / o->rate, l->dev->max_force,
+                      l->dev->max_stiffness > 0 ? 2.0 * l->dev->max_stiffness / o->rate : HAPTIC_MAX_DAMPING);
   uint64_t period_ns = (uint64_t)(1e9 / o->rate);
   double run_for = o->duration >= 0 ? o->duration : 1e300;
   uint64_t start = vtime_mono_ns(), next = start, prev_tick = 0;
@@ -162,5 +185,7 @@ void haptic_loop_run(const haptic_loop_t *l) {
     if (now > next + 100000000ull) next = now; /* resynchronise after a long stall */
   }
   if (l->csv) fclose(l->csv);
+  st->pc_ticks = s.render.pc.active_ticks;
+  st->cuts = s.render.cuts;
   st->elapsed_s = (double)(vtime_mono_ns() - start) * 1e-9;
 }
