@@ -37,10 +37,10 @@ double contact_render_target(contact_render_t *r, const contact_model_t *m, cons
   const double *n = m->normal;
   double k = m->stiffness;
   if (!r->anchored) {
-    /* The press begins: its surface point, and the tool's stiffness until
-     * the press is deep enough to measure the organ's. */
+    /* The press begins: its surface point, and no extrapolation until the
+     * press is deep enough to measure the organ's stiffness. */
     v3_copy(r->onset, m->proxy);
-    r->k_eff = k;
+    r->k_eff = 0;
     r->anchored = 1;
   }
   double x_cmd[3];
@@ -80,7 +80,10 @@ double contact_render_output(contact_render_t *r, const double target[3], int cu
     double g[3];
     v3_copy(g, target);
     if (!v3_isfinite(g)) v3_set(g, 0, 0, 0);
-    passivity_control(&r->pc, v, r->max_force, g);
+    /* Released at max_step per tick, a force f still delivers about
+     * (f . v) T |f| / (2 max_step) after the controller asks for less. */
+    double fv = v3_dot(g, v), reserve = fv > 0 ? fv * r->period_s * v3_norm(g) / (2 * r->max_step) : 0;
+    passivity_control(&r->pc, v, r->max_force, reserve, g);
     double d[3];
     v3_sub(d, g, r->f_prev);
     double step = v3_norm(d);
@@ -99,8 +102,8 @@ double contact_render_output(contact_render_t *r, const double target[3], int cu
   return v3_norm(f);
 }
 
-double contact_render_tick(contact_render_t *r, const contact_model_t *m, int cut, const double x[3],
-                           const double v[3], double f[3]) {
+double contact_render_tick(contact_render_t *r, const contact_model_t *m, int cut, const double x[3], const double v[3],
+                           double f[3]) {
   double target[3];
   contact_render_target(r, cut ? NULL : m, x, v, target);
   return contact_render_output(r, target, cut, v, f);

@@ -51,13 +51,13 @@ typedef struct contact_render {
   double period_s, max_step, max_force;
   uint64_t ring_seq[CONTACT_RENDER_RING];
   double ring_x[CONTACT_RENDER_RING][3];
-  int anchored;      /* the surface point where contact began is known */
-  double onset[3];   /* that point */
-  double k_eff;      /* N/m, the press's filtered secant stiffness */
-  double f_prev[3];  /* force rendered last tick */
-  double step_max;   /* N, the largest one-tick change rendered (cuts excluded) */
-  double step_tick;  /* N, this tick's change */
-  uint64_t cuts;     /* forces zeroed at once (server lost) */
+  int anchored;     /* the surface point where contact began is known */
+  double onset[3];  /* that point */
+  double k_eff;     /* N/m, the press's filtered secant stiffness */
+  double f_prev[3]; /* force rendered last tick */
+  double step_max;  /* N, the largest one-tick change rendered (cuts excluded) */
+  double step_tick; /* N, this tick's change */
+  uint64_t cuts;    /* forces zeroed at once (server lost) */
   uint64_t reanchored_ticks, plain_ticks;
   passivity_t pc;
 } contact_render_t;
@@ -77,8 +77,8 @@ double contact_render_target(contact_render_t *r, const contact_model_t *m, cons
 /* One tick: m the newest model (NULL: none usable, e.g. stale beyond
  * hold_s; the force ramps to zero), cut 1 when the server was lost (zero at
  * once). Writes the force to render into f and returns its magnitude. */
-double contact_render_tick(contact_render_t *r, const contact_model_t *m, int cut, const double x[3],
-                           const double v[3], double f[3]);
+double contact_render_tick(contact_render_t *r, const contact_model_t *m, int cut, const double x[3], const double v[3],
+                           double f[3]);
 
 /* Ramp and passivity for a force computed elsewhere (the guiding hand's
  * law): the same bounds and observer as contact_render_tick. */

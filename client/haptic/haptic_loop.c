@@ -19,8 +19,8 @@ typedef struct tick_state {
   uint64_t seq;
   int server_lost_reported;
   uint64_t live_lost_reported_ns;
-  int cut;            /* this tick: the server is lost, zero the force at once */
-  int stale;          /* no feedback for CONTACT_RENDER_HOLD_S: the model ramps out */
+  int cut;                 /* this tick: the server is lost, zero the force at once */
+  int stale;               /* no feedback for CONTACT_RENDER_HOLD_S: the model ramps out */
   contact_render_t render; /* re-anchoring, ramp, passivity (contact_render.h) */
 } tick_state_t;
 
@@ -151,8 +151,7 @@ void haptic_loop_run(const haptic_loop_t *l) {
   static tick_state_t s; /* the renderer's position ring is 32 kB */
   memset(&s, 0, sizeof s);
   s.own_station = o->station ? o->station : "";
-  contact_render_init(&s.render, 1.0 / o->rate, l->dev->max_force,
-                      l->dev->max_stiffness > 0 ? 2.0 * l->dev->max_stiffness / o->rate : HAPTIC_MAX_DAMPING);
+  contact_render_init(&s.render, 1.0 / o->rate, l->dev->max_force, HAPTIC_MAX_DAMPING);
   uint64_t period_ns = (uint64_t)(1e9 / o->rate);
   double run_for = o->duration >= 0 ? o->duration : 1e300;
   uint64_t start = vtime_mono_ns(), next = start, prev_tick = 0;

@@ -28,9 +28,11 @@ typedef struct haptic_stats {
   uint64_t pc_ticks, cuts, server_lost, feedback_stale;
 } haptic_stats_t;
 
-/* N s/m: the passivity controller's damper bound when the device states
- * no stiffness rating (with one: 2 k_device T, what it renders stably). */
-#define HAPTIC_MAX_DAMPING 5.0
+/* N s/m: the passivity controller's damper bound. It acts by scaling the
+ * rendered force down (never beyond zero), so the force it renders stays
+ * within the device's force limit whatever the bound; the bound only keeps
+ * it from reacting to velocity noise near rest (alpha |v| <= |f|). */
+#define HAPTIC_MAX_DAMPING 1e4
 
 typedef struct haptic_loop {
   const haptic_options_t *o;

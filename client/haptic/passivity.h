@@ -12,7 +12,8 @@
  * would make E positive, the controller adds a variable damper
  *   f' = f - alpha v,  alpha = E_pred / (T |v|^2),
  * the damping that dissipates exactly the excess, bounded by the device's
- * damping limit (max_damping) and its force limit. A bounded damper may
+ * damping limit (max_damping) and its force limit, and never reversing the
+ * force (it stops at zero rather than pull the hand into a wall). A bounded damper may
  * leave E above zero for some ticks; the excess is carried and dissipated
  * on the following ticks (energy_max reports the worst). */
 #ifndef VISCERA_PASSIVITY_H
@@ -32,9 +33,12 @@ typedef struct passivity {
 void passivity_init(passivity_t *p, double period_s, double max_damping);
 
 /* The controller: the force f (in place) corrected so that rendering it at
- * velocity v keeps E <= 0 where the damper bound allows; |f| stays within
- * max_force. Returns the damping used (0 when none). Does not update E. */
-double passivity_control(passivity_t *p, const double v[3], double max_force, double f[3]);
+ * velocity v keeps E + reserve <= 0 where the damper bound allows; |f|
+ * stays within max_force. reserve (J, >= 0) is energy the caller will
+ * still deliver whatever the controller asks now (a rate-limited force
+ * cannot drop at once: contact_render.c), so the damper starts early
+ * enough. Returns the damping used (0 when none). Does not update E. */
+double passivity_control(passivity_t *p, const double v[3], double max_force, double reserve, double f[3]);
 
 /* The observer: f was rendered during a tick at velocity v. */
 void passivity_observe(passivity_t *p, const double f[3], const double v[3]);
