@@ -51,7 +51,8 @@ static uint64_t read_feedback(const haptic_loop_t *l, tick_state_t *s, uint64_t 
   uint64_t last_fb_mono = feedback_slot_read(&l->h->slot, &s->model);
   uint64_t lost_ns = 0, lost_last = 0;
   int lost_live = feedback_slot_server_lost(&l->h->slot, &lost_ns, &lost_last);
-  int fresh = last_fb_mono && now - last_fb_mono < (uint64_t)(CONTACT_RENDER_HOLD_S * 1e9);
+  /* The listener stamps arrivals after this tick's clock read now and then. */
+  int fresh = last_fb_mono && (now <= last_fb_mono || now - last_fb_mono < (uint64_t)(CONTACT_RENDER_HOLD_S * 1e9));
   if (s->server_lost_reported && !lost_live && fresh && last_fb_mono > lost_ns) {
     fprintf(stderr, "haptic: server back, force ramps back to the tissue's\n");
     s->server_lost_reported = 0;
