@@ -47,14 +47,14 @@ static void send_command(const haptic_loop_t *l, tick_state_t *s, uint64_t now, 
  * sent nothing for CONTACT_RENDER_HOLD_S (a slow or lossy link, a stalled
  * server: the model is held, then ramped out, never a "server lost").
  * Returns the monotonic time of the last feedback (0: none yet). */
-static uint64_t read_feedback(const haptic_loop_t *l, tick_state_t *s, uint64_t now) {
+static uint64_t read_feedback(const haptic_loop_t *l, tick_state_t *s, double t, uint64_t now) {
   uint64_t last_fb_mono = feedback_slot_read(&l->h->slot, &s->model);
   uint64_t lost_ns = 0, lost_last = 0;
   int lost_live = feedback_slot_server_lost(&l->h->slot, &lost_ns, &lost_last);
   /* The listener stamps arrivals after this tick's clock read now and then. */
   int fresh = last_fb_mono && (now <= last_fb_mono || now - last_fb_mono < (uint64_t)(CONTACT_RENDER_HOLD_S * 1e9));
   if (s->server_lost_reported && !lost_live && fresh && last_fb_mono > lost_ns) {
-    fprintf(stderr, "haptic: server back, force ramps back to the tissue's\n");
+    fprintf(stderr, "haptic: t=%.3f s server back, force ramps back to the tissue's\n", t);
     s->server_lost_reported = 0;
   }
   s->cut = lost_live;
@@ -63,9 +63,9 @@ static uint64_t read_feedback(const haptic_loop_t *l, tick_state_t *s, uint64_t 
     if (lost_ns != s->live_lost_reported_ns) {
       s->live_lost_reported_ns = lost_ns;
       fprintf(stderr,
-              "haptic: server lost (liveliness lost, last feedback %.0f ms before, lease %d ms), force set to "
-              "zero\n",
-              lost_last ? (double)(lost_ns - lost_last) * 1e-6 : -1.0, VDDS_FEEDBACK_LEASE_MS);
+              "haptic: t=%.3f s server lost (liveliness lost, last feedback %.0f ms before, lease %d ms), force set "
+              "to zero\n",
+              t, lost_last ? (double)(lost_ns - lost_last) * 1e-6 : -1.0, VDDS_FEEDBACK_LEASE_MS);
       s->server_lost_reported = 1;
       l->st->server_lost++;
     }
@@ -74,7 +74,7 @@ static uint64_t read_feedback(const haptic_loop_t *l, tick_state_t *s, uint64_t 
   if (stale && !s->stale) {
     l->st->feedback_stale++;
     if (!l->o->quiet)
-      fprintf(stderr, "haptic: no feedback for %.0f ms from a live server, force ramps out\n",
+      fprintf(stderr, "haptic: t=%.3f s no feedback for %.0f ms from a live server, force ramps out\n", t,
               CONTACT_RENDER_HOLD_S * 1e3);
   }
   s->stale = stale;
@@ -170,7 +170,7 @@ void haptic_loop_run(const haptic_loop_t *l) {
     uint32_t buttons = 0;
     l->dev->ops->read(l->dev, t, pos, quat, &buttons);
     send_command(l, &s, now, pos, quat, buttons);
-    uint64_t last_fb_mono = read_feedback(l, &s, now);
+    uint64_t last_fb_mono = read_feedback(l, &s, t, now);
     guide_output_t gout;
     render_force(l, &s, t, now, last_fb_mono, pos, &gout);
     l->dev->ops->write_force(l->dev, gout.f);
