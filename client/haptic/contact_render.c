@@ -68,7 +68,8 @@ double contact_render_target(contact_render_t *r, const contact_model_t *m, cons
   return mag;
 }
 
-double contact_render_output(contact_render_t *r, const double target[3], int cut, const double v[3], double f[3]) {
+double contact_render_output(contact_render_t *r, const double target[3], int cut, int control, const double v[3],
+                             double f[3]) {
   double before[3];
   v3_copy(before, r->f_prev);
   if (cut) {
@@ -83,7 +84,7 @@ double contact_render_output(contact_render_t *r, const double target[3], int cu
     /* Released at max_step per tick, a force f still delivers about
      * (f . v) T |f| / (2 max_step) after the controller asks for less. */
     double fv = v3_dot(g, v), reserve = fv > 0 ? fv * r->period_s * v3_norm(g) / (2 * r->max_step) : 0;
-    passivity_control(&r->pc, v, r->max_force, reserve, g);
+    if (control) passivity_control(&r->pc, v, r->max_force, reserve, g);
     double d[3];
     v3_sub(d, g, r->f_prev);
     double step = v3_norm(d);
@@ -106,5 +107,5 @@ double contact_render_tick(contact_render_t *r, const contact_model_t *m, int cu
                            double f[3]) {
   double target[3];
   contact_render_target(r, cut ? NULL : m, x, v, target);
-  return contact_render_output(r, target, cut, v, f);
+  return contact_render_output(r, target, cut, 1, v, f);
 }

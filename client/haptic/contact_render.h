@@ -80,8 +80,12 @@ double contact_render_target(contact_render_t *r, const contact_model_t *m, cons
 double contact_render_tick(contact_render_t *r, const contact_model_t *m, int cut, const double x[3], const double v[3],
                            double f[3]);
 
-/* Ramp and passivity for a force computed elsewhere (the guiding hand's
- * law): the same bounds and observer as contact_render_tick. */
-double contact_render_output(contact_render_t *r, const double target[3], int cut, const double v[3], double f[3]);
+/* Ramp and passivity for a target force: the same bounds and observer as
+ * contact_render_tick; control 0 observes without the controller (the
+ * guiding hand: a led hand must receive the energy its guide puts in, so
+ * one port alone may not be held passive; guide_force.h damps the coupling
+ * for the delay instead). */
+double contact_render_output(contact_render_t *r, const double target[3], int cut, int control, const double v[3],
+                             double f[3]);
 
 #endif

@@ -1,6 +1,7 @@
 #include "haptic_loop.h"
 
 #include <math.h>
+#include <pthread.h>
 #include <string.h>
 
 #include "contact_model.h"
@@ -22,6 +23,8 @@ typedef struct tick_state {
   int cut;                 /* this tick: the server is lost, zero the force at once */
   int stale;               /* no feedback for CONTACT_RENDER_HOLD_S: the model ramps out */
   contact_render_t render; /* re-anchoring, ramp, passivity (contact_render.h) */
+  double rtt_s;            /* smoothed command->feedback round trip, s */
+  size_t rtt_samples;
 } tick_state_t;
 
 /* The device's pose as this tick's ToolCommand. */
@@ -82,6 +85,25 @@ static uint64_t read_feedback(const haptic_loop_t *l, tick_state_t *s, double t,
   return last_fb_mono;
 }
 
+/* The round trip to a guiding peer (guide_force.h: the coupling's damping
+ * grows with it): at least --guide-rtt, and twice our own smoothed round
+ * trip to the server (the peer's commands cross the same link when the
+ * server sits at the peer's site; when it sits at ours, --guide-rtt says). */
+static double guide_rtt(const haptic_loop_t *l, tick_state_t *s) {
+  feedback_slot_t *fs = &l->h->slot;
+  pthread_mutex_lock(&fs->lock);
+  size_t n = fs->nlatency;
+  double last_us = n ? fs->latency_us[n - 1] : 0;
+  pthread_mutex_unlock(&fs->lock);
+  if (n != s->rtt_samples) {
+    s->rtt_samples = n;
+    s->rtt_s = s->rtt_s > 0 ? s->rtt_s + 0.02 * (last_us * 1e-6 - s->rtt_s) : last_us * 1e-6;
+  }
+  double own = 2.0 * s->rtt_s;
+  l->st->guide_rtt_s = own > l->o->guide_rtt ? own : l->o->guide_rtt;
+  return l->st->guide_rtt_s;
+}
+
 /* The force to render: guided or not, one force law (guide_force.h); a
  * server silent for GUIDE_SERVER_TIMEOUT_S ends the coupling too. */
 static void render_force(const haptic_loop_t *l, tick_state_t *s, double t, uint64_t now, uint64_t last_fb_mono,
@@ -110,7 +132,8 @@ static void render_force(const haptic_loop_t *l, tick_state_t *s, double t, uint
                        .contact = &s->model,
                        .max_force = l->dev->max_force,
                        .max_stiffness = l->dev->max_stiffness,
-                       .period_s = 1.0 / o->rate};
+                       .period_s = 1.0 / o->rate,
+                       .rtt_s = guide_rtt(l, s)};
   memcpy(gin.x, pos, sizeof gin.x);
   memcpy(gin.v, vel, sizeof gin.v);
   memcpy(gin.peer, gv.peer, sizeof gin.peer);
@@ -122,7 +145,7 @@ static void render_force(const haptic_loop_t *l, tick_state_t *s, double t, uint
     memcpy(target, gout->f, sizeof target);
   else
     contact_render_target(&s->render, s->cut ? NULL : &s->model, pos, vel, target);
-  gout->magnitude = contact_render_output(&s->render, target, s->cut, vel, gout->f);
+  gout->magnitude = contact_render_output(&s->render, target, s->cut, !gout->coupled, vel, gout->f);
   guide_report_tick(l->guide, t, &gv.role, gv.peer_station, gv.peer_age_s, gout, o->quiet ? NULL : stderr);
 }
 
@@ -140,6 +163,7 @@ static void record_force(const haptic_loop_t *l, const tick_state_t *s, double t
   }
   if (mag > st->peak_force) st->peak_force = mag;
   st->energy_max_j = s->render.pc.energy_max;
+  st->energy_j = s->render.pc.energy;
   st->step_max_n = s->render.step_max;
   if (l->csv)
     fprintf(l->csv, "%.4f,%.6f,%.6f,%.6f,%.5f,%.5f,%.5f,%d,%.7f,%.5f\n", t, pos[0], pos[1], pos[2], f[0], f[1], f[2],

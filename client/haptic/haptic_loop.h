@@ -24,7 +24,8 @@ typedef struct haptic_stats {
    * largest energy (J, <= 0 passive), the largest one-tick force change
    * (N, cuts excluded), controller ticks, forces cut at a lost server,
    * liveliness losses and stale-feedback episodes. */
-  double energy_max_j, step_max_n;
+  double energy_max_j, energy_j, step_max_n;
+  double guide_rtt_s; /* the round trip the guiding coupling was damped for, s */
   uint64_t pc_ticks, cuts, server_lost, feedback_stale;
 } haptic_stats_t;
 

@@ -21,6 +21,7 @@ typedef struct haptic_options {
   double max_stiffness; /* --max-stiffness K, N/m; 0 = no stated limit */
   double wait_server;   /* --wait-server S */
   double duration;      /* --duration S; < 0: end of the trajectory + 0.5 s */
+  double guide_rtt;     /* --guide-rtt S: least round trip to a guiding peer (guide_force.h) */
 } haptic_options_t;
 
 /* Defaults, $VISCERA_DOMAIN, then argv. Returns CLI_RUN (cli.h) to run, or

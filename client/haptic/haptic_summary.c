@@ -50,8 +50,9 @@ void haptic_summary_print(const haptic_options_t *o, haptic_stats_t *st, haptic_
           st->energy_max_j, st->pc_ticks, st->step_max_n, st->cuts, st->server_lost, st->feedback_stale);
   printf("SUMMARY ticks=%" PRIu64 " rate_hz=%.1f peak_force=%.4f contact_ticks=%" PRIu64 " latency_us_median=%.1f "
          "latency_us_p99=%.1f period_us_p99=%.1f jitter_us_p99=%.1f late_ticks=%" PRIu64 " guide_coupled_s=%.2f "
-         "energy_max_j=%.6f step_max_n=%.4f server_lost=%" PRIu64 " feedback_stale=%" PRIu64 "\n",
+         "energy_max_j=%.6f energy_j=%.6f step_max_n=%.4f server_lost=%" PRIu64 " feedback_stale=%" PRIu64
+         " guide_rtt_ms=%.1f\n",
          st->ticks, (double)st->ticks / st->elapsed_s, st->peak_force, st->contact_ticks, lat.median, lat.p99, per.p99,
-         jitter_p99, st->late_ticks, guide_report_coupled_s(guide, 1.0 / o->rate), st->energy_max_j, st->step_max_n,
-         st->server_lost, st->feedback_stale);
+         jitter_p99, st->late_ticks, guide_report_coupled_s(guide, 1.0 / o->rate), st->energy_max_j, st->energy_j,
+         st->step_max_n, st->server_lost, st->feedback_stale, st->guide_rtt_s * 1e3);
 }
