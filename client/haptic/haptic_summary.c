@@ -46,8 +46,10 @@ void haptic_summary_print(const haptic_options_t *o, haptic_stats_t *st, haptic_
   fprintf(stderr,
           "haptic: contact under delay: passivity observer max %.6f J (<= 0 passive), controller active %" PRIu64
           " ticks; largest one-tick force change %.4f N; %" PRIu64 " force cut(s) at a lost server, %" PRIu64
-          " server loss(es), %" PRIu64 " stale-feedback episode(s)\n",
-          st->energy_max_j, st->pc_ticks, st->step_max_n, st->cuts, st->server_lost, st->feedback_stale);
+          " server loss(es), %" PRIu64 " stale-feedback episode(s); in contact %" PRIu64
+          " ticks re-anchored at the answered command, %" PRIu64 " plain plane\n",
+          st->energy_max_j, st->pc_ticks, st->step_max_n, st->cuts, st->server_lost, st->feedback_stale,
+          st->reanchored_ticks, st->plain_ticks);
   printf("SUMMARY ticks=%" PRIu64 " rate_hz=%.1f peak_force=%.4f contact_ticks=%" PRIu64 " latency_us_median=%.1f "
          "latency_us_p99=%.1f period_us_p99=%.1f jitter_us_p99=%.1f late_ticks=%" PRIu64 " guide_coupled_s=%.2f "
          "energy_max_j=%.6f energy_j=%.6f step_max_n=%.4f server_lost=%" PRIu64 " feedback_stale=%" PRIu64

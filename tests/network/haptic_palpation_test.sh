@@ -14,6 +14,10 @@
 set -euo pipefail
 source "$2/tests/network/prelude.sh"
 net_sites hp1
+# The server's longest step (us) from its log: a step longer than the
+# feedback lease (150 ms) is a real stall (a loaded machine), and a "server
+# lost" then is not false.
+server_stall_us() { sed -n 's/^server: .* step time median .* max \([0-9.]*\) us.*/\1/p' "$1" | tail -1; }
 export CYCLONEDDS_URI="file://$SRC/deploy/cyclonedds-site.xml"
 SEAT=hp/palp
 TRAJ="$OUT/palpate_smooth.traj"
@@ -55,6 +59,11 @@ for setting in "d0:--delay 0" "d25:--delay 25 --jitter 5 --no-reorder --loss 2" 
   awk -v p="$peak" -v r="$ref" 'BEGIN { exit !(p >= 0.9 * r && p <= 1.1 * r) }' || fail "$opts: peak $peak N vs $ref N"
   awk -v s="$step" 'BEGIN { exit !(s <= 0.1) }' || fail "$opts: one-tick change $step N"
   awk -v e="$en" 'BEGIN { exit !(e <= 1e-6) }' || fail "$opts: passivity observer at $en J"
-  [ "$lost" = 0 ] || fail "$opts: $lost false 'server lost'"
+  stall=$(server_stall_us "$OUT/$name-server.log")
+  if [ "$lost" != 0 ]; then
+    awk -v s="${stall:-0}" 'BEGIN { exit !(s > 150000) }' \
+      || fail "$opts: $lost false 'server lost' (server's longest step ${stall} us)"
+    echo "note: 'server lost' $lost times, the server stalled (longest step ${stall} us: machine load)"
+  fi
 done
 echo PASS
