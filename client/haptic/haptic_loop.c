@@ -60,8 +60,25 @@ static uint64_t read_feedback(const haptic_loop_t *l, tick_state_t *s, double t,
     fprintf(stderr, "haptic: t=%.3f s server back, force ramps back to the tissue's\n", t);
     s->server_lost_reported = 0;
   }
-  s->cut = lost_live;
-  if (lost_live) {
+  /* A server that died sent its last feedback a whole lease before its
+   * loss is heard. A loss heard within half a lease of the last feedback,
+   * or with feedback arriving after it, is this process starved past the
+   * lease (its own stall, a loaded machine): the samples were waiting in
+   * the socket. Then the model stays (no cut, no "server lost"), as the
+   * server keeps a client whose commands kept coming (liveliness_watch.h). */
+  int starved = lost_live && lost_last &&
+                (lost_ns - lost_last < (uint64_t)VDDS_FEEDBACK_LEASE_MS * 500000ull || last_fb_mono > lost_ns);
+  if (starved && lost_ns != s->live_lost_reported_ns) {
+    s->live_lost_reported_ns = lost_ns;
+    l->st->liveliness_blips++;
+    if (!l->o->quiet && l->st->liveliness_blips <= 3)
+      fprintf(stderr,
+              "haptic: t=%.3f s server liveliness lapsed %.0f ms after its last feedback (this process stalled?); "
+              "kept\n",
+              t, (double)(lost_ns - lost_last) * 1e-6);
+  }
+  s->cut = lost_live && !starved;
+  if (s->cut) {
     s->model.in_contact = 0;
     if (lost_ns != s->live_lost_reported_ns) {
       s->live_lost_reported_ns = lost_ns;
@@ -73,7 +90,7 @@ static uint64_t read_feedback(const haptic_loop_t *l, tick_state_t *s, double t,
       l->st->server_lost++;
     }
   }
-  int stale = last_fb_mono && !fresh && !lost_live;
+  int stale = last_fb_mono && !fresh && !s->cut;
   if (stale && !s->stale) {
     l->st->feedback_stale++;
     if (!l->o->quiet)

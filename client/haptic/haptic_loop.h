@@ -27,6 +27,7 @@ typedef struct haptic_stats {
   double energy_max_j, energy_j, step_max_n;
   double guide_rtt_s; /* the round trip the guiding coupling was damped for, s */
   uint64_t pc_ticks, cuts, server_lost, feedback_stale;
+  uint64_t liveliness_blips;              /* liveliness lapses heard with feedback still arriving: kept */
   uint64_t reanchored_ticks, plain_ticks; /* in contact: model re-anchored at the answered command, or not */
 } haptic_stats_t;
 

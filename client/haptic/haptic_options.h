@@ -14,6 +14,7 @@ typedef struct haptic_options {
   const char *device;     /* --device NAME (default "scripted") */
   const char *station;    /* --station NAME, or NULL */
   device_config_t dcfg;   /* --device-index, --workspace-scale/-offset, and the fields below once parsed */
+  double guide_rtt;       /* --guide-rtt S: least round trip to a guiding peer (guide_force.h) */
   int domain, quiet, rt_priority;
   unsigned tool;        /* --tool N */
   double rate;          /* --rate HZ, loop rate */
@@ -21,7 +22,6 @@ typedef struct haptic_options {
   double max_stiffness; /* --max-stiffness K, N/m; 0 = no stated limit */
   double wait_server;   /* --wait-server S */
   double duration;      /* --duration S; < 0: end of the trajectory + 0.5 s */
-  double guide_rtt;     /* --guide-rtt S: least round trip to a guiding peer (guide_force.h) */
 } haptic_options_t;
 
 /* Defaults, $VISCERA_DOMAIN, then argv. Returns CLI_RUN (cli.h) to run, or

@@ -50,11 +50,13 @@ void haptic_summary_print(const haptic_options_t *o, haptic_stats_t *st, haptic_
           " ticks re-anchored at the answered command, %" PRIu64 " plain plane\n",
           st->energy_max_j, st->pc_ticks, st->step_max_n, st->cuts, st->server_lost, st->feedback_stale,
           st->reanchored_ticks, st->plain_ticks);
+  /* Contact under delay (issue 14): scripts and the link benchmark read these. */
+  printf("CONTACT step_max_n=%.4f server_lost=%" PRIu64 " liveliness_blips=%" PRIu64 " feedback_stale=%" PRIu64
+         " cuts=%" PRIu64 " controller_ticks=%" PRIu64 " guide_rtt_ms=%.1f energy_j=%.6f energy_max_j=%.6f\n",
+         st->step_max_n, st->server_lost, st->liveliness_blips, st->feedback_stale, st->cuts, st->pc_ticks,
+         st->guide_rtt_s * 1e3, st->energy_j, st->energy_max_j);
   printf("SUMMARY ticks=%" PRIu64 " rate_hz=%.1f peak_force=%.4f contact_ticks=%" PRIu64 " latency_us_median=%.1f "
-         "latency_us_p99=%.1f period_us_p99=%.1f jitter_us_p99=%.1f late_ticks=%" PRIu64 " guide_coupled_s=%.2f "
-         "energy_max_j=%.6f energy_j=%.6f step_max_n=%.4f server_lost=%" PRIu64 " feedback_stale=%" PRIu64
-         " guide_rtt_ms=%.1f\n",
+         "latency_us_p99=%.1f period_us_p99=%.1f jitter_us_p99=%.1f late_ticks=%" PRIu64 " guide_coupled_s=%.2f\n",
          st->ticks, (double)st->ticks / st->elapsed_s, st->peak_force, st->contact_ticks, lat.median, lat.p99, per.p99,
-         jitter_p99, st->late_ticks, guide_report_coupled_s(guide, 1.0 / o->rate), st->energy_max_j, st->energy_j,
-         st->step_max_n, st->server_lost, st->feedback_stale, st->guide_rtt_s * 1e3);
+         jitter_p99, st->late_ticks, guide_report_coupled_s(guide, 1.0 / o->rate));
 }
