@@ -31,30 +31,40 @@ double contact_render_target(contact_render_t *r, const contact_model_t *m, cons
                              double f[3]) {
   v3_set(f, 0, 0, 0);
   if (!m || !m->in_contact) {
-    r->anchored = 0;
+    /* A press's anchor outlives a short gap in contact (the server's proxy
+     * let go for a few steps while the tissue moved away faster than the
+     * hand): re-anchoring mid-press at a deep proxy would take the tool's
+     * stiffness for the organ's and overshoot. */
+    if (r->anchored && ++r->off_ticks * r->period_s > CONTACT_RENDER_HOLD_S) r->anchored = 0;
     return 0;
   }
+  r->off_ticks = 0;
   const double *n = m->normal;
   double k = m->stiffness;
+  double x_cmd[3];
+  int known = sent_position(r, m->cmd_seq, x_cmd);
+  double d_cmd[3];
+  v3_sub(d_cmd, m->proxy, known ? x_cmd : x);
+  double spring = k * v3_dot(d_cmd, n); /* the server's proxy spring at x_cmd */
   if (!r->anchored) {
     /* The press begins: its surface point, and no extrapolation until the
-     * press is deep enough to measure the organ's stiffness. */
+     * press is deep enough to measure the organ's stiffness. A press that
+     * begins with the hand already inside (the server back after a blip)
+     * has no surface point: it is never extrapolated. */
     v3_copy(r->onset, m->proxy);
+    r->onset_spring = spring;
     r->k_eff = 0;
     r->anchored = 1;
   }
-  double x_cmd[3];
-  if (!sent_position(r, m->cmd_seq, x_cmd)) {
+  if (!known) {
     r->plain_ticks++;
     return contact_model_force(m, x, v, r->max_force, f);
   }
   r->reanchored_ticks++;
-  double d_cmd[3], d_onset[3];
-  v3_sub(d_cmd, m->proxy, x_cmd);
+  double d_onset[3];
   v3_sub(d_onset, r->onset, x_cmd);
-  double spring = k * v3_dot(d_cmd, n); /* the server's proxy spring at x_cmd */
-  double depth = v3_dot(d_onset, n);    /* x_cmd below where the press began */
-  if (depth > CONTACT_RENDER_MIN_DEPTH && spring > 0) {
+  double depth = v3_dot(d_onset, n); /* x_cmd below where the press began */
+  if (depth > CONTACT_RENDER_MIN_DEPTH && spring > 0 && r->onset_spring < CONTACT_RENDER_ONSET_SPRING) {
     double k_sec = fmin(k, spring / depth);
     r->k_eff += (k_sec - r->k_eff) * fmin(1.0, r->period_s / CONTACT_RENDER_K_TAU);
   }

@@ -46,18 +46,23 @@
 #define CONTACT_RENDER_MIN_DEPTH 5e-4
 /* s: time constant of the secant stiffness filter. */
 #define CONTACT_RENDER_K_TAU 0.02
+/* N: a press whose first sample already pushes this hard began inside the
+ * organ (the server back after a blip): no surface point, no extrapolation. */
+#define CONTACT_RENDER_ONSET_SPRING 0.1
 
 typedef struct contact_render {
   double period_s, max_step, max_force;
   uint64_t ring_seq[CONTACT_RENDER_RING];
   double ring_x[CONTACT_RENDER_RING][3];
-  int anchored;     /* the surface point where contact began is known */
-  double onset[3];  /* that point */
-  double k_eff;     /* N/m, the press's filtered secant stiffness */
-  double f_prev[3]; /* force rendered last tick */
-  double step_max;  /* N, the largest one-tick change rendered (cuts excluded) */
-  double step_tick; /* N, this tick's change */
-  uint64_t cuts;    /* forces zeroed at once (server lost) */
+  int anchored;        /* the surface point where contact began is known */
+  double onset[3];     /* that point */
+  double onset_spring; /* N, the server's spring in the press's first sample */
+  uint64_t off_ticks;  /* ticks without contact since the press's last sample */
+  double k_eff;        /* N/m, the press's filtered secant stiffness */
+  double f_prev[3];    /* force rendered last tick */
+  double step_max;     /* N, the largest one-tick change rendered (cuts excluded) */
+  double step_tick;    /* N, this tick's change */
+  uint64_t cuts;       /* forces zeroed at once (server lost) */
   uint64_t reanchored_ticks, plain_ticks;
   passivity_t pc;
 } contact_render_t;
