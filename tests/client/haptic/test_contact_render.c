@@ -138,7 +138,7 @@ static void run(const trace_t *tr, const link_t *lk, const size_t *probe, result
   }
   const contact_model_t *newest = NULL;
   long newest_tick = -1;
-  size_t next = 0, pi = 0;
+  size_t next = 0;
   double prev_x[3], plain_prev = 0;
   v3_copy(prev_x, tr->x);
   for (size_t j = 0; j < tr->n; j++) {
@@ -148,19 +148,18 @@ static void run(const trace_t *tr, const link_t *lk, const size_t *probe, result
     v3_scale(v, v, 1.0 / T_S);
     v3_copy(prev_x, x);
     contact_render_sent(&r, j + 1, x);
-    /* Every answer that has arrived by now; the newest wins. */
-    for (size_t i = 0; i < tr->n && i <= j; i++) {
-      (void)next;
-      if (arrive[i] == (long)j) {
-        static contact_model_t off;
-        newest = &tr->fb[i];
-        if (lk->toggle_from && (int)i >= lk->toggle_from && (int)i < lk->toggle_from + 8) {
-          off = tr->fb[i];
-          off.in_contact = 0;
-          newest = &off;
-        }
-        newest_tick = (long)j;
+    /* Every answer that has arrived by now (arrivals keep their order; a
+     * lost one never arrives); the newest wins. */
+    for (; next < tr->n && (arrive[next] < 0 || arrive[next] <= (long)j); next++) {
+      if (arrive[next] < 0) continue;
+      static contact_model_t off;
+      newest = &tr->fb[next];
+      if (lk->toggle_from && (int)next >= lk->toggle_from && (int)next < lk->toggle_from + 8) {
+        off = tr->fb[next];
+        off.in_contact = 0;
+        newest = &off;
       }
+      newest_tick = (long)j;
     }
     int cut = lk->stall_from >= 0 && (long)j >= lk->cut_from && newest_tick < lk->stall_to + 2 * lk->delay_ms;
     int stale = newest_tick < 0 || (double)((long)j - newest_tick) * T_S > CONTACT_RENDER_HOLD_S;
@@ -169,7 +168,6 @@ static void run(const trace_t *tr, const link_t *lk, const size_t *probe, result
     if (mag > res->peak) res->peak = mag;
     for (size_t q = 0; probe && q < 3; q++)
       if (probe[q] == j) res->f_at[q] = mag;
-    (void)pi;
     /* The plain plane at the delayed model, as rendered before. */
     double fp[3];
     double plain = stale || cut ? 0 : contact_model_force(newest, x, v, MAX_FORCE, fp);
