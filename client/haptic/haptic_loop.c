@@ -190,7 +190,7 @@ static void record_force(const haptic_loop_t *l, const tick_state_t *s, double t
 void haptic_loop_run(const haptic_loop_t *l) {
   const haptic_options_t *o = l->o;
   haptic_stats_t *st = l->st;
-  static tick_state_t s; /* the renderer's position ring is 32 kB */
+  tick_state_t s; /* 33 kB with the renderer's position ring: on the loop thread's stack */
   memset(&s, 0, sizeof s);
   s.own_station = o->station ? o->station : "";
   contact_render_init(&s.render, 1.0 / o->rate, l->dev->max_force, HAPTIC_MAX_DAMPING);
