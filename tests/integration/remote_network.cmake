@@ -4,7 +4,8 @@
 # registered only where that harness is in the tree. Label network, skip
 # (77) without root or namespaces; one lock with the other network tests.
 if(EXISTS ${PROJECT_SOURCE_DIR}/tests/network/sites.sh AND EXISTS ${PROJECT_SOURCE_DIR}/tests/network/prelude.sh)
-  foreach(spec "net_haptic_palpation;224;haptic_palpation_test.sh" "net_haptic_guide;225;haptic_guide_test.sh")
+  foreach(spec "net_haptic_palpation;224;haptic_palpation_test.sh" "net_haptic_guide;225;haptic_guide_test.sh"
+               "net_haptic_partition;226;haptic_partition_test.sh")
     list(GET spec 0 name)
     list(GET spec 1 domain)
     list(GET spec 2 script)
