@@ -11,12 +11,15 @@
 #ifndef VISCERA_CONTACT_MODEL_H
 #define VISCERA_CONTACT_MODEL_H
 
+#include <stdint.h>
+
 typedef struct contact_model {
   int in_contact;
   double proxy[3];
   double normal[3]; /* unit */
   double stiffness; /* N/m */
   double damping;   /* N s/m, set by the client from its period: passivity needs >= k T / 2 */
+  uint64_t cmd_seq; /* the ToolCommand the server answered (contact_render.h re-anchors to it) */
 } contact_model_t;
 
 /* Writes the force into f and returns its magnitude. v may be NULL (no damping). */

@@ -88,6 +88,7 @@ int feedback_slot_accept_from(feedback_slot_t *s, const viscera_ContactFeedback 
   }
   s->model.in_contact = fb->in_contact;
   s->model.stiffness = fb->stiffness;
+  s->model.cmd_seq = ours ? fb->cmd_seq : 0; /* another station's seq says nothing of our hand */
   for (int k = 0; k < 3; k++) {
     s->model.proxy[k] = fb->proxy_position[k];
     s->model.normal[k] = fb->normal[k];

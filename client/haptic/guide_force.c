@@ -62,6 +62,11 @@ static double clamp_force(double f[3], double max_force) {
   return mag;
 }
 
+double guide_coupling_damping(double w, double k, double period_s, double rtt_s) {
+  double tau = isfinite(rtt_s) && rtt_s > 0 ? rtt_s : 0;
+  return (1.0 - w) * k * (period_s + 0.5 * tau);
+}
+
 void guide_force(const guide_input_t *in, guide_output_t *out) {
   memset(out, 0, sizeof *out);
   out->side = guide_side_of(in->role, in->own_station);
@@ -90,9 +95,8 @@ void guide_force(const guide_input_t *in, guide_output_t *out) {
   v3_scale(v_tool, in->v, w);
   double fc[3];
   contact_model_force(in->contact, x_tool, v_tool, in->max_force, fc);
-  double f[3];
-  for (int i = 0; i < 3; i++)
-    f[i] = w * fc[i] + (1.0 - w) * (k * (in->peer[i] - in->x[i]) - k * in->period_s * in->v[i]);
+  double f[3], b = guide_coupling_damping(w, k, in->period_s, in->rtt_s);
+  for (int i = 0; i < 3; i++) f[i] = w * fc[i] + (1.0 - w) * k * (in->peer[i] - in->x[i]) - b * in->v[i];
   v3_copy(out->f, f);
   out->magnitude = clamp_force(out->f, in->max_force);
   out->coupled = 1;

@@ -13,7 +13,7 @@
  * Force law, for own position x and velocity v, the peer's latest commanded
  * position p and the tool position the server computes from the two,
  * x_tool = w x + (1 - w) p:
- *   F = w F_contact(x_tool, w v) + (1 - w) (k (p - x) - k T v)
+ *   F = w F_contact(x_tool, w v) + (1 - w) (k (p - x) - k (T + tau / 2) v)
  * - F_contact is the ContactFeedback plane model (contact_model.h), with the
  *   stiffness and damping the caller already set (device-clamped, passive at
  *   period T). Its velocity is w v: the peer is taken as still within a tick,
@@ -21,8 +21,12 @@
  *   damping w^2 b_c, the same ratio that keeps the plain wall passive.
  * - The coupling spring (1 - w) k pulls the hand towards the peer. Its
  *   damping, on own velocity only (a differenced peer velocity would be
- *   noisy and one network delay old), is (1 - w) k T: twice the k T / 2 a
- *   zero-order-hold spring at period T generates (docs/numerics.md §6).
+ *   noisy and one network delay old), is (1 - w) k (T + tau / 2): k T is
+ *   twice the k T / 2 a zero-order-hold spring at period T generates
+ *   (docs/numerics.md §6), and k tau / 2 for a round trip tau to the peer
+ *   is the delay-dependent dissipation that keeps a spring between two
+ *   delayed positions passive (Lee and Spong 2006, docs/remote.md): the
+ *   guiding hand across sites.
  * - k is clamped to the device's stiffness rating, like the contact wall.
  * - The total is clamped to max_force (direction kept).
  * Fallbacks: no role, no guide, neither side, an invalid role (authority
@@ -90,6 +94,7 @@ typedef struct guide_input {
   double max_force;     /* N, > 0 */
   double max_stiffness; /* N/m device rating, 0 = none stated */
   double period_s;      /* loop period T */
+  double rtt_s;         /* tau: round trip to the peer, s (0: same machine or LAN) */
 } guide_input_t;
 
 typedef struct guide_output {
@@ -103,6 +108,10 @@ typedef struct guide_output {
   const char *why;   /* when not coupled: "no role", "no guide", "not in the role", "no peer",
                         "peer silent", "server silent"; NULL when coupled */
 } guide_output_t;
+
+/* Damping of the coupling spring on the hand's own velocity, N s/m: the
+ * (1 - w) k (T + tau / 2) of the force law (0 when w = 1). */
+double guide_coupling_damping(double w, double k, double period_s, double rtt_s);
 
 /* Computes the force to render. Never returns a non-finite force: a
  * non-finite peer position counts as no peer. */

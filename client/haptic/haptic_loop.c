@@ -1,9 +1,11 @@
 #include "haptic_loop.h"
 
 #include <math.h>
+#include <pthread.h>
 #include <string.h>
 
 #include "contact_model.h"
+#include "contact_render.h"
 #include "guide_force.h"
 #include "viscera.h"
 #include "vtime.h"
@@ -18,6 +20,11 @@ typedef struct tick_state {
   uint64_t seq;
   int server_lost_reported;
   uint64_t live_lost_reported_ns;
+  int cut;                 /* this tick: the server is lost, zero the force at once */
+  int stale;               /* no feedback for CONTACT_RENDER_HOLD_S: the model ramps out */
+  contact_render_t render; /* re-anchoring, ramp, passivity (contact_render.h) */
+  double rtt_s;            /* smoothed command->feedback round trip, s */
+  size_t rtt_samples;
 } tick_state_t;
 
 /* The device's pose as this tick's ToolCommand. */
@@ -33,43 +40,85 @@ static void send_command(const haptic_loop_t *l, tick_state_t *s, uint64_t now, 
   cmd.buttons = buttons;
   cmd.max_force = (float)l->dev->max_force;
   feedback_slot_sent(&l->h->slot, cmd.seq, cmd.client_mono_ns); /* before the write: the echo may beat it back */
+  contact_render_sent(&s->render, cmd.seq, pos);
   dds_write(l->h->w_cmd, &cmd);
 }
 
-/* The latest contact model, cleared (and said once) when the server is lost.
+/* The latest contact model, and whether to render it (contact_render.h):
+ * cut when the server is lost by liveliness (its process is gone or
+ * unreachable for a whole lease, vdds.h), stale when it is alive but has
+ * sent nothing for CONTACT_RENDER_HOLD_S (a slow or lossy link, a stalled
+ * server: the model is held, then ramped out, never a "server lost").
  * Returns the monotonic time of the last feedback (0: none yet). */
-static uint64_t read_feedback(const haptic_loop_t *l, tick_state_t *s, uint64_t now) {
+static uint64_t read_feedback(const haptic_loop_t *l, tick_state_t *s, double t, uint64_t now) {
   uint64_t last_fb_mono = feedback_slot_read(&l->h->slot, &s->model);
   uint64_t lost_ns = 0, lost_last = 0;
   int lost_live = feedback_slot_server_lost(&l->h->slot, &lost_ns, &lost_last);
-  if (last_fb_mono && s->server_lost_reported && !lost_live && now - last_fb_mono < 50000000ull) {
-    fprintf(stderr, "haptic: server back\n");
+  /* The listener stamps arrivals after this tick's clock read now and then. */
+  int fresh = last_fb_mono && (now <= last_fb_mono || now - last_fb_mono < (uint64_t)(CONTACT_RENDER_HOLD_S * 1e9));
+  if (s->server_lost_reported && !lost_live && fresh && last_fb_mono > lost_ns) {
+    fprintf(stderr, "haptic: t=%.3f s server back, force ramps back to the tissue's\n", t);
     s->server_lost_reported = 0;
   }
-  /* The server process is gone (its feedback writer's liveliness lapsed):
-   * the listener already cleared the slot; say so once per loss, even when
-   * the feedback timeout happened to notice first on a loaded machine. */
-  if (lost_live) {
+  /* A server that died sent its last feedback a whole lease before its
+   * loss is heard. A loss heard within half a lease of the last feedback,
+   * or with feedback arriving after it, is this process starved past the
+   * lease (its own stall, a loaded machine): the samples were waiting in
+   * the socket. Then the model stays (no cut, no "server lost"), as the
+   * server keeps a client whose commands kept coming (liveliness_watch.h). */
+  int starved = lost_live && lost_last &&
+                (lost_ns - lost_last < (uint64_t)VDDS_FEEDBACK_LEASE_MS * 500000ull || last_fb_mono > lost_ns);
+  if (starved && lost_ns != s->live_lost_reported_ns) {
+    s->live_lost_reported_ns = lost_ns;
+    l->st->liveliness_blips++;
+    if (!l->o->quiet && l->st->liveliness_blips <= 3)
+      fprintf(stderr,
+              "haptic: t=%.3f s server liveliness lapsed %.0f ms after its last feedback (this process stalled?); "
+              "kept\n",
+              t, (double)(lost_ns - lost_last) * 1e-6);
+  }
+  s->cut = lost_live && !starved;
+  if (s->cut) {
     s->model.in_contact = 0;
     if (lost_ns != s->live_lost_reported_ns) {
       s->live_lost_reported_ns = lost_ns;
       fprintf(stderr,
-              "haptic: server lost (liveliness lost, last feedback %.0f ms before, lease %d ms), force set to "
-              "zero\n",
-              lost_last ? (double)(lost_ns - lost_last) * 1e-6 : -1.0, VDDS_FEEDBACK_LEASE_MS);
+              "haptic: t=%.3f s server lost (liveliness lost, last feedback %.0f ms before, lease %d ms), force set "
+              "to zero\n",
+              t, lost_last ? (double)(lost_ns - lost_last) * 1e-6 : -1.0, VDDS_FEEDBACK_LEASE_MS);
       s->server_lost_reported = 1;
+      l->st->server_lost++;
     }
   }
-  /* No feedback for 50 ms while the server is alive (stalled, or not
-   * answering this tool): render nothing rather than a stale wall. */
-  if (last_fb_mono && now > last_fb_mono + 50000000ull) {
-    s->model.in_contact = 0;
-    if (!s->server_lost_reported) {
-      fprintf(stderr, "haptic: server lost (no feedback for 50 ms), force set to zero\n");
-      s->server_lost_reported = 1;
-    }
+  int stale = last_fb_mono && !fresh && !s->cut;
+  if (stale && !s->stale) {
+    l->st->feedback_stale++;
+    if (!l->o->quiet)
+      fprintf(stderr, "haptic: t=%.3f s no feedback for %.0f ms from a live server, force ramps out\n", t,
+              CONTACT_RENDER_HOLD_S * 1e3);
   }
+  s->stale = stale;
+  if (stale) s->model.in_contact = 0;
   return last_fb_mono;
+}
+
+/* The round trip to a guiding peer (guide_force.h: the coupling's damping
+ * grows with it): at least --guide-rtt, and twice our own smoothed round
+ * trip to the server (the peer's commands cross the same link when the
+ * server sits at the peer's site; when it sits at ours, --guide-rtt says). */
+static double guide_rtt(const haptic_loop_t *l, tick_state_t *s) {
+  feedback_slot_t *fs = &l->h->slot;
+  pthread_mutex_lock(&fs->lock);
+  size_t n = fs->nlatency;
+  double last_us = n ? fs->latency_us[n - 1] : 0;
+  pthread_mutex_unlock(&fs->lock);
+  if (n != s->rtt_samples) {
+    s->rtt_samples = n;
+    s->rtt_s = s->rtt_s > 0 ? s->rtt_s + 0.02 * (last_us * 1e-6 - s->rtt_s) : last_us * 1e-6;
+  }
+  double own = 2.0 * s->rtt_s;
+  l->st->guide_rtt_s = own > l->o->guide_rtt ? own : l->o->guide_rtt;
+  return l->st->guide_rtt_s;
 }
 
 /* The force to render: guided or not, one force law (guide_force.h); a
@@ -100,11 +149,20 @@ static void render_force(const haptic_loop_t *l, tick_state_t *s, double t, uint
                        .contact = &s->model,
                        .max_force = l->dev->max_force,
                        .max_stiffness = l->dev->max_stiffness,
-                       .period_s = 1.0 / o->rate};
+                       .period_s = 1.0 / o->rate,
+                       .rtt_s = guide_rtt(l, s)};
   memcpy(gin.x, pos, sizeof gin.x);
   memcpy(gin.v, vel, sizeof gin.v);
   memcpy(gin.peer, gv.peer, sizeof gin.peer);
   guide_force(&gin, gout);
+  /* Uncoupled, the contact model re-anchored at our own position; coupled,
+   * the guiding law's force. Either way ramped and observed. */
+  double target[3];
+  if (gout->coupled)
+    memcpy(target, gout->f, sizeof target);
+  else
+    contact_render_target(&s->render, s->cut ? NULL : &s->model, pos, vel, target);
+  gout->magnitude = contact_render_output(&s->render, target, s->cut, !gout->coupled, vel, gout->f);
   guide_report_tick(l->guide, t, &gv.role, gv.peer_station, gv.peer_age_s, gout, o->quiet ? NULL : stderr);
 }
 
@@ -121,15 +179,21 @@ static void record_force(const haptic_loop_t *l, const tick_state_t *s, double t
     st->force_sum += mag;
   }
   if (mag > st->peak_force) st->peak_force = mag;
+  st->energy_max_j = s->render.pc.energy_max;
+  st->energy_j = s->render.pc.energy;
+  st->step_max_n = s->render.step_max;
   if (l->csv)
-    fprintf(l->csv, "%.4f,%.6f,%.6f,%.6f,%.5f,%.5f,%.5f,%d\n", t, pos[0], pos[1], pos[2], f[0], f[1], f[2],
-            s->model.in_contact);
+    fprintf(l->csv, "%.4f,%.6f,%.6f,%.6f,%.5f,%.5f,%.5f,%d,%.7f,%.5f\n", t, pos[0], pos[1], pos[2], f[0], f[1], f[2],
+            s->model.in_contact, s->render.pc.energy, s->render.step_tick);
 }
 
 void haptic_loop_run(const haptic_loop_t *l) {
   const haptic_options_t *o = l->o;
   haptic_stats_t *st = l->st;
-  tick_state_t s = {.own_station = o->station ? o->station : ""};
+  tick_state_t s; /* 33 kB with the renderer's position ring: on the loop thread's stack */
+  memset(&s, 0, sizeof s);
+  s.own_station = o->station ? o->station : "";
+  contact_render_init(&s.render, 1.0 / o->rate, l->dev->max_force, HAPTIC_MAX_DAMPING);
   uint64_t period_ns = (uint64_t)(1e9 / o->rate);
   double run_for = o->duration >= 0 ? o->duration : 1e300;
   uint64_t start = vtime_mono_ns(), next = start, prev_tick = 0;
@@ -147,7 +211,7 @@ void haptic_loop_run(const haptic_loop_t *l) {
     uint32_t buttons = 0;
     l->dev->ops->read(l->dev, t, pos, quat, &buttons);
     send_command(l, &s, now, pos, quat, buttons);
-    uint64_t last_fb_mono = read_feedback(l, &s, now);
+    uint64_t last_fb_mono = read_feedback(l, &s, t, now);
     guide_output_t gout;
     render_force(l, &s, t, now, last_fb_mono, pos, &gout);
     l->dev->ops->write_force(l->dev, gout.f);
@@ -162,5 +226,9 @@ void haptic_loop_run(const haptic_loop_t *l) {
     if (now > next + 100000000ull) next = now; /* resynchronise after a long stall */
   }
   if (l->csv) fclose(l->csv);
+  st->pc_ticks = s.render.pc.active_ticks;
+  st->reanchored_ticks = s.render.reanchored_ticks;
+  st->plain_ticks = s.render.plain_ticks;
+  st->cuts = s.render.cuts;
   st->elapsed_s = (double)(vtime_mono_ns() - start) * 1e-9;
 }

@@ -20,13 +20,28 @@ typedef struct haptic_stats {
   double peak_force, force_sum; /* N; the sum over ticks in contact */
   uint64_t ticks, contact_ticks, late_ticks;
   double elapsed_s; /* wall time of the loop */
+  /* Contact under delay (contact_render.h): the passivity observer's
+   * largest energy (J, <= 0 passive), the largest one-tick force change
+   * (N, cuts excluded), controller ticks, forces cut at a lost server,
+   * liveliness losses and stale-feedback episodes. */
+  double energy_max_j, energy_j, step_max_n;
+  double guide_rtt_s; /* the round trip the guiding coupling was damped for, s */
+  uint64_t pc_ticks, cuts, server_lost, feedback_stale;
+  uint64_t liveliness_blips;              /* liveliness lapses heard with feedback still arriving: kept */
+  uint64_t reanchored_ticks, plain_ticks; /* in contact: model re-anchored at the answered command, or not */
 } haptic_stats_t;
+
+/* N s/m: the passivity controller's damper bound. It acts by scaling the
+ * rendered force down (never beyond zero), so the force it renders stays
+ * within the device's force limit whatever the bound; the bound only keeps
+ * it from reacting to velocity noise near rest (alpha |v| <= |f|). */
+#define HAPTIC_MAX_DAMPING 1e4
 
 typedef struct haptic_loop {
   const haptic_options_t *o;
   device_t *dev;
   haptic_dds_t *h;
-  FILE *csv;             /* t,x,y,z,fx,fy,fz,in_contact per tick, or NULL */
+  FILE *csv;             /* t,x,y,z,fx,fy,fz,in_contact,energy_j,step_n per tick, or NULL */
   guide_report_t *guide; /* guiding events and ages */
   haptic_stats_t *st;    /* period_us allocated by the caller */
   volatile sig_atomic_t *stop;

@@ -31,7 +31,9 @@ void haptic_usage(FILE *f) {
           "                      rendered clamped to it (default 0: no stated limit)\n"
           "  --wait-server S     wait up to S s for the server's scene before starting (default 10)\n"
           "  --duration S        stop after S s (default: end of the trajectory + 0.5 s)\n"
-          "  --force-csv FILE    write t,x,y,z,fx,fy,fz,in_contact per tick\n"
+          "  --force-csv FILE    write t,x,y,z,fx,fy,fz,in_contact,energy_j,step_n per tick\n"
+          "  --guide-rtt S       guiding hand: round trip to the peer station, s, at least (default 0;\n"
+          "                      the client also takes twice its own round trip to the server)\n"
           "  --rt-priority N     run the loop thread (only it) SCHED_FIFO at priority N (1..99) with\n"
           "                      memory locked (needs root, CAP_SYS_NICE or LimitRTPRIO; if refused:\n"
           "                      a warning naming the reason, normal priority)\n"
@@ -58,6 +60,7 @@ enum {
   OPT_DEVICE_INDEX = 'I',
   OPT_WORKSPACE_SCALE = 'S',
   OPT_WORKSPACE_OFFSET = 'O',
+  OPT_GUIDE_RTT = 'G',
 };
 
 static const struct option haptic_long_options[] = {{"trajectory", required_argument, 0, OPT_TRAJECTORY},
@@ -71,6 +74,7 @@ static const struct option haptic_long_options[] = {{"trajectory", required_argu
                                                     {"force-csv", required_argument, 0, OPT_FORCE_CSV},
                                                     {"rt-priority", required_argument, 0, OPT_RT_PRIORITY},
                                                     {"device", required_argument, 0, OPT_DEVICE},
+                                                    {"guide-rtt", required_argument, 0, OPT_GUIDE_RTT},
                                                     {"device-index", required_argument, 0, OPT_DEVICE_INDEX},
                                                     {"workspace-scale", required_argument, 0, OPT_WORKSPACE_SCALE},
                                                     {"workspace-offset", required_argument, 0, OPT_WORKSPACE_OFFSET},
@@ -95,6 +99,8 @@ static const char *number_option(int code) {
     return "workspace-scale";
   case OPT_TOOL:
     return "tool";
+  case OPT_GUIDE_RTT:
+    return "guide-rtt";
   default:
     return NULL;
   }
@@ -153,6 +159,13 @@ static int on_option(void *ctx, int code, const char *arg) {
     return 0;
   case OPT_DURATION:
     o->duration = v;
+    return 0;
+  case OPT_GUIDE_RTT:
+    if (v > 2) {
+      fprintf(stderr, "viscera-haptic: --guide-rtt %s: at most 2 s\n", arg);
+      return 2;
+    }
+    o->guide_rtt = v;
     return 0;
   case OPT_FORCE_CSV:
     o->force_csv = arg;

@@ -15,6 +15,7 @@ typedef struct haptic_options {
   const char *device;     /* --device NAME (default "scripted") */
   const char *station;    /* --station NAME, or NULL */
   device_config_t dcfg;   /* --device-index, --workspace-scale/-offset, and the fields below once parsed */
+  double guide_rtt;       /* --guide-rtt S: least round trip to a guiding peer (guide_force.h) */
   int domain, quiet, rt_priority;
   unsigned tool;                       /* --tool N */
   double rate;                         /* --rate HZ, loop rate */

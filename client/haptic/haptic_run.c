@@ -25,7 +25,7 @@ static int open_outputs(const haptic_options_t *o, FILE **csv, haptic_stats_t *s
       fprintf(stderr, "viscera-haptic: %s: cannot open for writing\n", o->force_csv);
       return 1;
     }
-    fprintf(*csv, "t,x,y,z,fx,fy,fz,in_contact\n");
+    fprintf(*csv, "t,x,y,z,fx,fy,fz,in_contact,energy_j,step_n\n");
   }
   /* A 1 kHz loop sharing two cores with physics and rendering misses its
    * tick whenever the scheduler prefers them; SCHED_FIFO and locked pages

@@ -49,12 +49,15 @@ typedef struct vdds {
  *   machine would release the tool and drop a grasp, which breaks the task,
  *   so the lease is three times the longest scheduler stall seen on the
  *   shared 2-core machine (~50 ms), and still well below the 0.5 s timeout.
- * - ContactFeedback (server -> haptic client), 30 ms: a false "lost" only
- *   zeroes the force until the next sample (the safe direction for a
- *   device), and the lease must beat the 50 ms feedback timeout or the
- *   timeout would always be the one to notice. */
+ * - ContactFeedback (server -> haptic client), 150 ms: a lost server cuts
+ *   the force within a tick, which the hand feels as a step, so a false
+ *   "lost" is not free: across a site link (100 ms one way, jitter, 10 %
+ *   loss, docs/remote.md) a 30 ms lease lapsed 1-3 times per 13 s. Until
+ *   the lease runs out the client renders its last model (a local plane,
+ *   passive however old), then ramps it out after
+ *   CONTACT_RENDER_HOLD_S without samples (client/haptic/contact_render.h). */
 #define VDDS_TOOL_LEASE_MS 150
-#define VDDS_FEEDBACK_LEASE_MS 30
+#define VDDS_FEEDBACK_LEASE_MS 150
 
 /* Default partition when none is given. */
 #define VDDS_DEFAULT_PARTITION "viscera/local"

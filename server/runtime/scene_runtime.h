@@ -69,7 +69,8 @@ void runtime_set_tool(runtime_t *rt, size_t t, const double pos[3], double devic
 void runtime_set_buttons(runtime_t *rt, size_t t, uint32_t buttons);
 /* The command's orientation (unit quaternion w, x, y, z): the shaft axis. */
 void runtime_set_orientation(runtime_t *rt, size_t t, const double q[4]);
-/* Tool no longer driven (client gone): releases contact, stops acting. */
+/* Tool no longer driven (client gone): drops what it holds, stops acting;
+ * its god-object keeps its contact for the client's return. */
 void runtime_release_tool(runtime_t *rt, size_t t);
 
 /* After a model's topology was restored from a checkpoint (checkpoint.c):

@@ -118,7 +118,11 @@ void interact_release_tool(runtime_t *rt, size_t t) {
   tool->buttons = tool->prev_buttons = 0;
   tool->fb_contact = 0;
   tool->active = 0;
-  proxy_reset(&tool->proxy);
+  /* The proxy keeps its contact: a client that drops out for a moment (a
+   * stall, a link blip, a false "client lost") comes back to the same
+   * scene, so a hand still inside the organ is pushed out again rather
+   * than left inside with no entry crossing to find (docs/remote.md).
+   * A hand that comes back elsewhere releases it at the first update. */
   interact_hand_force(rt, t);
 }
 

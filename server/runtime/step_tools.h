@@ -36,8 +36,9 @@ void interact_tools(runtime_t *rt);
 int interact_uses_proxy(const runtime_t *rt, size_t t);
 void interact_apply(runtime_t *rt, organ_rt_t *o, model_t *m);
 void interact_outputs(runtime_t *rt);
-/* The tool's client is gone: drop whatever it holds, leave the contact,
- * stop acting (tool inactive, no force). */
+/* The tool's client is gone: drop whatever it holds, stop acting (tool
+ * inactive, no force). The god-object keeps its contact, so a client back
+ * with its hand inside the organ feels it again (docs/remote.md). */
 void interact_release_tool(runtime_t *rt, size_t t);
 
 /* The force the hand feels on tool t (tool->force, N) from this step's

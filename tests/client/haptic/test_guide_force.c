@@ -175,7 +175,7 @@ static void test_fallbacks_and_clamps(void) {
   CHECK_NEAR(o.f[0], 2.0 - 0.01, 1e-9);
   /* Not in the role: plain contact at our own position even with a peer. */
   guide_role_t other = role("carol", "bob", 0.5, 200);
-  contact_model_t wall = {1, {0, 0, 0.01}, {0, 0, 1}, 400, 0.4};
+  contact_model_t wall = {1, {0, 0, 0.01}, {0, 0, 1}, 400, 0.4, 0};
   in = input(&other, "alice", A, B, &wall);
   guide_force(&in, &o);
   CHECK(!o.coupled && o.side == GUIDE_SIDE_NONE);
@@ -189,7 +189,7 @@ static void test_fallbacks_and_clamps(void) {
 /* Contact is evaluated where the server puts the tool, and each side feels
  * its share of it. */
 static void test_contact_share(void) {
-  contact_model_t wall = {1, {0, 0, 0}, {0, 0, 1}, 400, 0.4}; /* surface z = 0, outward +z */
+  contact_model_t wall = {1, {0, 0, 0}, {0, 0, 1}, 400, 0.4, 0}; /* surface z = 0, outward +z */
   guide_role_t r = role("", "bob", 0.5, 200);
   guide_output_t o;
   /* Both hands 1 cm deep: tool 1 cm deep, 4 N of tissue, 2 N each. */

@@ -1,0 +1,96 @@
+/* contact_render: what the haptic client renders from a contact model that
+ * is one network round trip old (docs/remote.md). Pure arithmetic, no
+ * clock and no allocation: the 1 kHz loop and the delayed-feedback unit test
+ * (tests/client/haptic/test_contact_render.c) run the same code.
+ *
+ * 1. Re-anchoring. A ContactFeedback answers one of our commands (cmd_seq):
+ *    the server placed its proxy for the hand where it was then, x_cmd, and
+ *    the tissue under the proxy has since kept deforming. The plain plane
+ *    model k (p - x) . n renders the tool's stiffness k for the distance the
+ *    hand moved since, although the server, pressing a soft organ, would
+ *    let the proxy sink with it: an old plane overshoots (up to 2x at
+ *    50 ms). So the force is the server's own spring at the command it
+ *    answered plus the organ's effective stiffness for the way since:
+ *      F = k (p - x_cmd) . n + k_eff (x_cmd - x) . n - b (v . n),
+ *    k_eff the secant stiffness of the press (the server's force over the
+ *    depth of x_cmd below the surface point where contact began, low-pass
+ *    filtered, within [0, k]). With no delay x_cmd is the hand and F is the
+ *    server's force; our positions are kept by command seq (a ring of
+ *    CONTACT_RENDER_RING, 1 s at 1 kHz), a feedback answering a command we
+ *    no longer know (or another station's) is rendered as the plain plane.
+ * 2. Ramping. Every change of model (contact begins or ends, a new sample
+ *    after a gap, the server back) reaches the hand through a bound on the
+ *    force's change per tick, max_step: no step is felt.
+ * 3. Passivity. A time-domain passivity observer and controller
+ *    (passivity.h) on the rendered force, after the ramp.
+ * 4. A stale model (no feedback for hold_s: the link is slow, lossy or the
+ *    server stalls) is held, re-anchored at our own position, and then
+ *    ramped to zero; only a cut (the server's liveliness lost: it is gone)
+ *    zeroes the force within the tick.
+ * The model's stiffness and damping are the caller's (device-clamped,
+ * contact_model.h). */
+#ifndef VISCERA_CONTACT_RENDER_H
+#define VISCERA_CONTACT_RENDER_H
+
+#include <stdint.h>
+
+#include "contact_model.h"
+#include "passivity.h"
+
+#define CONTACT_RENDER_RING 1024
+/* N: the largest change of the rendered force per tick (issue target 0.1 N). */
+#define CONTACT_RENDER_MAX_STEP 0.08
+/* s: how long a model is rendered without a new sample before it ramps out. */
+#define CONTACT_RENDER_HOLD_S 0.25
+/* m: the depth below which the press's secant stiffness is not estimated. */
+#define CONTACT_RENDER_MIN_DEPTH 5e-4
+/* s: time constant of the secant stiffness filter. */
+#define CONTACT_RENDER_K_TAU 0.02
+/* N: a press whose first sample already pushes this hard began inside the
+ * organ (the server back after a blip): no surface point, no extrapolation. */
+#define CONTACT_RENDER_ONSET_SPRING 0.1
+
+typedef struct contact_render {
+  double period_s, max_step, max_force;
+  uint64_t ring_seq[CONTACT_RENDER_RING];
+  double ring_x[CONTACT_RENDER_RING][3];
+  int anchored;        /* the surface point where contact began is known */
+  double onset[3];     /* that point */
+  double onset_spring; /* N, the server's spring in the press's first sample */
+  uint64_t off_ticks;  /* ticks without contact since the press's last sample */
+  double k_eff;        /* N/m, the press's filtered secant stiffness */
+  double f_prev[3];    /* force rendered last tick */
+  double step_max;     /* N, the largest one-tick change rendered (cuts excluded) */
+  double step_tick;    /* N, this tick's change */
+  uint64_t cuts;       /* forces zeroed at once (server lost) */
+  uint64_t reanchored_ticks, plain_ticks;
+  passivity_t pc;
+} contact_render_t;
+
+/* max_damping: the passivity controller's damper bound (N s/m). */
+void contact_render_init(contact_render_t *r, double period_s, double max_force, double max_damping);
+
+/* Our command `seq` put the hand at x. */
+void contact_render_sent(contact_render_t *r, uint64_t seq, const double x[3]);
+
+/* The model's force at hand position x and velocity v (before the ramp and
+ * the passivity controller), into f; returns its magnitude. m NULL or not in
+ * contact: zero (and the press's anchor is forgotten). */
+double contact_render_target(contact_render_t *r, const contact_model_t *m, const double x[3], const double v[3],
+                             double f[3]);
+
+/* One tick: m the newest model (NULL: none usable, e.g. stale beyond
+ * hold_s; the force ramps to zero), cut 1 when the server was lost (zero at
+ * once). Writes the force to render into f and returns its magnitude. */
+double contact_render_tick(contact_render_t *r, const contact_model_t *m, int cut, const double x[3], const double v[3],
+                           double f[3]);
+
+/* Ramp and passivity for a target force: the same bounds and observer as
+ * contact_render_tick; control 0 observes without the controller (the
+ * guiding hand: a led hand must receive the energy its guide puts in, so
+ * one port alone may not be held passive; guide_force.h damps the coupling
+ * for the delay instead). */
+double contact_render_output(contact_render_t *r, const double target[3], int cut, int control, const double v[3],
+                             double f[3]);
+
+#endif
