@@ -50,6 +50,40 @@ int vdds_config_secure(void) {
   return secure;
 }
 
+int vdds_config_loopback(void) {
+  const char *uri = getenv("CYCLONEDDS_URI");
+  if (!uri || !*uri) return 1;
+  char *copy = strdup(uri);
+  if (!copy) return 0;
+  int loop = 1;
+  char *save = NULL;
+  static const char want[] = "/cyclonedds-loopback.xml";
+  for (char *e = strtok_r(copy, ",", &save); e && loop; e = strtok_r(NULL, ",", &save)) {
+    while (*e == ' ' || *e == '\t' || *e == '\n') e++;
+    size_t n = strlen(e);
+    while (n && (e[n - 1] == ' ' || e[n - 1] == '\n')) e[--n] = 0;
+    loop = strncmp(e, "file://", 7) == 0 && n >= sizeof want - 1 && !strcmp(e + n - (sizeof want - 1), want);
+  }
+  free(copy);
+  return loop;
+}
+
+int vdds_config_warn_insecure(FILE *f, const char *tag, int *warned) {
+  if ((warned && *warned) || vdds_config_loopback() || vdds_config_secure()) return 0;
+  const char *uri = getenv("CYCLONEDDS_URI");
+  const char *ins = getenv("VISCERA_INSECURE");
+  if (ins && !strcmp(ins, "1"))
+    fprintf(f, "%s: WARNING: insecure (VISCERA_INSECURE=1): DDS Security is off on %s\n", tag, uri);
+  else
+    fprintf(f,
+            "%s: WARNING: DDS Security is off and CYCLONEDDS_URI (%s) is not the loopback configuration: anyone on "
+            "that network can read this session and drive its tools. Use identities from deploy/pki.sh (deploy/lab.sh "
+            "--secure), or set VISCERA_INSECURE=1 to say this is intended.\n",
+            tag, uri);
+  if (warned) *warned = 1;
+  return 1;
+}
+
 int vdds_matched_writers(dds_entity_t reader) {
   dds_subscription_matched_status_t st;
   return dds_get_subscription_matched_status(reader, &st) == DDS_RETCODE_OK ? (int)st.current_count : 0;

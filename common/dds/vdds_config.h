@@ -35,6 +35,21 @@ int vdds_config_default(void);
  * <Security>/<DDSSecurity> section inline or in a file:// element), else 0. */
 int vdds_config_secure(void);
 
+/* 1 when every file:// element of CYCLONEDDS_URI is the loopback
+ * configuration (VDDS_LOOPBACK_CONFIG: nothing leaves the machine) and
+ * nothing else is inline; 0 otherwise (unset counts as loopback: the
+ * default, vdds_config_default). */
+int vdds_config_loopback(void);
+
+/* Off loopback, secure by default (issue 14): when the configuration is
+ * neither loopback nor secure, writes a warning naming the configuration
+ * and what anyone on that network can do to f (once per process: the
+ * caller keeps `warned`), unless $VISCERA_INSECURE is 1 (the explicit
+ * choice deploy/net_guard.sh also honours), in which case the warning is
+ * one line saying so. Returns 1 when it warned. The deploy scripts refuse
+ * such a configuration outright; a program started by hand warns. */
+int vdds_config_warn_insecure(FILE *f, const char *tag, int *warned);
+
 /* Publications (writers) matched by `reader` now; 0 on error. */
 int vdds_matched_writers(dds_entity_t reader);
 /* Subscriptions (readers) matched by `writer` now; 0 on error. */

@@ -64,5 +64,32 @@ int main(void) {
   CHECK(strstr(t, "DDS Security on") != NULL && strstr(t, "do not accept this identity") != NULL);
   unlink(sec);
   unlink(plain);
+  /* Off loopback and not secure: a warning (issue 14 item 5); loopback,
+   * secure or unset: none; VISCERA_INSECURE=1: one line saying so. */
+  {
+    char out[1024];
+    FILE *f;
+    int warned = 0;
+    unsetenv("VISCERA_INSECURE");
+    setenv("CYCLONEDDS_URI", "file:///opt/viscera/deploy/cyclonedds-loopback.xml", 1);
+    CHECK(vdds_config_loopback() == 1);
+    CHECK(vdds_config_warn_insecure(stderr, "t", NULL) == 0);
+    setenv("CYCLONEDDS_URI", "file:///opt/viscera/deploy/cyclonedds-lan.xml", 1);
+    CHECK(vdds_config_loopback() == 0);
+    f = fmemopen(out, sizeof out, "w");
+    CHECK(f && vdds_config_warn_insecure(f, "t", &warned) == 1 && warned == 1);
+    if (f) fclose(f);
+    CHECK(strstr(out, "DDS Security is off") && strstr(out, "cyclonedds-lan.xml") && strstr(out, "VISCERA_INSECURE=1"));
+    CHECK(vdds_config_warn_insecure(stderr, "t", &warned) == 0); /* once */
+    setenv("VISCERA_INSECURE", "1", 1);
+    f = fmemopen(out, sizeof out, "w");
+    CHECK(f && vdds_config_warn_insecure(f, "t", NULL) == 1);
+    if (f) fclose(f);
+    CHECK(strstr(out, "insecure (VISCERA_INSECURE=1)") != NULL);
+    unsetenv("VISCERA_INSECURE");
+    setenv("CYCLONEDDS_URI", "file:///x/cyclonedds-loopback.xml,<CycloneDDS><Domain><Security/></Domain></CycloneDDS>",
+           1);
+    CHECK(vdds_config_loopback() == 0 && vdds_config_warn_insecure(stderr, "t", NULL) == 0);
+  }
   return check_report("test_vdds_config");
 }
