@@ -12,12 +12,13 @@
  *
  * force_check hold FORCE_CSV FROM_ROW TO_ROW
  *   Ticks FROM_ROW..TO_ROW-1 (data rows, 0-based; the rows written while a
- *   client was killed or stalled): at least 100 of them, >= 90 % with a
+ *   client was killed or stalled): at least 100 of them, >= 75 % with a
  *   force above 0.1 N, and no run of HOLD_MAX_GAP ticks in a row without.
  *   A server blocked by a stalled reader stops its feedback for up to 1 s
- *   per write: about 1000 ticks in a row without force. On a machine loaded
- *   far beyond its cores (load average 17 on 2 cores) the client's false
- *   "server lost" blips were seen to zero runs of 9-94 ticks, 5 % of them. */
+ *   per write: about 1000 ticks in a row without force, and most of the
+ *   stall. On a machine loaded far beyond its cores (load average 17 on 2
+ *   cores, two busy loops beside the test) the client's false "server lost"
+ *   blips were seen to zero runs of 9-233 ticks, 5-13 % of the ticks. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -25,7 +26,7 @@
 
 #define LIFT_Z 0.05      /* m: above the kidney (its top is at 0.035 m) */
 #define INSIDE_Z 0.03    /* m: pressing */
-#define HOLD_MAX_GAP 300 /* ticks in a row without force: a blocked server, not a blip */
+#define HOLD_MAX_GAP 500 /* ticks in a row without force: a blocked server, not a blip */
 
 typedef struct row {
   double t, z, f;
@@ -98,7 +99,7 @@ static int hold(const row_t *r, size_t n, size_t from, size_t to) {
     if (run > longest) longest = run;
   }
   printf("ticks %zu..%zu: %zu, with force > 0.1 N: %zu; longest run without: %zu ticks\n", from, to, m, f, longest);
-  return m >= 100 && (double)f >= 0.9 * (double)m && longest < HOLD_MAX_GAP ? 0 : 1;
+  return m >= 100 && (double)f >= 0.75 * (double)m && longest < HOLD_MAX_GAP ? 0 : 1;
 }
 
 int main(int argc, char **argv) {
