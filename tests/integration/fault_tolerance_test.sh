@@ -57,8 +57,10 @@ kill -0 $VC || fail "an unaffected viewer died"
 kill -0 $VB || fail "the stalled viewer did not survive"
 # A server blocked by a stalled reliable reader would stop stepping for up
 # to the writers' max blocking time (1 s) per write, and its feedback would
-# stop: the haptic client would render zero force for most of those ticks.
-# Through both events >= 98 % of its ticks felt the organ (force_check hold).
+# stop: the haptic client would render zero force for about 1000 ticks in a
+# row. Through both events >= 75 % of its ticks felt the organ and no run
+# without force reached 500 ticks (force_check hold; false "server lost"
+# blips of a starved client stay well below both).
 "$BUILD/tests/integration/force_check" hold "$OUT/force.csv" "$R0" "$R1" \
   || fail "contact force was disturbed by a killed or stalled client"
 

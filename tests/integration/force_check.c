@@ -12,16 +12,21 @@
  *
  * force_check hold FORCE_CSV FROM_ROW TO_ROW
  *   Ticks FROM_ROW..TO_ROW-1 (data rows, 0-based; the rows written while a
- *   client was killed or stalled): at least 100 of them, and >= 98 % with a
- *   force above 0.1 N (a 50 ms feedback gap on a loaded machine zeroes a
- *   few ticks; a blocked server would zero most). */
+ *   client was killed or stalled): at least 100 of them, >= 75 % with a
+ *   force above 0.1 N, and no run of HOLD_MAX_GAP ticks in a row without.
+ *   A server blocked by a stalled reader stops its feedback for up to 1 s
+ *   per write: about 1000 ticks in a row without force, and most of the
+ *   stall. On a machine loaded far beyond its cores (load average 17 on 2
+ *   cores, two busy loops beside the test) the client's false "server lost"
+ *   blips were seen to zero runs of 9-233 ticks, 5-13 % of the ticks. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#define LIFT_Z 0.05   /* m: above the kidney (its top is at 0.035 m) */
-#define INSIDE_Z 0.03 /* m: pressing */
+#define LIFT_Z 0.05      /* m: above the kidney (its top is at 0.035 m) */
+#define INSIDE_Z 0.03    /* m: pressing */
+#define HOLD_MAX_GAP 500 /* ticks in a row without force: a blocked server, not a blip */
 
 typedef struct row {
   double t, z, f;
@@ -87,10 +92,14 @@ static int failover(const row_t *r, size_t n) {
 
 static int hold(const row_t *r, size_t n, size_t from, size_t to) {
   if (to > n) to = n;
-  size_t m = 0, f = 0;
-  for (size_t k = from; k < to; k++, m++) f += r[k].f > 0.1;
-  printf("ticks %zu..%zu: %zu, with force > 0.1 N: %zu\n", from, to, m, f);
-  return m >= 100 && (double)f >= 0.98 * (double)m ? 0 : 1;
+  size_t m = 0, f = 0, run = 0, longest = 0;
+  for (size_t k = from; k < to; k++, m++) {
+    f += r[k].f > 0.1;
+    run = r[k].f > 0.1 ? 0 : run + 1;
+    if (run > longest) longest = run;
+  }
+  printf("ticks %zu..%zu: %zu, with force > 0.1 N: %zu; longest run without: %zu ticks\n", from, to, m, f, longest);
+  return m >= 100 && (double)f >= 0.75 * (double)m && longest < HOLD_MAX_GAP ? 0 : 1;
 }
 
 int main(int argc, char **argv) {
