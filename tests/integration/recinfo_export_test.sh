@@ -36,7 +36,7 @@ near() { # NAME GOT WANT ABS REL
 "$RECINFO" "$REC" --export csv --topic viscera_ContactFeedback "$OUT/fb.csv" 2> "$OUT/csv.err" \
   || { cat "$OUT/csv.err"; fail "csv export failed"; }
 head -1 "$OUT/fb.csv"
-head -1 "$OUT/fb.csv" | grep -q '^source_time_ns,partition,tool_id,cmd_seq,.*,in_contact,.*,force\[0\],force\[1\],force\[2\]$' \
+head -1 "$OUT/fb.csv" | grep -q '^source_time_ns,partition,tool_id,cmd_seq,.*,in_contact,.*,force\[0\],force\[1\],force\[2\],seq$' \
   || fail "unexpected CSV header"
 [ "$(tail -n +2 "$OUT/fb.csv" | wc -l)" = "$(count viscera_ContactFeedback)" ] || fail "CSV rows differ from recinfo's count"
 read -r peak contact < <(awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next }

@@ -117,20 +117,21 @@ static void test_csv(void) {
   fb.organ_id = 0;
   fb.force[0] = 0.5f, fb.force[1] = -0.25f, fb.force[2] = 1.0f;
   fb.stiffness = 400;
+  fb.seq = 7;
   rt_model_t m;
   CHECK(load(&m, &viscera_ContactFeedback_desc, "viscera::ContactFeedback") == 0);
   rt_str_t h = {0};
   rt_csv_header(m.top, &h);
   CHECK(h.s && strcmp(h.s, "tool_id,cmd_seq,cmd_client_mono_ns,sim_time_ns,in_contact,organ_id,proxy_position[0],"
                            "proxy_position[1],proxy_position[2],normal[0],normal[1],normal[2],stiffness,force[0],"
-                           "force[1],force[2]") == 0);
+                           "force[1],force[2],seq") == 0);
   for (int x = 1; x <= 2; x++) {
     size_t len;
     unsigned char *b = serialize(&fb, &viscera_ContactFeedback_desc, x, &len);
     rt_str_t o = {0};
     verr_t err = {{0}};
     CHECK(rt_cdr_csv(m.top, b, len, &o, &err) == 0);
-    CHECK(o.s && strcmp(o.s, "2,99,0,5000000,true,0,0,0,0,0,0,0,400,0.5,-0.25,1") == 0);
+    CHECK(o.s && strcmp(o.s, "2,99,0,5000000,true,0,0,0,0,0,0,0,400,0.5,-0.25,1,7") == 0);
     /* a boolean that is neither 0 nor 1 */
     size_t at = x == 1 ? 4 + 32 : 4 + 28; /* XCDR2 aligns 8-byte fields to 4 */
     CHECK(b[at] == 1);
