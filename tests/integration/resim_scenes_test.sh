@@ -57,6 +57,12 @@ record() {
 }
 
 scenes=("$SRC"/assets/scenes/*.yaml)
+# VISCERA_RESIM_SCENES="a b": only those (the sanitizer pass keeps the ones
+# with buttons, cuts, grasps and two tools: its physics runs 2-3 times slower).
+if [ -n "${VISCERA_RESIM_SCENES:-}" ]; then
+  scenes=()
+  for n in $VISCERA_RESIM_SCENES; do scenes+=("$SRC/assets/scenes/$n.yaml"); done
+fi
 for ((i = 0; i < ${#scenes[@]}; i += 3)); do
   pids=()
   for sc in "${scenes[@]:i:3}"; do
