@@ -75,10 +75,14 @@ static dds_qos_t *make_qos(qos_kind_t k, int lease_ms) {
     /* Every sample counts (a recording must hold each applied input to
      * re-simulate), at up to 1 kHz: reliable, keep-last 1000 (a second), so
      * neither a recorder stalled by a disk commit loses one nor the writer
-     * ever blocks the physics loop (a loss shows as a seq gap). */
+     * ever blocks the physics loop (a loss shows as a seq gap); and
+     * transient-local, so a recorder whose discovery of the writer came late
+     * on a loaded machine still gets the last second of inputs. */
     dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
-    dds_qset_durability(q, DDS_DURABILITY_VOLATILE);
+    dds_qset_durability(q, DDS_DURABILITY_TRANSIENT_LOCAL);
     dds_qset_history(q, DDS_HISTORY_KEEP_LAST, 1000);
+    dds_qset_durability_service(q, 0, DDS_HISTORY_KEEP_LAST, 1000, DDS_LENGTH_UNLIMITED, DDS_LENGTH_UNLIMITED,
+                                DDS_LENGTH_UNLIMITED);
     break;
   }
   return q;

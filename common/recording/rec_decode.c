@@ -49,7 +49,10 @@ static bool decode_with(const unsigned char *payload, uint32_t size, bool bswap,
   return ok;
 }
 
-bool rec_decode_cdr(const void *cdr, size_t len, const dds_topic_descriptor_t *desc, void *out) {
+/* rec_decode_cdr with the ops to read by (NULL: desc's own; a format-1
+ * twin's read into the prefix of desc's struct). */
+static bool decode_cdr_ops(const void *cdr, size_t len, const dds_topic_descriptor_t *desc, const uint32_t *ops,
+                           void *out) {
   memset(out, 0, desc->m_size); /* dds_stream_read would free or reuse garbage pointers */
   const unsigned char *b = cdr;
   if (!b || len < 4 || len - 4 > UINT32_MAX || b[0] != 0) return false;
@@ -68,13 +71,11 @@ bool rec_decode_cdr(const void *cdr, size_t len, const dds_topic_descriptor_t *d
   uint32_t xcdrv = id <= 3 ? 1 : 2;
   uint32_t size = (uint32_t)(len - 4);
   bool bswap = le != (DDSRT_ENDIAN == DDSRT_LITTLE_ENDIAN);
-  if (decode_with(b + 4, size, bswap, xcdrv, desc->m_ops, out)) return true;
-  /* A format-1 sample of a type that has grown since (fields appended at
-   * its end): the frozen twin reads it into the prefix of `out`. */
-  const dds_topic_descriptor_t *twin = xcdrv == 1 ? format1_twin(desc) : NULL;
-  if (twin && decode_with(b + 4, size, bswap, xcdrv, twin->m_ops, out)) return true;
-  memset(out, 0, desc->m_size);
-  return false;
+  return decode_with(b + 4, size, bswap, xcdrv, ops ? ops : desc->m_ops, out);
+}
+
+bool rec_decode_cdr(const void *cdr, size_t len, const dds_topic_descriptor_t *desc, void *out) {
+  return decode_cdr_ops(cdr, len, desc, NULL, out);
 }
 
 void rec_decode_free(void *sample, const dds_topic_descriptor_t *desc) {
@@ -107,6 +108,7 @@ bool rec_decode_enum_value(const dds_topic_descriptor_t *desc, const char *liter
 
 typedef struct decode_ctx {
   const dds_topic_descriptor_t *desc;
+  const uint32_t *ops; /* NULL, or the format-1 twin's (the topic was recorded with it) */
   void *sample;
   rec_decode_cb cb;
   void *arg;
@@ -116,7 +118,7 @@ typedef struct decode_ctx {
 static int on_row(void *arg, const recfile_row_t *row) {
   decode_ctx_t *c = arg;
   if (row->kind != REC_KIND_DATA) return 0;
-  if (!rec_decode_cdr(row->cdr, row->cdr_len, c->desc, c->sample)) {
+  if (!decode_cdr_ops(row->cdr, row->cdr_len, c->desc, c->ops, c->sample)) {
     if (c->rep->undecodable++ == 0) c->rep->first_undecodable = row->id;
     return 0;
   }
@@ -124,6 +126,41 @@ static int on_row(void *arg, const recfile_row_t *row) {
   int stop = c->cb(c->arg, c->sample, row);
   rec_decode_free(c->sample, c->desc);
   return stop;
+}
+
+/* Stops a scan at the first data row that decodes with ctx->ops (NULL:
+ * the descriptor's own). */
+typedef struct probe_ctx {
+  const dds_topic_descriptor_t *desc;
+  const uint32_t *ops;
+  void *sample;
+  bool found;
+} probe_ctx_t;
+static int probe_row(void *arg, const recfile_row_t *row) {
+  probe_ctx_t *p = arg;
+  if (row->kind != REC_KIND_DATA || !decode_cdr_ops(row->cdr, row->cdr_len, p->desc, p->ops, p->sample)) return 0;
+  rec_decode_free(p->sample, p->desc);
+  p->found = true;
+  return 1;
+}
+
+/* A topic recorded before its type grew (fields appended at its end) holds
+ * format-1 samples that the grown type does not read: when not one data row
+ * decodes with the compiled type but one does with its frozen format-1 twin
+ * (idl/viscera_format1.idl), the whole topic is read with the twin, into the
+ * prefix of the compiled struct (the appended fields stay zero). Decided
+ * per topic, never per sample, so a truncated sample of the compiled type
+ * is not taken for an older one. Returns the twin's ops or NULL. */
+static const uint32_t *format1_ops(recfile_t *rf, int64_t topic_id, const dds_topic_descriptor_t *desc, void *sample) {
+  const dds_topic_descriptor_t *twin = format1_twin(desc);
+  if (!twin) return NULL;
+  probe_ctx_t p = {desc, NULL, sample, false};
+  recfile_scan_report_t r;
+  recfile_scan(rf, topic_id, true, probe_row, &p, &r);
+  if (p.found || r.rows == 0) return NULL;
+  p.ops = twin->m_ops;
+  recfile_scan(rf, topic_id, true, probe_row, &p, &r);
+  return p.found ? twin->m_ops : NULL;
 }
 
 int rec_decode_topic(recfile_t *rf, const char *topic, const dds_topic_descriptor_t *desc, rec_decode_cb cb, void *arg,
@@ -134,8 +171,9 @@ int rec_decode_topic(recfile_t *rf, const char *topic, const dds_topic_descripto
     rep->topic_missing = true;
     return 0;
   }
-  decode_ctx_t c = {desc, calloc(1, desc->m_size ? desc->m_size : 1), cb, arg, rep};
+  decode_ctx_t c = {desc, NULL, calloc(1, desc->m_size ? desc->m_size : 1), cb, arg, rep};
   if (!c.sample) return -1;
+  c.ops = format1_ops(rf, t->id, desc, c.sample);
   recfile_scan(rf, t->id, true, on_row, &c, &rep->scan);
   free(c.sample);
   return 0;

@@ -993,6 +993,8 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
   publish_event(&s, viscera_EVENT_SESSION_STOPPED, -1, -1, 0, scene->name);
 
   stats->steps = s.rt.steps;
+  applied_input_flush(&s.ai);
+  stats->published[VT_APPLIED_INPUT] = s.ai.published;
   for (size_t i = 0; i < s.rt.norgans; i++) {
     stats->published[VT_MESH_STATE] += s.pubs[i].keyframes;
     stats->published[VT_MESH_DELTA] += s.pubs[i].frames;

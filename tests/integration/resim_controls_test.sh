@@ -27,9 +27,11 @@ pids=()
 trap 'for p in "${pids[@]}"; do kill -9 "$p" 2>/dev/null || true; done' EXIT
 "$BUILD/server/viscera-server" --scene "$SRC/assets/scenes/stone_removal.yaml" "${common[@]}" \
   >"$OUT/server.out" 2>"$OUT/server.log" & S=$!; pids+=($S)
-"$BUILD/client/recorder/viscera-recorder" "${common[@]}" --out "$OUT/session.db" --quiet \
+"$BUILD/client/recorder/viscera-recorder" "${common[@]}" --out "$OUT/session.db" \
   >"$OUT/recorder.out" 2>"$OUT/recorder.log" & R=$!; pids+=($R)
-sleep 1.5
+# The hands move once the recorder records the server's inputs (at most 20 s).
+for _ in $(seq 1 200); do grep -q "recording topic viscera_AppliedInput" "$OUT/recorder.log" && break; sleep 0.1; done
+sleep 0.3
 hp=()
 "$BUILD/client/haptic/viscera-haptic" --trajectory "$T/palpate_kidney.traj" --tool 0 --station alice "${common[@]}" \
   --quiet >"$OUT/haptic_alice.out" 2>"$OUT/haptic_alice.log" & hp+=($!)

@@ -36,10 +36,12 @@ record() {
   mkdir -p "$d"
   "$BUILD/server/viscera-server" --scene "$scene" "${common[@]}" >"$d/server.out" 2>"$d/server.log" &
   local s=$!
-  "$BUILD/client/recorder/viscera-recorder" "${common[@]}" --out "$d/session.db" --quiet \
+  "$BUILD/client/recorder/viscera-recorder" "${common[@]}" --out "$d/session.db" \
     >"$d/recorder.out" 2>"$d/recorder.log" &
   local r=$!
-  sleep 1.5 # discovery before the hands move
+  # The hands move once the recorder records the server's inputs (at most 20 s).
+  for _ in $(seq 1 200); do grep -q "recording topic viscera_AppliedInput" "$d/recorder.log" && break; sleep 0.1; done
+  sleep 0.3
   local hp=() spec rc=0
   for spec in $(drives "$name"); do
     "$BUILD/client/haptic/viscera-haptic" --trajectory "${spec#*:}" --tool "${spec%%:*}" "${common[@]}" --quiet \
@@ -55,6 +57,12 @@ record() {
 }
 
 scenes=("$SRC"/assets/scenes/*.yaml)
+# VISCERA_RESIM_SCENES="a b": only those (the sanitizer pass keeps the ones
+# with buttons, cuts, grasps and two tools: its physics runs 2-3 times slower).
+if [ -n "${VISCERA_RESIM_SCENES:-}" ]; then
+  scenes=()
+  for n in $VISCERA_RESIM_SCENES; do scenes+=("$SRC/assets/scenes/$n.yaml"); done
+fi
 for ((i = 0; i < ${#scenes[@]}; i += 3)); do
   pids=()
   for sc in "${scenes[@]:i:3}"; do
