@@ -79,9 +79,10 @@ double contact_render_target(contact_render_t *r, const contact_model_t *m, cons
 }
 
 double contact_render_output(contact_render_t *r, const double target[3], int cut, int control, const double v[3],
-                             double f[3]) {
+                             const double dx[3], double f[3]) {
   double before[3];
   v3_copy(before, r->f_prev);
+  passivity_observe(&r->pc, r->f_prev, dx); /* last tick's force over the way the hand went since */
   if (cut) {
     /* The server is gone: nothing to ramp towards, and a wall it no longer
      * computes must not stay under the hand. */
@@ -92,8 +93,11 @@ double contact_render_output(contact_render_t *r, const double target[3], int cu
     v3_copy(g, target);
     if (!v3_isfinite(g)) v3_set(g, 0, 0, 0);
     /* Released at max_step per tick, a force f still delivers about
-     * (f . v) T |f| / (2 max_step) after the controller asks for less. */
-    double fv = v3_dot(g, v), reserve = fv > 0 ? fv * r->period_s * v3_norm(g) / (2 * r->max_step) : 0;
+     * (f . v) T (|f| / (2 max_step) + 1) after the controller asks for
+     * less: the ramp's ticks, and the tick the force is held before the
+     * observer sees it. */
+    double fv = v3_dot(g, v);
+    double reserve = fv > 0 ? fv * r->period_s * (v3_norm(g) / (2 * r->max_step) + 1.0) : 0;
     if (control) passivity_control(&r->pc, v, r->max_force, reserve, g);
     double d[3];
     v3_sub(d, g, r->f_prev);
@@ -106,7 +110,6 @@ double contact_render_output(contact_render_t *r, const double target[3], int cu
     step = v3_norm(d);
     if (step > r->step_max) r->step_max = step;
   }
-  passivity_observe(&r->pc, f, v);
   v3_sub(before, f, before);
   r->step_tick = v3_norm(before);
   v3_copy(r->f_prev, f);
@@ -114,8 +117,8 @@ double contact_render_output(contact_render_t *r, const double target[3], int cu
 }
 
 double contact_render_tick(contact_render_t *r, const contact_model_t *m, int cut, const double x[3], const double v[3],
-                           double f[3]) {
+                           const double dx[3], double f[3]) {
   double target[3];
   contact_render_target(r, cut ? NULL : m, x, v, target);
-  return contact_render_output(r, target, cut, 1, v, f);
+  return contact_render_output(r, target, cut, 1, v, dx, f);
 }

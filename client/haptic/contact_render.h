@@ -81,9 +81,11 @@ double contact_render_target(contact_render_t *r, const contact_model_t *m, cons
 
 /* One tick: m the newest model (NULL: none usable, e.g. stale beyond
  * hold_s; the force ramps to zero), cut 1 when the server was lost (zero at
- * once). Writes the force to render into f and returns its magnitude. */
+ * once), v the hand's velocity and dx its displacement since the last tick
+ * (the passivity observer's input). Writes the force to render into f and
+ * returns its magnitude. */
 double contact_render_tick(contact_render_t *r, const contact_model_t *m, int cut, const double x[3], const double v[3],
-                           double f[3]);
+                           const double dx[3], double f[3]);
 
 /* Ramp and passivity for a target force: the same bounds and observer as
  * contact_render_tick; control 0 observes without the controller (the
@@ -91,6 +93,6 @@ double contact_render_tick(contact_render_t *r, const contact_model_t *m, int cu
  * one port alone may not be held passive; guide_force.h damps the coupling
  * for the delay instead). */
 double contact_render_output(contact_render_t *r, const double target[3], int cut, int control, const double v[3],
-                             double f[3]);
+                             const double dx[3], double f[3]);
 
 #endif

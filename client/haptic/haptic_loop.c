@@ -8,6 +8,7 @@
 #include "contact_render.h"
 #include "guide_force.h"
 #include "viscera.h"
+#include "vmath.h"
 #include "vtime.h"
 
 /* State carried from tick to tick. */
@@ -127,9 +128,10 @@ static void render_force(const haptic_loop_t *l, tick_state_t *s, double t, uint
                          const double pos[3], guide_output_t *gout) {
   const haptic_options_t *o = l->o;
   /* Device velocity by backward difference over the actual tick. */
-  double vel[3] = {0, 0, 0};
+  double vel[3] = {0, 0, 0}, moved[3] = {0, 0, 0};
+  if (s->have_prev_pos) v3_sub(moved, pos, s->prev_pos);
   if (s->have_prev_pos && now > s->prev_pos_ns)
-    for (int k = 0; k < 3; k++) vel[k] = (pos[k] - s->prev_pos[k]) / ((double)(now - s->prev_pos_ns) * 1e-9);
+    for (int k = 0; k < 3; k++) vel[k] = moved[k] / ((double)(now - s->prev_pos_ns) * 1e-9);
   memcpy(s->prev_pos, pos, sizeof s->prev_pos);
   s->prev_pos_ns = now;
   s->have_prev_pos = 1;
@@ -162,7 +164,7 @@ static void render_force(const haptic_loop_t *l, tick_state_t *s, double t, uint
     memcpy(target, gout->f, sizeof target);
   else
     contact_render_target(&s->render, s->cut ? NULL : &s->model, pos, vel, target);
-  gout->magnitude = contact_render_output(&s->render, target, s->cut, !gout->coupled, vel, gout->f);
+  gout->magnitude = contact_render_output(&s->render, target, s->cut, !gout->coupled, vel, moved, gout->f);
   guide_report_tick(l->guide, t, &gv.role, gv.peer_station, gv.peer_age_s, gout, o->quiet ? NULL : stderr);
 }
 

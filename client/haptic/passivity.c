@@ -33,8 +33,8 @@ double passivity_control(passivity_t *p, const double v[3], double max_force, do
   return (1.0 - s) * fv / vv;
 }
 
-void passivity_observe(passivity_t *p, const double f[3], const double v[3]) {
-  double de = v3_dot(f, v) * p->period_s;
+void passivity_observe(passivity_t *p, const double f[3], const double dx[3]) {
+  double de = v3_dot(f, dx);
   if (!isfinite(de)) return;
   p->energy += de;
   if (p->energy > p->energy_max) p->energy_max = p->energy;
