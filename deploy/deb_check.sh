@@ -213,6 +213,8 @@ if [ "$SYSTEMD" = 1 ]; then
     { tail -20 "$WORK/apt-systemd.log"; fail "apt-get install systemd failed"; }
   grep -E "^(Need to get|After this operation)" "$WORK/apt-systemd.log" || true
   cp -n "$R"/var/cache/apt/archives/*.deb "$CACHE/archives/" 2> /dev/null || true
+  # Not made by systemd's own postinst: then the user below is the postinst's.
+  if in_root getent passwd viscera > /dev/null; then fail "a viscera user exists before the postinst ran with systemd"; fi
   in_root sh -c "cd /root && apt-get install -y --reinstall ./$(basename "$DEB")" > "$WORK/apt-reinstall.log" 2>&1 ||
     { tail -20 "$WORK/apt-reinstall.log"; fail "reinstalling the .deb with systemd present failed"; }
   in_root getent passwd viscera > "$WORK/user.txt" || fail "postinst did not create the viscera user (systemd-sysusers)"
