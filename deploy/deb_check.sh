@@ -50,7 +50,7 @@ while [ $# -gt 0 ]; do
   --mirror) MIRROR=$2; shift 2 ;;
   --no-systemd) SYSTEMD=0; shift ;;
   --keep) KEEP=1; shift ;;
-  -h | --help) sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0 ;;
+  -h | --help) sed -n '3,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0 ;;
   *) echo "deb_check.sh: unknown option $1 (see --help)" >&2; exit 2 ;;
   esac
 done
