@@ -14,6 +14,7 @@
 #include "mesh_import.h"
 #include "tet_mesh.h"
 
+#include "asset_usage.h"
 #include "asset_volume.h"
 
 
@@ -61,15 +62,6 @@ static void usage(FILE *f) {
              "found.\n");
 }
 
-int bad_usage(const char *fmt, ...) {
-  va_list ap;
-  va_start(ap, fmt);
-  fprintf(stderr, "viscera-asset: ");
-  vfprintf(stderr, fmt, ap);
-  fprintf(stderr, "\n(run viscera-asset --help for usage)\n");
-  va_end(ap);
-  return EXIT_USAGE;
-}
 
 /* viscera works in metres; an organ a metre long almost surely is not. */
 static void units_hint(const mesh_report_t *r) {
