@@ -37,9 +37,10 @@ static dds_duration_t scaled(const rp_setup_t *r, dds_duration_t d) {
   return v > 9e18 ? DDS_INFINITY : (dds_duration_t)v;
 }
 
-/* Durations of the recorded QoS (untrusted, issue 15: a deadline of 0 made
- * the writer spin): NULL or DDS_INFINITY-like "not set" is fine, else at
- * least 1 ms and finite. Returns NULL or what is wrong. */
+/* Durations of the recorded QoS (untrusted; fuzz_recording found a deadline
+ * of 0 that made the writer spin and one of 292 years that hung its
+ * deletion): NULL or DDS_INFINITY ("not set") is fine, else 1 ms .. 1 day
+ * (max_blocking may be 0). Returns NULL or what is wrong. */
 static const char *qos_values_ok(sqlite3_stmt *st, char *why, size_t n) {
   static const struct {
     int col;
@@ -49,8 +50,10 @@ static const char *qos_values_ok(sqlite3_stmt *st, char *why, size_t n) {
     if (sqlite3_column_type(st, durs[i].col) == SQLITE_NULL) continue;
     int64_t d = sqlite3_column_int64(st, durs[i].col);
     if (d == DDS_INFINITY) continue;
-    if (d < DDS_MSECS(1) && !(durs[i].col == 13 && d >= 0)) {
-      snprintf(why, n, "recorded %s %lld ns out of range (>= 1 ms or infinite)", durs[i].name, (long long)d);
+    /* A finite duration near INT64_MAX overflows Cyclone's timers (a
+     * deadline of 292 years hung the writer's deletion). */
+    if ((d < DDS_MSECS(1) && !(durs[i].col == 13 && d >= 0)) || d > DDS_SECS(86400)) {
+      snprintf(why, n, "recorded %s %lld ns out of range (1 ms .. 1 day, or infinite)", durs[i].name, (long long)d);
       return why;
     }
   }

@@ -11,9 +11,12 @@
  * information and type mapping with Cyclone's own readers and checks that
  * every type object hashes to the identifier stored with it and that the
  * topic's minimal and complete identifiers are in the mapping (the
- * descriptor is rebuilt from what is stored, a mismatch refused).
- * Both return 0, or -1 with the reason in `why`. Pure functions over their
- * inputs; thread-safe. */
+ * descriptor is rebuilt from what is stored, a mismatch refused). Cyclone's
+ * readers abort on some damaged mappings, so rp_types_check runs them in a
+ * child process (fork, 5 s limit): a reader that dies or hangs there means
+ * refused. Both return 0, or -1 with the reason in `why`. rp_ops_check is a
+ * pure function; rp_types_check forks (call it from one thread at a time
+ * with no lock held that the child would need). */
 #ifndef VISCERA_REPLAY_TYPECHECK_H
 #define VISCERA_REPLAY_TYPECHECK_H
 

@@ -97,7 +97,7 @@ echo "== 4. one flipped bit in a MeshDelta header"
 # frame_seq, then sim_time_ns (little-endian) at bytes 20..27: byte 25 bit 4
 # is bit 44 of the time, +17,592 s.
 cp "$DB" "$WORK/flip.db"
-"$FLIP" "$WORK/flip.db" viscera_MeshDelta 50 25 16 || fail=1
+"$FLIP" "$WORK/flip.db" viscera_MeshDelta 10 25 16 || fail=1
 run resim_flip_reported "0|1" "beyond the recording" "$RESIM" --scene "$SRC/assets/scenes/default.yaml" \
   "$WORK/flip.db" --quiet
 steps=$(sed -n 's/^RESIM [A-Z]* steps=\([0-9]*\).*/\1/p' "$WORK/resim_flip_reported.out")
