@@ -37,7 +37,8 @@ static void usage(FILE *f) {
              "  --version       print the version and exit\n"
              "SIGUSR1 toggles pause/resume; after a resume the original timing goes on\n"
              "(the schedule is shifted by the paused time, no burst of missed samples).\n"
-             "Exit status: 0 done, 1 unreadable recording, DDS error or usage error.\n");
+             "Exit status: 0 done, 1 unreadable or damaged recording (what was readable was replayed), DDS error\n"
+             "or usage error.\n");
 }
 
 enum { OPT_SPEED = 's', OPT_SEEK = 'k', OPT_LOOP = 'l', OPT_PAUSE_AT = 'P' };

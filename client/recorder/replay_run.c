@@ -281,7 +281,9 @@ static int publish_all(replay_t *r) {
     status = 1;
     goto out;
   }
-  rp_setup_t su = {.db = r->db, .path = r->o.path, .pp = r->pp, .pub = r->pub, .speed = r->o.speed};
+  size_t refused = 0;
+  rp_setup_t su = {
+      .db = r->db, .path = r->o.path, .pp = r->pp, .pub = r->pub, .speed = r->o.speed, .refused = &refused};
   if (rp_topics_setup(&su, &r->topics, &r->ntopics, &err) < 0) {
     fprintf(stderr, "replay: %s\n", err.msg);
     status = 1;
@@ -328,6 +330,16 @@ static int publish_all(replay_t *r) {
             (unsigned long long)r->total_out_of_span);
   printf("SUMMARY written=%llu topics=%zu bad=%llu skipped=%llu\n", (unsigned long long)r->total_written, r->ntopics,
          (unsigned long long)r->total_bad, (unsigned long long)r->total_skipped);
+  /* Damage never stops a replay (what is readable goes out), but it is
+   * never a success either: the caller learns the recording is damaged. */
+  if (refused || r->total_bad || r->total_out_of_span || rep.damaged) {
+    fprintf(stderr,
+            "replay: %s is damaged (%zu topic(s) not replayed, %llu undecodable sample(s), %llu outside its span%s): "
+            "what was readable was replayed; exit 1\n",
+            r->o.path, refused, (unsigned long long)r->total_bad, (unsigned long long)r->total_out_of_span,
+            rep.damaged ? ", a damaged sample table" : "");
+    status = 1;
+  }
 out:
   if (r->pp > 0) dds_delete(r->pp);
   for (size_t i = 0; i < r->ntopics; i++) rp_topic_free(&r->topics[i]);

@@ -269,6 +269,7 @@ int rp_topics_setup(const rp_setup_t *r, rp_topic_t **topics, size_t *ntopics, v
     verr_t e;
     if (setup_topic(r, st, t, &e) < 0) {
       fprintf(stderr, "replay: NOT replayed: %s\n", e.msg);
+      if (r->refused) (*r->refused)++;
       if (t->writer > 0) dds_delete(t->writer);
       if (t->topic > 0) dds_delete(t->topic);
       rp_topic_free(t);

@@ -43,7 +43,8 @@ typedef struct rp_setup {
   sqlite3 *db;      /* the recording, read-only: the descriptor columns recfile does not expose */
   const char *path; /* its file name, for messages */
   dds_entity_t pp, pub;
-  double speed; /* --speed */
+  double speed;    /* --speed */
+  size_t *refused; /* if not NULL: incremented per topic NOT replayed */
 } rp_setup_t;
 
 /* Sets up every topic of the recording that can be (the others are named

@@ -62,35 +62,35 @@ RP=(--domain "$OUT_DOMAIN" --partition hardinput/out --speed 20 --quiet)
 echo "== 2. stored type descriptors"
 TC="WHERE name = 'viscera_ToolCommand'"
 damaged ti_null "UPDATE topics SET typeinfo = NULL $TC"
-run ti_null 0 "NOT replayed: topic viscera_ToolCommand: stored type information is damaged" "$REPLAY" "$WORK/ti_null.db" "${RP[@]}"
+run ti_null 1 "NOT replayed: topic viscera_ToolCommand: stored type information is damaged" "$REPLAY" "$WORK/ti_null.db" "${RP[@]}"
 damaged tm_null "UPDATE topics SET typemap = NULL $TC"
-run tm_null 0 "NOT replayed: topic viscera_ToolCommand: stored type information is damaged" "$REPLAY" "$WORK/tm_null.db" "${RP[@]}"
+run tm_null 1 "NOT replayed: topic viscera_ToolCommand: stored type information is damaged" "$REPLAY" "$WORK/tm_null.db" "${RP[@]}"
 damaged tm_cut "UPDATE topics SET typemap = substr(typemap, 1, 300) $TC"
-run tm_cut 0 "viscera_ToolCommand: stored type information is damaged: type mapping unreadable" "$REPLAY" "$WORK/tm_cut.db" "${RP[@]}"
+run tm_cut 1 "viscera_ToolCommand: stored type information is damaged: type mapping unreadable" "$REPLAY" "$WORK/tm_cut.db" "${RP[@]}"
 damaged tm_other "UPDATE topics SET typemap = (SELECT typemap FROM topics WHERE name = 'viscera_Metrics') $TC"
-run tm_other 0 "viscera_ToolCommand: stored type information is damaged: the minimal type is not in the type mapping" \
+run tm_other 1 "viscera_ToolCommand: stored type information is damaged: the minimal type is not in the type mapping" \
   "$REPLAY" "$WORK/tm_other.db" "${RP[@]}"
 # A sequence of structs whose element program is the member itself (ADR SEQ
 # STU, offset 0, 16 bytes, jump 4 / element +0): Cyclone's op counter
 # recursed into it without end.
 damaged ops_self "UPDATE topics SET ops = x'000A07010000000010000000'
   || x'00000400' || substr(ops, 17) $TC"
-run ops_self 0 "viscera_ToolCommand: stored type program is damaged" "$REPLAY" "$WORK/ops_self.db" "${RP[@]}"
+run ops_self 1 "viscera_ToolCommand: stored type program is damaged" "$REPLAY" "$WORK/ops_self.db" "${RP[@]}"
 damaged ops_zero "UPDATE topics SET ops = zeroblob(length(ops)) $TC"
-run ops_zero 0 "viscera_ToolCommand: stored type program is damaged" "$REPLAY" "$WORK/ops_zero.db" "${RP[@]}"
+run ops_zero 1 "viscera_ToolCommand: stored type program is damaged" "$REPLAY" "$WORK/ops_zero.db" "${RP[@]}"
 damaged ops_junk "UPDATE topics SET ops = substr(x'$(printf 'ba1c4db1%.0s' $(seq 1 40))', 1, length(ops)) $TC"
-run ops_junk 0 "viscera_ToolCommand: stored type program is damaged: op 0" "$REPLAY" "$WORK/ops_junk.db" "${RP[@]}"
+run ops_junk 1 "viscera_ToolCommand: stored type program is damaged: op 0" "$REPLAY" "$WORK/ops_junk.db" "${RP[@]}"
 
 echo "== 3. source times outside the recording"
 ROW="(SELECT id FROM samples WHERE kind = 0 ORDER BY id LIMIT 1 OFFSET 100)"
 damaged ts_max "UPDATE samples SET source_ts_ns = 9223372036854775807 WHERE id = $ROW"
-run ts_max 0 "outside the recording's span" "$REPLAY" "$WORK/ts_max.db" "${RP[@]}"
+run ts_max 1 "outside the recording's span" "$REPLAY" "$WORK/ts_max.db" "${RP[@]}"
 damaged ts_min "UPDATE samples SET source_ts_ns = -9223372036854775808 WHERE id = $ROW"
-run ts_min 0 "outside the recording's span" "$REPLAY" "$WORK/ts_min.db" "${RP[@]}"
+run ts_min 1 "outside the recording's span" "$REPLAY" "$WORK/ts_min.db" "${RP[@]}"
 damaged ts_max_nosession "DELETE FROM session; UPDATE samples SET source_ts_ns = 9223372036854775807 WHERE id = $ROW"
-run ts_max_nosession 0 "outside the recording's span" "$REPLAY" "$WORK/ts_max_nosession.db" "${RP[@]}"
+run ts_max_nosession 1 "outside the recording's span" "$REPLAY" "$WORK/ts_max_nosession.db" "${RP[@]}"
 damaged ts_min_nosession "DELETE FROM session; UPDATE samples SET source_ts_ns = -9223372036854775808 WHERE id = $ROW"
-run ts_min_nosession 0 "outside the recording's span" "$REPLAY" "$WORK/ts_min_nosession.db" "${RP[@]}"
+run ts_min_nosession 1 "outside the recording's span" "$REPLAY" "$WORK/ts_min_nosession.db" "${RP[@]}"
 
 echo "== 4. one flipped bit in a MeshDelta header"
 # MeshDelta CDR: 4-byte header, organ_id, topology_version, keyframe_seq,

@@ -137,7 +137,9 @@ if command -v sqlite3 >/dev/null 2>&1; then
     2>"$WORK/damaged.log"
   rc=$?
   cat "$WORK/damaged.log" "$WORK/damaged.out"
-  [ $rc -eq 0 ] || fail "replay of damaged.db exited $rc"
+  [ $rc -eq 1 ] || fail "replay of damaged.db exited $rc (want 1: replayed what was readable, said it is damaged)"
+  grep -q "damaged.db is damaged (1 topic(s) not replayed, 5 undecodable" "$WORK/damaged.log" ||
+    fail "the damage is not summed up"
   grep -q "NOT replayed: topic viscera_Metrics: stored type program is damaged" "$WORK/damaged.log" ||
     fail "damaged type program not reported"
   grep -q "^SUMMARY written=[1-9][0-9]* topics=[0-9]* bad=5 " "$WORK/damaged.out" || fail "garbled samples not counted"
