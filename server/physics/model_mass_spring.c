@@ -102,6 +102,13 @@ static void embed(ms_model_t *mm) {
   if (mm->tet) tet_embedding_apply(&mm->emb, &mm->tm, mm->ms.x, mm->surf_buf);
 }
 
+/* Symplectic Euler, between kick and drift: the declared tool springs
+ * implicitly (physics/coupling.h). */
+static void correct_v(force_system_t *s, double h) {
+  ms_model_t *mm = s->ctx;
+  coupling_set_apply(&mm->cpl, mm->ms.inv_mass, h, mm->ms.v);
+}
+
 /* Before every sub-step: external forces are valid for one sub-step only;
  * the surface is brought to the sub-step's positions so the contact hook
  * sees where the tissue is. */
@@ -111,13 +118,8 @@ static void pre_substep(force_system_t *s) {
   coupling_set_clear(&mm->cpl);
   embed(mm);
   if (mm->m.hook) mm->m.hook(&mm->m, mm->m.hook_ctx);
-}
-
-/* Symplectic Euler, between kick and drift: the declared tool springs
- * implicitly (physics/coupling.h). */
-static void correct_v(force_system_t *s, double h) {
-  ms_model_t *mm = s->ctx;
-  coupling_set_apply(&mm->cpl, mm->ms.inv_mass, h, mm->ms.v);
+  /* Without a tool spring the integrator keeps its fused kick-drift loop. */
+  if (mm->m.implicit_tools) mm->ms.fs.correct_v = mm->cpl.n ? correct_v : NULL;
 }
 
 /* Total energy and the part that measures motion and deformation (kinetic +
