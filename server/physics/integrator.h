@@ -31,9 +31,9 @@ typedef struct integrator {
   size_t n;
   double cg_tolerance;
   int cg_max_iterations;
-  int last_cg_iterations;   /* diagnostics of the last implicit step */
+  int last_cg_iterations; /* diagnostics of the last implicit step */
   double last_cg_residual;
-  double *buf[8];           /* scratch, 3n each */
+  double *buf[8]; /* scratch, 3n each */
 } integrator_t;
 
 /* Name as in scene files ("rk4"); -1 if unknown. */

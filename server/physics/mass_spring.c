@@ -27,6 +27,7 @@ static int ms_alloc(mass_spring_t *ms, size_t n, const double *pos, const ms_par
   ms->n = n;
   ms->cap = n;
   ms->p = *p;
+  ms->damping_scale = 1;
   ms->x = calloc(3 * n, sizeof(double));
   ms->v = calloc(3 * n, sizeof(double));
   ms->x_rest = calloc(3 * n, sizeof(double));
@@ -431,9 +432,8 @@ void mass_spring_forces_path(const mass_spring_t *ms, const double *x, const dou
   const double *restrict xx = x, *restrict vv = v;
   double *restrict ff = f;
   const double g0 = ms->p.gravity[0], g1 = ms->p.gravity[1], g2 = ms->p.gravity[2];
-  /* With implicit_damping the dampers are left to mass_spring_damp. */
-  const double hk = ms->p.home_stiffness, hc = ms->implicit_damping ? 0.0 : ms->p.home_damping;
-  const double damping = ms->implicit_damping ? 0.0 : ms->p.damping;
+  const double hk = ms->p.home_stiffness, hc = ms->p.home_damping;
+  const double damping = ms->p.damping * ms->damping_scale; /* mass_spring.h: damping_scale */
   const size_t n = ms->n;
   for (size_t i = 0; i < n; i++) {
     const size_t c = 3 * i;
@@ -455,45 +455,6 @@ void mass_spring_forces_path(const mass_spring_t *ms, const double *x, const dou
     ms_spring_forces(ms, x, v, f, 1, damping);
   else
     ms_spring_forces(ms, x, v, f, 0, damping);
-}
-
-void mass_spring_damp(const mass_spring_t *ms, const double *x, double h, double *v) {
-  const double *restrict im = ms->inv_mass;
-  const double hc = h * ms->p.home_damping, c = h * ms->p.damping;
-  double *restrict vv = v;
-  /* Home dampers: diagonal, solved exactly. */
-  if (hc > 0)
-    for (size_t i = 0; i < ms->n; i++) {
-      const double s = 1.0 / (1.0 + hc * im[i]);
-      vv[3 * i] *= s;
-      vv[3 * i + 1] *= s;
-      vv[3 * i + 2] *= s;
-    }
-  if (!(c > 0)) return;
-  /* Edge dampers: one Gauss-Seidel sweep. The impulse c_h dvn' along the
-   * unit axis u (c_h = h c) with dvn' the relative speed after it gives
-   * dvn' = dvn / (1 + c_h (w_i + w_j)), the implicit solve of this one
-   * damper; it is equal and opposite along the axis (momenta kept) and
-   * never reverses dvn (it dissipates at any h). */
-  const ms_spring_t *restrict sp = ms->springs;
-  for (size_t s = 0; s < ms->nsprings; s++) {
-    const size_t i = sp[s].i, j = sp[s].j;
-    const double wi = im[i], wj = im[j], w = wi + wj;
-    if (w == 0) continue;
-    const double d0 = x[3 * j] - x[3 * i], d1 = x[3 * j + 1] - x[3 * i + 1], d2 = x[3 * j + 2] - x[3 * i + 2];
-    const double l2 = d0 * d0 + d1 * d1 + d2 * d2;
-    if (!(l2 > MS_TINY)) continue;
-    const double dvd =
-        (vv[3 * j] - vv[3 * i]) * d0 + (vv[3 * j + 1] - vv[3 * i + 1]) * d1 + (vv[3 * j + 2] - vv[3 * i + 2]) * d2;
-    /* dvn = dvd / L and the impulse acts along d / L: one factor 1 / L^2. */
-    const double p = c * dvd / (l2 * (1.0 + c * w));
-    vv[3 * i] += wi * p * d0;
-    vv[3 * i + 1] += wi * p * d1;
-    vv[3 * i + 2] += wi * p * d2;
-    vv[3 * j] -= wj * p * d0;
-    vv[3 * j + 1] -= wj * p * d1;
-    vv[3 * j + 2] -= wj * p * d2;
-  }
 }
 
 /* The Jacobian product, walked by runs of equal i like the forces (above).

@@ -68,11 +68,11 @@ typedef struct mass_spring {
   double *inv_mass; /* n, 0 for fixed nodes */
   ms_spring_t *springs;
   int definite_jacobian; /* see above; 0 after create */
-  /* 1: forces() leaves out the edge and home dampers, which the caller
-   * applies implicitly with mass_spring_damp after each kick (symplectic
-   * Euler: the dampers then drop out of the stability bound); 0 after
-   * create. */
-  int implicit_damping;
+  /* Factor on the edge dampers in forces() (1 after create; the Jacobian
+   * products and energies ignore it). An explicit scheme whose sub-step h
+   * would make h lambda_c large caps the dampers' rate in the stiffest
+   * modes with it (model_mass_spring.c), instead of taking more sub-steps. */
+  double damping_scale;
   /* Optional per-spring stiffness factor (nsprings, indexed like springs):
    * spring s has stiffness p.stiffness * k_scale[s]; damping stays uniform.
    * NULL (the default) means 1 for every spring and costs nothing. Set only
@@ -123,15 +123,6 @@ void mass_spring_forces(const mass_spring_t *ms, const double *x, const double *
 void mass_spring_forces_path(const mass_spring_t *ms, const double *x, const double *v, double *f, int simd);
 int mass_spring_simd_available(void);
 
-/* The dampers implicitly, on velocities v (3n) after a kick of length h,
- * at positions x: the home dampers exactly, v_i / (1 + h c_home / m_i), then
- * the edge dampers by one Gauss-Seidel sweep in spring order, each the
- * implicit solve of one damper: the relative speed along the spring
- * becomes dvn / (1 + h c (1/m_i + 1/m_j)). Every update dissipates and
- * keeps linear and angular momentum, so the dampers impose no step limit;
- * for slow motion (h c / m small) it is the explicit damper to first
- * order. Fixed nodes (inverse mass 0) are not moved. */
-void mass_spring_damp(const mass_spring_t *ms, const double *x, double h, double *v);
 /* out = (a K(x) + b C(x)) y, as described above. */
 void mass_spring_stiffness_mul(const mass_spring_t *ms, const double *x, double a, double b, const double *y,
                                double *out);

@@ -20,6 +20,21 @@
  * home damping ratio is lower than the edges'. More than 256 sub-steps are
  * refused with the figures.
  *
+ * Symplectic Euler (the live default) keeps two things out of that bound
+ * (issue 17). The tool springs: they are integrated implicitly
+ * (physics/coupling.h, declared by the runtime through
+ * add_surface_coupling), so the stiffest tool is not added to the nodes.
+ * And the edge dampers' rate in the stiffest modes: on fine meshes the
+ * Kelvin-Voigt dampers (lambda_c of M^-1 C, large because the nodes are
+ * light) made most of the bound (gallbladder: 4 of its 1 ms step's
+ * sub-steps instead of 2). With the sub-step h, the damper force is
+ * scaled by s = min(1, MS_DAMPING_CAP / (h lambda_c)) (damping_scale,
+ * mass_spring.h) for the fewest sub-steps that are stable with
+ * lambda_c s: modes slower than lambda_c s keep their physical damping,
+ * the stiffest ones lose at most half their velocity per sub-step instead
+ * of more (they are not resolved at that h either way). Requested
+ * sub-steps (solver.substeps) keep the full damping.
+ *
  * Implicit Euler is one linearised step (integrator.h), which is blind to
  * what the linearisation misses: a flat cloth let go under gravity has no
  * out-of-plane stiffness at rest, so one 33 ms step moves its nodes straight
@@ -55,6 +70,9 @@
 #include "tet_mesh.h"
 #include "vmath.h"
 
+/* h lambda_c at most this in the stiffest modes (file comment). */
+#define MS_DAMPING_CAP 0.5
+
 typedef struct ms_model {
   model_t m; /* first: the model_t the caller holds */
   mass_spring_t ms;
@@ -85,6 +103,13 @@ static void embed(ms_model_t *mm) {
   if (mm->tet) tet_embedding_apply(&mm->emb, &mm->tm, mm->ms.x, mm->surf_buf);
 }
 
+/* Symplectic Euler, between kick and drift: the declared tool springs
+ * implicitly (physics/coupling.h). */
+static void correct_v(force_system_t *s, double h) {
+  ms_model_t *mm = s->ctx;
+  coupling_set_apply(&mm->cpl, mm->ms.inv_mass, h, mm->ms.v);
+}
+
 /* Before every sub-step: external forces are valid for one sub-step only;
  * the surface is brought to the sub-step's positions so the contact hook
  * sees where the tissue is. */
@@ -94,14 +119,8 @@ static void pre_substep(force_system_t *s) {
   coupling_set_clear(&mm->cpl);
   embed(mm);
   if (mm->m.hook) mm->m.hook(&mm->m, mm->m.hook_ctx);
-}
-
-/* Symplectic Euler, between kick and drift: the dampers (mass_spring.h)
- * and the declared tool springs (physics/coupling.h) implicitly. */
-static void correct_v(force_system_t *s, double h) {
-  ms_model_t *mm = s->ctx;
-  mass_spring_damp(&mm->ms, mm->ms.x, h, mm->ms.v);
-  coupling_set_apply(&mm->cpl, mm->ms.inv_mass, h, mm->ms.v);
+  /* Without a tool spring the integrator keeps its fused kick-drift loop. */
+  if (mm->m.implicit_tools) mm->ms.fs.correct_v = mm->cpl.n ? correct_v : NULL;
 }
 
 /* Total energy and the part that measures motion and deformation (kinetic +
@@ -279,10 +298,24 @@ static const model_ops_t TET_OPS = {.name = "mass_spring_tet",
 
 /* Stable dt of the scheme for this system (see the file comment). */
 static int substeps_from(ms_model_t *mm, integrator_kind_t kind, double lk, double lc, verr_t *err) {
-  const mass_spring_t *ms = &mm->ms;
+  mass_spring_t *ms = &mm->ms;
   double m_node = ms->p.mass / (double)ms->n;
   double lk0 = (ms->p.home_stiffness + mm->tool_stiffness) / m_node, lc0 = ms->p.home_damping / m_node;
-  if (ms->implicit_damping) lc = lc0 = 0; /* the dampers impose no limit */
+  if (kind == INT_SYMPLECTIC_EULER && mm->requested_substeps <= 0 && lc > 0) {
+    /* Damping-capped sub-steps (file comment): the fewest n whose h = dt / n
+     * is stable with the edge dampers' rate capped at MS_DAMPING_CAP / h. */
+    for (int n = 1; n <= INTEGRATOR_MAX_SUBSTEPS; n++) {
+      double h = mm->dt / n, scale = fmin(1.0, MS_DAMPING_CAP / (h * lc));
+      double stable = fmin(integrator_stable_dt(kind, lk, lc * scale), integrator_stable_dt(kind, lk0, lc0));
+      if (h <= 0.9 * stable) {
+        ms->damping_scale = scale;
+        mm->m.substeps = n;
+        mm->m.stable_dt = stable;
+        return 0;
+      }
+    }
+  }
+  ms->damping_scale = 1;
   return integrator_choose_substeps(kind, mm->dt, mm->requested_substeps, lk, lc, lk0, lc0,
                                     "lower material stiffness, damping or tool stiffness, raise the mass, or use "
                                     "implicit_euler (explicit_euler needs damping)",
@@ -343,7 +376,6 @@ static model_t *ms_create(const model_params_t *p, int tet, verr_t *err) {
   if (kind == INT_SYMPLECTIC_EULER) {
     mm->ms.fs.correct_v = correct_v;
     mm->m.implicit_tools = 1;
-    mm->ms.implicit_damping = 1;
     if (coupling_set_init(&mm->cpl, 256, 8192, err)) {
       ms_destroy(&mm->m);
       return NULL;

@@ -335,9 +335,8 @@ static int cut_model(const char *what, const mesh_t *mesh, double ax, double ay,
   double lk, lc;
   const mass_spring_t *sys = model_mass_spring_surface_system(m);
   CHECK(mass_spring_eigen_bounds(sys, 0, &lk, &lc) == 0);
-  /* Symplectic Euler takes the dampers implicitly (mass_spring_damp): they
-   * are not in its bound. */
-  double cold = integrator_stable_dt(INT_SYMPLECTIC_EULER, lk, sys->implicit_damping ? 0 : lc);
+  /* Symplectic Euler caps the dampers' rate (damping_scale, mass_spring.h). */
+  double cold = integrator_stable_dt(INT_SYMPLECTIC_EULER, lk, lc * sys->damping_scale);
   CHECK(fabs(m->stable_dt / cold - 1) < 0.01);
   const ms_cut_stats_t *st = ms_cut_stats(c);
   CHECK(st->cuts == 1 && st->holes_left_open == 0);
