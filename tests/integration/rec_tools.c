@@ -1,6 +1,7 @@
 /* rec_tools: reads a session recording (rec_read.h) and prints, decoded
  * with the compiled-in descriptors, what the tool tests check (issue 4):
- *   EVENT KIND tool=N organ=N value=V sim=S TEXT grasp and task SessionEvents
+ *   EVENT KIND tool=N organ=N value=V sim=S TEXT grasp, task and applied
+ *                                                control SessionEvents
  *                                                (S: simulated time, s)
  *   TOOLMETRICS tool=N name=.. peak_force=.. ... last ToolMetrics per tool
  *   OBJECT id=N x= y= z= held_by= removed=       last ObjectState per object
@@ -61,12 +62,14 @@ static const char *kind_name(viscera_EventKind k) {
     return "TASK_STARTED";
   case viscera_EVENT_TASK_COMPLETED:
     return "TASK_COMPLETED";
+  case viscera_EVENT_CONTROL_APPLIED:
+    return "CONTROL_APPLIED";
   default:
     return NULL;
   }
 }
 
-/* The grasp and task events, kept for the checks. */
+/* The grasp, task and control events, kept for the checks. */
 enum { MAXEV = 256 };
 typedef struct event {
   viscera_EventKind kind;
