@@ -66,8 +66,9 @@ cat "$OUT/ctl.log"
 "${HAPTIC[@]}" --trajectory "$OUT/press_hold.traj" > "$OUT/haptic2.out" 2> "$OUT/haptic2.log" & HAP=$!; PIDS+=($HAP)
 await "$OUT/server.log" "task 'find-spot' completed" || fail "the second press did not complete the task"
 kill -INT $HAP; wait $HAP || fail "the second probe failed"
-sleep 0.5 # the recorder receives the last samples
-for p in $REC $SRV; do kill -INT "$p" 2>/dev/null || true; wait "$p" 2>/dev/null || true; done
+# The server publishes its final ToolMetrics as it exits (a reliable writer
+# lingers for the recorder's acknowledgement): stop it before the recorder.
+for p in $SRV $REC; do kill -INT "$p" 2>/dev/null || true; wait "$p" 2>/dev/null || true; done
 PIDS=()
 
 # The first press touched the tissue (ticks in contact in the first probe's
