@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Tasks started by the instructor (issue 7 "starts tasks"), real processes on
 # loopback: a kidney scene whose palpate_target task has `start: instructor`.
-# A scripted probe (a haptic client) presses on the target, lifts and exits.
+# A scripted probe (a haptic client) presses on the target and leaves.
 # That first press must NOT start the task (with `start: first_command` it
 # would start at the first command and complete at the first press). Then
 # `viscera-control start-task find-spot` starts it (TASK_STARTED "by the
@@ -34,13 +34,6 @@ tasks:
      start: instructor}
 YAML
 # The probe's trajectory starts when it has the server's scene (--wait-server).
-cat > "$OUT/press_lift.traj" <<TRAJ
-0.0   0.012  0.004  0.070
-0.5   0.012  0.004  0.070
-1.5   0.012  0.004  0.029
-3.0   0.012  0.004  0.029
-3.8   0.012  0.004  0.070
-TRAJ
 cat > "$OUT/press_hold.traj" <<TRAJ
 0.0   0.012  0.004  0.070
 0.5   0.012  0.004  0.070
@@ -54,9 +47,13 @@ HAPTIC=("$BUILD/client/haptic/viscera-haptic" --tool 0 "${COMMON[@]}" --wait-ser
 SRV=$!; PIDS+=($SRV)
 "$BUILD/client/recorder/viscera-recorder" "${COMMON[@]}" --out "$OUT/session.db" --quiet \
   > "$OUT/recorder.out" 2> "$OUT/recorder.log" & REC=$!; PIDS+=($REC)
-# 1. The first probe presses, lifts and exits (its trajectory's end).
-"${HAPTIC[@]}" --trajectory "$OUT/press_lift.traj" --force-csv "$OUT/probe.csv" \
-  > "$OUT/haptic.out" 2> "$OUT/haptic.log" || fail "the first probe failed"
+# 1. The first probe presses until it has felt the tissue for 200 of its
+# ticks (its force log's in_contact), then leaves (SIGINT).
+"${HAPTIC[@]}" --trajectory "$OUT/press_hold.traj" --force-csv "$OUT/probe.csv" \
+  > "$OUT/haptic.out" 2> "$OUT/haptic.log" & HAP=$!; PIDS+=($HAP)
+touched() { awk -F, 'NR > 1 && $8 == 1 { n++ } END { print n + 0 }' "$OUT/probe.csv" 2>/dev/null || echo 0; }
+for _ in $(seq 600); do [ "$(touched)" -ge 200 ] && break; sleep 0.1; done
+kill -INT $HAP; wait $HAP || fail "the first probe failed"
 # 2. The instructor: an unknown task refused, then find-spot started.
 if "${CTL[@]}" start-task no-such-task > "$OUT/ctl.log" 2>&1; then fail "an unknown task was started"; fi
 grep -q "refused: .*no task of that name" "$OUT/ctl.log" || fail "unknown task not refused with its reason"
