@@ -8,36 +8,48 @@
 # usage: client_left_test.sh BUILD SRC OUT
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/prelude.sh"
+# Every step waits (60 s at most, a safety stop) for the event it needs: the
+# server's log lines and the dashboard's own rows, never a wall-clock time
+# (issue 15.6).
 TRAJ="$SRC/assets/trajectories/palpate_kidney.traj"
-"$BUILD/server/viscera-server" --scene "$SRC/assets/scenes/default.yaml" --partition lab/seat01 --duration 20 \
-  > "$OUT/server.log" 2>&1 & PIDS+=("$!")
-"$BUILD/client/dashboard/viscera-dashboard" --seats 1 --out "$OUT/dash" --interval-ms 250 --duration 19 \
+"$BUILD/server/viscera-server" --scene "$SRC/assets/scenes/default.yaml" --partition lab/seat01 \
+  > "$OUT/server.log" 2>&1 & SRV=$!; PIDS+=("$SRV")
+"$BUILD/client/dashboard/viscera-dashboard" --seats 1 --out "$OUT/dash" --interval-ms 250 \
   > "$OUT/dashboard.log" 2>&1 & DASH=$!; PIDS+=("$DASH")
-sleep 2
-"$BUILD/client/haptic/viscera-haptic" --partition lab/seat01 --trajectory "$TRAJ" --wait-server 10 --quiet \
-  > "$OUT/haptic1.log" 2>&1 || fail "the first trainee did not exit cleanly"
 csv="$OUT/dash/dashboard.csv"
 # columns: 11 client_lost, 13 client_left
-last_row() { grep ',lab/seat01,' "$csv" | tail -1; }
-for ((t = 0; t < 50; t++)); do [ "$(last_row | cut -d, -f13)" = 1 ] && break; sleep 0.1; done
+last_row() { grep ',lab/seat01,' "$csv" 2>/dev/null | tail -1; }
+nrows() { grep -c ',lab/seat01,' "$csv" 2>/dev/null || true; }
+count() { local n; n=$(grep -c -- "$1" "$OUT/server.log" 2>/dev/null) || true; echo "${n:-0}"; }
+# until COMMAND succeeds; 60 s at most
+until_ok() { for ((t = 0; t < 600; t++)); do "$@" && return 0; sleep 0.1; done; return 1; }
+col_is() { [ "$(last_row | cut -d, -f"$1")" = "$2" ]; }
+more_rows() { [ "$(nrows)" -ge "$1" ]; }
+more_lines() { [ "$(count "$1")" -gt "$2" ]; }
+"$BUILD/client/haptic/viscera-haptic" --partition lab/seat01 --trajectory "$TRAJ" --wait-server 60 --quiet \
+  > "$OUT/haptic1.log" 2>&1 || fail "the first trainee did not exit cleanly"
+until_ok col_is 13 1 || true
 row="$(last_row)"; echo "after a clean exit: $row"
 [ "$(echo "$row" | cut -d, -f13)" = 1 ] || fail "a clean exit is not shown as left"
-sleep 1 # the server's CLIENT_LOST("left") event has arrived by now
+# The server's CLIENT_LOST("left") event: its line, then two more dashboard rows.
+until_ok more_lines "haptic client left" 0 || fail "the server did not see the client leave"
+until_ok more_rows $(($(nrows) + 2)) || fail "the dashboard stopped writing"
 row="$(last_row)"
 [ "$(echo "$row" | cut -d, -f11),$(echo "$row" | cut -d, -f13)" = "0,1" ] || fail "a clean exit shown as lost: $row"
-grep -q "haptic client left" "$OUT/server.log" || fail "the server did not see the client leave"
 
-"$BUILD/client/haptic/viscera-haptic" --partition lab/seat01 --trajectory "$TRAJ" --quiet > "$OUT/haptic2.log" 2>&1 &
+n_st=$(count "ST crossed up")
+"$BUILD/client/haptic/viscera-haptic" --partition lab/seat01 --trajectory "$TRAJ" --wait-server 60 --quiet > "$OUT/haptic2.log" 2>&1 &
 H=$!; PIDS+=("$H")
-for ((t = 0; t < 100; t++)); do [ "$(last_row | cut -d, -f13)" = 0 ] && break; sleep 0.1; done
-[ "$(last_row | cut -d, -f13)" = 0 ] || fail "a new trainee did not clear 'left'"
-sleep 1
+until_ok col_is 13 0 || fail "a new trainee did not clear 'left'"
+until_ok more_lines "ST crossed up" "$n_st" || fail "the second trainee never pressed"
+n_lost=$(count "haptic client lost")
 kill -KILL $H
-for ((t = 0; t < 50; t++)); do [ "$(last_row | cut -d, -f11)" = 1 ] && break; sleep 0.1; done
-sleep 1
+until_ok col_is 11 1 || true
+until_ok more_lines "haptic client lost" "$n_lost" || fail "the server did not report the loss"
+until_ok more_rows $(($(nrows) + 2)) || fail "the dashboard stopped writing"
 row="$(last_row)"; echo "after kill -9: $row"
 [ "$(echo "$row" | cut -d, -f11),$(echo "$row" | cut -d, -f13)" = "1,0" ] || fail "a killed client is not shown as lost: $row"
-grep -q "haptic client lost" "$OUT/server.log" || fail "the server did not report the loss"
-wait $DASH || fail "dashboard failed"
+kill -INT $DASH; wait $DASH || fail "dashboard failed"
+kill -INT $SRV; wait $SRV || fail "server exited with an error"
 PIDS=()
 echo PASS

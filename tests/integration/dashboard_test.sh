@@ -7,16 +7,25 @@
 # usage: dashboard_test.sh BUILD SRC OUT
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/prelude.sh"
+# Every step waits (60 s at most, a safety stop) for the event it needs: the
+# trainee starts when it has the scene and exits at its trajectory's end;
+# the dashboard is stopped once it has written rows after that and at least
+# 10 frames (its own counters), never after a wall-clock time (issue 15.6).
+SRVS=()
 for s in seat01 seat02; do
-  "$BUILD/server/viscera-server" --scene "$SRC/assets/scenes/default.yaml" --partition lab/$s --duration 12 \
-    > "$OUT/server_$s.log" 2>&1 & PIDS+=($!)
+  "$BUILD/server/viscera-server" --scene "$SRC/assets/scenes/default.yaml" --partition lab/$s \
+    > "$OUT/server_$s.log" 2>&1 & PIDS+=($!); SRVS+=($!)
 done
-"$BUILD/client/dashboard/viscera-dashboard" --prefix lab --seats 3 --out "$OUT/dash" --interval-ms 500 --duration 11 \
+"$BUILD/client/dashboard/viscera-dashboard" --prefix lab --seats 3 --out "$OUT/dash" --interval-ms 500 \
   > "$OUT/dashboard.log" 2>&1 & DASH=$!; PIDS+=($DASH)
-sleep 2
 "$BUILD/client/haptic/viscera-haptic" --trajectory "$SRC/assets/trajectories/palpate_kidney.traj" --partition lab/seat01 \
-  --quiet > "$OUT/haptic.log" 2>&1 || fail "haptic client failed"
-wait $DASH || fail "dashboard failed"
+  --wait-server 60 --quiet > "$OUT/haptic.log" 2>&1 || fail "haptic client failed"
+rows() { grep -c ',lab/seat03,' "$OUT/dash/dashboard.csv" 2>/dev/null || true; }
+pngs() { ls "$OUT/dash"/dashboard_*.png 2>/dev/null | wc -l; }
+r0=$(rows)
+for _ in $(seq 600); do [ "$(rows)" -ge $((r0 + 2)) ] && [ "$(pngs)" -ge 10 ] && break; sleep 0.1; done
+kill -INT $DASH; wait $DASH || fail "dashboard failed"
+for p in "${SRVS[@]}"; do kill -INT "$p"; wait "$p" || fail "a server exited with an error"; done
 PIDS=()
 csv="$OUT/dash/dashboard.csv"
 [ -f "$csv" ] || fail "no dashboard.csv"

@@ -2,13 +2,16 @@
  * row per tick) and the trajectory's positions, never by wall-clock windows
  * (issue 15.6), for the failover and fault_tolerance tests.
  *
- * force_check failover FORCE_CSV
+ * force_check failover FORCE_CSV [KILL_ROW]
  *   The server is killed while the hand presses and restarted while it is
  *   still inside; the hand lifts above LIFT_Z and presses again. Asserts:
  *   the first press felt the organ (>= 100 ticks above 0.1 N); the force
  *   went to exactly zero while the hand was still inside, for >= 10 ticks
  *   in a row (nothing rendered from a dead server); the second press, on
  *   the restarted server, felt the organ again (>= 100 ticks above 0.1 N).
+ *   With KILL_ROW (the log's data rows on disk when the server was killed:
+ *   stdio buffering makes it at most the ticks done by then), that zero run
+ *   starts at or after it: the force did not drop for good before the kill.
  *
  * force_check hold FORCE_CSV FROM_ROW TO_ROW
  *   Ticks FROM_ROW..TO_ROW-1 (data rows, 0-based; the rows written while a
@@ -58,7 +61,7 @@ static row_t *load(const char *path, size_t *n) {
   return r;
 }
 
-static int failover(const row_t *r, size_t n) {
+static int failover(const row_t *r, size_t n, size_t kill_row) {
   size_t i = 0, press1 = 0, zero_inside = 0, press2 = 0;
   while (i < n && r[i].f <= 0.1) i++; /* first press begins */
   size_t first = i;
@@ -87,6 +90,9 @@ static int failover(const row_t *r, size_t n) {
   if (zero_inside < 10)
     bad = fprintf(stderr, "FAIL: the force did not drop to zero while the hand was inside (server killed)\n");
   if (press2 < 100) bad = fprintf(stderr, "FAIL: the second press, on the restarted server, was not felt\n");
+  if (zero_inside >= 10 && best_start < kill_row)
+    bad = fprintf(stderr, "FAIL: the force dropped for good at tick %zu, before the server was killed (tick >= %zu)\n",
+                  best_start, kill_row);
   return bad ? 1 : 0;
 }
 
@@ -106,9 +112,11 @@ int main(int argc, char **argv) {
   size_t n = 0;
   row_t *r = argc >= 3 ? load(argv[2], &n) : NULL;
   int rc = 2;
-  if (r && argc == 3 && strcmp(argv[1], "failover") == 0) rc = failover(r, n);
+  if (r && (argc == 3 || argc == 4) && strcmp(argv[1], "failover") == 0)
+    rc = failover(r, n, argc == 4 ? strtoul(argv[3], 0, 10) : 0);
   if (r && argc == 5 && strcmp(argv[1], "hold") == 0) rc = hold(r, n, strtoul(argv[3], 0, 10), strtoul(argv[4], 0, 10));
-  if (rc == 2) fprintf(stderr, "usage: force_check failover FORCE_CSV | force_check hold FORCE_CSV FROM_ROW TO_ROW\n");
+  if (rc == 2)
+    fprintf(stderr, "usage: force_check failover FORCE_CSV [KILL_ROW] | force_check hold FORCE_CSV FROM_ROW TO_ROW\n");
   free(r);
   return rc;
 }

@@ -1,6 +1,8 @@
 /* rec_tools: reads a session recording (rec_read.h) and prints, decoded
  * with the compiled-in descriptors, what the tool tests check (issue 4):
- *   EVENT KIND tool=N organ=N value=V TEXT       grasp and task SessionEvents
+ *   EVENT KIND tool=N organ=N value=V sim=S TEXT grasp, task and applied
+ *                                                control SessionEvents
+ *                                                (S: simulated time, s)
  *   TOOLMETRICS tool=N name=.. peak_force=.. ... last ToolMetrics per tool
  *   OBJECT id=N x= y= z= held_by= removed=       last ObjectState per object
  *   FEEDBACK_PAIRS n=.. min_tip_distance=..      ContactFeedback of tools 0
@@ -60,18 +62,20 @@ static const char *kind_name(viscera_EventKind k) {
     return "TASK_STARTED";
   case viscera_EVENT_TASK_COMPLETED:
     return "TASK_COMPLETED";
+  case viscera_EVENT_CONTROL_APPLIED:
+    return "CONTROL_APPLIED";
   default:
     return NULL;
   }
 }
 
-/* The grasp and task events, kept for the checks. */
+/* The grasp, task and control events, kept for the checks. */
 enum { MAXEV = 256 };
 typedef struct event {
   viscera_EventKind kind;
   int tool, organ;
   double value;
-  char text[sizeof ((viscera_SessionEvent *)0)->text];
+  char text[sizeof((viscera_SessionEvent *)0)->text];
 } event_t;
 static event_t ev[MAXEV];
 static int nev;
@@ -82,7 +86,8 @@ static int on_event(void *ctx, const void *p, const recfile_row_t *row) {
   const viscera_SessionEvent *e = p;
   const char *k = kind_name(e->kind);
   if (!k) return 0;
-  printf("EVENT %s tool=%d organ=%d value=%.4f %s\n", k, (int)e->tool_id, (int)e->organ_id, e->value, e->text);
+  printf("EVENT %s tool=%d organ=%d value=%.4f sim=%.4f %s\n", k, (int)e->tool_id, (int)e->organ_id, e->value,
+         (double)e->sim_time_ns * 1e-9, e->text);
   if (nev < MAXEV) {
     event_t *d = &ev[nev++];
     *d = (event_t){.kind = e->kind, .tool = (int)e->tool_id, .organ = (int)e->organ_id, .value = e->value};
@@ -235,7 +240,8 @@ static int csv_pull(const char *path, double t0, double t1, double fz_min, long 
 static void expect_grasp_pull(const vtrack_t *v, const char *haptic_csv, const char *server_out) {
   check(find_event(viscera_EVENT_GRASP_BEGIN, 0, 0, "") != NULL, "GRASP_BEGIN of tool 0 on organ 0 recorded");
   check(find_event(viscera_EVENT_GRASP_END, 0, 0, "") != NULL, "GRASP_END of tool 0 on organ 0 recorded");
-  check(find_event(viscera_EVENT_TASK_COMPLETED, 0, -2, "lift-kidney") != NULL, "grasp_pull task lift-kidney completed");
+  check(find_event(viscera_EVENT_TASK_COMPLETED, 0, -2, "lift-kidney") != NULL,
+        "grasp_pull task lift-kidney completed");
   check(v && v->index >= 0 && v->max_dz > 0.005 && v->final_dz < 0.0005 && v->final_dz > -0.0005,
         "grasped vertex rose > 5 mm and ended within 0.5 mm");
   if (haptic_csv) {

@@ -69,10 +69,14 @@ cat "$WORK/replay.log" "$WORK/replay.out"
 [ $rc -eq 0 ] || fail "viscera-replay exited with $rc"
 grep -q '^SUMMARY written=[1-9][0-9]* topics=[0-9]* bad=0 skipped=0$' "$WORK/replay.out" || fail "no clean SUMMARY line"
 grep -q 'samples written, sim time' "$WORK/replay.log" || fail "no progress lines"
-# the session lasts ~7 s: at speed 2 the replay must neither rush nor crawl
-awk -v s="$start" -v e="$end" 'BEGIN { d = e - s; exit !(d > 2.0 && d < 10.0) }' ||
-  fail "replay took $(awk -v s="$start" -v e="$end" 'BEGIN{print e-s}') s, expected about 4 s"
-sleep 0.5
+# the session lasts ~7 s: at speed 2 the replay is paced (about 4 s), never
+# rushed out at once; a loaded machine only makes it later, so the upper
+# bound is a safety stop for a hang, not a rate (issue 15.6)
+awk -v s="$start" -v e="$end" 'BEGIN { d = e - s; printf "replay took %.2f s (about 4 s expected)\n", d; exit !(d > 2.0 && d < 60.0) }' ||
+  fail "replay took $(awk -v s="$start" -v e="$end" 'BEGIN{print e-s}') s: rushed (< 2 s) or hung (> 60 s)"
+# The viewer writes a frame every 100 ms at best; a loaded machine renders
+# fewer: wait (60 s at most) for its sixth frame rather than a fixed time.
+for _ in $(seq 600); do [ "$(ls "$WORK/frames"/frame_*.png 2>/dev/null | wc -l)" -gt 5 ] && break; sleep 0.1; done
 kill -INT $VPID $RPID
 wait $VPID || fail "viewer exited with an error"
 wait $RPID || fail "second recorder exited with an error"
