@@ -18,6 +18,7 @@
  * topic are not a failure); 1 otherwise or when the recording cannot be
  * read. usage: rec_feedback_first FILE.db MIN */
 #include <inttypes.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 
