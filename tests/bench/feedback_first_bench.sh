@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Command -> feedback latency before/after "feedback before the tissue step"
-# (issue 17 item 5): RUNS short sessions per build, the two builds
+# (issue 17 item 5): RUNS short sessions per server build (the haptic
+# client is NEW_BUILD's in both: only the server differs), the two builds
 # interleaved (run i: old then new for odd i, new then old for even i), each
 # a real server on the default scene and a scripted haptic client
 # (palpate_kidney.traj, SECONDS s) over DDS on loopback, the client started
@@ -29,7 +30,7 @@ one() { # BUILD TAG RUN: prints latency_us_mean latency_us_median
   local s=$!; pids+=($s)
   sleep 1.2
   sleep "$(printf '0.%06d' $((RANDOM % 1000)))"
-  "$b/client/haptic/viscera-haptic" --trajectory "$SRC/assets/trajectories/palpate_kidney.traj" --domain "$D" \
+  "$NEW/client/haptic/viscera-haptic" --trajectory "$SRC/assets/trajectories/palpate_kidney.traj" --domain "$D" \
     --partition "$part" --duration "$SECS" >"$OUT/$tag$i.haptic.out" 2>"$OUT/$tag$i.haptic.log" || true
   kill -INT $s; wait $s 2>/dev/null || true
   pids=()

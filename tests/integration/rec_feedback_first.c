@@ -133,7 +133,7 @@ int main(int argc, char **argv) {
       if (d.fb[t][f].sim_ns == c->start_ns) {
         on_time++;
         early[f] = 1;
-      } else if (d.fb[t][f].sim_ns == c->start_ns + d.dt_ns) {
+      } else if (llabs((int64_t)(d.fb[t][f].sim_ns - c->start_ns) - (int64_t)d.dt_ns) <= 1) { /* ns truncation */
         late++;
       } else {
         other++;
