@@ -46,7 +46,8 @@ one() { # BUILD TAG RUN: prints latency_us_mean latency_us_median
   echo "${mean:-nan} ${med:-nan}"
 }
 
-echo "load before: $(uptime); loops: ${RT_PRIORITY:+SCHED_FIFO $RT_PRIORITY}${RT_PRIORITY:-normal priority}"
+loops="normal priority"; [ -n "${RT_PRIORITY:-}" ] && loops="SCHED_FIFO $RT_PRIORITY"
+echo "load before: $(uptime); loops: $loops"
 : >"$OUT/runs.txt"
 for i in $(seq 1 "$RUNS"); do
   if [ $((i % 2)) -eq 1 ]; then order="old new"; else order="new old"; fi
