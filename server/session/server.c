@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/prctl.h>
 #include <unistd.h>
 
 #include "mesh.h"
@@ -875,7 +876,6 @@ static int session_step(server_t *s, uint64_t t0, uint64_t c0, uint64_t *t1) {
       if (s->roles.changed & (1u << t)) vdds_gate_unblock_key(&s->cmd_gate, (uint32_t)t);
     publish_roles(s);
   }
-  applied_input_flush(&s->ai); /* before the step it precedes */
   /* Step: paused, the organs and the measures freeze; commands are still
    * read (so nothing queues up) and the last contact model keeps going out. */
   /* A tool with a fresh command is answered between the step's contact
@@ -886,8 +886,11 @@ static int session_step(server_t *s, uint64_t t0, uint64_t c0, uint64_t *t1) {
   if (!s->control.paused) {
     runtime_step_begin(&s->rt);
     early = publish_feedback_early(s, fresh);
-    rolled = runtime_step_finish(&s->rt);
   }
+  /* Before the tissue step it precedes (after the early answers, which
+   * wait for nothing; the sample's content was fixed at the take). */
+  applied_input_flush(&s->ai);
+  if (!s->control.paused) rolled = runtime_step_finish(&s->rt);
   if (rolled) report_rollbacks(s, rolled);
   /* Out: keyframes after a topology change, the ContactFeedback of every
    * driven tool not answered before the step (its force, tip and normal
@@ -999,6 +1002,10 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
    * every second by default) is the safety net that still lets the other
    * tasks (this server's DDS threads, a shell to stop it) run there. */
   if (opts->rt_priority) vrt_make_realtime(opts->rt_priority, "server", "physics loop", opts->quiet, stderr);
+  /* A SCHED_OTHER loop wakes up to the thread's timer slack (50 us by
+   * default) after each tick: every command would wait that much longer
+   * for its step and its answer (issue 17 item 5). 1 ns: on time. */
+  prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
   uint64_t start = vtime_mono_ns(), next = start;
   double sim0 = s.rt.sim_time; /* a resumed run starts where its checkpoint was */
   while (!*stop && (opts->duration <= 0 || (double)(vtime_mono_ns() - start) * 1e-9 < opts->duration)) {
