@@ -65,9 +65,10 @@ void haptic_summary_print(const haptic_options_t *o, haptic_stats_t *st, haptic_
          st->step_max_n, st->server_lost, st->liveliness_blips, st->feedback_stale, st->cuts, st->pc_ticks,
          st->guide_rtt_s * 1e3, st->energy_j, st->energy_max_j);
   printf("SUMMARY ticks=%" PRIu64 " rate_hz=%.1f peak_force=%.4f contact_ticks=%" PRIu64 " latency_us_median=%.1f "
-         "latency_us_p99=%.1f period_us_p99=%.1f jitter_us_p99=%.1f late_ticks=%" PRIu64 " guide_coupled_s=%.2f\n",
+         "latency_us_p99=%.1f period_us_p99=%.1f jitter_us_p99=%.1f late_ticks=%" PRIu64 " guide_coupled_s=%.2f "
+         "latency_us_mean=%.1f latency_samples=%zu\n",
          st->ticks, (double)st->ticks / st->elapsed_s, st->peak_force, st->contact_ticks, lat.median, lat.p99, per.p99,
-         jitter_p99, st->late_ticks, guide_report_coupled_s(guide, 1.0 / o->rate));
+         jitter_p99, st->late_ticks, guide_report_coupled_s(guide, 1.0 / o->rate), lat.mean, h->slot.nlatency);
   /* Whose feedback was believed (issue 15.2) and its order (14.2). */
   printf("FEEDBACK received=%" PRIu64 " ignored=%" PRIu64 " gate_dropped=%" PRIu64 " out_of_limits=%" PRIu64
          " stale=%" PRIu64 " servers_adopted=%" PRIu64 "\n",

@@ -398,31 +398,50 @@ static int step_models(runtime_t *rt) {
 /* Phase contact, after the models: the god-objects settle on the moved
  * surfaces; their spring is the proxy's contribution to the hand force
  * (tool->from.proxy). */
+static void settle_tool(const runtime_t *rt, tool_rt_t *tool) {
+  if (!tool->active) return;
+  proxy_settle(&tool->proxy, rt->scene.dt);
+  proxy_follow_surface(&tool->proxy, rt->surfaces, rt->norgans);
+  tool->from.proxy_mag =
+      proxy_spring_force(&tool->proxy, tool->cmd.pos, tool->cfg->stiffness, tool->max_force, tool->from.proxy);
+}
+
 static void settle_contact(runtime_t *rt) {
-  for (size_t t = 0; t < rt->ntools; t++) {
-    tool_rt_t *tool = &rt->tools[t];
-    if (!tool->active) continue;
-    proxy_settle(&tool->proxy, rt->scene.dt);
-    proxy_follow_surface(&tool->proxy, rt->surfaces, rt->norgans);
-    tool->from.proxy_mag =
-        proxy_spring_force(&tool->proxy, tool->cmd.pos, tool->cfg->stiffness, tool->max_force, tool->from.proxy);
-  }
+  for (size_t t = 0; t < rt->ntools; t++) settle_tool(rt, &rt->tools[t]);
 }
 
 /* The phases in order: inputs (the accepted commands' jaws), tools (grasp,
- * release, carry), contact (god-objects onto the surfaces), models (organ
- * steps, each followed by its cut and topology follow-up), contact again
- * (settle, proxy spring), outputs (hand force, feedback, events, tasks). */
-int runtime_step(runtime_t *rt) {
+ * release, carry), contact (god-objects onto the surfaces) = begin; models
+ * (organ steps, each followed by its cut and topology follow-up), contact
+ * again (settle, proxy spring), outputs (hand force, feedback, events,
+ * tasks) = finish. Between the two the preview may run: it settles copies
+ * of the tool records on the surfaces as they are (settle_tool, the
+ * settle phase's own code) and runs the outputs' feedback part
+ * (interact_feedback) on those copies, never on rt. */
+void runtime_step_begin(runtime_t *rt) {
   rt->organs_stepped = 0;
   rt->organs_reset = 0;
   interact_inputs(rt);
   interact_tools(rt);
   step_contact(rt);
+}
+
+void runtime_feedback_preview(const runtime_t *rt, tool_rt_t tools[SCENE_MAX_TOOLS]) {
+  memcpy(tools, rt->tools, rt->ntools * sizeof *tools);
+  for (size_t t = 0; t < rt->ntools; t++) settle_tool(rt, &tools[t]);
+  interact_feedback(rt, tools);
+}
+
+int runtime_step_finish(runtime_t *rt) {
   int rolled = step_models(rt);
   settle_contact(rt);
   rt->steps++;
   rt->sim_time = (double)rt->steps * rt->scene.dt;
   interact_outputs(rt);
   return rolled;
+}
+
+int runtime_step(runtime_t *rt) {
+  runtime_step_begin(rt);
+  return runtime_step_finish(rt);
 }

@@ -87,4 +87,23 @@ void runtime_topology_restored(runtime_t *rt, size_t organ);
  * row is put back to rest in that step (organs_reset). */
 int runtime_step(runtime_t *rt);
 
+/* runtime_step in two halves, for a caller that answers a command before
+ * the tissue moves (the session, docs/architecture.md): runtime_step(rt)
+ * is exactly runtime_step_begin(rt) then runtime_step_finish(rt) (same
+ * phases, same order, same results bit for bit).
+ *   begin:  inputs, tools, contact (god-objects moved toward the new tips
+ *           over the surfaces as they are, patches built)
+ *   finish: models (with cut and topology), contact settle, time, outputs;
+ *           returns what runtime_step returns. */
+void runtime_step_begin(runtime_t *rt);
+int runtime_step_finish(runtime_t *rt);
+/* After runtime_step_begin: what each tool's client would be told if the
+ * tissue did not move in this step. Fills tools[0..rt->ntools) with copies
+ * of rt->tools, settles each copy's proxy on the current surfaces and runs
+ * the outputs phase's feedback part on the copies (interact_feedback:
+ * fb_contact, fb_organ, fb_pos, fb_normal, force; the copies' peak_force is
+ * raised, not rt's). Reads rt only: no event, no peak, no tally, no state
+ * of the step changes. */
+void runtime_feedback_preview(const runtime_t *rt, tool_rt_t tools[SCENE_MAX_TOOLS]);
+
 #endif

@@ -157,8 +157,7 @@ void interact_tools(runtime_t *rt) {
 
 /* The shaft of a driven tool that meets tissue (not the extractor: it
  * enters through its port); its tip is where the hand's tip is held. */
-static int shaft_of(const runtime_t *rt, size_t t, double p0[3], double p1[3]) {
-  const tool_rt_t *tool = &rt->tools[t];
+static int shaft_of(const runtime_t *rt, const tool_rt_t *tool, size_t t, double p0[3], double p1[3]) {
   /* A cutting scalpel parts the tissue instead of pushing it (runtime/step_cut.h). */
   if (!tool->active || is_kind(tool, "extractor") || scalpel_cutting(rt, t)) return 0;
   const double *tip = tool->proxy.in_contact ? tool->proxy.pos : tool->cmd.pos;
@@ -217,7 +216,7 @@ void interact_apply(runtime_t *rt, organ_rt_t *o, model_t *m) {
   for (size_t t = 0; t < rt->ntools; t++) {
     tool_rt_t *tool = &rt->tools[t];
     double p0[3], p1[3], ft[3] = {0, 0, 0};
-    if (!shaft_of(rt, t, p0, p1)) continue;
+    if (!shaft_of(rt, tool, t, p0, p1)) continue;
     double radius = SHAFT_RADIUS_FRACTION * tool->cfg->radius;
     spring_ctx_t sc = {m, tool->cfg->stiffness};
     if (tip_on(tool, o->id)) {
@@ -268,12 +267,11 @@ static void add_nothing(void *ctx, uint32_t i, const double f[3]) {
 /* The shaft's reaction at the end of the step (from->shaft): added to
  * what the tip feels; a shaft touching while the tip is free is a contact
  * of its own. */
-static void shaft_contribution(runtime_t *rt, size_t t) {
-  tool_rt_t *tool = &rt->tools[t];
+static void shaft_contribution(const runtime_t *rt, tool_rt_t *tool, size_t t) {
   tool_forces_t *from = &tool->from;
   double p0[3], p1[3];
   v3_set(from->shaft, 0, 0, 0);
-  if (!shaft_of(rt, t, p0, p1)) return;
+  if (!shaft_of(rt, tool, t, p0, p1)) return;
   for (size_t i = 0; i < rt->norgans; i++) {
     const organ_rt_t *o = &rt->organs[i];
     const model_t *m = o->model;
@@ -295,7 +293,7 @@ static void shaft_contribution(runtime_t *rt, size_t t) {
 
 /* The extractor's tip against a stone it does not hold: a god-object on
  * the sphere of radius stone + tip (from->touch). */
-static void stone_touch(runtime_t *rt, tool_rt_t *tool) {
+static void stone_touch(const runtime_t *rt, tool_rt_t *tool) {
   tool_forces_t *from = &tool->from;
   for (size_t i = 0; i < rt->nstones; i++) {
     const stone_t *s = &rt->stones[i];
@@ -316,8 +314,7 @@ static void stone_touch(runtime_t *rt, tool_rt_t *tool) {
 /* What the outputs phase adds to tool t's contributions: the grasp's pull
  * or the held stone's reaction, an extractor's touch of a free stone, the
  * shaft's reaction. */
-static void contributions(runtime_t *rt, size_t t) {
-  tool_rt_t *tool = &rt->tools[t];
+static void contributions(const runtime_t *rt, tool_rt_t *tool, size_t t) {
   tool_forces_t *from = &tool->from;
   from->pull = from->touch = from->tool_tool = 0;
   from->pull_organ = from->shaft_organ = -1;
@@ -335,7 +332,7 @@ static void contributions(runtime_t *rt, size_t t) {
   } else if (is_kind(tool, "extractor")) {
     stone_touch(rt, tool);
   }
-  shaft_contribution(rt, t);
+  shaft_contribution(rt, tool, t);
 }
 
 /* The tip's force before other tools push it: the grasp pull or held
@@ -361,8 +358,7 @@ static void tip_force(const tool_rt_t *tool, double f[3]) {
 /* What tool t's client is told about its tip: a pull's plane, the stone
  * the extractor touches, or the god-object; a shaft touching while the tip
  * is free is told as a pull of its own. */
-static void tip_feedback(runtime_t *rt, size_t t) {
-  tool_rt_t *tool = &rt->tools[t];
+static void tip_feedback(tool_rt_t *tool) {
   const tool_forces_t *from = &tool->from;
   tool->fb_contact = 0;
   tool->fb_organ = -1;
@@ -396,12 +392,12 @@ static void tip_feedback(runtime_t *rt, size_t t) {
  * half the overlap along the line between them (a few Gauss-Seidel passes
  * for three or more tools in a cluster). A moved tip is a contact
  * (from->tool_tool): the tool feels K (tip - device), clamped. */
-static void tool_tool_contact(runtime_t *rt) {
+static void tool_tool_contact(tool_rt_t *tools, size_t ntools) {
   for (int pass = 0; pass < 4; pass++) {
     int any = 0;
-    for (size_t a = 0; a < rt->ntools; a++)
-      for (size_t b = a + 1; b < rt->ntools; b++) {
-        tool_rt_t *ta = &rt->tools[a], *tb = &rt->tools[b];
+    for (size_t a = 0; a < ntools; a++)
+      for (size_t b = a + 1; b < ntools; b++) {
+        tool_rt_t *ta = &tools[a], *tb = &tools[b];
         if (!ta->active || !tb->active) continue;
         double d[3], need = ta->cfg->radius + tb->cfg->radius;
         v3_sub(d, ta->fb_pos, tb->fb_pos);
@@ -419,8 +415,10 @@ static void tool_tool_contact(runtime_t *rt) {
   }
 }
 
-void interact_hand_force(runtime_t *rt, size_t t) {
-  tool_rt_t *tool = &rt->tools[t];
+/* The one function that writes a tool record's force (tool->force):
+ * interact_hand_force on the runtime's record, interact_feedback on the
+ * preview's copies (runtime_feedback_preview). */
+static void hand_force(tool_rt_t *tool) {
   const tool_forces_t *from = &tool->from;
   if (!tool->active) {
     v3_set(tool->force, 0, 0, 0);
@@ -441,6 +439,8 @@ void interact_hand_force(runtime_t *rt, size_t t) {
   if (mag > tool->peak_force) tool->peak_force = mag;
 }
 
+void interact_hand_force(runtime_t *rt, size_t t) { hand_force(&rt->tools[t]); }
+
 /* A tip another tool moved is a contact: with another tool (organ -1, the
  * force's direction) unless the god-object still touches an organ. */
 static void tool_tool_feedback(tool_rt_t *tool) {
@@ -452,16 +452,20 @@ static void tool_tool_feedback(tool_rt_t *tool) {
   }
 }
 
+void interact_feedback(const runtime_t *rt, tool_rt_t *tools) {
+  for (size_t t = 0; t < rt->ntools; t++) {
+    contributions(rt, &tools[t], t);
+    tip_feedback(&tools[t]);
+  }
+  tool_tool_contact(tools, rt->ntools);
+  for (size_t t = 0; t < rt->ntools; t++) {
+    hand_force(&tools[t]);
+    if (tools[t].active && tools[t].from.tool_tool) tool_tool_feedback(&tools[t]);
+  }
+}
+
 void interact_outputs(runtime_t *rt) {
-  for (size_t t = 0; t < rt->ntools; t++) {
-    contributions(rt, t);
-    tip_feedback(rt, t);
-  }
-  tool_tool_contact(rt);
-  for (size_t t = 0; t < rt->ntools; t++) {
-    interact_hand_force(rt, t);
-    if (rt->tools[t].active && rt->tools[t].from.tool_tool) tool_tool_feedback(&rt->tools[t]);
-  }
+  interact_feedback(rt, rt->tools);
   for (size_t i = 0; i < rt->nstones; i++) {
     stone_t *s = &rt->stones[i];
     if (s->held_by < 0 || s->removed || rt->steps % STONE_CHECK_EVERY) continue;

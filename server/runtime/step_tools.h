@@ -36,14 +36,21 @@ void interact_tools(runtime_t *rt);
 int interact_uses_proxy(const runtime_t *rt, size_t t);
 void interact_apply(runtime_t *rt, organ_rt_t *o, model_t *m);
 void interact_outputs(runtime_t *rt);
+/* The feedback part of the outputs phase over the records `tools` (rt->ntools
+ * of them, indexed like rt->tools): each tool's contributions, what its
+ * client is told (fb_*), tool-tool contact, the hand force. interact_outputs
+ * runs it on rt->tools; runtime_feedback_preview on copies, so it reads rt
+ * (organs, stones, the scalpel) and writes only `tools`. */
+void interact_feedback(const runtime_t *rt, tool_rt_t *tools);
 /* The tool's client is gone: drop whatever it holds, stop acting (tool
  * inactive, no force). The god-object keeps its contact, so a client back
  * with its hand inside the organ feels it again (docs/remote.md). */
 void interact_release_tool(runtime_t *rt, size_t t);
 
 /* The force the hand feels on tool t (tool->force, N) from this step's
- * contributions (tool->from): the only writer of tool->force. Zero for an
- * inactive tool. Also raises the tool's peak force. */
+ * contributions (tool->from): the only writer of tool->force (the same
+ * code writes the force of the preview's copies, interact_feedback). Zero
+ * for an inactive tool. Also raises the tool's peak force. */
 void interact_hand_force(runtime_t *rt, size_t t);
 
 #endif

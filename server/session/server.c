@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/prctl.h>
 #include <unistd.h>
 
 #include "mesh.h"
@@ -56,10 +57,11 @@ typedef struct server {
   /* What each loop iteration applied, for the recording (applied_input.h). */
   applied_input_t ai;
   uint64_t event_seq;
-  uint64_t feedback_seq;     /* ContactFeedback.seq of the last sample written */
-  double *step_us;           /* ring of recent step times */
-  double *step_cpu_us;       /* the same steps' thread CPU times */
-  unsigned char *step_awake; /* the same steps: 1 when an organ was stepped (not all asleep, not paused) */
+  uint64_t feedback_seq;              /* ContactFeedback.seq of the last sample written */
+  tool_rt_t preview[SCENE_MAX_TOOLS]; /* the step's feedback preview (publish_feedback_early) */
+  double *step_us;                    /* ring of recent step times */
+  double *step_cpu_us;                /* the same steps' thread CPU times */
+  unsigned char *step_awake;          /* the same steps: 1 when an organ was stepped (not all asleep, not paused) */
   size_t nstep_us;
   uint64_t publish_every, metrics_every; /* steps between frames, between metrics */
   server_stats_t *stats;
@@ -537,31 +539,55 @@ static int read_controls(server_t *s) {
   return 0;
 }
 
-static void publish_feedback(server_t *s) {
+/* One ContactFeedback of tool t from the record `tool` (the core's, or the
+ * preview's copy), stamped with the simulated time now. */
+static void write_feedback(server_t *s, size_t t, const tool_rt_t *tool) {
+  viscera_ContactFeedback fb;
+  memset(&fb, 0, sizeof fb);
+  fb.tool_id = (uint32_t)t;
+  fb.cmd_seq = tool->cmd.seq;
+  fb.cmd_client_mono_ns = tool->cmd.echo;
+  fb.sim_time_ns = sim_ns(s);
+  fb.seq = ++s->feedback_seq;
+  /* fb_*: the god-object, or what a grasp, a stone or another tool
+   * makes the hand feel (runtime/step_tools.c). */
+  fb.in_contact = tool->fb_contact != 0;
+  fb.organ_id = tool->fb_contact ? tool->fb_organ : -1;
+  fb.stiffness = (float)tool->cfg->stiffness;
+  for (int k = 0; k < 3; k++) {
+    fb.proxy_position[k] = (float)tool->fb_pos[k];
+    fb.normal[k] = (float)tool->fb_normal[k];
+    fb.force[k] = (float)tool->force[k];
+  }
+  if (dds_write(s->w_feedback, &fb) >= 0) s->stats->published[VT_CONTACT_FEEDBACK]++;
+}
+
+/* Before the tissue step (issue 17): every driven tool with a fresh command
+ * (bit t of `fresh`) is answered at once from the preview (its god-object
+ * moved over the surfaces as they are; runtime_feedback_preview), stamped
+ * with the step's start time. Returns the tools answered. */
+static uint32_t publish_feedback_early(server_t *s, uint32_t fresh) {
+  uint32_t done = 0;
+  for (size_t t = 0; t < s->rt.ntools; t++)
+    if ((fresh & (1u << t)) && s->rt.tools[t].active) done |= 1u << t;
+  if (!done) return 0;
+  runtime_feedback_preview(&s->rt, s->preview);
+  for (size_t t = 0; t < s->rt.ntools; t++)
+    if (done & (1u << t)) write_feedback(s, t, &s->preview[t]);
+  return done;
+}
+
+/* After the step: the ContactFeedback of every driven tool not answered
+ * before it (`early`), from the core record; the contact begin/end events
+ * of every tool from the core record, as the step left it. */
+static void publish_feedback(server_t *s, uint32_t early) {
   for (size_t t = 0; t < s->rt.ntools; t++) {
     const tool_rt_t *tool = &s->rt.tools[t];
     if (!tool->active) continue;
-    viscera_ContactFeedback fb;
-    memset(&fb, 0, sizeof fb);
-    fb.tool_id = (uint32_t)t;
-    fb.cmd_seq = tool->cmd.seq;
-    fb.cmd_client_mono_ns = tool->cmd.echo;
-    fb.sim_time_ns = sim_ns(s);
-    fb.seq = ++s->feedback_seq;
-    /* fb_*: the god-object, or what a grasp, a stone or another tool
-     * makes the hand feel (runtime/step_tools.c). */
-    fb.in_contact = tool->fb_contact != 0;
-    fb.organ_id = tool->fb_contact ? tool->fb_organ : -1;
-    fb.stiffness = (float)tool->cfg->stiffness;
-    for (int k = 0; k < 3; k++) {
-      fb.proxy_position[k] = (float)tool->fb_pos[k];
-      fb.normal[k] = (float)tool->fb_normal[k];
-      fb.force[k] = (float)tool->force[k];
-    }
-    if (dds_write(s->w_feedback, &fb) >= 0) s->stats->published[VT_CONTACT_FEEDBACK]++;
+    if (!(early & (1u << t))) write_feedback(s, t, tool);
     int c = tool->fb_contact != 0;
     if (c != s->tool[t].was_contact) {
-      publish_event(s, c ? viscera_EVENT_CONTACT_BEGIN : viscera_EVENT_CONTACT_END, fb.organ_id, (int)t, 0,
+      publish_event(s, c ? viscera_EVENT_CONTACT_BEGIN : viscera_EVENT_CONTACT_END, c ? tool->fb_organ : -1, (int)t, 0,
                     c ? "contact begins" : "contact ends");
       s->tool[t].was_contact = c;
     }
@@ -850,16 +876,28 @@ static int session_step(server_t *s, uint64_t t0, uint64_t c0, uint64_t *t1) {
       if (s->roles.changed & (1u << t)) vdds_gate_unblock_key(&s->cmd_gate, (uint32_t)t);
     publish_roles(s);
   }
-  applied_input_flush(&s->ai); /* before the step it precedes */
   /* Step: paused, the organs and the measures freeze; commands are still
    * read (so nothing queues up) and the last contact model keeps going out. */
-  int rolled = s->control.paused ? 0 : runtime_step(&s->rt);
+  /* A tool with a fresh command is answered between the step's contact
+   * phase and its tissue step (runtime_step_begin/finish: the same step as
+   * runtime_step), so its ContactFeedback does not wait for the organs. */
+  int rolled = 0;
+  uint32_t early = 0;
+  if (!s->control.paused) {
+    runtime_step_begin(&s->rt);
+    early = publish_feedback_early(s, fresh);
+  }
+  /* Before the tissue step it precedes (after the early answers, which
+   * wait for nothing; the sample's content was fixed at the take). */
+  applied_input_flush(&s->ai);
+  if (!s->control.paused) rolled = runtime_step_finish(&s->rt);
   if (rolled) report_rollbacks(s, rolled);
   /* Out: keyframes after a topology change, the ContactFeedback of every
-   * driven tool (its force, tip and normal from the core record), the
-   * trainee measures, the step's events, frames and metrics. */
+   * driven tool not answered before the step (its force, tip and normal
+   * from the core record), the trainee measures, the step's events, frames
+   * and metrics. */
   follow_topology(s);
-  publish_feedback(s);
+  publish_feedback(s, early);
   if (!s->control.paused) {
     track_thresholds(s);
     for (size_t t = 0; t < s->rt.ntools; t++) tool_tally_update(&s->tool[t].tally, &s->rt.tools[t], s->rt.scene.dt);
@@ -964,6 +1002,10 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
    * every second by default) is the safety net that still lets the other
    * tasks (this server's DDS threads, a shell to stop it) run there. */
   if (opts->rt_priority) vrt_make_realtime(opts->rt_priority, "server", "physics loop", opts->quiet, stderr);
+  /* A SCHED_OTHER loop wakes up to the thread's timer slack (50 us by
+   * default) after each tick: every command would wait that much longer
+   * for its step and its answer (issue 17 item 5). 1 ns: on time. */
+  prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
   uint64_t start = vtime_mono_ns(), next = start;
   double sim0 = s.rt.sim_time; /* a resumed run starts where its checkpoint was */
   while (!*stop && (opts->duration <= 0 || (double)(vtime_mono_ns() - start) * 1e-9 < opts->duration)) {

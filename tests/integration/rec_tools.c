@@ -133,10 +133,17 @@ static int on_object(void *ctx, const void *p, const recfile_row_t *row) {
   return 0;
 }
 
-/* ContactFeedback of tools 0 and 1: the tip each is told, matched by sim
- * time (both are published in the same step). */
+/* ContactFeedback of tools 0 and 1: the tip each is told, matched when
+ * both come from one evaluation of the tools (the tool-tool contact keeps
+ * the tips apart within one): the same sim time and the same kind. A
+ * sample answering a new command (cmd_seq changed) was evaluated before
+ * its step's tissue step (sim time = the step's start; issue 17 item 5),
+ * the others after a step (sim time = its end), so an answer of step k and
+ * the other tool's after-step sample of step k - 1 share a sim time but
+ * not an evaluation. */
 typedef struct fb_pairs {
-  unsigned long long t[2];
+  unsigned long long t[2], cmd_seq[2];
+  int early[2];
   float pos[2][3];
   int have[2];
   long n;
@@ -148,10 +155,12 @@ static int on_feedback(void *ctx, const void *p, const recfile_row_t *row) {
   const viscera_ContactFeedback *f = p;
   if (f->tool_id > 1) return 0;
   int i = (int)f->tool_id;
+  fp->early[i] = !fp->have[i] || f->cmd_seq != fp->cmd_seq[i];
+  fp->cmd_seq[i] = f->cmd_seq;
   fp->t[i] = f->sim_time_ns;
   memcpy(fp->pos[i], f->proxy_position, sizeof fp->pos[i]);
   fp->have[i] = 1;
-  if (fp->have[0] && fp->have[1] && fp->t[0] == fp->t[1]) {
+  if (fp->have[0] && fp->have[1] && fp->t[0] == fp->t[1] && fp->early[0] == fp->early[1]) {
     double d = 0;
     for (int k = 0; k < 3; k++) d += ((double)fp->pos[0][k] - fp->pos[1][k]) * ((double)fp->pos[0][k] - fp->pos[1][k]);
     d = sqrt(d);

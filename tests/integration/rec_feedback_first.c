@@ -1,0 +1,159 @@
+/* rec_feedback_first: reads a session recording (rec_read.h) and judges,
+ * from the server's own records, when each tool command was answered
+ * (issue 17 item 5: feedback before the tissue step).
+ *
+ * AppliedInput says which command each tool took before which step (its
+ * sim_time_ns is the simulated time at the start of that step). The first
+ * ContactFeedback echoing that command (its cmd_seq, lowest
+ * ContactFeedback.seq) must carry that start time: it was written before
+ * the step's tissue step. Written after the step (the old order) it would
+ * carry the start time + dt ("late"). Per tool the feedback samples, each
+ * placed on the step it answers (an answer before the step: start / dt; any
+ * other: end / dt - 1), must fall on strictly increasing steps: never two
+ * in one step.
+ *
+ * Prints `FEEDBACK_FIRST commands=N answered=A on_time=O late=L other=X
+ * repeated=R dt_ns=D` and exits 0 when late = other = repeated = 0 and at
+ * least `min` commands were answered (missing samples of a best-effort
+ * topic are not a failure); 1 otherwise or when the recording cannot be
+ * read. usage: rec_feedback_first FILE.db MIN */
+#include <inttypes.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "rec_read.h"
+#include "viscera.h"
+
+#define MAXT 8
+
+typedef struct cmd {
+  uint64_t seq, start_ns;
+} cmd_t;
+typedef struct fb {
+  uint64_t seq, cmd_seq, sim_ns;
+} fb_t;
+
+typedef struct data {
+  cmd_t *cmd[MAXT];
+  size_t ncmd[MAXT], capc[MAXT];
+  fb_t *fb[MAXT];
+  size_t nfb[MAXT], capf[MAXT];
+  uint64_t dt_ns;
+  int oom;
+} data_t;
+
+static void *grow(void *p, size_t *cap, size_t n, size_t size, int *oom) {
+  if (n < *cap) return p;
+  size_t c = *cap ? 2 * *cap : 1024;
+  void *q = realloc(p, c * size);
+  if (!q) {
+    *oom = 1;
+    return NULL;
+  }
+  *cap = c;
+  return q;
+}
+
+static int on_applied(void *arg, const void *sample, const recfile_row_t *row) {
+  (void)row;
+  data_t *d = arg;
+  const viscera_AppliedInput *a = sample;
+  if (a->step > 0 && !d->dt_ns) d->dt_ns = (uint64_t)llround((double)a->sim_time_ns / (double)a->step);
+  if (a->paused) return 0; /* a paused session takes no step */
+  for (uint32_t i = 0; i < a->tools._length; i++) {
+    const viscera_AppliedTool *t = &a->tools._buffer[i];
+    if (t->released || t->tool_id >= MAXT) continue;
+    size_t k = t->tool_id;
+    cmd_t *c = grow(d->cmd[k], &d->capc[k], d->ncmd[k], sizeof *c, &d->oom);
+    if (!c) return 0;
+    d->cmd[k] = c;
+    c[d->ncmd[k]++] = (cmd_t){t->cmd_seq, a->sim_time_ns};
+  }
+  return 0;
+}
+
+static int on_feedback(void *arg, const void *sample, const recfile_row_t *row) {
+  (void)row;
+  data_t *d = arg;
+  const viscera_ContactFeedback *f = sample;
+  if (f->tool_id >= MAXT) return 0;
+  size_t k = f->tool_id;
+  fb_t *b = grow(d->fb[k], &d->capf[k], d->nfb[k], sizeof *b, &d->oom);
+  if (!b) return 0;
+  d->fb[k] = b;
+  b[d->nfb[k]++] = (fb_t){f->seq, f->cmd_seq, f->sim_time_ns};
+  return 0;
+}
+
+static int by_seq(const void *a, const void *b) {
+  uint64_t x = ((const fb_t *)a)->seq, y = ((const fb_t *)b)->seq;
+  return x < y ? -1 : x > y;
+}
+
+int main(int argc, char **argv) {
+  if (argc != 3) {
+    fprintf(stderr, "usage: rec_feedback_first FILE.db MIN\n");
+    return 2;
+  }
+  recfile_t *rf = NULL;
+  verr_t err;
+  if (recfile_open(&rf, argv[1], &err) < 0) {
+    fprintf(stderr, "rec_feedback_first: %s\n", err.msg);
+    return 1;
+  }
+  static data_t d;
+  int bad =
+      rec_read_topic("rec_feedback_first", rf, "viscera_AppliedInput", &viscera_AppliedInput_desc, on_applied, &d);
+  bad += rec_read_topic("rec_feedback_first", rf, "viscera_ContactFeedback", &viscera_ContactFeedback_desc, on_feedback,
+                        &d);
+  recfile_close(rf);
+  if (bad || d.oom || !d.dt_ns) {
+    fprintf(stderr, "rec_feedback_first: %s\n", d.oom ? "out of memory" : bad ? "unreadable samples" : "no step seen");
+    return 1;
+  }
+  size_t commands = 0, answered = 0, on_time = 0, late = 0, other = 0, repeated = 0;
+  for (size_t t = 0; t < MAXT; t++) {
+    qsort(d.fb[t], d.nfb[t], sizeof *d.fb[t], by_seq);
+    /* The step each sample answers: before the step it took a command in,
+     * after the step otherwise. `early[i]` marks the first answers. */
+    char *early = calloc(d.nfb[t] + 1, 1);
+    if (!early) return 1;
+    size_t j = 0;
+    for (size_t i = 0; i < d.ncmd[t]; i++) {
+      const cmd_t *c = &d.cmd[t][i];
+      commands++;
+      /* Commands and answers go in the same order: the first sample at or
+       * after j echoing this seq. */
+      size_t f = j;
+      while (f < d.nfb[t] && d.fb[t][f].cmd_seq != c->seq) f++;
+      if (f == d.nfb[t]) continue; /* not recorded (best effort) */
+      j = f + 1;
+      answered++;
+      if (d.fb[t][f].sim_ns == c->start_ns) {
+        on_time++;
+        early[f] = 1;
+      } else if (llabs((int64_t)(d.fb[t][f].sim_ns - c->start_ns) - (int64_t)d.dt_ns) <= 1) { /* ns truncation */
+        late++;
+      } else {
+        other++;
+        if (other <= 5)
+          fprintf(stderr, "tool %zu command %" PRIu64 " taken at %" PRIu64 " ns first answered at %" PRIu64 " ns\n", t,
+                  c->seq, c->start_ns, d.fb[t][f].sim_ns);
+      }
+    }
+    int64_t last = -1;
+    for (size_t i = 0; i < d.nfb[t]; i++) {
+      int64_t step = (int64_t)llround((double)d.fb[t][i].sim_ns / (double)d.dt_ns) - (early[i] ? 0 : 1);
+      if (step <= last) repeated++;
+      last = step;
+    }
+    free(early);
+    free(d.cmd[t]);
+    free(d.fb[t]);
+  }
+  long min = strtol(argv[2], NULL, 10);
+  printf("FEEDBACK_FIRST commands=%zu answered=%zu on_time=%zu late=%zu other=%zu repeated=%zu dt_ns=%" PRIu64 "\n",
+         commands, answered, on_time, late, other, repeated, d.dt_ns);
+  return late == 0 && other == 0 && repeated == 0 && (long)answered >= min ? 0 : 1;
+}
