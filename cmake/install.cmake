@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # install(): what `cmake --install` and the .deb put where (GNUInstallDirs
 # under CMAKE_INSTALL_PREFIX, /usr/local by default, /usr in the .deb):
 #   bin/                      every viscera binary this build has

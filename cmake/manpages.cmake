@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Man pages, generated at build time by help2man (Debian package help2man,
 # deploy/install_deps.sh) from each binary's --help and --version, and
 # installed to share/man/man1. Without help2man the build goes on without

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # CPack: `cpack -G DEB` in the build directory makes viscera_VERSION_ARCH.deb
 # from the install() rules (cmake/install.cmake) with the prefix /usr. Its
 # Depends are computed by dpkg-shlibdeps from the binaries' shared libraries

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # The version every binary prints with --version (common/cli.c): the CMake
 # project version, plus `git describe` of the source tree when it is a git
 # checkout and git is installed (e.g. "0.1.0 (git a69fab4-dirty)"). Read at

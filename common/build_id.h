@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* build_id: which build this program is (issue 16: a recording names the
  * build that ran the session, because bit-exact re-simulation holds for
  * the same build only): the project version, the compiler and the flags

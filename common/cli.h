@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* cli: the command-line options every viscera program shares, parsed in one
  * place: --domain N, --partition P, --quiet, -h/--help and --version.
  *

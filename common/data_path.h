@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* data_path: where a viscera binary finds its data files (scenes, meshes,
  * trajectories, Cyclone DDS configurations) from any working directory.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* mesh: an indexed triangle surface, the form every part of viscera shares.
  * Positions are double (metres), 3 per vertex; triangles are 3 uint32 indices,
  * counter-clockwise seen from outside (outward normals). A mesh owns its arrays. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* mesh_admit: what an organ mesh must be before a model is built on it,
  * refused or repaired with a message (issue 15: meshes 1e30 m or 1e-30 m
  * across, inside out, inconsistently wound, non-manifold, open or in two

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* mesh_check: what is wrong with a triangle mesh, measured, never repaired.
  * Works on any mesh_t, including broken ones: faces with an out-of-range index
  * and non-finite vertices are counted and left out of the other measures.

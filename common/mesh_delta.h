@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* mesh_delta: quantized, cumulative vertex deltas against a keyframe.
  *
  * Contract: for any keyframe K (float positions as published) and current

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* mesh_import: any file assimp reads (OBJ, STL, PLY, glTF, ...) to one welded mesh_t.
  * All meshes of the file are merged with their node transforms applied; points and
  * lines are ignored; vertices with bit-identical positions are welded (files repeat a

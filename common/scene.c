@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* scene: YAML scene file -> scene_t.
  *
  * Two passes. libyaml's event parser first builds a small tree of scalars,

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* scene: the scene file, parsed and validated before anything starts.
  *
  * Format: YAML (comments allowed), SI units. See assets/scenes/default.yaml

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* scene_limits: the physical range of every numeric scene key and every
  * SessionControl value that edits one, in one table (scene_limits.c), with
  * the reason for each bound.

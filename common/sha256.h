@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* sha256: the SHA-256 digest (FIPS 180-4) of a buffer or a file, as 64
  * lowercase hex digits. Used to name the exact scene text and mesh files a
  * recording was made with (issue 16), so a re-simulation can tell whether

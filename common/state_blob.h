@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* state_blob: a growable byte buffer written and read in one piece, the
  * format of checkpoints (checkpoint.c) and of the models' topology
  * save/restore hooks (physics/model.h).

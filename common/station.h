@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* station: the name of a station (a seat, an instructor's desk) that drives
  * tools (scene `station:`, idl ToolRole, a ToolCommand writer's USER_DATA).
  * A name is 1..STATION_NAME_MAX-1 characters of [A-Za-z0-9_.-]. No

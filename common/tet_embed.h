@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* tet_embed: the parts of a given tetrahedral mesh the tetrahedral models
  * need when the mesh comes from a file (volume_mesh.h) instead of
  * tet_mesh_build(): a copy, its boundary surface, and the barycentric

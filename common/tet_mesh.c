@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* tet_mesh: regular-grid tetrahedral meshes and the surface embedding.
  * See tet_mesh.h for the contract. */
 #include "tet_mesh.h"

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* tet_mesh: tetrahedral volume meshes, built automatically from an organ's
  * surface, and the barycentric embedding of the render surface in them.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* text_scan: a whitespace-token reader over a whole text file, for the
  * line-oriented mesh formats (gmsh, VTK legacy, TetGen). Every token knows
  * its line, so a parser can say "file.msh:12: ..." about what it refused.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* verr: one error-message style for the whole product.
  * Library code never exits or prints on failure: it fills a verr_t naming the
  * file, line or field at fault and returns a negative code. main() prints it. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 #include "vmath.h"
 
 /* Region-based closest point (Ericson, Real-Time Collision Detection 5.1.5):

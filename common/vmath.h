@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* vmath: small 3-vector helpers on double[3]. Header-only, no allocation.
  * Normalisation is guarded: a zero vector stays zero instead of becoming NaN. */
 #ifndef VISCERA_VMATH_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Writers of the formats volume_import() reads (volume_mesh.h), used by the
  * asset tool to hand a generated tetrahedral mesh to other tools and by the
  * tests to make small files in every format. Coordinates with 17

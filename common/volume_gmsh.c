@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* gmsh MSH reader (ASCII 2.2, 4.0 and 4.1): see volume_mesh.h for what is
  * read, skipped and refused. Only $MeshFormat, $Nodes and $Elements matter;
  * every other section ($PhysicalNames, $Entities, $NodeData, ...) is skipped

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* volume_mesh: reading and writing offline tetrahedral meshes (see
  * volume_mesh.h); the format readers are volume_gmsh.c, volume_vtk.c and
  * volume_tetgen.c, which hand over node tags and corners as written. Here

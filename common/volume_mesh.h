@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* volume_mesh: tetrahedral meshes made offline (gmsh, TetGen, any tool that
  * writes VTK), read into a tet_mesh_t the tetrahedral models simulate, and
  * written back in the same formats (the asset tool's `tet --out`).

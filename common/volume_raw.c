@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* volume_raw: the node and tetrahedron lists the format readers fill
  * (volume_raw.h), grown geometrically and bounded by VOLUME_MAX_TETS. */
 #include "volume_raw.h"

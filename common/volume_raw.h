@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* volume_raw: what the format readers of volume_mesh.c hand over before
  * validation: node tags as the file wrote them and tetrahedra naming nodes
  * by those tags, each with its line for messages. Internal to volume_*.c. */

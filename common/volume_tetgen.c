@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* TetGen .node/.ele reader: see volume_mesh.h. Corners name nodes by the
  * index the .node file gives them, so files numbered from 0 and from 1 are
  * both read as written. */

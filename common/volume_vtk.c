@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* VTK legacy reader (ASCII, UNSTRUCTURED_GRID): see volume_mesh.h for what
  * is read, skipped and refused. POINTS, CELLS and CELL_TYPES may come in any
  * order; FIELD blocks are skipped; reading ends at POINT_DATA or CELL_DATA,

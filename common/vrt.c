@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* SCHED_RESET_ON_FORK is a GNU/Linux extension of <sched.h>. */
 #define _GNU_SOURCE
 #include "vrt.h"

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* vrt: make one loop thread real-time (SCHED_FIFO, memory locked), shared by
  * the server's physics loop and the haptic client's 1 kHz loop.
  *

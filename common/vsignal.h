@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* vsignal: the stop signals every long-running binary honours. Each main
  * keeps its own sig_atomic_t flag (no global state here) and passes the
  * handler that sets it; SIGINT and SIGTERM get it, with `flags` (e.g.

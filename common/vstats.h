@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* vstats: order statistics over a sample buffer, for benchmark tables and
  * the rate/latency summaries clients print on exit. */
 #ifndef VISCERA_VSTATS_H

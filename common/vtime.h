@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* vtime: monotonic time in nanoseconds and absolute sleeps for fixed-rate loops. */
 #ifndef VISCERA_VTIME_H
 #define VISCERA_VTIME_H

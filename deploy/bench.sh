@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Benchmarks (figures, not pass/fail): server step time per generated organ
 # and MeshDelta size (bench_server), then the haptic tick and command->feedback
 # latency on loopback over 60 s of palpation, then the recorder's throughput

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Configures and builds viscera. Usage: deploy/build.sh [BUILD_DIR] [extra cmake args...]
 # Default BUILD_DIR is build/ at the repository root.
 set -euo pipefail

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # The main job: installs what is missing, builds, and runs a complete local
 # session on loopback (server, scripted haptic client pushing into the kidney
 # and releasing, offscreen viewer writing PNG frames, recorder writing one

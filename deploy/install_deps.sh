@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Installs, with apt-get, exactly the Debian 12 packages viscera needs that are
 # missing. Idempotent and non-interactive; run as root (or with sudo present).
 set -euo pipefail

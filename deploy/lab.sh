@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Starts an N-seat classroom lab on this machine: one simulation server per
 # seat (partition PREFIX/seatNN of one domain), optional scripted trainees,
 # offscreen viewers per seat, and one recorder for the whole lab (PREFIX/*).
@@ -44,7 +45,7 @@ ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD="$ROOT/build" OUT="$ROOT/out/lab" SEATS=3 FIRST=1 PREFIX=lab SCENE="$ROOT/assets/scenes/default.yaml"
 TRAINEES=0 VIEWERS=1 DURATION=20 SECURE=0 INSECURE=0 RECORD=1 PKI="" RTPRIO=0 HRTPRIO=0
 STOP_GRACE_S="${VISCERA_LAB_STOP_GRACE:-10}"
-usage() { awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"; }
+usage() { awk 'NR > 2 && /^#/ { sub(/^# ?/, ""); print; next } NR > 2 { exit }' "$0"; }
 while [ $# -gt 0 ]; do
   case "$1" in
     --build) BUILD="$2"; shift 2 ;;

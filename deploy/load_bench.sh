@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Classroom load benchmark (issue 7): SEATS servers (assets/scenes/
 # classroom_kidney.yaml, meshes at 60 Hz, or --scene FILE) with a scripted
 # trainee each pressing and releasing for the whole run (--busy: pressing
@@ -58,7 +59,7 @@ while [ $# -gt 0 ]; do
     --haptic-rt-priority) HRTPRIO="$2"; shift 2 ;;
     --scene) SCENE="$2"; shift 2 ;;
     --busy) BUSY=1; shift ;;
-    -h|--help) sed -n 2,42p "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n 3,43p "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "load_bench.sh: unknown option '$1'" >&2; exit 2 ;;
   esac
 done

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # shellcheck shell=bash
 # Off loopback, secure by default (issue 14): sourced by the deploy scripts
 # that start processes with a CYCLONEDDS_URI (lab.sh, session.sh,

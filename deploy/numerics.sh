@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Numerics benchmark (docs/numerics.md): error against run time and stability for
 # every deformation model and integrator. Builds a Release tree and runs
 # bench_numerics on one core; writes CSV files and PNG charts into

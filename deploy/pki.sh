@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Generates everything DDS Security needs for a viscera lab: two certificate
 # authorities (identity, permissions), one certificate per participant
 # identity, and the signed governance and permissions documents that enforce
@@ -20,7 +21,7 @@
 # account (the script makes it 0700). Needs openssl only.
 set -euo pipefail
 
-usage() { sed -n 2,22p "$0" | sed 's/^# \{0,1\}//'; }
+usage() { sed -n 3,23p "$0" | sed 's/^# \{0,1\}//'; }
 [ $# -ge 1 ] || { usage >&2; exit 2; }
 case "$1" in -h|--help) usage; exit 0 ;; esac
 OUT="$1"; shift

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Runs one complete local session on loopback: server, recorder, offscreen
 # viewer and a scripted haptic client, each a separate process talking over
 # Cyclone DDS. Used by demo.sh and by the integration tests.

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Installs what is missing, builds with warnings as errors, and runs the whole
 # test suite (unit, integration over DDS on loopback, stability, fuzz), then
 # the unit, integration, stability and fuzz tests again under AddressSanitizer +

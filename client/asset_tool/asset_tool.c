@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* viscera-asset: inspects mesh files and converts them to the OBJ form the
  * server loads (through the same mesh_import, so what this tool reports is
  * what the server sees). See usage() for the commands. */

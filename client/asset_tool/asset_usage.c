@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The asset tool's usage errors, shared by its commands (asset_usage.h). */
 #include "asset_usage.h"
 

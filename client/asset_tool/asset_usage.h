@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The asset tool's exit statuses and its one way of reporting bad usage,
  * shared by asset_tool.c and asset_volume.c. */
 #ifndef VISCERA_ASSET_USAGE_H

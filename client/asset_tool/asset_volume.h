@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The asset tool's tetrahedral-mesh parts: `volume FILE` (what the server
  * reads from an organ's `volume:`) and the output format of `tet --out`.
  * Exit statuses: asset_usage.h. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* viscera-control: sends one instructor command (SessionControl) to a seat's
  * server and waits for the server's answer (a SessionEvent saying it was
  * applied or refused), so a script or an instructor sees the outcome.

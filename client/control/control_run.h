@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* control_run: viscera-control once its command is parsed: wait for the
  * seat's server, send the SessionControl until the server answers, and say
  * whether it was applied or refused. */

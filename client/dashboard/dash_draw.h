@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* dash_draw: the dashboard's two pictures, drawn with cairo over the seats'
  * state (seat.h), for the PNG frames and the window alike.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* dash_run: viscera-dashboard once its options are parsed (dashboard.c):
  * open the seats, then draw the grid (and focus view) as PNG frames with a
  * CSV row per seat, or live in a window, until a signal or --duration. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* dash_window: the dashboard live in an SDL2 window (viscera-dashboard
  * --window), built only when SDL2 is (CMake VISCERA_BUILD_WINDOW).
  *

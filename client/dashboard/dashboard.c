@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* viscera-dashboard: the instructor's view of a lab's seats (issue 7).
  *
  * One tile per seat (partition PREFIX/seatNN): the organ and tool as the

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* seat: what the dashboard follows of one seat: the scene (scene_view.h:
  * organs, tools, contact force), the seat's SessionEvents (threshold
  * crossings, lost clients, instructor commands; the last SEAT_EVENTS kept

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* seat_text: what the dashboard says about a seat, as plain functions of
  * plain data (no DDS, no drawing), so unit tests pin the wording and the
  * colours an instructor learns to read.

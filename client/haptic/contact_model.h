@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* contact_model: the local force model the haptic client renders at 1 kHz
  * from the latest ContactFeedback: a plane through the proxy with outward
  * normal n, stiffness k and damping b:

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* contact_render: what the haptic client renders from a contact model that
  * is one network round trip old (docs/remote.md). Pure arithmetic, no
  * clock and no allocation: the 1 kHz loop and the delayed-feedback unit test

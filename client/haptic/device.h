@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* device: the haptic device interface the 1 kHz loop drives.
  *
  * Contract (every implementation):

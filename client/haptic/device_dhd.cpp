@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 // device_dhd: Force Dimension devices (omega, delta, sigma, Novint Falcon
 // with the Force Dimension driver) through the DHD SDK. Compiled only when
 // CMake finds dhdc.h and libdhd (option VISCERA_DEVICE_DHD); select with

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 // device_falcon: the Novint Falcon through libnifalcon (open source driver).
 // Compiled only when CMake finds libnifalcon's headers and library (option
 // VISCERA_DEVICE_FALCON); select with viscera-haptic --device falcon.

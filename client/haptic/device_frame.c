@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 #include "device_frame.h"
 
 void device_to_scene(const device_config_t *c, const double p[3], double out[3]) {

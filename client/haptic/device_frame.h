@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* device_frame: the workspace mapping every real device applies in its
  * read(): device position (axes already turned to scene axes, metres) ->
  * scene position, scene = offset + scale * device (device_config_t in

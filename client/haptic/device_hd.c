@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* device_hd: 3D Systems / SensAble devices (Touch, Phantom) through the
  * OpenHaptics HDAPI. Compiled only when CMake finds HD/hd.h and libHD
  * (option VISCERA_DEVICE_HD); select with viscera-haptic --device hd.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* device_registry: device names -> open functions. Devices whose SDK was not found at
  * configure time are still listed, so asking for one says why it is absent
  * instead of "unknown device". */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* feedback_slot: the single-slot latest-value buffer between the DDS receive
  * thread and the 1 kHz haptic loop. A DDS listener validates each
  * ContactFeedback for our tool as it arrives, stamps its arrival time (so the

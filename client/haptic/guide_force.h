@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* guide_force: the force a haptic client renders while its tool is guided
  * ("guiding hand", idl/viscera.idl, the comment above ToolRole). Pure
  * arithmetic: no DDS, no clock, no allocation, so the 1 kHz loop can call it

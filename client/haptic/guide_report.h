@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* guide_report: what a person (and a test) learns about the guiding hand
  * from viscera-haptic's log: one line when the coupling starts, changes
  * (side, authority, stiffness, peer) or stops, stamped with the same loop

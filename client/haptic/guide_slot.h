@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* guide_slot: what the 1 kHz loop needs to render the guiding hand
  * (guide_force.h), filled by DDS listeners the way feedback_slot is: the
  * latest ToolRole of our tool and the latest commanded position of every

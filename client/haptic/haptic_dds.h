@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* haptic_dds: viscera-haptic's side of DDS: the participant, the
  * ToolCommand writer, the ContactFeedback slot, the SceneInfo reader and the
  * guiding slot (ToolRole and the peer station's commands). */

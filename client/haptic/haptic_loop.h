@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* haptic_loop: viscera-haptic's fixed-rate loop. Each tick reads the
  * device, writes a ToolCommand, reads the latest contact model and renders
  * the one force law of guide_force.h on the device. */

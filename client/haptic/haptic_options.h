@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* haptic_options: the viscera-haptic command line (common options through
  * common/cli.h, the device and loop options here). */
 #ifndef VISCERA_HAPTIC_OPTIONS_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* haptic_run: viscera-haptic once its options are parsed: open the device
  * and DDS, wait for the server's scene, run the loop, print the summary. */
 #ifndef VISCERA_HAPTIC_RUN_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* haptic_summary: what viscera-haptic prints on exit: rate, period and
  * jitter, force, latency and guiding figures on stderr and one SUMMARY line
  * on stdout (scripts read it). */

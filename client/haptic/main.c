@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* viscera-haptic: a haptic-device client. Runs a 1 kHz loop that reads the
  * device, publishes ToolCommand and renders force from the latest
  * ContactFeedback's local contact model, coupled to the peer station's

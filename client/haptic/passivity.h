@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* passivity: a time-domain passivity observer and controller on one
  * impedance port (docs/remote.md; Hannaford and Ryu, "Time-domain
  * passivity control of haptic interfaces", 2002). Pure arithmetic, no

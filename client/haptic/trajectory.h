@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* trajectory: a scripted tool path read from a text file.
  *
  * Format: one sample per line, `t x y z [buttons]` (seconds, metres, integer

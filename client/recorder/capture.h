@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* capture: one recorded topic — its reader, its writers, and the path from
  * dds_takecdr to rows in the store.
  *

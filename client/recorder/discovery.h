@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* discovery: which writers exist, on which topics, in the recorded partition.
  *
  * Reads the DCPSPublication built-in topic of the recorder's participant

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* export_scene: the recorded organ meshes as Foxglove scene primitives,
  * for recinfo --export mcap --foxglove-scene: one extra MCAP channel
  * "/viscera/scene" (message encoding json, schema foxglove.SceneUpdate,

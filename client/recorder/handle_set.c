@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 #include "handle_set.h"
 
 #include <stdlib.h>

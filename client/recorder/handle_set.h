@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* handle_set: a set of 64-bit DDS instance handles (open addressing).
  *
  * The capture uses it to remember, within one drain of a reader, which

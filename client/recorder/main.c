@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* viscera-recorder: records every topic of a session into one SQLite file.
  *
  * Generic by design: it compiles in no product type. Topics and their types

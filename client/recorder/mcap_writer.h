@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* mcap_writer: writes an MCAP file (the published MCAP format, major
  * version 0): magic, Header, the data section (Schema and Channel records,
  * then the messages in uncompressed Chunks, each followed by one Message

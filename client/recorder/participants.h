@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* participants: who took part in a recorded session.
  *
  * Reads the DCPSParticipant built-in topic of the recorder's participant

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* viscera-recinfo: what is in a session recording, and is it sane.
  *
  * Prints the session metadata and one line per topic (samples by kind,

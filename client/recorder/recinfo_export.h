@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* recinfo_export: viscera-recinfo --export: a recording in formats other
  * tools read, from the recording alone (types from its stored type
  * information, rec_types.h; no compiled-in type).

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* recinfo_run: viscera-recinfo once its options are parsed: the session
  * metadata, the participants, one line per topic and, when asked, the
  * per-writer timestamp order. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* recorder_run: viscera-recorder once its options are parsed: open the
  * session, record until a signal, --duration or a full disk, and close. */
 #ifndef VISCERA_RECORDER_RUN_H

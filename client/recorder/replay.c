@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* viscera-replay: republishes a session recording (recording.h) over DDS,
  * with no compiled-in type.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 #include "replay_pause.h"
 
 void rpause_set(rpause_t *p, bool paused, int64_t now) {

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* replay_pause: pausing a replay without losing its original timing.
  *
  * The replay schedules every sample at base_due = pass start + recorded

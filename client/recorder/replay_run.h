@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* replay_run: viscera-replay once its options are parsed: open the
  * recording, set up its topics (replay_topic.h), publish its samples in
  * recorded (insertion) order at their original pace (source timestamps,

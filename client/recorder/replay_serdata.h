@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* replay_serdata: a minimal serdata that wraps stored CDR bytes (4-byte
  * encapsulation header included) so they can be handed to dds_forwardcdr
  * with their original source timestamp and status info.

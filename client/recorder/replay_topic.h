@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* replay_topic: a recorded topic set up for replay, with no compiled-in
  * type.
  *

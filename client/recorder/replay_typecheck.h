@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* replay_typecheck: a stored type descriptor checked before Cyclone DDS
  * sees it (issue 15: a NULL or damaged type mapping crashed
  * dds_create_topic, damaged ops made dds_stream_countops loop for ever).

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* replay_write: one stored sample out again, as it was recorded.
  *
  * The stored CDR is first checked with dds_stream_normalize against the

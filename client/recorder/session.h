@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* session: one recording session — a DDS participant in the recorded
  * domain, the partition it listens to, the topics found so far and the
  * store they are written to.

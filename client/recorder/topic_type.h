@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* topic_type: turns a discovered writer's type information into a topic
  * descriptor the recorder can create a topic from, with no compiled-in
  * type.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* charts: the report's PNG figures, drawn with common/plot (cairo).
  *   force chart   contact force magnitude over simulated time, one line per
  *                 tool, with the ST / MPF / SFT levels as dashed lines;

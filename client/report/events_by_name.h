@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* events_by_name: SessionEvents this build's compiled type cannot decode,
  * read through the type recorded with them instead (rec_types.h,
  * rec_cdr.h). A recording made before a field was appended to

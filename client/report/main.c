@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* viscera-report: per-trainee report from one or several session
  * recordings: HTML with embedded charts, CSV, and with several recordings a
  * comparison (novice against expert, docs/methods.md A Table 2, docs/methods.md B ch. 6).

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* measure_table: the list of measures a report shows, in one place, so the
  * HTML tables, the CSV columns and the comparison charts cannot disagree on
  * names, units or values. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* recording_data: everything a report needs from one recording, decoded
  * into plain arrays and measures (see measures.h for the definitions).
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* report_run: viscera-report once its options are parsed (main.c): read
  * each recording, draw the charts, write report.html and report.csv. */
 #ifndef VISCERA_REPORT_RUN_H

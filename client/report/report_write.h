@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* report_write: the report files.
  *   report.csv   one row per recording or seat (trainee): identification
  *                (seat, station), every measure of measure_table.h,

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* verdict: pass or fail of a trainee against limits on the report's
  * measures (measure_table.h), each limit "KEY <= BOUND" or "KEY >= BOUND".
  * BOUND is a number in the measure's unit, or a threshold of the session

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* input_drive: the 1 kHz ToolCommand publisher of the window viewer's
  * driving mode. The window's event loop runs at display rate (~60 Hz) and
  * hands the latest input pose over with input_drive_set; a separate thread

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* viscera-viewer: offscreen viewer of a running scene (see options.c or
  * --help for the command line).
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* mesh_dump: each organ's current reconstructed mesh (keyframe + applied
  * delta) as Wavefront OBJ, for checking what a viewer shows against what the
  * server simulates.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 #include "options.h"
 
 #include <errno.h>
@@ -63,8 +64,9 @@ void options_usage(FILE *f, const char *prog) {
           "On exit prints 'viewer: N frames written to DIR' and 'SUMMARY frames=N\n"
           "rejected=M ignored=I gate_dropped=G' (M: samples refused as malformed; I:\n"
           "samples of server topics not from the seat's server; G: samples its readers'\n"
-          "gates dropped: ids beyond the tables, writers blocked). Exit status: 0 on success or\n"
-          "SIGINT/SIGTERM, 1 when OSMesa, DDS or output setup fails, 2 on bad usage.\n"
+          "gates dropped: ids beyond the tables, writers blocked).\n"
+          "Exit status: 0 on success or SIGINT/SIGTERM, 1 when OSMesa, DDS or output setup\n"
+          "fails, 2 on bad usage.\n"
           "DDS configuration comes from CYCLONEDDS_URI.\n",
           prog, RENDER_MAX_SIZE, RENDER_MAX_SIZE,
 #ifdef VISCERA_HAVE_WINDOW

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* options: the viscera-viewer command line (getopt_long). */
 #ifndef VISCERA_VIEWER_OPTIONS_H
 #define VISCERA_VIEWER_OPTIONS_H

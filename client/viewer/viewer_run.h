@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* viewer_run: viscera-viewer once its options are parsed (options.c):
  * the window (--window), or the offscreen frames until a signal,
  * --duration or --max-frames. */

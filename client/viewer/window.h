@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* window: the interactive viewer (viscera-viewer --window), built only when
  * SDL2 is found (CMake option VISCERA_BUILD_WINDOW).
  *

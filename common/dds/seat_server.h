@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* seat_server: which participant is this seat's server (issue 15.2), so a
  * client believes server topics (ContactFeedback, MeshState, MeshDelta,
  * ObjectState, Metrics, SessionEvent, ToolMetrics...) from it alone.

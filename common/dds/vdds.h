@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* vdds: DDS participant setup and the product's topic/QoS table.
  *
  * One participant per process, one publisher and one subscriber bound to the

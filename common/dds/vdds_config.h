@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* vdds_config: the Cyclone DDS configuration every viscera process uses, and
  * the explanation a client prints when it sees nothing.
  *

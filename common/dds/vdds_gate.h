@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* vdds_gate: what a keyed reader lets in from the network, decided before
  * Cyclone stores a sample (issue 15.1).
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* vdds_ident: who a viscera process says it is, in its DDS participant's
  * USER_DATA QoS, and how a reader turns received USER_DATA back into safe
  * text.

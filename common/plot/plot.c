@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* plot: cairo rendering of line charts. See plot.h. */
 #include "plot/plot.h"
 

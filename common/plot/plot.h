@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* plot: line charts rendered with cairo into PNG files: the charts of the
  * numerics benchmark (docs/numerics.md §4) and the report tool's time series; bar
  * charts are in plot_bars.h.

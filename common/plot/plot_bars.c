@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* plot_bars: cairo bar charts. See plot_bars.h. */
 #include "plot/plot_bars.h"
 

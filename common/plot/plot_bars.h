@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* plot_bars: a bar chart (one bar per labelled value, e.g. one per trainee)
  * rendered with cairo into a PNG file, in the palette of plot.h.
  *

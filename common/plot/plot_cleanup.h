@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* plot_cleanup: releases what cairo and fontconfig cache for the life of
  * the process (font faces, patterns, configuration). Call once at exit,
  * after the last chart, from programs that draw charts: without it the

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* rec_cdr: stored CDR samples decoded with the recorded type (rec_types.h)
  * into text, for viscera-recinfo --export csv / jsonl: no compiled-in type
  * is used, so any recorded topic decodes as it was written.

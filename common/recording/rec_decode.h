@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* rec_decode: turns the raw CDR stored in a recording back into the
  * compiled-in IDL types (viscera.h), for programs that know the product
  * types: the report tool, viscera-resim and the integration-test readers.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 #include "recording/rec_idl.h"
 
 #include <string.h>

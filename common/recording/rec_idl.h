@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* rec_idl: the OMG IDL text of a recorded topic's type (rec_types.h), as
  * MCAP's "omgidl" schema encoding and Foxglove expect: every struct and
  * enum the type uses, each before its first use, inside its modules, with

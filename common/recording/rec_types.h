@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* rec_types: the type of a recorded topic as a small tree, rebuilt from
  * the XTypes type information the recording stores beside its samples (the
  * topics.typemap column, recording.h): structs with their member names and

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* rec_writers: the writers table of a recording (recording.h), and who
  * each writer belongs to: its partitions (a lab recording's seats) and the
  * participant that owns it (the identity that participant announced).

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 #include "recording/recfile.h"
 #include "dds/vdds_ident.h"
 

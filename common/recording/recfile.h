@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* recfile: reads a session recording (format in recording.h) defensively.
  *
  * Opening tells a missing file, a file that is not SQLite, a SQLite file

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* recording: the on-disk format of a viscera session recording.
  *
  * One SQLite file per session, written by viscera-recorder (store.c) and read

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* store: writes a session recording (format in recording.h) to one SQLite
  * file, with batched transactions.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* measures: the trainee measures of a report, computed from plain sample
  * arrays decoded from a recording (no I/O here, so tests feed synthetic
  * arrays).

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* thresholds: per-tool palpation measures (docs/methods.md B ch. 6). Tracks the
  * contact force magnitude against the tool's three palpation thresholds
  * (ST sound threshold < MPF maximum palpation force <= SFT stopping force

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* camera: a fixed perspective camera that frames a bounding box, and the
  * projection of scene points to window pixels.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* frame_log: the output directory of a viewer run: frame file names and the
  * frames.csv index, one row per written frame.
  *

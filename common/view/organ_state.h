@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* organ_state: one organ's current mesh as a viewer rebuilds it from the
  * wire: the latest keyframe (MeshState) plus the newest delta (MeshDelta).
  *

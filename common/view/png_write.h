@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* png_write: an 8-bit RGB image to a PNG file with libpng.
  *
  * The renderer's rows come bottom-up (OpenGL's origin is the bottom-left

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* render: offscreen drawing of organs and tools with OSMesa and fixed-function
  * OpenGL, producing an 8-bit sRGB image.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* scene_draw: turns what the viewer knows of the scene into a frame: draw
  * calls for the renderer, and the frames.csv readouts of the same frame
  * (contact, force and where the tool tip and proxy land in the image). */

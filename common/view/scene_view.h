@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* scene_view: what the viewer knows of a running scene, taken from DDS.
  *
  * Subscribes to SceneInfo (organ colours, tool sizes), MeshState and

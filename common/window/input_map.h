@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* input_map: mouse and keyboard to a tool pose, for driving a tool without a
  * haptic device (viscera-viewer --window --drive TOOL). Pure functions on
  * plain data, no SDL: the window translates its events into input_event_t,

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* input_script: a file of timed input events, for demos and tests of the
  * window viewer's driving mode (viscera-viewer --window --drive N
  * --script-input FILE) and of the dashboard window (viscera-dashboard

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* sdl_window: an SDL2 window that shows ready-made frames, shared by the
  * window viewer (window.h) and the dashboard window (dash_window.h).
  *

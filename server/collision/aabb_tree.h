@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* aabb_tree: a bounding-volume hierarchy of axis-aligned boxes over a
  * deforming triangle surface (docs/methods.md A §3.1).
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* cylinder: a long, thin tool (scalpel, laparoscope shaft) against mesh
  * nodes (docs/methods.md D §2.2).
  *

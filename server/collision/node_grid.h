@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* node_grid: a uniform grid over mesh nodes for "which node does the tool
  * touch" queries (docs/methods.md B §4.3, Tables 4.1-4.2: the touched node found by
  * space partitioning instead of a linear scan).

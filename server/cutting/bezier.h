@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* bezier: the cubic Bezier incision curve of docs/methods.md D §2.3.2 (eq. 5-8).
  *
  * P(a) = sum_k P_k B_k,3(a), a in [0, 1], with the Bernstein polynomials

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* ms_cut: three-stage cutting of a surface mass-spring model with residual
  * stress (docs/methods.md D, Zhang et al. 2021, §2.1 and §2.3).
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* ms_cut_sweep: stage 1 of docs/methods.md D's cutting (§2.3.1, Algorithm 1): the
  * swept volume of the tool's circular region along its path, and what it
  * deletes from a triangle surface.

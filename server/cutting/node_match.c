@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 #include "cutting/node_match.h"
 
 #include <math.h>

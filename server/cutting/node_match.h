@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* node_match: stage 3 of docs/methods.md D's cutting (§2.3.3, Algorithm 2, Fig. 3),
  * the shortest-distance nodes matching method, on the hole that stage 1 left.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* tet_cut: progressive cutting of a tetrahedral mesh by a moving blade
  * (docs/methods.md C §5.2-§5.3).
  *

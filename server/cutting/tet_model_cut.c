@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 #include "cutting/tet_model_cut.h"
 
 #include <stdlib.h>

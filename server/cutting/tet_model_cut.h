@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* tet_model_cut: cutting a tetrahedral model (model.h edit kind
  * MODEL_EDIT_TETS: pbd, xpbd) with a scalpel: the progressive cutter of
  * tet_cut.h on its own copy of the model's mesh, committed to the model

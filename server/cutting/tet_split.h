@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* tet_split: the case table of a tetrahedron's cut state (docs/methods.md C §5.2,
  * figs. 8-9) and the seed's rest-length rules. Internal to tet_cut.c and its
  * tests; the splitting itself (recursive bisection, see tet_cut.h) is in

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* proxy: god-object haptic proxy with a virtual spring (docs/methods.md A eq. 12).
  *
  * The device point (SUN) may sink into an organ; the proxy (IUN) may not: it

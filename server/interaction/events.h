@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* events: what the interactions report to whoever runs the runtime (the
  * server turns them into SessionEvents). A small queue the runtime appends
  * to and the server drains; when full, new events are counted and dropped

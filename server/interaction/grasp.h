@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* grasp: a grasper holding a small patch of tissue (docs/methods.md A: hold, pull).
  *
  * When the jaws close with the tip within the grasp radius of a surface,

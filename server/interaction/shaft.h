@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* shaft: the tool shaft against tissue (issue 4; docs/methods.md D §2.2 cylinder
  * test, plus segment-triangle contact). The shaft is a cylinder of radius
  * SHAFT_RADIUS_FRACTION x the tip radius (as the viewer draws it) around the

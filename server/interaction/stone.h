@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* stone: a rigid spherical object inside an organ (docs/methods.md A: kidney-stone
  * removal with a laparoscope).
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* tasks: progress of the scene's training tasks (scene `tasks:`), docs/methods.md A
  * Table 2 (operation time per task) and docs/methods.md B ch. 6 (exploration time).
  * A task starts at the first command of its tool (`start: first_command`)

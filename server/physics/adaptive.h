@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* adaptive: adaptive area-based refinement and simplification of a surface
  * Kelvin-Voigt mass-spring model (docs/methods.md B ch. 5).
  *

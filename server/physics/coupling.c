@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* coupling: the rank-one implicit solve of coupling.h, spring by spring. */
 #include "physics/coupling.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* coupling: tool springs integrated implicitly, so that a stiff tool does
  * not enter an organ's explicit stability bound (issue 17.1).
  *

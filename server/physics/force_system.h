@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* force_system: what a force-based model (mass-spring on surfaces or
  * tetrahedra, molecular) exposes to the integrators in integrator.h.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* integrator: one sub-step of a force_system_t with the scheme chosen in the
  * scene (see integrator.h for the list and their orders).
  *

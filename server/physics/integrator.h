@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* integrator: time integrators for force_system_t (one sub-step each).
  *
  *   explicit_euler    x += h v; v += h M^-1 F(x, v)           (1st order, unstable undamped)

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* mass_spring: mass-spring forces as a force_system_t (docs/methods.md B §4.2.3,
  * §5.2.4; docs/methods.md A eq. 1-5), for the integrators in integrator.h.
  *

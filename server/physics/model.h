@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* model: the one interface every deformation model implements, so the
  * server runtime, the tests and the benchmarks treat them alike.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* model_adaptive: the "adaptive_mass_spring" scene model (docs/methods.md B ch. 5)
  * behind the common model interface. A surface model (surf_x == x) whose
  * surface changes: after a step that refined or simplified, nnodes, nsurf,

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* model_guard: the one roll-back and non-finite guard every model's step
  * goes through (mass_spring, molecular, pbd/xpbd, vertex_based, adaptive).
  *

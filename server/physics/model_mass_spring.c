@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* model_mass_spring: the mass-spring force systems of mass_spring.h as
  * model_t, stepped by an integrator from integrator.h.
  *

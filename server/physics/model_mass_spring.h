@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* model_mass_spring: what the surface mass-spring model (mass_spring_surface)
  * does with its topology edits, and its force system for tests.
  *

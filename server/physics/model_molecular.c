@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* model_molecular: the molecular force system (molecular.h, docs/methods.md A eq.
  * 6-11) as model_t for the scene model name "molecular", stepped by the
  * scene's integrator (integrator.h).

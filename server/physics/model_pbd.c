@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* model_pbd: the scene models "pbd" and "xpbd" behind model_t. The organ's
  * surface is filled with tetrahedra (tet_mesh_build), the solver in pbd.c
  * runs on their nodes, and the render/contact surface rides along through

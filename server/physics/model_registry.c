@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* model_registry: model_create() picks the implementation of the scene's
  * model name from one table.
  *

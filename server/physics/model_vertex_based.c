@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* model_vertex_based: the "vertex_based" scene model (docs/methods.md B ch. 4) behind
  * the common model interface. A surface model: nodes are the surface
  * vertices, surf_x == x. Gravity is not applied: the thesis model has none,

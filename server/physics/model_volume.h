@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* model_volume: the tetrahedral mesh a volumetric model (mass_spring_tet,
  * pbd, xpbd) simulates and the embedding of its render surface in it:
  * either the organ's own tetrahedra from a file (model_params_t.volume,

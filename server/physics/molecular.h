@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* molecular: the molecular modelling system (MMS) on a triangle surface
  * (docs/methods.md A §2.2, eq. 6-11; Sekercioglu and Duysak 2009).
  *

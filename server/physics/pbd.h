@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* pbd: position based dynamics on a tetrahedral mesh (docs/methods.md C §4; Müller
  * et al. 2007 for PBD, Macklin et al. 2016 for XPBD).
  *

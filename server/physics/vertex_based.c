@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 #include "physics/vertex_based.h"
 
 #include <math.h>

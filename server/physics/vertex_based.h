@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* vertex_based: vertex-based local deformation (docs/methods.md B ch. 4).
  *
  * The touched node and its first and second rings of neighbours are moved

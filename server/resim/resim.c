@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* viscera-resim: deterministic re-simulation of a recorded session.
  *
  * Feeds the inputs the server applied (AppliedInput; in older recordings

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* viscera-resim after its options (resim.c): load the scene and the
  * recording, re-simulate, compare and print the SCHEDULE, ORGAN, STREAM and
  * RESIM lines. */

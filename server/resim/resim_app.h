@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* resim_app: what viscera-resim does once its command line is parsed. */
 #ifndef VISCERA_RESIM_APP_H
 #define VISCERA_RESIM_APP_H

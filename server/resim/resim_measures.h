@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* resim_measures: the trainee measures the server publishes as ToolMetrics
  * (session/tool_metrics.h), recomputed in a re-simulation so they can be
  * compared with the recorded ones: per tool, the palpation tracker

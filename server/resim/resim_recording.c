@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 #include "resim/resim_recording.h"
 
 #include <math.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* resim_recording: what viscera-resim needs from a session recording
  * (recording.h), decoded into plain arrays: the SceneInfo, every tool's
  * ToolCommands, ContactFeedbacks and releases (CLIENT_LOST events) in the

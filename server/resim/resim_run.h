@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* resim_run: re-simulates a recorded session in a fresh runtime and
  * compares, at every recorded frame, the surface with the recorded mesh.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* resim_scene: the scene viscera-resim re-simulates (issue 16:
  * self-contained recordings).
  *

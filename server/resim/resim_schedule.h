@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* resim_schedule: which ToolCommand was in effect at every server step of a
  * recorded session, rebuilt from what the recorder stored.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* checkpoint_state: the scene's state as bytes and back, without files or
  * networking (the session's checkpoint, session/checkpoint.h, puts these
  * bytes in a file with a magic, a format version and a CRC).

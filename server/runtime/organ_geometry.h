@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* organ_geometry: an organ's rest geometry as its scene entry names it,
  * placed in the scene (coordinates * scale + position): the surface mesh
  * (`mesh`, any format assimp reads), and, when the entry names `volume`,

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* organ_rt: one organ of the running scene (scene_runtime.h): its model,
  * the collision tree over its contact surface, the topology it was last
  * rebuilt for, and whether it sleeps. */

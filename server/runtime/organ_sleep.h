@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* organ_sleep: an organ at rest is not stepped until something can touch it.
  *
  * Why: a classroom runs one server per seat on shared machines, and a

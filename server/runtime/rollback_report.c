@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 #include "runtime/rollback_report.h"
 
 void rollback_report_init(rollback_report_t *r, uint64_t every) {

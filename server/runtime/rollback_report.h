@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* rollback_report: how often the server reports rolled-back steps. A seat
  * whose steps keep rolling back (runtime_step) would otherwise write one
  * SessionEvent and one log line per step, 1000 a second: the first rolled

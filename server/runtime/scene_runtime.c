@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 #include "runtime/scene_runtime.h"
 
 #include "runtime/topology_follow.h"

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* scene_runtime: the simulated scene without any networking: organs with
  * their deformation models, tools with their haptic proxies, and the fixed
  * step. The server wraps it with DDS; benchmarks and tests drive it directly.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* step_cut: the runtime's cut phase (scalpel_*), the scalpel tool cutting
  * organs in the live runtime (issue 5).
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* step_tools: the runtime's tool phases (interact_*): what tools do
  * besides the god-object contact. Graspers grasp, hold, pull and release
  * tissue (interaction/grasp.h), extractors take and carry stones

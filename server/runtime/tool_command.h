@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* tool_command: validation of tool commands from outside the core (idl
  * ToolCommand samples from the network, converted by the session:
  * session/command_intake.h). Every field is untrusted: a command with a bad

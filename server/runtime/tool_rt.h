@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* tool_rt: one tool of the running scene (scene_runtime.h), the one record
  * of the tool in the core. Its parts, in the order the step uses them:
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* topology_follow: what the runtime rebuilds when an organ's model changes
  * its surface topology (model.h: topology_version moved during a step, e.g.
  * adaptive refinement or simplification, or a cut).

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* applied_input: what the server applied to its runtime in one loop
  * iteration, published as one AppliedInput sample (idl/viscera.idl, issue
  * 16), so a recording holds exactly the inputs viscera-resim must replay:

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 #include "session/checkpoint.h"
 
 #include "runtime/checkpoint_state.h"

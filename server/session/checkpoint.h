@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* checkpoint: the scene's state on disk, so a server killed mid-session
  * (crash, kill -9, power) restarts where it was instead of from rest
  * (issue 7, fault tolerance).

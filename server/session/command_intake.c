@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 #include "session/command_intake.h"
 
 void command_from_dds(const viscera_ToolCommand *in, tool_cmd_t *out) {

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* command_intake: a ToolCommand sample taken from DDS as the simulation
  * core's plain command (runtime/tool_command.h), which the core validates
  * (tool_command_check) before anything is applied. */

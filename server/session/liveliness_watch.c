@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 #include "session/liveliness_watch.h"
 
 #include <string.h>

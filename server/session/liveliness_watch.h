@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* liveliness_watch: which ToolCommand writers (haptic clients) have lost
  * their liveliness, handed from the DDS listener thread to the server loop.
  *

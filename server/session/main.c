@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* viscera-server: loads a scene file and runs it, publishing over Cyclone DDS.
  * This file is the command line; session/server_app.c what follows it. */
 #include <stdio.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 #include "session/mesh_publisher.h"
 
 #include <stdlib.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* mesh_publisher: turns an organ's positions into MeshState keyframes and
  * cumulative MeshDelta frames (common/mesh_delta.h).
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* scene_check: what `viscera-server --check` adds to validating the scene:
  * whether its step keeps real time, and whether its organs have a plausible
  * size. Both only warn: the scene is valid either way.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* scene_source: the SceneSource sample (idl/viscera.idl, issue 16) of a
  * session: the scene file's text and digest, the digest and size of every
  * mesh it names (at its absolute path, so a re-simulation on this machine

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* server: the scene runtime wired to DDS. Reads ToolCommand, steps physics in
  * real time at the scene's fixed dt, publishes ContactFeedback every step,
  * MeshDelta at publish_hz, MeshState keyframes, SceneInfo, SessionEvent and

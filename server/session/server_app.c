@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* viscera-server after its options: scene check or session run, then the
  * summary lines on stderr and stdout (SUMMARY, PUBLISHED, PALPATION, TOOL,
  * TASK, OBJECT) that scripts read. */

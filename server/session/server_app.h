@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* server_app: what viscera-server does once its command line is parsed
  * (session/main.c): load the scene, then either check it (--check) or run
  * the session until a signal or --duration, and print the summary. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* session_control: the instructor's commands to one seat (SessionControl
  * topic, issue 7 roles), validated and applied to the server's state.
  *

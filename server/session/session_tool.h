@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* session_tool: what the session adds to one tool, the tool's session
  * record, indexed like the core's rt->tools (runtime/tool_rt.h: the tool's
  * one record in the core: command, mechanics, contact, hand force,

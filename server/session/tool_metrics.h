@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* tool_metrics: the per-tool trainee measures published on ToolMetrics and
  * printed at exit (issue 4): the palpation measures of thresholds.h for
  * this tool alone, grasps, time holding, exploration time to the target

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* tool_roles: who drives each tool and where the tool goes when two
  * stations drive it (issue 7 roles; the contract is the comment above
  * `struct ToolRole` in idl/viscera.idl).

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 #include "session/writer_stations.h"
 
 #include <stdio.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* writer_stations: the station each ToolCommand writer announced, per
  * publication handle (idl ToolRole; vdds.h vdds_station_of_writer).
  *

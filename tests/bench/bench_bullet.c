@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* bench_bullet: the surface mass-spring step against a Bullet soft body at
  * the same dent (issue 17 item 4, docs/numerics.md §8).
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* bench_collision: cost of the collision queries (docs/numerics.md §7: nearest
  * feature on the 23,522-vertex liver <= 1 us median; the thesis of docs/methods.md B
  * reports 1.35 us).

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* bench_ms_cut: three-stage mass-spring cutting (docs/methods.md D) on the tissue
  * block (45 v) and the gallbladder (5,393 v).
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* bench_ms_forces: ns per spring of mass_spring_forces and
  * mass_spring_stiffness_mul (the run-based loops of mass_spring.c) against
  * the loop they replaced (kept here only, as the reference: one spring at a

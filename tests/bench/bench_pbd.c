@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* bench_pbd: step time of the PBD / XPBD solver (docs/numerics.md §7 targets).
  *
  *   bar     the BarDemo bar of the PositionBasedDynamics library: 30x5x5

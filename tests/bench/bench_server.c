@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* bench_server: server step time per generated organ and integrator, and
  * MeshDelta size.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* bench_tet: tetrahedral mesh build time and quality per organ.
  *
  * For each .obj in ASSETS_DIR/meshes and, when given and present,

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* bench_tet_cut: progressive cutting on the spleen-size XPBD model, in the
  * style of docs/methods.md C Table 1 (vertices, elements, physics ms, topology update
  * ms, intersection ms), then 100 random incisions

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* bench_topology: what a topology change costs the server end to end, on the
  * adaptive kidney (assets/scenes/kidney_adaptive.yaml): a scripted probe
  * presses in until the mesh refines, then lifts off until it simplifies,

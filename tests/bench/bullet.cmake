@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # bench_bullet: surface mass-spring against a Bullet soft body at the same
 # dent (issue 17). Built only when libbullet-dev (pkg-config bullet) and a
 # C++ compiler are installed: Bullet is a benchmark peer, never a product

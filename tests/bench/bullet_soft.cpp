@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 // bullet_soft: the Bullet side of bench_bullet (see bullet_soft.h).
 #include "bullet_soft.h"
 

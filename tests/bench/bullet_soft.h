@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* bullet_soft: a Bullet btSoftBody built from a triangle surface, behind a
  * C interface so bench_bullet.c (C11) can drive it. The peer of the
  * surface mass-spring benchmark (docs/numerics.md §8): Debian's

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Collision query benchmark: AABB tree, node grid and proxy costs; prints a table.
 add_executable(bench_collision ${CMAKE_CURRENT_LIST_DIR}/bench_collision.c)
 target_link_libraries(bench_collision PRIVATE viscera_sim viscera_test_support)

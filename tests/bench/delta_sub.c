@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* delta_sub: a light stand-in for a viewer in the load benchmark: joins a
  * seat, waits for its MeshState keyframe (a late joiner must get one at
  * once: transient-local), then takes every MeshDelta as it arrives and

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Command -> feedback latency before/after "feedback before the tissue step"
 # (issue 17 item 5): RUNS short sessions per server build (the haptic
 # client is NEW_BUILD's in both: only the server differs), the two builds

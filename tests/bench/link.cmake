@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # link_bench.sh: a remote session over an emulated link, delay x loss x
 # reordering (issue 14; tests/network/sites.sh, needs root); link_plot draws
 # its CSV. The smoke run: loopback and 50 ms at 5 % loss, with and without

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Remote session over an emulated link (issue 14): sweeps one-way delay x
 # loss x reordering with tests/network/sites.sh and link_emu. At each
 # setting: the server in site a, a scripted trainee (palpate_kidney.traj,

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* link_plot: the charts of link_bench.sh (issue 14). Reads its link.csv
  * (delay_ms,jitter_ms,loss_pct,reorder,peak_force_n,peak_error_pct,max_step_n,
  * energy_j,applied_pct,keyframe_ms,seat_kbps,viewer_kbps; the loopback row is

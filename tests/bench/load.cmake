@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Classroom load benchmark (issue 7): deploy/load_bench.sh starts seats and
 # light subscribers (delta_sub); the smoke test runs it for a few seconds.
 add_executable(delta_sub ${CMAKE_CURRENT_LIST_DIR}/delta_sub.c)

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # bench_ms_cut: three-stage mass-spring cutting: incision width over time
 # (docs/methods.md D Fig. 6), cost per cut and per step; CSV and cairo plots.
 add_executable(bench_ms_cut ${CMAKE_CURRENT_LIST_DIR}/bench_ms_cut.c)

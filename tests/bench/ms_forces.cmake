@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # bench_ms_forces: ns per spring of the mass-spring force and Jacobian loops,
 # old (one spring at a time, kept in the benchmark) vs new (runs of equal i).
 add_executable(bench_ms_forces ${CMAKE_CURRENT_LIST_DIR}/bench_ms_forces.c)

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Recorder throughput under the issue 6 load (two haptic clients at 1 kHz,
 # gallbladder at 60 Hz): a 4 s smoke run proves the benchmark works (figures
 # are printed, not checked); deploy/bench.sh runs it for 45 s. Domain 111.

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Recorder throughput under the issue 6 load (figures, not pass/fail): the
 # 5,393-vertex gallbladder published at 60 Hz (assets/scenes/
 # bench_two_tools.yaml) and two probes, each driven by its own scripted

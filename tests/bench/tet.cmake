@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # bench_tet: tetrahedral mesh build time and quality per organ (figures are not checked).
 add_executable(bench_tet ${CMAKE_CURRENT_LIST_DIR}/bench_tet.c)
 target_link_libraries(bench_tet PRIVATE viscera_common)

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # bench_tet_cut: progressive cutting on the spleen-size XPBD model (docs/methods.md C
 # Table 1 style) and 100 random incisions: time per cut, element growth,
 # minimum quality; table, CSV and a cairo plot (figures are not checked).

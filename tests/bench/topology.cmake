@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Topology change cost on the server (model change, tree rebuild and proxy
 # re-attachment, keyframe publish); prints a table. DDS on loopback, domain 84.
 add_executable(bench_topology ${CMAKE_CURRENT_LIST_DIR}/bench_topology.c)

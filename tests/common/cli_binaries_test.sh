@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # cli_binaries_test.sh VERSION BAD_STATUS BINARY NAME: one program answers the
 # options every viscera program shares (common/cli.c): --version prints
 # exactly "NAME VERSION" (cmake/version.cmake) and exits 0; -h and --help

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # bash completion of every binary (issue 18): deploy/completion/viscera.bash.
 set(_viscera_completion_bins "")
 foreach(bin viscera-server viscera-resim viscera-haptic viscera-viewer viscera-dashboard viscera-control

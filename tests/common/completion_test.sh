@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # bash completion (deploy/completion/viscera.bash, installed once per binary):
 # for every binary this build has, "BIN --<TAB>" offers --help, --version and
 # every --option of its --help; "viscera-control pa<TAB>" offers pause;

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The shared command-line parser (common/cli.c): the common options with
  * their checks, a program's own options through its callback, --help and
  * --version answered with exit 0, bad values and unknown options refused

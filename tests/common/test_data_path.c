@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* data_path (common/data_path.h): $VISCERA_DATA_DIR comes first; a relative
  * name is found under ROOT/subdir (also by its base name); a path that
  * exists as given is used as given; a name found nowhere is handed back

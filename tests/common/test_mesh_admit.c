@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* test_mesh_admit: each mesh defect of issue 15 refused or repaired with a
  * message (common/mesh_admit.c): a clean cube passes untouched; inside out
  * and inconsistently wound cubes are repaired (outward, consistent); open,

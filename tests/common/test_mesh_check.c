@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* mesh_check on meshes whose answers are known by construction, then on the
  * generated assets in assets/meshes (the ones the scenes use). */
 #include <stdio.h>

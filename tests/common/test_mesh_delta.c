@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Property test: keyframe plus any delta equals the exact state within the
  * quantization step; malformed deltas are refused. */
 #include <stdint.h>

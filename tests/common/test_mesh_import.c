@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* mesh_import: the same solid written as OBJ, STL and PLY imports to the same
  * welded mesh; every kind of bad input fails with a message naming the file. */
 #include <stdio.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The third-party organ meshes in ../shared/data/organs (real, imperfect
  * files): each imports, keeps every triangle of the file and prints its report.
  * Skips (77) when the shared folder is not there. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* test_scene: the scene parser gives the file's values and the documented
  * defaults, and every class of mistake is refused with a message that names
  * the right line and field. Most cases go through scene_load_string; a temp

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* test_scene_limits: the one range table (common/scene_limits.c) as the
  * scene parser applies it: the values issue 15 found accepted (mass
  * 1e-300 kg, dt 1e-300 s, stiffness 1e300 N/m) are refused naming file,

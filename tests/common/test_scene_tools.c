@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* test_scene_tools: the scene keys of issue 4 (tool kinds and capabilities,
  * friction, objects, tasks): values and defaults are read, and every
  * mistake is refused with the right line and field. */

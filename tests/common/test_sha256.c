@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* sha256 (common/sha256.h): the FIPS 180-4 test vectors (empty, "abc",
  * the two-block 448-bit message, a million 'a' fed as a file across read
  * boundaries) and a missing file named in the error. */

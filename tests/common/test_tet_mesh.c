@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* tet_mesh: the box grid (counts, orientation, volume, conforming faces), the
  * measures, and tet_mesh_build on generated cubes and spheres, on the organs in
  * assets/meshes and on the open tissue patch, which must fail clearly.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Closest point on triangle and segment-triangle intersection against
  * hand-computed answers and brute-force sampling. */
 #include <stdlib.h>

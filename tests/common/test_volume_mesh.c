@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* volume_mesh and tet_embed: tetrahedral meshes from files. Every format
  * written by the project's own writer (the asset tool's `tet --out`) reads
  * back exactly; hand-written files exercise what real exporters put in

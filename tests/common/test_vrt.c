@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* vrt (common/vrt.h): the --rt-priority parser, and vrt_enter on a thread of
  * its own: granted, that thread alone runs SCHED_FIFO at the priority and a
  * thread it creates afterwards starts as SCHED_OTHER (RESET_ON_FORK); refused

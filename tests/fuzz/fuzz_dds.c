@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* fuzz_dds: throws mutated CDR at a running seat over DDS (issue 7, fault
  * tolerance: "a client sending garbage never crashes the server").
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* fuzz_files: what the file fuzz harnesses share (fuzz_scene.c, fuzz_mesh.c,
  * fuzz_recording.c; issue 15 item 5).
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* fuzz_mesh: mutated mesh files (OBJ text) against the importer and the
  * organ mesh checks (fuzz_files.h; issue 15 items 3 and 5). Contracts:
  * mesh_import never crashes and what it returns passes mesh_validate;

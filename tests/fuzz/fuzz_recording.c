@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* fuzz_recording: damaged recordings against every reader of the format
  * (fuzz_files.h; issue 15 items 4 and 5): recfile (open, scan),
  * rec_decode (every product topic, as the report reads it), the resim

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* fuzz_scene: mutated scene files against the scene parser and, when a
  * mutant is accepted, the simulation runtime (fuzz_files.h; issue 15
  * items 3 and 5). Contracts: scene_load_string never crashes; a refusal

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Garbage in, seat keeps serving (issue 7, fault tolerance). A server and a
 # viewer run; fuzz_dds sends thousands of mutated ToolCommand, SessionControl,
 # MeshState and MeshDelta samples (corpus in tests/fuzz/corpus, fixed seed)

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* bad_commands: an adversarial haptic client. Against a running server it
  * sends ToolCommands with NaN, Inf, absurd positions, bad quaternions, bad
  * ids and bad force capabilities, then a valid push into the organ. Exits 0

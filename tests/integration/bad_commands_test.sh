@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Garbage ToolCommands (NaN, Inf, absurd poses, bad ids) are dropped and
 # counted, never applied; the server keeps serving valid ones.
 # usage: bad_commands_test.sh BUILD SRC OUT

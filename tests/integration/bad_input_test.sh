@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Bad scene and mesh files: a message naming the file and what is wrong, and
 # a non-zero exit. usage: bad_input_test.sh BUILD SRC OUT
 set -uo pipefail

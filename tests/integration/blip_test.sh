@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Short blips while the hand is inside the kidney (issue 14 item 6), real
 # processes on loopback, judged from the haptic client's force log (CSV:
 # t,x,y,z,fx,fy,fz,in_contact,energy_j,step_n), its log lines (stamped with

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # A cut organ survives a server crash (issue 7 "after a restart the scene
 # resumes from its last checkpoint", checkpoint format 2): real processes on
 # loopback, for the xpbd spleen (cut_spleen_xpbd.yaml, cut_spleen.traj) and

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # A clean client exit shows as "left", a killed client as "lost" (issue 18).
 # One seat, a dashboard writing its CSV every 250 ms: a scripted trainee runs
 # its trajectory to the end and exits 0: the seat shows client_left 1 and

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Issue 14.2: ToolCommands arriving newer-first in pairs (as over a
 # reordering link) are applied newest-wins: the server skips each older one
 # and counts it (flood_commands reorder / reorder-check).

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # The instructor's commands to a running seat (issue 7), real processes on
 # loopback: pause freezes simulated time (the server's own clock stands still
 # from the pause to the resume, and the viewer's frames stop advancing) and

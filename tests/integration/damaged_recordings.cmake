@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Damaged recordings (issue 15 item 4): a real session is recorded on domain
 # 193, then copies are damaged with sqlite3 edits and rec_flip (one bit of a
 # stored sample) and every recording tool is run on them: no crash, no hang,

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Damaged recordings never crash or hang a tool (issue 15 item 4).
 # usage: damaged_recordings_test.sh BUILD_DIR SOURCE_DIR WORKDIR REC_FLIP
 #   1. record a short real session (deploy/session.sh) on $VISCERA_DOMAIN;

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # The instructor's focus view of one seat, headless (issue 7): a 2-seat lab,
 # seat 1 has a trainee (scripted, station alice) who presses above MPF,
 # holds, and lets go. viscera-dashboard --focus 1 writes focus_NNNNN.png next

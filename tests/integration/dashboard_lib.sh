@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Shared by the dashboard_focus and dashboard_window tests (sourced once
 # BUILD and OUT are set): process clean-up, fail(), a fresh $OUT, the
 # trainee's trajectory, and pixel checks of the dashboard's focus view.

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # The instructor's dashboard over a 3-seat lab (issue 7): seats 1 and 2 run a
 # server, only seat 1 has a trainee (scripted palpation crossing ST and MPF),
 # seat 3 has no server. Asserts from dashboard.csv: seat 1 raised an MPF

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # The instructor's dashboard live in a window (issue 7), under Xvfb: one seat
 # whose scripted trainee presses above MPF and holds. viscera-dashboard
 # --window is driven by a script of keys and clicks through its SDL event

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # deploy/deb_check.sh (issue 18 item 3): apt install of the .deb on a clean
 # Debian 12 and a session from the installed files, in a network namespace
 # of its own (default domain). Label

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # The deployment kit (issue 7): deploy/lab.sh, the LAN configuration and the
 # service units, run as users run them. Domains 161-165.
 viscera_integration_test(lab_launcher 161 lab_launcher_test.sh)

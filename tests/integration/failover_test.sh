@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Failures between haptic client and server, with real processes:
 # 1. the server is killed (-9) while the probe presses the organ: the haptic
 #    client reports "server lost" and renders zero force from then on; when a

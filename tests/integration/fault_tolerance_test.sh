@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Fault tolerance of a seat (issue 7), with real processes on loopback:
 #   1. killing the recorder (-9) and one viewer (-9) mid-session disturbs
 #      nothing: the haptic client keeps its contact force, the server and

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Issue 17 item 5: a command's ContactFeedback is written before the
 # step's tissue step, judged from the recording (rec_feedback_first.c).
 # Domain 228 (the assigned 232 is above the CLI limit 0..230, common/cli.c).

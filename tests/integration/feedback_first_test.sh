@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Feedback before the tissue step (issue 17 item 5), end to end: a real
 # server on the default scene, the recorder and a scripted haptic client
 # (palpate_kidney.traj: press, hold, release), each a process over DDS on

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* flood_commands: a hostile participant against one seat (issue 15.1), and
  * the checker of what the seat's processes counted.
  *

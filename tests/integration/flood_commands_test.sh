@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Issue 15.1: a bounded ToolCommand flood against a seat whose tool 0 is
 # owned by station "trainee" (a scripted haptic client holding still in free
 # space): new tool ids, garbage for tool 0, and well-formed commands for

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* force_check: the haptic client's force log judged by its own ticks (one
  * row per tick) and the trajectory's positions, never by wall-clock windows
  * (issue 15.6), for the failover and fault_tolerance tests.

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Grasp, hold, pull, release over DDS (issue 4): a scripted grasper closes
 # its jaws (buttons column) on the top of the kidney, lifts 12 mm, holds,
 # opens. Asserts from the recording (decoded CDR): a GRASP_BEGIN and a

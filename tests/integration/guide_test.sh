@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Guiding hand (issue 7), real processes on loopback: a server on the default
 # probe scene; a trainee client (--station alice) held still at A and an
 # instructor client (--station bob) held still at B, 2 cm apart in free

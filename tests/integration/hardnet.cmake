@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Network hardening (issue 15.1, 15.2, 14.2 tool streams): floods and
 # impostors against a seat. Domains 186-190.
 add_executable(flood_commands ${CMAKE_CURRENT_LIST_DIR}/flood_commands.c)

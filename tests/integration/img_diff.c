@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* img_diff: compares two PNG frames (same size) inside a square window and
  * outside it. Prints "window_mean=<v> outside_mean=<v> window_changed=<n>"
  * (mean absolute RGB difference, 0..255; pixels whose difference > 24).

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* impostor: a participant that is not the seat's server publishing the
  * server's topics (issue 15.2), and the checker of what the seat's clients
  * made of it.

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Issue 15.2: an impostor participant (not the seat's server) publishes
 # ContactFeedback for tool 0 (4 N into the tissue) and a forged MeshState
 # and MeshDelta for organ 0 while a trainee holds its probe still in free

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # shellcheck shell=bash
 # Checks shared by the lab launcher tests (lab_launcher_test.sh,
 # lab_launcher_secure_test.sh), sourced, not run. Each check fails the test

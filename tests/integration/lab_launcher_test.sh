@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # deploy/lab.sh end to end (issue 7), on loopback, as two launches sharing one
 # domain, the way a lab spreads over two machines (--first/--seats):
 #   A: seats 1-2, a scripted trainee and a viewer per seat, the lab recorder,

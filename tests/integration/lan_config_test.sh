@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # deploy/cyclonedds-lan.xml as a lab uses it (issue 7), on one machine with
 # VISCERA_IFACE=lo so that nothing leaves 127.0.0.0/8:
 #   1. a server and a scripted haptic client, both on the LAN configuration

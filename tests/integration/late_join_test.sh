@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # A viewer started late, while the probe holds the organ dented, shows the
 # current deformed mesh: its reconstruction (keyframe + latest delta) at the
 # server's last published frame equals the server's exact positions within

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # End-to-end tests of the whole loop: real processes over Cyclone DDS on
 # loopback, each on its own domain id.
 add_executable(img_diff ${CMAKE_CURRENT_LIST_DIR}/img_diff.c)

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Loss detection by DDS liveliness (issue 4), real processes, kill -9:
 # 1. the server dies while the probe presses the organ: the haptic client
 #    hears its ContactFeedback writer's liveliness lapse, says "server lost

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 // Independent check of viscera-recinfo --export mcap: reads the file with
 // the MCAP reference reader published on the npm registry (@mcap/core),
 // once as a stream and once through its summary and chunk index, with CRC

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # "Nothing seen" explained (issue 18): with no server in the domain, the
 # viewer, the dashboard, the recorder and viscera-control each print, after
 # 5 s without a match, the domain, the partition, the configuration file,

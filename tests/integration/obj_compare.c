@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* obj_compare: compares the vertex positions ("v" lines) of two OBJ files and
  * their first comment lines. Prints "vertices=<n> max_diff=<m>" and exits 0 if
  * both have the same vertex count and max |a - b| <= TOL, 1 otherwise.

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # The Debian package (issue 18): `cpack -G DEB` in the build tree makes the
 # .deb; its Depends were computed (dpkg-shlibdeps: Cyclone DDS, assimp, yaml,
 # sqlite3 ... appear without being listed anywhere by hand); it holds every

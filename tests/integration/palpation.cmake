@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Palpation thresholds end to end (issue 4): the scripted palpation of the
 # default scene must raise threshold-crossing SessionEvents and Metrics with
 # time above the crossed thresholds, asserted in C over the recording

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Palpation thresholds end to end: a whole session (server, recorder, viewer,
 # scripted haptic client) on the default scene, whose probe has
 # thresholds {st: 0.5, mpf: 0.8, sft: 1.5}; the scripted 8 mm press holds

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* png_region: counts the pixels of a PNG inside a rectangle that are close
  * to a colour, so a test can say "the badge is red" or "the force curve is
  * drawn" without comparing whole images.

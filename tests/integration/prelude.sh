@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # prelude.sh: what every integration test script starts with, sourced right
 # after `set -euo pipefail`:
 #   BUILD, SRC, OUT   the build tree, the source tree and the test's output

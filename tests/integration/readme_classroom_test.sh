@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # The README's "Classroom in five minutes" block, run verbatim (issue 18):
 # extracted from README.md (the sh block after the classroom-block marker)
 # and run by bash in a scratch directory laid out like the repository root

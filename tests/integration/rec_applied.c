@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* rec_applied: reads a session recording's AppliedInput samples (issue 16,
  * rec_read.h) and prints, per sample that acted on a SessionControl:
  *   CONTROL row=ID tick=N step=K epoch=E kind=C result=R task=T

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* rec_check: verifies a recording made of rec_pub's session, straight from
  * the SQLite file (independent of viscera-recinfo):
  *   - session row: partition, domain, end time written;

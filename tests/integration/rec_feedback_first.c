@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* rec_feedback_first: reads a session recording (rec_read.h) and judges,
  * from the server's own records, when each tool command was answered
  * (issue 17 item 5: feedback before the tissue step).

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* rec_flip: flips bits in one stored sample of a recording, the way one
  * damaged disk block or a bit error would (damaged_recordings_test.sh).
  *

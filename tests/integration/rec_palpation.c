@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* rec_palpation: the checker of the palpation_thresholds integration test.
  * Reads a session recording of the default scene (rec_read.h: every sample
  * decoded with the compiled-in descriptors) and asserts, for the scripted

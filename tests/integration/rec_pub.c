@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* rec_pub: the publisher side of the recorder integration test.
  *
  * Publishes, through the product's own vdds setup and types:

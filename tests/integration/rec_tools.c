@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* rec_tools: reads a session recording (rec_read.h) and prints, decoded
  * with the compiled-in descriptors, what the tool tests check (issue 4):
  *   EVENT KIND tool=N organ=N value=V sim=S TEXT grasp, task and applied

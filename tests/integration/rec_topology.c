@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* rec_topology: reads a session recording (rec_read.h) and prints every
  * recorded MeshState keyframe and EVENT_TOPOLOGY_CHANGED SessionEvent,
  * decoded with the compiled-in descriptors:

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* rec_values: what rec_pub publishes, so rec_check can verify a recording
  * against it. Shared by the recorder integration test programs only. */
 #ifndef VISCERA_TEST_REC_VALUES_H

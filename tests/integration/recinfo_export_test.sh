@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # viscera-recinfo --export csv / jsonl (issue 16 item 4): a stone_removal
 # session (probe and extractor, two tasks) is recorded and one topic at a
 # time exported, decoded with the recorded types; the contents are checked

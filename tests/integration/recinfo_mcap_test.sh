@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # viscera-recinfo --export mcap against an independent reader (issue 16
 # items 4 and 6): records the demo session (deploy/session.sh: default
 # scene, palpate_kidney trajectory), exports it to MCAP and reads the file

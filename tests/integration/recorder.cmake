@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Recorder: a real publisher (product types, vdds) and viscera-recorder as
 # separate processes on domain 41; the recording is then checked with
 # viscera-recinfo and rec_check (sqlite3 + compiled-in descriptors). The

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Full disk while recording (issue 6 part 5): a recorder under a 512 KB
 # file-size limit (ulimit -f) records a real session (server + scripted
 # haptic client) beside a second recorder that is killed with SIGKILL

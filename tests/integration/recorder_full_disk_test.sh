@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Full disk while recording. The recorder runs under a file-size limit
 # (ulimit -f: writes past it fail with EFBIG, as on a full disk; the
 # recorder ignores SIGXFSZ) while a real palpation session runs. Asserts:

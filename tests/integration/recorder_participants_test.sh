@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Participants and roles in a recording (issue 6). usage: BUILD SRC OUT
 #   1. a real session (deploy/session.sh: server, recorder, viewer, haptic)
 #      on $VISCERA_DOMAIN; viscera-recinfo must list the server, haptic,

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: Apache-2.0
 # Recorder integration test driver (registered by recorder.cmake).
 # usage: recorder_test.sh RECORDER RECINFO REC_PUB REC_CHECK WORKDIR DOMAIN
 #   1. late join + normal stop: rec_pub writes MeshState keyframes, then the

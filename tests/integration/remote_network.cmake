@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Remote sessions across emulated sites (issue 14 items 3, 4, 7), haptic
 # side. The scripts source the two-site harness tests/network/prelude.sh and
 # sites.sh and run link_emu (tests/network/, another branch of issue 14):

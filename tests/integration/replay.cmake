@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Replay: a real session (deploy/session.sh: server, recorder, viewer, haptic
 # on domain 61) is recorded, then viscera-replay republishes the recording
 # into domain 62 where an unchanged viewer and a second recorder listen.

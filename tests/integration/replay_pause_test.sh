@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Replay pause (issue 6). usage: BUILD SRC OUT; domains $VISCERA_DOMAIN
 # (recorded session) and $VISCERA_DOMAIN+1 (replay target).
 #   A session is recorded, then replayed into the second domain with

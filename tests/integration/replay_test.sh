@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Replay integration test driver (registered by replay.cmake).
 # usage: replay_test.sh BUILD_DIR SOURCE_DIR WORKDIR
 #   1. record a short real session (deploy/session.sh) on domain 61;

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Report tool end to end (issue 6 part 4): two real palpation sessions
 # (expert and novice trajectories) recorded, reported, and the report's
 # figures checked against the servers' own PALPATION lines; a truncated copy,

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # viscera-report of a lab (issue 16 items 3 and 6): deploy/lab.sh runs 3
 # seats (a server and a scripted trainee each, partitions lab/seat01..03)
 # and records every lab partition into one file; the report must have one

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # viscera-report per task and per seat, and the recording exports
 # (issue 16 items 3, 4, 6). Domains 201-205.
 if(TARGET viscera-report AND TARGET viscera-viewer)

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # viscera-report per task (issue 16 item 3): a stone_removal session with two
 # tasks running at once (find-spot by the probe, remove-stone by the
 # extractor) is recorded and reported; the report's time of every task must

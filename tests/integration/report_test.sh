@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # viscera-report end to end. Records two whole sessions of the default scene
 # (probe thresholds ST 0.5, MPF 0.8, SFT 1.5 N) with the expert and the
 # novice palpation trajectories, runs viscera-report on both and asserts:

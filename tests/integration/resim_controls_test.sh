@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Re-simulation of every input the server applied (issue 16 item 1): a
 # stone_removal session with two tools (probe palpating, extractor taking the
 # stone), a second station guiding the probe (its commands mixed in by the

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Issue 16: every shipped scene, recorded with its trajectory, re-simulates
 # bit for bit from the recording alone (resim_scenes_test.sh). Domain 197.
 # 2 to 4 minutes on the loaded 2-core machine (load 15-20): its own timeout;

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Every shipped scene re-simulates from its recording alone (issue 16 item 6):
 # for each scene in assets/scenes, a real server, the recorder and one
 # scripted haptic client per driven tool (the scene's trajectory: palpation

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Deterministic re-simulation end to end (issue 6 part 3): a real server on
 # the default scene, the recorder and a scripted haptic client
 # (palpate_kidney.traj: 8 mm press, hold, release), each a process over DDS

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # The instructor's dashboard beyond the grid (issue 7): the focus view of a
 # seat written headless, and the live window under Xvfb driven by scripted
 # keys and clicks. Domains 159 (window), 160 (focus).

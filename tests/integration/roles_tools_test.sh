@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Tool roles on the server (issue 7), real processes on loopback: a probe
 # scene, two scripted haptic clients on tool 0, station alice holding still
 # at A and station bob at B (3 cm apart, free space), and the instructor's

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* roles_watch: waits until a running server shows a tool's role and where
  * the tool is, as the server publishes them (ToolRole, ContactFeedback).
  *

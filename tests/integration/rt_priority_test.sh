@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # rt_priority: --rt-priority N of viscera-server and viscera-haptic (the shared
 # common/vrt.c), domain 180.
 #   1. --rt-priority 0, 100 and x: exit 2 and a message naming the option and

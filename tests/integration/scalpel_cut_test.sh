@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # The scalpel end to end (issue 5): for the xpbd spleen and the mass-spring
 # tissue sheet, real processes over DDS: server, recorder, a viewer from the
 # start (tools not drawn, so frames show the tissue only), a scripted haptic

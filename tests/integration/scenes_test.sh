@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Every example scene in assets/scenes runs (SOFA-style smoke test): the server
 # loads it, a scripted probe palpates the kidney, contact force rises above
 # 0.1 N, and no step is rolled back; an adaptive_mass_spring scene must also

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # DDS Security end to end (issue 7): a PKI from deploy/pki.sh, a secure seat
 # (server-seat01 + trainee-seat01 haptic client) on loopback, and what the
 # other identities may and may not do:

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # The whole loop end to end: server, recorder, viewer and scripted haptic
 # client as separate processes over DDS on loopback. Asserts: contact force
 # above zero while the probe is inside and zero after release; the viewer's

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Organ sleeping over DDS (issue 7, load): a classroom seat
 # (assets/scenes/classroom_kidney.yaml, sleep_speed 1e-4 m/s) with a scripted
 # trainee who waits 2 s away from the kidney, presses it 8 mm, and leaves.

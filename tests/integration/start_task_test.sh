@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Tasks started by the instructor (issue 7 "starts tasks"), real processes on
 # loopback: a kidney scene whose palpate_target task has `start: instructor`.
 # A scripted probe (a haptic client) presses on the target and leaves.

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Kidney-stone removal over DDS (docs/methods.md A, issue 4): two scripted clients,
 # the probe (tool 0) palpates the spot of the palpate_target task, the
 # extractor (tool 1) goes in, closes on the stone, carries it out, opens.

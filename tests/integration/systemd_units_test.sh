@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # The service units in deploy/systemd/ (issue 7), without installing them:
 #   1. `systemd-analyze verify` accepts copies of them whose paths point into
 #      the build tree (ExecStart binaries resolvable) and the test directory:

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Tasks started by the instructor (issue 7 "starts tasks"): scene
 # `start: instructor`, viscera-control start-task. Domain 157.
 if(TARGET viscera-recorder)

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Devices and loss detection (issue 4). Domains 120-124.
 # Liveliness: kill -9 of server and of haptic client, detected through the
 # DDS liveliness of their tool writers.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Tools over DDS (issue 4): grasp-pull-release, kidney-stone removal, two
 # tools with tool-tool contact; real processes, domains 90-92.
 if(TARGET viscera-recorder AND TARGET viscera-viewer)

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Shared by the tool tests (issue 4): one session with real processes over
 # Cyclone DDS on loopback: server, recorder, offscreen viewer and one or
 # more scripted haptic clients started together (one per "TOOL:TRAJ" pair).

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Topology streaming end to end (issues 3 and 5): the adaptive kidney refines
 # under a scripted probe; an early and a late-joining viewer both end on the
 # server's final refined mesh; the recording holds one MeshState keyframe per

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Topology streaming end to end: the server runs the adaptive kidney
 # (assets/scenes/kidney_adaptive.yaml), a scripted probe presses in and holds
 # (push_hold_kidney.traj), the mesh refines under it (a new MeshState keyframe

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Two tools on one organ over DDS (issue 4): two haptic clients drive the two
 # probes of two_tools.yaml (kidney + spleen) so their tips meet above and on
 # the kidney. Asserts: in every recorded pair of ContactFeedback samples of

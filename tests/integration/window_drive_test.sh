@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Interactive driving without a haptic device (issue 4), under Xvfb: the
 # window viewer (--window --drive 0) is fed a scripted input session through
 # its SDL event queue (mouse motion down the screen, wheel and W into the

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Calibration of the two-site harness (issue 14): a server in site a and a
 # scripted trainee (palpate_kidney.traj) in site b on deploy/cyclonedds-site.xml,
 # through link_emu, at three link settings:

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # link_emu itself (issue 14), with numbered UDP datagrams (udp_probe) from
 # site a to site b, 2 ms apart (the sites carry no other frame: no IPv6, static
 # neighbours):

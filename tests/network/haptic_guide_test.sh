@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # The guiding hand across an emulated site link (issue 14 items 4 and 7): the
 # server, the instructor's client (--station bob) and viscera-control in
 # site a; the trainee's client (--station alice) in site b; 50 ms and 200 ms

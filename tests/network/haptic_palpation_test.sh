@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Palpation across an emulated site link (issue 14 items 3 and 7): the
 # server in site a, a scripted trainee at 1 kHz in site b on
 # deploy/cyclonedds-site.xml, at 0, 25, 50 and 100 ms one way with jitter

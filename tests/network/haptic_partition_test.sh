@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Partition and heal, the trainee's hand (issue 14 item 6): the server in
 # site a, a scripted trainee in site b pressing the kidney 8 mm and holding;
 # the link goes down for 5 s (longer than the 4 s participant lease of

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* keyframe_wait: a late joiner that measures how long its first MeshState
  * keyframe takes once the server's writer is matched (issue 14: a keyframe
  * must survive a lossy link). Subscribes to MeshState and MeshDelta of one

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # A lab split over two sites (issue 14) as deploy/README.md describes for
 # several machines: deploy/lab.sh --seats 2 (with the lab recorder) in site a,
 # deploy/lab.sh --first 3 --seats 2 --no-record in site b, both with

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Late join across a lossy link (issue 14), at two link settings: the server
 # in site a, the trainee (push_hold_kidney.traj: the probe holds the organ
 # dented) and, started late, a viewer and a keyframe_wait subscriber in

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* link_emu: a two-port Ethernet link emulator for the network tests (issue 14).
  *
  * Forwards every frame received on interface A out of interface B and back,

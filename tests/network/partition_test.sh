@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Partition and heal from the network side (issue 14): the server in site a;
 # a trainee, a viewer and the seat's recorder in site b; the link goes down
 # for 5 s (longer than the 4 s participant lease of cyclonedds-site.xml, so

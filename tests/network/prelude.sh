@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # prelude.sh: what every network test script starts with, sourced right after
 # `set -euo pipefail` (arguments BUILD SRC OUT as ctest passes them):
 #   BUILD, SRC, OUT   build tree, source tree, the test's output directory (emptied)

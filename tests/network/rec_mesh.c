@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* rec_mesh: the mesh a recording ends on. Reads a session recording
  * (rec_read.h), feeds organ ORGAN's MeshState keyframes and MeshDelta samples
  * in recording order into an organ_state (as a viewer rebuilds the mesh from

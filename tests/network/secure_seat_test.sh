@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # The secure seat across the link (issue 14): a PKI from deploy/pki.sh; the
 # server with identity server-seat01 in site a; in site b the trainee
 # (trainee-seat01), a recorder with the 'recorder' identity and one without

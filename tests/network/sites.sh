@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Two emulated sites joined by an emulated link (issue 14). Source it:
 #
 #   source tests/network/sites.sh

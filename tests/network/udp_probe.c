@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* udp_probe: numbered UDP datagrams through the emulated link, for the
  * emulator's own test (emulator_test.sh).
  *   udp_probe send ADDR PORT COUNT INTERVAL_US SIZE

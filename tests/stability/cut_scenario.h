@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* cut_scenario.h: random scalpel cuts through the spleen-size PBD model,
  * shared by the stability test (stab_cut.c, docs/numerics.md §5 case 15) and the
  * benchmark (tests/bench/bench_tet_cut.c). Header-only.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Contact that settles under a held probe (issue 17, items 1 and 7):
 # stab_settle checks the implicit tool coupling; stab_settle_<scene> holds a
 # tool on every organ of one shipped scene (one test per scene file, found

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* stab_cut: docs/numerics.md §5 case 15, 100 random cuts on the spleen-size PBD
  * model (tests/stability/cut_scenario.h: the model, the cuts and what
  * "stable dt" means for PBD). Pass criteria:

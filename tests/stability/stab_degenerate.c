@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* docs/numerics.md §5 case 5: a zero-length spring, and two vertices moved onto
  * each other: all forces (and the Jacobian products the implicit solver
  * uses) stay finite, and every integrator steps on without a rollback.

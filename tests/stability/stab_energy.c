@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* docs/numerics.md §5 case 12: 1e6 undamped symplectic Euler steps at half the
  * critical dt (h omega_max = 1) on a small mesh.
  *

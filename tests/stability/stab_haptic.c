@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* docs/numerics.md §5 cases 9 and 16, the haptic extremes.
  *
  * 9: on the default kidney scene, a one-step load of 1000 g on every node

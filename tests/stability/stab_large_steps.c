@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* docs/numerics.md §5 case 4: 30 Hz large steps on a cloth and a bar; the energy
  * never exceeds its start plus the work done on the system from outside.
  *

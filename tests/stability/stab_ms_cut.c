@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* docs/numerics.md §5 case 15 for three-stage mass-spring cutting: 100 random
  * straight cuts (random position, direction, length and blade radius, many
  * crossing earlier wounds) on a generated sheet and on the spleen. After

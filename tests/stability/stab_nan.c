@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* docs/numerics.md §5 case 14: NaN (or Inf) injected into one vertex is
  * detected within one step, the step rolls back and reports, and nothing
  * spreads.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Contact that settles (issue 17, items 1 and 7).
  *
  * settle: every shipped scene (every .yaml of assets/scenes, read from the folder

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* docs/numerics.md §5 case 1: step-limit sweep, edge stiffness k = 1 .. 1e6 on a
  * 6 x 6 cloth (36 nodes, no damping).
  *

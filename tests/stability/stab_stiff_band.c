@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* docs/numerics.md §5 case 2: stiffness ratio 1e6 inside one mesh.
  *
  * A bar of 13 x 3 x 3 nodes (1 cm spacing, 0.12 m long, 0.1 kg, 5 tets per

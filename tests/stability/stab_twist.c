@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* docs/numerics.md §5 case 11: 360 and 720 degree twist, release.
  *
  * A bar 0.24 x 0.03 x 0.03 m (a closed box surface, filled with tetrahedra

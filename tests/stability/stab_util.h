@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* stab_util.h: small meshes and model construction shared by the stability
  * tests (docs/numerics.md §5). Header-only; each test is one executable. */
 #ifndef VISCERA_STAB_UTIL_H

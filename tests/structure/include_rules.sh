@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # include_rules.sh ROOT: checks the include and build rules of
 # docs/architecture.md over the source tree at ROOT and prints one line per
 # violation ("file:line: what is wrong"). Exit 0 when there is none, 1 when

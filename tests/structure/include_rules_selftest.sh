@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # include_rules_selftest.sh RULES_SCRIPT: the checker must find each kind of
 # violation it promises in a small tree made here, and pass that tree once
 # the violations are gone. Without this a checker that always says "no

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # sim_without_dds.sh SOURCE_ROOT BUILD_DIR [cmake args...]: the simulation
 # core builds and its unit tests pass without Cyclone DDS. Configures the tree
 # with -DVISCERA_SIM_ONLY=ON (which never looks for CycloneDDS or the IDL),

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* check.h: the few assertion macros the unit tests share. A failed check
  * prints file:line and the values, and the test exits non-zero at the end. */
 #ifndef VISCERA_CHECK_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* ms_cut_fixture: what the cutting unit test and benchmark share: a
  * generated sheet, a mass_spring_surface model from a mesh, a straight
  * blade stroke driven step by step, and mesh validity checks (manifold

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* rec_read: the strict reading the integration-test tools (rec_tools,
  * rec_topology, rec_palpation) do on a recording: every data sample of a
  * topic decoded with the compiled-in descriptor (rec_decode_topic), and

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* scene_expect: the two outcomes the scene-parsing unit tests assert for a
  * YAML text (loaded as "t.yaml"): it loads, or it fails with a message that
  * holds given fragments (file:line, field path, reason). On a mismatch the

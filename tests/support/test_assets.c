@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* test_assets.c: asset paths and mesh loading for tests (test_assets.h). */
 #include "test_assets.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* test_assets: the repository's assets in tests, stability cases and
  * benchmarks. The source tree is $VISCERA_SOURCE_DIR when set (ctest sets
  * it), else the tree this library was built from, so a test run by hand

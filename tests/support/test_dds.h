@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* test_dds: values the DDS-side unit tests feed their code without a
  * participant. Header-only (the rest of the support library is DDS-free). */
 #ifndef VISCERA_TEST_DDS_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* test_rng: the pseudo-random numbers randomized tests and benchmarks draw
  * (splitmix64, and an older 32-bit LCG): the same sequence on every machine and run for a given
  * seed, so a failing randomized case reproduces. The caller owns the state

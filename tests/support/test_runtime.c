@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* test_runtime.c: scenes into the runtime for tests (test_runtime.h). */
 #include "test_runtime.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* test_runtime: a scene loaded into the real simulation runtime, the
  * fixture of the runtime, interaction, checkpoint and stability tests.
  * Scene texts name their meshes relative to assets/scenes (e.g.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* test_tmpfile.c: temporary files of a test (test_tmpfile.h). */
 #include "test_tmpfile.h"
 

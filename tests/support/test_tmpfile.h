@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* test_tmpfile: temporary files of a test. Paths are
  * /tmp/viscera_test_<pid>_<name>, so parallel test runs do not collide;
  * the caller unlinks them. A file that cannot be written ends the test

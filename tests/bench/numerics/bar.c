@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* bar: see bar.h. */
 #include "bar.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* bar: the benchmark's cantilever bar (tet_mesh_box_grid) and the models
  * that run on it, shared by the bar scenes, the stability sweep and the
  * scaling plot.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* bench_numerics: error against run time and stability for every
  * deformation model and integrator (docs/numerics.md §1-§4).
  *

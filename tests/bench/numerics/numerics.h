@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* numerics: the benchmark of docs/numerics.md (error against run time, stability)
  * for every deformation model and integrator.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* S7: a tetrahedral ball dropped on a plane.
  *
  * A sphere of radius 5 cm (icosphere, 642 vertices), 0.5 kg, edge springs

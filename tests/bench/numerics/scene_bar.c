@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Bar scenes (bar.h: 30 x 5 x 5 nodes, 2 cm spacing, 0.58 x 0.08 x 0.08 m,
  * 3.7 kg rubber-like, edge springs k = 2e4 N/m, x = 0 face fixed):
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* S3: hanging cloth pinned at two corners, on the product's surface
  * mass-spring force system (mass_spring_create_surface: springs on the
  * triangle edges, so stretch and shear, no bending).

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* S9: a straight incision across the spleen (assets/meshes/spleen.obj,
  * 120 x 70 x 40 mm), for every model that cuts: mass_spring_surface (three-
  * stage cutting, server/cutting/ms_cut.h) with symplectic Euler, Verlet, RK4

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* S8: probe indentation on the spleen (assets/meshes/spleen.obj, 600
  * vertices), driven through the product's own scene runtime
  * (scene_runtime.h): the organ's model from model_create, the god-object

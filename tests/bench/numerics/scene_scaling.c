@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Plot 7: step time against vertex count (docs/numerics.md §4 plot 7, §7 "step cost
  * vs size: linear").
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Scenes on the benchmark's own force system (springnet.h), where every
  * integrator of integrator.h runs on forces we know exactly:
  *

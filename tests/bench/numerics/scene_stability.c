@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Plot 3: the largest stable time step against stiffness, measured by
  * bisection, beside the bound 2/omega_max with omega_max from power
  * iteration (docs/numerics.md §4 plot 3, §5 case 1, §6).

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* sim: one stepping interface over force systems + integrators, PBD/XPBD
  * solvers and scene models, and the timed, sampled run loop. */
 #include <math.h>

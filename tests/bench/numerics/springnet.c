@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* springnet: see springnet.h. */
 #include "springnet.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* springnet: a small force system written for the benchmark (S1 spring, S2
  * chain, the stiffness sweep), so every integrator of integrator.h runs on a
  * system whose forces, Jacobians and energy we know exactly.

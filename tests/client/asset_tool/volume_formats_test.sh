@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # viscera-asset tet --out writes the spleen's fill in every volume format,
 # `volume` reads each back with the same counts, the server takes each as an
 # organ's `volume:` (--check), and a damaged file is refused with exit 1

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The dashboard's wording and colours (client/dashboard/seat_text.h): the
  * level of a force against the thresholds, who drives a tool from its
  * ToolRole, untrusted text cleaned, which events the focus view lists. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Contact rendering over a delayed feedback stream (contact_render.c, the
  * code viscera-haptic's loop renders with), deterministic and in process.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Device selection by name (device_registry): the scripted device opens
  * through it, SDK devices that are not in this build say so and name their
  * CMake option, unknown names list what is there; the workspace mapping of

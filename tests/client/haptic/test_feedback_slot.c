@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Loss detection bookkeeping of the haptic client: the feedback slot clears
  * the contact the moment the server's writer is lost, fed with the status
  * values Cyclone's liveliness-changed listener delivers (the server's side

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The feedback slot's newest-wins order and value limits (issue 14.2 and
  * 15.2): per writer, a ContactFeedback whose seq is not above the last one
  * taken is never used after it (best effort may deliver out of order); a

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The guiding hand across sites (guide_force.c, issue 14 item 4): an
  * instructor's and a trainee's device coupled through guide_force, each
  * client at 1 kHz seeing the other's position one way later, with jitter

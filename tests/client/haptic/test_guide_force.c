@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Guiding hand, client side (idl ToolRole): the force law each coupled
  * client renders (guide_force), its fallbacks and clamps, its passivity at
  * 1 kHz; the slot the DDS listeners fill (role validation, peer choice,

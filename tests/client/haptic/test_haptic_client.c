@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Haptic client pieces: trajectory files (good and bad) and the local
  * contact model it renders at 1 kHz. */
 #include <stdio.h>

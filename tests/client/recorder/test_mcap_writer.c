@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* mcap_writer: the CRC-32 against its check value, and a file written
  * with two channels and messages spread over several chunks, walked back
  * record by record as the MCAP format lays it out: magic at both ends,

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Recording files, good and bad.
  *
  * Writes a recording with the store (as the recorder does), reads it back

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Session metadata pieces of issue 6 that are pure or file-only:
  * - the participant announcement (common/dds/vdds_ident): format, bounds,
  *   sanitizing of hostile USER_DATA, role extraction;

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* test_replay_typecheck: the checks replay runs on a stored descriptor
  * before Cyclone sees it (replay_typecheck.c, issue 15 item 4). Every
  * product type's own descriptor passes them (the verifier is strict: a new

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* vdds_config (common/dds/vdds_config.h): without CYCLONEDDS_URI the loopback
  * configuration is set (and an existing value is kept); security is told
  * from inline XML and from file:// elements of the list; the "nothing seen"

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* vdds_gate (issue 15.1): the verdict for each sample (key bound, content
  * check, blocked writers per key and for every key, unblocking, the
  * bounded table), then the gate in front of a real reader in one process

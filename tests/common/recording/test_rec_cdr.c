@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* rec_types, rec_idl, rec_cdr: a topic's type rebuilt from its XTypes
  * type information (here the compiled one, as the recorder stores it), its
  * OMG IDL text, and samples serialized as a writer does (XCDR1 and XCDR2,

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* rec_decode: stored CDR back into the compiled-in types. Serializes
  * samples as a writer does (XCDR1, little-endian header), decodes them,
  * and feeds the decoder every kind of bad blob: truncated, garbled, an

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* rec_decode (common/recording/rec_decode.h) in a LATER build whose types
  * have grown (grown_types.idl: a field appended to SessionEvent and to
  * ToolCommand): every SessionEvent and ToolCommand of the format-1

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The store on a full disk. A file-size limit (RLIMIT_FSIZE, with SIGXFSZ
  * ignored as the recorder does) makes writes fail with EFBIG the way a full
  * disk does, deterministically and without root. Asserts: the store stops

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Report measures on synthetic sample arrays: a ramp up, hold and ramp down
  * whose threshold times are known in closed form, with and without the
  * hysteresis of common/training/thresholds.c, gaps in the samples, force chatter at

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* test_thresholds: the palpation threshold tracker reports each crossing
  * once, upward above the level and downward only below level minus the
  * hysteresis; accounts time above, contact time, mean contact force, peak

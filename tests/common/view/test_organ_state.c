@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* test_organ_state: the viewer's keyframe + delta reconstruction on plain
  * arrays: matching rules, a delta waiting for its keyframe, untrusted input
  * never changing what is drawn, and topology versions: a new keyframe

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* test_render: the viewer's offscreen renderer, camera projection and PNG
  * writer, on an icosphere built here. Checks what a person would look for:
  * the sphere is drawn where the camera projects it and nowhere else, it is

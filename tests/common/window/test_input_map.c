@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Interactive driving without a display: the mouse/keyboard -> tool pose
  * mapping (input_map) against the camera it is defined by, and the input
  * script reader (good and bad files). */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* aabb_tree against brute force on the generated organs (assets/meshes):
  * structure (every triangle in exactly one leaf of 1-4, boxes nested, depth
  * of a median split), then nearest point, first segment hit (any side and

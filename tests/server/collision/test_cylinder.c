@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Cylinder tool against nodes (docs/methods.md D §2.2) on hand-made cases: inside,
  * beyond either end (on the axis line but failing an angle test), on the end
  * planes, at the radius, a slanted axis, a zero-length axis, the force

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* node_grid against a linear scan (the thesis's "linear method", docs/methods.md B
  * Table 4.1): the nearest node (same id, same squared distance, ties to the
  * lowest id) for points on, near, inside, around and far from the organ

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Three-stage mass-spring cutting (docs/methods.md D): Bezier eq. 5-8 against hand
  * values; swept deletion against brute force; node matching (shortest
  * distance, shorter diagonals); straight cuts across and inside the tissue

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* test_tet_cut: progressive tetrahedral cutting (server/cutting/tet_cut.h).
  *
  * Every split case on one hand-made tetrahedron (G1, G2, P1, P2, P3): rest

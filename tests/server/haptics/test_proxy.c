@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* God-object proxy on a flat square patch (z = 0, normal +z) and on a closed
  * octahedron: force f = K (proxy - device) (docs/methods.md A eq. 12), proxy stays on
  * the surface however deep the device goes, clamped force, release above the

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* test_proxy_friction: friction and force shading on the god-object proxy
  * (server/haptics/proxy.c, docs/methods.md A eq. 12).
  * - Friction: on a plane, the proxy sticks while the tangential spring

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* test_shaft: segment-triangle contact of tool shafts (shaft.h):
  * - on the coarse tissue_block (45 vertices, triangles ~1.7 x 1 cm) a tilted
  *   shaft whose axis crosses the middle of a triangle, every vertex far

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* test_tool_actions: grasping, stones, tool-tool contact and tasks on the
  * real runtime (kidney mesh, mass-spring model), no networking:
  * - grasp_take / grasp_force: weights, nearest vertices, clamp, direction;

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Adaptive area-based refinement of a surface Kelvin-Voigt mass-spring
  * (docs/methods.md B ch. 5): refinement raises the local triangle count without
  * T-junctions (every edge in two triangles, orientation kept, springs =

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Per-element stiffness (mass_spring_set_stiffness_scale,
  * pbd_set_edge_compliance_scale) and edge-only PBD meshes
  * (pbd_create_edges):

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Integrators on linear springs, where the exact answer is known:
  * convergence order fitted from the error-vs-dt slope (explicit and
  * symplectic Euler ~1, Verlet ~2, RK4 ~4, implicit Euler ~1), the implicit

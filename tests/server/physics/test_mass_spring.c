@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Mass-spring force systems and their models.
  *
  * Forces against finite differences of the potential energy, stiffness_mul

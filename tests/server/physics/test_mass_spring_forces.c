@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The run-based spring loops of mass_spring_forces and
  * mass_spring_stiffness_mul (server/physics/mass_spring.c) against a
  * straightforward reference written here (one spring at a time, the

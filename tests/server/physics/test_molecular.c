@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Molecular model (docs/methods.md A eq. 6-11): forces against central differences
  * of the energy per term and together, the analytic K y and C y against
  * differences of the forces, momentum conservation of the internal forces,

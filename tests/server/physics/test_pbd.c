@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* PBD / XPBD on tetrahedral meshes (server/physics/pbd.c, model_pbd.c):
  * constraint gradients against central differences; constraint forces
  * (weight carried by the fixed end, internal forces summing to zero);

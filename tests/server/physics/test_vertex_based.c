@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Vertex-based local deformation (docs/methods.md B ch. 4): rings on hand-built
  * meshes, the slope-intercept displacement profile (eq. 4.2-4.4), release
  * through the home springs (eq. 4.11), the closed loop with a tool spring at

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Schema evolution (issue 16 item 5): the recordings kept in tests/data
 # (tests/data/README.md) must be read, re-simulated and reported by every
 # later build. For each: viscera-resim from the recording alone (its meshes

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* resim_run (server/resim/resim_run.h) without DDS: a reference run of the default
  * scene (probe pressed 8 mm into the kidney, held, released) writes its
  * frames as the server's publisher encodes them, with one feedback per step

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Schedule reconstruction of viscera-resim (server/resim/resim_schedule.h) on
  * synthetic command / feedback arrays: exact when nothing is missing, gaps
  * bridged or estimated and counted, releases honoured, unrecorded commands

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* test_organ_sleep: organs at rest are not stepped (server/runtime/organ_sleep.h).
  * - the stillness evidence: `need` still steps put an organ to sleep; a
  *   vertex moving more than the limit, a NaN, a disturbance or a new

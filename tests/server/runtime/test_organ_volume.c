@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* An organ with its own tetrahedra (scene key `volume`, organ_geometry.c and
  * physics/model_volume.c): the kidney's fill written by the project's own
  * writer and read back gives the same model as the automatic fill (nodes,

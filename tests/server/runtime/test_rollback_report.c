@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* test_rollback_report: rolled-back steps are reported at once the first
  * time, then at most once per `every` steps with the count held back, by
  * the step count alone (issue 15: one event and one log line per step). */

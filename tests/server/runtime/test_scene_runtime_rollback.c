@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* test_scene_runtime_rollback: an organ whose state the guard restores but
  * that can never step (here a node velocity of 1e308: every step overflows
  * and rolls back to it) is put back to rest after RUNTIME_ROLLBACK_RESET

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* test_scalpel: the scalpel wired into the real runtime (scene files, organ
  * meshes, models; no networking):
  * - a scene without a scalpel allocates no cutting structures (no pbd

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* test_step_halves: runtime_step in two halves (scene_runtime.h, issue 17
  * item 5: the session answers a fresh command before the tissue step).
  * - Two runtimes on the same kidney scene driven by the same probe path

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Tool command validation (runtime/tool_command.h): NaN, Inf, absurd positions, bad quaternions, bad
  * ids and capabilities are rejected; a sane command passes. */
 #include <string.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Topology changes in the live runtime (topology_follow.h): a probe pressing
  * into the adaptive kidney (assets/scenes/kidney_adaptive.yaml) keeps its
  * contact and its force does not jump when the mesh refines under it,

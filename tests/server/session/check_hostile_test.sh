@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # viscera-server --check on the hostile scenes of issue 15 item 3: values
 # out of their physical range and mesh defects are refused with exit 1 and a
 # message naming file, line, key (or the mesh and its defect); an inside-out

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # viscera-server --check warns (issue 18) without failing the scene:
 #   1. a scene made heavy (the 5,393-vertex gallbladder at 1000 times the
 #      default stiffness, about 50 sub-steps per 1 ms step, next to a small

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* applied_input (server/session/applied_input.h), without DDS (writer 0):
  * entries keep the server's order (commands and releases, then controls),
  * exactly the effective command's fields; the header is the state when the

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* test_checkpoint: a pressed organ saved and restored into a fresh runtime
  * continues exactly where it was; damaged, truncated, foreign and
  * mismatched files are refused and change nothing. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* test_checkpoint_state: checkpoints of everything a session changes
  * (checkpoint format 2, issue 7), on the real runtime:
  * - stones, tasks and tool tallies: a stone carried out (removed, its task

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Loss detection bookkeeping of the server: the liveliness watch (which
  * writers to release), fed with the status values Cyclone's
  * liveliness-changed listener delivers (the haptic client's side is

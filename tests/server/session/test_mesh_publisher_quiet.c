@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* mesh_publisher quiet frames (encode only, no DDS writers): with
  * keepalive_ns > 0 a frame whose quantised delta equals the last written
  * one is skipped (frames and frame_seq stay, skipped counts it) unless the

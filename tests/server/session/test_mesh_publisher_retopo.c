@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* mesh_publisher_retopo in encode-only mode (no DDS writers): a topology
  * change adopts the new arrays and counts, grows the buffers, moves
  * topology_version and keyframe_seq on, keyframes the new positions at once,

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* session_control: what an instructor command does to a seat, and what it
  * is refused for. */
 #include <math.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* test_task_start: tasks started by the instructor (issue 7 "starts tasks")
  * on the real runtime (kidney mesh, mass-spring model), no networking:
  * - scene `start:` read (default first_command), anything else refused

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* test_tool_roles: who drives a tool and where it goes (server/session/tool_roles.h,
  * the contract above idl ToolRole): command classification per station, the
  * authority mix, an absent side, buttons and orientation of the dominant
