@@ -34,7 +34,36 @@ void feedback_slot_destroy(feedback_slot_t *s) {
 }
 
 void feedback_slot_sent(feedback_slot_t *s, uint64_t seq, uint64_t client_mono_ns) {
-  atomic_store_explicit(&s->sent_mono_ns[seq % FEEDBACK_SENT_RING], client_mono_ns, memory_order_relaxed);
+  feedback_slot_sent_at(s, seq, client_mono_ns, NULL);
+}
+
+void feedback_slot_sent_at(feedback_slot_t *s, uint64_t seq, uint64_t client_mono_ns, const double pos[3]) {
+  size_t i = seq % FEEDBACK_SENT_RING;
+  /* The tip first, then the time that publishes it (release): a reader that
+   * sees this time sees this tip. */
+  for (int k = 0; k < 3; k++)
+    atomic_store_explicit(&s->sent_pos[i][k], pos ? (float)pos[k] : NAN, memory_order_relaxed);
+  atomic_store_explicit(&s->sent_mono_ns[i], client_mono_ns, memory_order_release);
+}
+
+void feedback_slot_set_reach(feedback_slot_t *s, float max_reach) {
+  pthread_mutex_lock(&s->lock);
+  s->max_reach = max_reach > 0 && isfinite(max_reach) ? max_reach : 0;
+  pthread_mutex_unlock(&s->lock);
+}
+
+/* The proxy of an echo of our command `seq` against the tip we sent with
+ * it: 1 when within reach (or either is unknown). */
+static int within_reach(const feedback_slot_t *s, const viscera_ContactFeedback *fb) {
+  if (!(s->max_reach > 0)) return 1;
+  size_t i = fb->cmd_seq % FEEDBACK_SENT_RING;
+  double d2 = 0;
+  for (int k = 0; k < 3; k++) {
+    double p = atomic_load_explicit(&s->sent_pos[i][k], memory_order_relaxed);
+    if (!isfinite(p)) return 1;
+    d2 += (fb->proxy_position[k] - p) * (fb->proxy_position[k] - p);
+  }
+  return sqrt(d2) <= s->max_reach * 1.001 + 1e-6;
 }
 
 void feedback_slot_set_limits(feedback_slot_t *s, float max_stiffness, float max_force) {
@@ -67,9 +96,9 @@ int feedback_slot_accept_from(feedback_slot_t *s, const viscera_ContactFeedback 
   /* Our own command's echo (seq and send time as we sent them), or another
    * station's sharing the tool: only ours is a round trip of ours. */
   int ours = fb->cmd_client_mono_ns > 0 && atomic_load_explicit(&s->sent_mono_ns[fb->cmd_seq % FEEDBACK_SENT_RING],
-                                                                memory_order_relaxed) == fb->cmd_client_mono_ns;
+                                                                memory_order_acquire) == fb->cmd_client_mono_ns;
   pthread_mutex_lock(&s->lock);
-  if (ok && !within_limits(s, fb)) {
+  if (ok && (!within_limits(s, fb) || (ours && !within_reach(s, fb)))) {
     s->out_of_limits++;
     ok = 0;
   }
@@ -126,8 +155,10 @@ static void on_data(dds_entity_t reader, void *arg) {
   int n = dds_take(reader, samples, infos, 8, 8);
   uint64_t now = vtime_mono_ns();
   seat_limits_t lim;
-  if (n > 0 && s->server && seat_server_limits(s->server, &lim) && s->tool_id < lim.ntools)
+  if (n > 0 && s->server && seat_server_limits(s->server, &lim) && s->tool_id < lim.ntools) {
     feedback_slot_set_limits(s, lim.tool_stiffness[s->tool_id], lim.tool_max_force[s->tool_id]);
+    feedback_slot_set_reach(s, lim.tool_reach[s->tool_id]);
+  }
   for (int i = 0; i < n; i++)
     if (infos[i].valid_data && from_server(s, reader, infos[i].publication_handle))
       feedback_slot_accept_from(s, samples[i], infos[i].publication_handle, now);

@@ -24,7 +24,9 @@
  * writers blocked at the reader's gate (dds/vdds_gate.h: only this tool's
  * instance exists at all), and their liveliness does not count as the
  * server's. A sample whose stiffness or force exceeds what the adopted
- * scene gives the tool is refused (`out_of_limits`). Order (issue 14.2):
+ * scene gives the tool, or (an echo of our own command) whose proxy lies
+ * farther from the tip we sent than the tool reaches, is refused
+ * (`out_of_limits`). Order (issue 14.2):
  * a sample whose seq is not above the last one taken from the same writer
  * is never used after it (`stale`). */
 #ifndef VISCERA_FEEDBACK_SLOT_H
@@ -58,6 +60,7 @@ typedef struct feedback_slot {
   uint64_t last_cmd_seq;
   uint64_t foreign_echoes;                           /* feedback answering another station's command */
   _Atomic uint64_t sent_mono_ns[FEEDBACK_SENT_RING]; /* by seq % ring */
+  _Atomic float sent_pos[FEEDBACK_SENT_RING][3];     /* m, the tip sent with it (NaN: not known) */
   /* Liveliness of the server's feedback writer(s). */
   uint32_t writers_alive;
   int server_lost;            /* every writer lost its liveliness */
@@ -68,6 +71,7 @@ typedef struct feedback_slot {
   seat_server_t *server; /* NULL: every writer is believed (unit tests) */
   vdds_gate_t gate;
   float max_stiffness, max_force; /* the scene's for this tool; 0 = not known */
+  float max_reach;                /* m, proxy to commanded tip (seat_limits_t.tool_reach); 0 = not known */
   uint64_t ignored, out_of_limits, stale;
   int32_t nonserver_alive;           /* alive feedback writers that are not the server */
   dds_instance_handle_t last_writer; /* the writer of the last sample taken, and its seq */
@@ -81,6 +85,9 @@ void feedback_slot_destroy(feedback_slot_t *s);
 dds_entity_t feedback_slot_attach(feedback_slot_t *s, vdds_t *v, verr_t *err);
 /* The loop sent command `seq` at client_mono_ns (lock-free). */
 void feedback_slot_sent(feedback_slot_t *s, uint64_t seq, uint64_t client_mono_ns);
+/* The same with the tip it commanded (m): an echo of it is then also
+ * checked against max_reach (feedback_slot_set_reach). */
+void feedback_slot_sent_at(feedback_slot_t *s, uint64_t seq, uint64_t client_mono_ns, const double pos[3]);
 /* Applies one ContactFeedback arriving at now (the listener calls this;
  * tests may too): -1 refused (not finite, or beyond the limits), 0 another
  * tool's, 1 taken. */
@@ -92,6 +99,10 @@ int feedback_slot_accept_from(feedback_slot_t *s, const viscera_ContactFeedback 
                               uint64_t now);
 /* The scene's stiffness and force maxima for this tool (0: unknown). */
 void feedback_slot_set_limits(feedback_slot_t *s, float max_stiffness, float max_force);
+/* The scene's reach for this tool (m, 0: unknown): an echo of our own
+ * command whose proxy lies farther than this from the tip we sent is
+ * refused (`out_of_limits`). */
+void feedback_slot_set_reach(feedback_slot_t *s, float max_reach);
 /* Copies the newest value; returns its arrival time (0: none yet). */
 uint64_t feedback_slot_read(feedback_slot_t *s, contact_model_t *out);
 /* 1 while the server is lost by liveliness (its feedback writer's lease

@@ -41,7 +41,8 @@ static void send_command(const haptic_loop_t *l, tick_state_t *s, uint64_t now, 
   for (int k = 0; k < 4; k++) cmd.orientation[k] = (float)quat[k];
   cmd.buttons = buttons;
   cmd.max_force = (float)l->dev->max_force;
-  feedback_slot_sent(&l->h->slot, cmd.seq, cmd.client_mono_ns); /* before the write: the echo may beat it back */
+  /* before the write: the echo may beat it back */
+  feedback_slot_sent_at(&l->h->slot, cmd.seq, cmd.client_mono_ns, pos);
   contact_render_sent(&s->render, cmd.seq, pos);
   dds_write(l->h->w_cmd, &cmd);
 }

@@ -53,6 +53,7 @@ static void limits_from(seat_limits_t *l, const viscera_SceneInfo *si) {
   for (uint32_t t = 0; t < l->ntools; t++) {
     l->tool_stiffness[t] = si->tools._buffer[t].stiffness;
     l->tool_max_force[t] = si->tools._buffer[t].max_force;
+    l->tool_reach[t] = si->tools._buffer[t].length + si->tools._buffer[t].radius;
   }
 }
 

@@ -43,6 +43,10 @@ typedef struct seat_limits {
   uint32_t ntools, norgans;
   float tool_stiffness[viscera_MAX_TOOLS]; /* N/m, the proxy spring */
   float tool_max_force[viscera_MAX_TOOLS]; /* N */
+  /* m: the tool's shaft length plus its tip radius. A tip is never deeper in
+   * tissue than its shaft reaches, so no god-object (the proxy of a
+   * ContactFeedback) lies farther from the commanded tip than this. */
+  float tool_reach[viscera_MAX_TOOLS];
 } seat_limits_t;
 
 typedef struct seat_server {

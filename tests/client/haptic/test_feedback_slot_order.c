@@ -73,8 +73,38 @@ static void test_limits(void) {
   feedback_slot_destroy(&s);
 }
 
+/* An echo of our own command whose proxy lies beyond the tool's reach
+ * (shaft length + tip radius) from the tip we sent is a forgery: refused.
+ * Within reach, or not our echo (no tip known), it is taken. */
+static void test_reach(void) {
+  feedback_slot_t s;
+  CHECK(feedback_slot_init(&s, 0, 16) == 0);
+  feedback_slot_set_limits(&s, 400, 4);
+  feedback_slot_set_reach(&s, 0.103f);
+  const double tip[3] = {0.01, 0.0, 0.03};
+  feedback_slot_sent_at(&s, 5, 1000, tip);
+  viscera_ContactFeedback far = sample(1, 0.5f), near = sample(2, 0.08f), foreign = sample(3, 0.5f);
+  far.cmd_seq = near.cmd_seq = 5;
+  far.cmd_client_mono_ns = near.cmd_client_mono_ns = 1000;
+  far.proxy_position[0] = near.proxy_position[0] = 0.01f;
+  CHECK(feedback_slot_accept_from(&s, &far, 7, 2000) == -1); /* 0.47 m from the tip */
+  CHECK(s.out_of_limits == 1);
+  CHECK(feedback_slot_accept_from(&s, &near, 7, 3000) == 1); /* 5 cm deep: within the shaft */
+  foreign.cmd_seq = 6;                                       /* not an echo of ours: no tip to compare */
+  foreign.cmd_client_mono_ns = 999;
+  CHECK(feedback_slot_accept_from(&s, &foreign, 7, 4000) == 1);
+  /* Without a known reach nothing is refused for distance. */
+  feedback_slot_set_reach(&s, 0);
+  viscera_ContactFeedback far2 = sample(4, 0.5f);
+  far2.cmd_seq = 5;
+  far2.cmd_client_mono_ns = 1000;
+  CHECK(feedback_slot_accept_from(&s, &far2, 7, 5000) == 1);
+  feedback_slot_destroy(&s);
+}
+
 int main(void) {
   test_newest_wins();
   test_limits();
+  test_reach();
   return check_report("test_feedback_slot_order");
 }
