@@ -18,7 +18,10 @@ void rep_force_measures(const rep_force_sample_t *s, size_t n, const double leve
   int was_contact = 0;
   for (size_t i = 0; i < n; i++) {
     double dt = i > 0 ? s[i].t - s[i - 1].t : dt_nominal;
-    if (!(dt > 0) || (dt > gap_s && !(s[i].in_contact && s[i - 1].in_contact))) dt = dt_nominal;
+    /* Two samples of one simulated instant (the server answers a command
+     * before the tissue step, stamped with the step's start, right after
+     * the previous step's own answer, stamped with its end) take no time. */
+    if (dt != 0 && (!(dt > 0) || (dt > gap_s && !(s[i].in_contact && s[i - 1].in_contact)))) dt = dt_nominal;
     thr_event_t ev[THR_COUNT];
     thr_update(&tr, dt, s[i].force, s[i].in_contact, NULL, ev);
     if (s[i].in_contact && isnan(m->first_contact_t)) m->first_contact_t = s[i].t;

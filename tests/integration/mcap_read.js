@@ -91,7 +91,9 @@ async function main() {
       // each sample stands for the simulated time since the previous one
       // (as the report counts), so samples a loaded recorder lost do not count
       const t = Number(msg.sim_time_ns) * 1e-9;
-      const dt = lastT !== undefined && t > lastT && t - lastT <= 0.5 ? t - lastT : 0.001;
+      // (two samples of one simulated instant, an early answer and the
+      // previous step's, take no time)
+      const dt = lastT !== undefined && t === lastT ? 0 : lastT !== undefined && t > lastT && t - lastT <= 0.5 ? t - lastT : 0.001;
       if (msg.in_contact) inContact += dt;
       lastT = t;
     }

@@ -42,7 +42,7 @@ head -1 "$OUT/fb.csv" | grep -q '^source_time_ns,partition,tool_id,cmd_seq,.*,in
 [ "$(tail -n +2 "$OUT/fb.csv" | wc -l)" = "$(count viscera_ContactFeedback)" ] || fail "CSV rows differ from recinfo's count"
 read -r peak contact < <(awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next }
   $c["tool_id"] == 0 { f = sqrt($c["force[0]"]^2 + $c["force[1]"]^2 + $c["force[2]"]^2); if (f > p) p = f;
-    t = $c["sim_time_ns"] * 1e-9; dt = (seen && t > last && t - last <= 0.5) ? t - last : 0.001
+    t = $c["sim_time_ns"] * 1e-9; dt = (seen && t == last) ? 0 : (seen && t > last && t - last <= 0.5) ? t - last : 0.001
     if ($c["in_contact"] == "true") n += dt; last = t; seen = 1 } END { printf "%.4f %.3f\n", p, n }' "$OUT/fb.csv")
 near "probe peak force (N)" "$peak" "$(srv peak_force)" 0.02 0
 near "probe contact time (s)" "$contact" "$(srv contact_time)" 0.05 0.03

@@ -174,9 +174,29 @@ static void test_tasks_by_id(void) {
   CHECK(t[1].id == 1 && fabs(t[1].end - t[1].start - 2.539) < 1e-9 && fabs(t[1].start - 0.521) < 1e-9);
 }
 
+/* The server answers a command before the tissue step (stamped with the
+ * step's start) right after the previous step's own answer (stamped with
+ * its end): two samples of one instant take no time. 1 s in contact with
+ * every tenth step answered twice is still 1 s. */
+static void test_same_instant(void) {
+  static rep_force_sample_t s[1200];
+  size_t n = 0;
+  for (int k = 1; k <= 1000; k++) {
+    s[n++] = (rep_force_sample_t){k * DT, 1.0, 1};
+    if (k % 10 == 0) s[n++] = (rep_force_sample_t){k * DT, 1.0, 1};
+  }
+  const double lv[THR_COUNT] = {0.5, 0.8, 1.5};
+  rep_force_measures_t m;
+  rep_force_measures(s, n, lv, DT, 0.5, &m);
+  CHECK(n == 1100);
+  CHECK_NEAR(m.contact_time, 1.0, 1.5e-9);
+  CHECK_NEAR(m.time_above[THR_MPF], 1.0, 1.5e-9);
+}
+
 int main(void) {
   test_ramp();
   test_gap();
+  test_same_instant();
   test_chatter();
   test_path();
   test_tasks();
