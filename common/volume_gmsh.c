@@ -110,25 +110,42 @@ static int elements_v2(text_scan_t *s, volume_raw_t *r, verr_t *err) {
   return text_scan_expect(s, "$EndElements", err);
 }
 
+/* A 4.x section's header: "blocks count" and, in 4.1, "min_tag max_tag";
+ * `what` names the section's items ("node", "element"). */
+static int section_v4(text_scan_t *s, int v41, const char *what, long long *nblocks, long long *n, verr_t *err) {
+  char a[48], b[48];
+  long long tag;
+  snprintf(a, sizeof a, "number of %s blocks", what);
+  snprintf(b, sizeof b, "number of %ss", what);
+  if (text_scan_long(s, a, 0, MSH_MAX_COUNT, nblocks, err) || text_scan_long(s, b, 0, MSH_MAX_COUNT, n, err)) return -1;
+  snprintf(a, sizeof a, "minimum %s tag", what);
+  snprintf(b, sizeof b, "maximum %s tag", what);
+  if (v41 && (text_scan_long(s, a, 0, INT64_MAX, &tag, err) || text_scan_long(s, b, 0, INT64_MAX, &tag, err)))
+    return -1;
+  return 0;
+}
+
+/* A block's first two numbers: "dim entity" in 4.1, "entity dim" in 4.0. */
+static int block_dim_v4(text_scan_t *s, int v41, long long *dim, verr_t *err) {
+  long long entity;
+  if (v41)
+    return text_scan_long(s, "block dimension", 0, 3, dim, err) ||
+                   text_scan_long(s, "block entity", INT64_MIN, INT64_MAX, &entity, err)
+               ? -1
+               : 0;
+  return text_scan_long(s, "block entity", INT64_MIN, INT64_MAX, &entity, err) ||
+                 text_scan_long(s, "block dimension", 0, 3, dim, err)
+             ? -1
+             : 0;
+}
+
 /* 4.1 blocks start "dim entity parametric count", 4.0 ones "entity dim
  * parametric count"; 4.1 lists the block's tags first, then coordinates. */
 static int nodes_v4(text_scan_t *s, volume_raw_t *r, int v41, verr_t *err) {
-  long long nblocks, n, dummy, dim, parametric, count;
-  if (text_scan_long(s, "number of node blocks", 0, MSH_MAX_COUNT, &nblocks, err) ||
-      text_scan_long(s, "number of nodes", 0, MSH_MAX_COUNT, &n, err))
-    return -1;
-  if (v41 && (text_scan_long(s, "minimum node tag", 0, INT64_MAX, &dummy, err) ||
-              text_scan_long(s, "maximum node tag", 0, INT64_MAX, &dummy, err)))
-    return -1;
+  long long nblocks, n, dim, parametric, count;
+  if (section_v4(s, v41, "node", &nblocks, &n, err)) return -1;
   for (long long b = 0; b < nblocks; b++) {
-    if (v41) {
-      if (text_scan_long(s, "block dimension", 0, 3, &dim, err) ||
-          text_scan_long(s, "block entity", INT64_MIN, INT64_MAX, &dummy, err))
-        return -1;
-    } else if (text_scan_long(s, "block entity", INT64_MIN, INT64_MAX, &dummy, err) ||
-               text_scan_long(s, "block dimension", 0, 3, &dim, err)) {
-      return -1;
-    }
+    if (block_dim_v4(s, v41, &dim, err)) return -1;
     if (text_scan_long(s, "parametric flag", 0, 1, &parametric, err) ||
         text_scan_long(s, "nodes in block", 0, n, &count, err))
       return -1;
@@ -156,22 +173,10 @@ static int nodes_v4(text_scan_t *s, volume_raw_t *r, int v41, verr_t *err) {
 }
 
 static int elements_v4(text_scan_t *s, volume_raw_t *r, int v41, verr_t *err) {
-  long long nblocks, n, dummy, dim, type, count, tag;
-  if (text_scan_long(s, "number of element blocks", 0, MSH_MAX_COUNT, &nblocks, err) ||
-      text_scan_long(s, "number of elements", 0, MSH_MAX_COUNT, &n, err))
-    return -1;
-  if (v41 && (text_scan_long(s, "minimum element tag", 0, INT64_MAX, &dummy, err) ||
-              text_scan_long(s, "maximum element tag", 0, INT64_MAX, &dummy, err)))
-    return -1;
+  long long nblocks, n, dim, type, count, tag;
+  if (section_v4(s, v41, "element", &nblocks, &n, err)) return -1;
   for (long long b = 0; b < nblocks; b++) {
-    if (v41) {
-      if (text_scan_long(s, "block dimension", 0, 3, &dim, err) ||
-          text_scan_long(s, "block entity", INT64_MIN, INT64_MAX, &dummy, err))
-        return -1;
-    } else if (text_scan_long(s, "block entity", INT64_MIN, INT64_MAX, &dummy, err) ||
-               text_scan_long(s, "block dimension", 0, 3, &dim, err)) {
-      return -1;
-    }
+    if (block_dim_v4(s, v41, &dim, err)) return -1;
     if (text_scan_long(s, "element type", 0, 1000, &type, err) ||
         text_scan_long(s, "elements in block", 0, n, &count, err))
       return -1;
