@@ -12,7 +12,10 @@
 #   4. a trainee certificate cannot publish into another seat (its haptic
 #      client is refused in lab/seat02);
 #   5. an observer certificate publishes nothing: its SessionControl and its
-#      haptic client's ToolCommand are refused.
+#      haptic client's ToolCommand are refused;
+#   3b. a trainee certificate cannot write the server's topics even when it
+#      announces role "server" (the certificate, not the claimed role,
+#      decides: issue 15.2).
 # usage: security_test.sh BUILD SRC OUT
 set -euo pipefail
 BUILD="$1"; SRC="$2"; OUT="$3"
@@ -49,6 +52,18 @@ grep -q "Not Allowed By Security" "$OUT/ctl_trainee.log" || fail "trainee Sessio
 CYCLONEDDS_URI="$(as instructor)" "$CTL" --partition $SEAT --wait 8 thresholds 0 0.5 0.8 1.5 \
   > "$OUT/ctl_instructor.log" 2>&1 || fail "the instructor's SessionControl was not applied"
 grep -q "^applied:" "$OUT/ctl_instructor.log" || fail "no 'applied' answer for the instructor"
+
+# 3b. The server's topics (issue 15.2, under --secure): a trainee's certificate
+# cannot write them, whatever role it announces: the impostor tool claiming
+# role "server" cannot create its writers (ContactFeedback, MeshState,
+# MeshDelta).
+IMP="$BUILD/tests/integration/impostor"
+if [ -x "$IMP" ]; then
+  if CYCLONEDDS_URI="$(as trainee-seat01)" "$IMP" run "${VISCERA_DOMAIN:-0}" $SEAT server 1 > "$OUT/impostor_trainee.log" 2>&1; then
+    fail "a trainee identity wrote the server's ContactFeedback"
+  fi
+  grep -q "Not Allowed By Security" "$OUT/impostor_trainee.log" || fail "the trainee's forged feedback was not refused by access control"
+fi
 
 # 4. Another seat: the trainee of seat 1 cannot take part in seat 2.
 if CYCLONEDDS_URI="$(as trainee-seat01)" timeout 20 "$HAP" --trajectory "$SRC/assets/trajectories/palpate_kidney.traj" \
