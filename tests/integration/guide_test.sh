@@ -34,9 +34,10 @@ PART=test/guide
 AX=0.032; BX=0.012; Y=0.004; Z=0.070; PRESS_Z=0.029
 printf '0 %s %s %s\n' $AX $Y $Z > "$OUT/alice.traj"
 printf '0 %s %s %s\n' $BX $Y $Z > "$OUT/bob1.traj"
-# The restarted instructor holds B 2 s (time to see the trainee again), presses
-# 4-6 mm into the kidney for 4 s and comes back up to B.
-printf '0 %s %s %s\n2.0 %s %s %s\n2.5 %s %s %s\n6.5 %s %s %s\n7.0 %s %s %s\n' \
+# The restarted instructor holds B 3 s (time to see the trainee again: only
+# his ticks after that are judged), presses 4-6 mm into the kidney for 4 s and
+# comes back up to B.
+printf '0 %s %s %s\n3.0 %s %s %s\n3.5 %s %s %s\n7.5 %s %s %s\n8.0 %s %s %s\n' \
   $BX $Y $Z $BX $Y $Z $BX $Y $PRESS_Z $BX $Y $PRESS_Z $BX $Y $Z > "$OUT/bob2.traj"
 CTL=("$BUILD/client/control/viscera-control" --partition $PART --wait 30)
 # Every process is stopped by the script; --duration only bounds a run gone wrong.
