@@ -17,14 +17,16 @@
 #                        the last feedback and both forces stay zero.
 # No wall-clock timing (issue 15.6): every step waits (60 s at most, a hang
 # stop only) for the clients' log lines saying a command took effect and then
-# for a number of each client's own ticks (rows of its force CSV) before the
-# next command. Each phase is a range of a client's own rows: from 300 ticks
-# after its log line (same clock as its CSV) to 100 rows before the rows on
-# disk when the next command was given (stdio buffering keeps that at or
-# before the ticks done by then). Phases are judged on medians over >= 200
-# ticks, so a peer stalled for a moment (coupling dropped after 100 ms of
-# silence, as designed) does not fail them; the press is cut by the
-# instructor's own position and the trainee's rows pulled down towards it.
+# for 600 of each client's own ticks (rows of its force CSV) in the expected
+# coupling state before the next command. A phase is a range of a client's
+# own rows, from its log line (same clock as its CSV) to 100 rows before the
+# rows on disk when the next command was given (stdio buffering keeps that at
+# or before the ticks done by then), and only its ticks in the phase's
+# coupling state (from the log's "guide:" lines), 100 ticks past each change
+# (the force ramps), are judged, on medians over >= 200 ticks: a loaded
+# machine where a peer stalls for 100 ms (the coupling drops, as designed)
+# makes the test wait longer instead of failing it. The press is cut by the
+# instructor's own position and by the trainee's rows pulled down towards it.
 # usage: guide_test.sh BUILD SRC OUT
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/prelude.sh"
@@ -67,11 +69,28 @@ t_lost() { awk 'match($0, /t=[0-9.]+ s/) { t = substr($0, RSTART + 2, RLENGTH - 
                 END { print lost }' "$OUT/$1.log"; }
 # CSV line number (header = 1) of the first tick at or after loop time T.
 row_of() { awk -F, -v t="$2" 'NR > 1 && $1 + 0 >= t + 0 { print NR; exit }' "$1"; }
-# settled WHO T0 PAT N: WHO logged PAT after loop time T0 and its CSV has N
-# ticks past that line; the line's loop time in EV.
+# ann WHO: WHO's force CSV with two columns added from its log (same clock):
+# $11 the coupling state of the tick (owner0.50, guide1.00, ... or none) and
+# $12 the ticks since that state began (the force ramps in after a change).
+ann() {
+  awk -F, 'FNR == NR { if (match($0, /t=[0-9.]+ s guide: /)) {
+             n++; T[n] = substr($0, RSTART + 2) + 0; S[n] = "none"
+             if (match($0, /coupled as (owner|guide) .*own share [0-9.]+/)) {
+               S[n] = (index($0, "as owner") ? "owner" : "guide") substr($0, RSTART + RLENGTH - 4, 4) } }
+           next }
+           FNR == 1 { print $0 ",state,since"; next }
+           { while (k < n && $1 + 0 >= T[k + 1]) { k++; since = 0 }
+             print $0 "," (k ? S[k] : "none") "," since; since++ }' "$OUT/$1.log" "$OUT/$1.csv" > "$OUT/$1.ann"
+}
+# settled WHO T0 PAT STATE N: WHO logged PAT after loop time T0 and has, from
+# that line on, N ticks in STATE past its ramp (100 ticks); the line's loop time in EV.
+RAMP=100
 settled() {
   local t r; t=$(t_from "$1" "$2" "$3"); [ -n "$t" ] || return 1
-  r=$(row_of "$OUT/$1.csv" "$t"); [ -n "$r" ] && has_rows "$OUT/$1.csv" $((r + $4)) && EV=$t
+  r=$(row_of "$OUT/$1.csv" "$t"); [ -n "$r" ] || return 1
+  ann "$1"
+  awk -F, -v r="$r" -v s="$4" -v n="$5" -v ramp=$RAMP 'NR >= r && $11 == s && $12 >= ramp { c++ } END { exit !(c >= n) }' \
+    "$OUT/$1.ann" && EV=$t
 }
 lost_settled() { local t r; t=$(t_lost "$1"); [ -n "$t" ] || return 1
   r=$(row_of "$OUT/$1.csv" "$t"); [ -n "$r" ] && has_rows "$OUT/$1.csv" $((r + 500)); }
@@ -79,18 +98,18 @@ OWN=(coupled as owner "(trainee),"); GDE=(coupled as guide "(instructor),")
 A50="${OWN[*]} own share 0.50"; B50="${GDE[*]} own share 0.50"
 A00="${OWN[*]} own share 0.00"; B100="${GDE[*]} own share 1.00"
 REL="guide ''"
-TICKS=800 # ticks each phase lasts at least on each client before the next command
+TICKS=600 # ticks each phase lasts at least on each client (in its state, past the ramp) before the next command
 
-wait_for has_rows "$OUT/alice.csv" $TICKS || fail "the trainee's client did not start driving"
-wait_for has_rows "$OUT/bob1.csv" $TICKS || fail "the instructor's client did not start driving"
+wait_for has_rows "$OUT/alice.csv" $((TICKS + 300)) || fail "the trainee's client did not start driving"
+wait_for has_rows "$OUT/bob1.csv" $((TICKS + 300)) || fail "the instructor's client did not start driving"
 ra_g=$(rows "$OUT/alice.csv"); rb_g=$(rows "$OUT/bob1.csv")
 "${CTL[@]}" guide 0 bob 0.5 200 > "$OUT/ctl.log" 2>&1 || fail "guide not applied"
-wait_for settled alice -1 "$A50" $TICKS || fail "the trainee's client did not couple at 0.5"; ta_g=$EV
-wait_for settled bob1 -1 "$B50" $TICKS || fail "the instructor's client did not couple at 0.5"; tb_g=$EV
+wait_for settled alice -1 "$A50" owner0.50 $TICKS || fail "the trainee's client did not couple at 0.5"; ta_g=$EV
+wait_for settled bob1 -1 "$B50" guide0.50 $TICKS || fail "the instructor's client did not couple at 0.5"; tb_g=$EV
 ra_t=$(rows "$OUT/alice.csv"); rb_t=$(rows "$OUT/bob1.csv")
 "${CTL[@]}" takeover 0 bob >> "$OUT/ctl.log" 2>&1 || fail "takeover not applied"
-wait_for settled alice "$ta_g" "$A00" $TICKS || fail "the trainee's client did not couple as taken over"; ta_t=$EV
-wait_for settled bob1 "$tb_g" "$B100" $TICKS || fail "the instructor's client did not couple as taking over"; tb_t=$EV
+wait_for settled alice "$ta_g" "$A00" owner0.00 $TICKS || fail "the trainee's client did not couple as taken over"; ta_t=$EV
+wait_for settled bob1 "$tb_g" "$B100" guide1.00 $TICKS || fail "the instructor's client did not couple as taking over"; tb_t=$EV
 # The instructor's client is replaced by one that presses (still taken over).
 ra_p=$(rows "$OUT/alice.csv"); rb_end=$(rows "$OUT/bob1.csv")
 kill -INT $BOB; wait $BOB || fail "the first instructor client failed"
@@ -98,17 +117,17 @@ haptic bob2 bob; BOB=$HPID
 # pressed_and_back: bob2 went below 0.031 and has 500 ticks back up at B.
 pressed_and_back() { awk -F, -v z="$Z" 'NR > 1 && $4 < 0.031 { p = 1; n = 0 } p && $4 >= z - 1e-6 { n++ }
                                          END { exit !(p && n >= 500) }' "$OUT/bob2.csv"; }
-wait_for settled bob2 -1 "$B100" 1 || fail "the restarted instructor's client did not couple as taking over"; tb_p=$EV
+wait_for settled bob2 -1 "$B100" guide1.00 1 || fail "the restarted instructor's client did not couple as taking over"; tb_p=$EV
 wait_for pressed_and_back || fail "the instructor's press did not end"
 ra_rel=$(rows "$OUT/alice.csv"); rb_rel=$(rows "$OUT/bob2.csv")
 "${CTL[@]}" release 0 >> "$OUT/ctl.log" 2>&1 || fail "release not applied"
-wait_for settled alice "$ta_t" "$REL" $TICKS || fail "the trainee's client was not released"; ta_r=$EV
-wait_for settled bob2 "$tb_p" "$REL" $TICKS || fail "the instructor's client was not released"; tb_r=$EV
+wait_for settled alice "$ta_t" "$REL" none $TICKS || fail "the trainee's client was not released"; ta_r=$EV
+wait_for settled bob2 "$tb_p" "$REL" none $TICKS || fail "the instructor's client was not released"; tb_r=$EV
 ra_tk2=$(rows "$OUT/alice.csv"); rb_tk2=$(rows "$OUT/bob2.csv")
 # Taken over again, then the server dies: the coupling must end with it.
 "${CTL[@]}" takeover 0 bob >> "$OUT/ctl.log" 2>&1 || fail "second takeover not applied"
-wait_for settled alice "$ta_r" "$A00" $TICKS || fail "the trainee's client did not couple again"; ta_t2=$EV
-wait_for settled bob2 "$tb_r" "$B100" $TICKS || fail "the instructor's client did not couple again"
+wait_for settled alice "$ta_r" "$A00" owner0.00 $TICKS || fail "the trainee's client did not couple again"; ta_t2=$EV
+wait_for settled bob2 "$tb_r" "$B100" guide1.00 $TICKS || fail "the instructor's client did not couple again"
 ra_k=$(rows "$OUT/alice.csv")
 { kill -9 $SRV && wait $SRV; } 2>/dev/null || true
 for who in alice bob2; do
@@ -121,37 +140,45 @@ wait $BOB || fail "instructor client failed"
 PIDS=()
 grep -h 'guide:\|GUIDE\|latency\|another station' "$OUT/alice.log" "$OUT/bob1.log" "$OUT/bob2.log"
 
-# start WHO T: CSV line of WHO's first tick 300 ticks after its loop time T.
-start() { echo $(($(row_of "$OUT/$1.csv" "$2") + 300)); }
-# median CSV R0 R1 EXPR [FILTER]: median of an awk expression over CSV lines
-# R0..R1 (and FILTER); prints "median count".
+# start WHO T: CSV line of WHO's first tick at its loop time T.
+start() { row_of "$OUT/$1.csv" "$2"; }
+for who in alice bob1 bob2; do ann $who; done
+# median ANN R0 R1 EXPR [FILTER]: median of an awk expression over lines
+# R0..R1 (and FILTER) of an annotated CSV, only the ticks in state ST past the
+# ramp (ann above); prints "median count".
 median() {
-  awk -F, -v r0="$2" -v r1="$3" "NR > 1 && NR >= r0 && NR <= r1 ${5:+&& ($5)} { print $4 }" "$1" | sort -g |
+  awk -F, -v r0="$2" -v r1="$3" -v st="$ST" -v ramp=$RAMP \
+    "NR > 1 && NR >= r0 && NR <= r1 && \$11 == st && \$12 >= ramp ${5:+&& ($5)} { print $4 }" "$1" | sort -g |
     awk '{ a[NR] = $1 } END { if (NR == 0) print "nan 0"; else print a[int((NR + 1) / 2)], NR }'
 }
 mag='sqrt($5*$5 + $6*$6 + $7*$7)'
 # expect WHAT WHO R0 R1 EXPR LO HI [FILTER]: the median over WHO's CSV lines
-# R0..R1 lies in [LO, HI], over at least 200 ticks.
+# R0..R1 in state ST lies in [LO, HI], over at least 200 ticks.
 expect() {
-  local r; r=$(median "$OUT/$2.csv" "$3" "$4" "$5" "${8:-}")
+  local r; r=$(median "$OUT/$2.ann" "$3" "$4" "$5" "${8:-}")
   local m=${r% *} n=${r#* }
   printf '  %-44s median %9.4f over %5d ticks (want %s..%s)\n' "$1" "$m" "$n" "$6" "$7"
   awk -v m="$m" -v n="$n" -v lo="$6" -v hi="$7" 'BEGIN { exit !(n >= 200 && m >= lo && m <= hi) }' \
     || fail "$1: median $m over $n ticks, want $6..$7 over >= 200 ticks"
 }
 # Before guiding: free space, no force.
+ST=none
 expect "alice before guiding |F|" alice 300 $((ra_g - 100)) "$mag" 0 0.05
 expect "bob before guiding |F|" bob1 300 $((rb_g - 100)) "$mag" 0 0.05
 # Authority 0.5: 2 N along x, towards each other (B is at smaller x).
 a=$(start alice "$ta_g"); b=$(start bob1 "$tb_g")
+ST=owner0.50
 expect "alice guided 0.5: Fx" alice "$a" $((ra_t - 100)) '$5' -2.2 -1.8
 expect "alice guided 0.5: |F|" alice "$a" $((ra_t - 100)) "$mag" 1.8 2.2
+ST=guide0.50
 expect "bob guiding 0.5: Fx" bob1 "$b" $((rb_t - 100)) '$5' 1.8 2.2
 expect "bob guiding 0.5: |F|" bob1 "$b" $((rb_t - 100)) "$mag" 1.8 2.2
 # Take-over, the instructor still at B: trainee pulled with the whole spring, instructor free.
 a=$(start alice "$ta_t"); b=$(start bob1 "$tb_t")
+ST=owner0.00
 expect "alice taken over: Fx" alice "$a" $((ra_p - 100)) '$5' -4.4 -3.6
 expect "alice taken over: |F|" alice "$a" $((ra_p - 100)) "$mag" 3.6 4.4
+ST=guide1.00
 expect "bob taking over: |F|" bob1 "$b" $((rb_end - 100)) "$mag" 0 0.05
 # The press, still taken over (the instructor's ticks below z 0.031): he feels
 # the tissue push up (no coupling on his side); the trainee is pulled towards
@@ -163,6 +190,7 @@ expect "bob pressing: Fz (tissue)" bob2 "$b" "$rb_rel" '$7' 0.3 6 "$pz"
 expect "bob pressing: |Fx| (tissue only, no spring)" bob2 "$b" "$rb_rel" 'sqrt($5*$5)' 0 0.3 "$pz"
 expect "bob pressing: in contact" bob2 "$b" "$rb_rel" '$8' 1 1 "$pz"
 down='$7 < -2'
+ST=owner0.00
 expect "alice during the press: |F| (clamped)" alice "$ra_p" "$ra_rel" "$mag" 5.9 6.01 "$down"
 # Direction towards the instructor's commanded position (BX - AX, 0, PRESS_Z -
 # AX's z) normalised: (-0.44, 0, -0.90).
@@ -170,11 +198,13 @@ expect "alice during the press: Fx/|F|" alice "$ra_p" "$ra_rel" "\$5 / $mag" -0.
 expect "alice during the press: Fz/|F|" alice "$ra_p" "$ra_rel" "\$7 / $mag" -0.93 -0.86 "$down"
 # Released: both free, nothing felt (until the second take-over).
 a=$(start alice "$ta_r"); b=$(start bob2 "$tb_r")
+ST=none
 expect "alice released |F|" alice "$a" $((ra_tk2 - 100)) "$mag" 0 0.05
 expect "bob released |F|" bob2 "$b" $((rb_tk2 - 100)) "$mag" 0 0.05
 # Server killed during the second take-over: the trainee is pulled until the
 # server has been silent for 250 ms, then both render nothing to the end.
 a=$(start alice "$ta_t2")
+ST=owner0.00
 expect "alice taken over again: Fx" alice "$a" $((ra_k - 100)) '$5' -4.4 -3.6
 for who in alice bob2; do
   tl=$(t_lost $who); [ -n "$tl" ] || fail "$who: the coupling did not end when the server was killed"
