@@ -17,7 +17,7 @@
 #                        the last feedback and both forces stay zero.
 # No wall-clock timing (issue 15.6): every step waits (60 s at most, a hang
 # stop only) for the clients' log lines saying a command took effect and then
-# for 600 of each client's own ticks (rows of its force CSV) in the expected
+# for 400 of each client's own ticks (rows of its force CSV) in the expected
 # coupling state before the next command. A phase is a range of a client's
 # own rows, from its log line (same clock as its CSV) to 100 rows before the
 # rows on disk when the next command was given (stdio buffering keeps that at
@@ -98,7 +98,7 @@ OWN=(coupled as owner "(trainee),"); GDE=(coupled as guide "(instructor),")
 A50="${OWN[*]} own share 0.50"; B50="${GDE[*]} own share 0.50"
 A00="${OWN[*]} own share 0.00"; B100="${GDE[*]} own share 1.00"
 REL="guide ''"
-TICKS=600 # ticks each phase lasts at least on each client (in its state, past the ramp) before the next command
+TICKS=400 # ticks each phase lasts at least on each client (in its state, past the ramp) before the next command
 
 wait_for has_rows "$OUT/alice.csv" $((TICKS + 300)) || fail "the trainee's client did not start driving"
 wait_for has_rows "$OUT/bob1.csv" $((TICKS + 300)) || fail "the instructor's client did not start driving"
