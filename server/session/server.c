@@ -541,8 +541,15 @@ static int read_controls(server_t *s) {
 }
 
 /* One ContactFeedback of tool t from the record `tool` (the core's, or the
- * preview's copy), stamped with the simulated time now. */
+ * preview's copy), stamped with the simulated time now. Its `force` is
+ * always the core's: the hand force the server committed at that instant
+ * (for an early answer, the previous step's, whose end is this step's
+ * start), the one its own measures track, so a report rebuilt from the
+ * recorded feedback equals the server's PALPATION figures; the preview
+ * moves only the contact model the client renders (god-object, normal,
+ * contact). */
 static void write_feedback(server_t *s, size_t t, const tool_rt_t *tool) {
+  const tool_rt_t *core = &s->rt.tools[t];
   viscera_ContactFeedback fb;
   memset(&fb, 0, sizeof fb);
   fb.tool_id = (uint32_t)t;
@@ -558,7 +565,7 @@ static void write_feedback(server_t *s, size_t t, const tool_rt_t *tool) {
   for (int k = 0; k < 3; k++) {
     fb.proxy_position[k] = (float)tool->fb_pos[k];
     fb.normal[k] = (float)tool->fb_normal[k];
-    fb.force[k] = (float)tool->force[k];
+    fb.force[k] = (float)core->force[k];
   }
   if (dds_write(s->w_feedback, &fb) >= 0) s->stats->published[VT_CONTACT_FEEDBACK]++;
 }
