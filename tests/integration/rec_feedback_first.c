@@ -115,7 +115,7 @@ int main(int argc, char **argv) {
   }
   size_t commands = 0, answered = 0, on_time = 0, late = 0, other = 0, repeated = 0;
   for (size_t t = 0; t < MAXT; t++) {
-    qsort(d.fb[t], d.nfb[t], sizeof *d.fb[t], by_seq);
+    if (d.nfb[t]) qsort(d.fb[t], d.nfb[t], sizeof *d.fb[t], by_seq); /* (a tool without samples has no array) */
     /* The step each sample answers: before the step it took a command in,
      * after the step otherwise. `early[i]` marks the first answers. */
     char *early = calloc(d.nfb[t] + 1, 1);
