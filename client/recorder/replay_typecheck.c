@@ -4,6 +4,7 @@
 #include <errno.h>
 #include <stdio.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -211,7 +212,13 @@ int rp_types_check(const unsigned char *typeinfo, uint32_t tilen, const unsigned
     return -1;
   }
   if (pid == 0) {
-    alarm(5);
+    /* A reader that loops spends CPU: 5 s of it end the child (SIGXCPU).
+     * Wall time is only the backstop of a child that waits: on a loaded
+     * machine a sound check can take seconds of it (seen under the
+     * sanitizers with a CPU-bound process beside them). */
+    struct rlimit cpu = {5, 6};
+    setrlimit(RLIMIT_CPU, &cpu);
+    alarm(60);
     _exit(types_check_here(typeinfo, tilen, typemap, tmlen));
   }
   int st = 0;
