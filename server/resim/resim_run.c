@@ -190,19 +190,24 @@ static void compare_delta(run_ctx_t *c, resim_delta_t *d) {
 
 /* Frames sorted by organ, topology version, step (then seq): the frames
  * of one organ at one step of one topology are a run found by bisection. */
+static int cmp_u64(uint64_t a, uint64_t b) { return a < b ? -1 : a > b; }
+/* Organ, then topology version, then step, then the sequence number. */
+static int cmp_otp(uint64_t oa, uint64_t ta, uint64_t sa, uint64_t qa, uint64_t ob, uint64_t tb, uint64_t sb,
+                   uint64_t qb) {
+  int r = cmp_u64(oa, ob);
+  if (!r) r = cmp_u64(ta, tb);
+  if (!r) r = cmp_u64(sa, sb);
+  return r ? r : cmp_u64(qa, qb);
+}
 static int cmp_key_otp(const void *a, const void *b) {
   const resim_keyframe_t *x = a, *y = b;
-  if (x->organ != y->organ) return x->organ < y->organ ? -1 : 1;
-  if (x->topology_version != y->topology_version) return x->topology_version < y->topology_version ? -1 : 1;
-  if (x->step != y->step) return x->step < y->step ? -1 : 1;
-  return x->keyframe_seq < y->keyframe_seq ? -1 : x->keyframe_seq > y->keyframe_seq;
+  return cmp_otp(x->organ, x->topology_version, x->step, x->keyframe_seq, y->organ, y->topology_version, y->step,
+                 y->keyframe_seq);
 }
 static int cmp_delta_otp(const void *a, const void *b) {
   const resim_delta_t *x = a, *y = b;
-  if (x->organ != y->organ) return x->organ < y->organ ? -1 : 1;
-  if (x->topology_version != y->topology_version) return x->topology_version < y->topology_version ? -1 : 1;
-  if (x->step != y->step) return x->step < y->step ? -1 : 1;
-  return x->frame_seq < y->frame_seq ? -1 : x->frame_seq > y->frame_seq;
+  return cmp_otp(x->organ, x->topology_version, x->step, x->frame_seq, y->organ, y->topology_version, y->step,
+                 y->frame_seq);
 }
 static int cmp_metrics(const void *a, const void *b) {
   const resim_tool_metrics_t *x = a, *y = b;
