@@ -8,14 +8,14 @@
 #  - viscera-recinfo reads the file alone (no -wal left next to it: the WAL
 #    was checkpointed into it) and finds exactly those N samples, with no end
 #    time; viscera-report gives a report of it with a warning;
-#  - a second recorder killed with SIGKILL mid-session (after the contact,
-#    while the server still publishes) leaves a file and its WAL that recinfo
-#    reads and viscera-report reports, contact included.
+#  - a second recorder killed with SIGKILL mid-session (while the probe
+#    holds its press and the server publishes) leaves a file and its WAL
+#    that recinfo reads and viscera-report reports, contact included.
 # usage: recorder_full_disk_test.sh BUILD SRC OUT
 set -euo pipefail
 BUILD="$1"; SRC="$2"; OUT="$3"
 DOMAIN="${VISCERA_DOMAIN:-101}"; PART="fulldisk/seat01"
-LIMIT_KB=512
+LIMIT_KB=1024
 rm -rf "$OUT"; mkdir -p "$OUT"
 pids=()
 cleanup() { for p in "${pids[@]}"; do kill -9 "$p" 2>/dev/null || true; done; }
@@ -23,33 +23,39 @@ trap cleanup EXIT
 fail() { echo "FAIL: $*" >&2; for f in "$OUT"/*.err "$OUT"/*.log; do [ -f "$f" ] && { echo "--- $f"; tail -5 "$f"; }; done >&2; exit 1; }
 common=(--domain "$DOMAIN" --partition "$PART")
 
-"$BUILD/server/viscera-server" --scene "$SRC/assets/scenes/default.yaml" "${common[@]}" --quiet \
+"$BUILD/server/viscera-server" --scene "$SRC/assets/scenes/default.yaml" "${common[@]}" \
   >"$OUT/server.out" 2>"$OUT/server.log" &
 SERVER=$!; pids+=($SERVER)
+await() { for _ in $(seq 600); do grep -q -- "$2" "$1" 2>/dev/null && return 0; sleep 0.1; done; return 1; }
+"$BUILD/client/recorder/viscera-recorder" "${common[@]}" --out "$OUT/killed.db" --quiet \
+  >"$OUT/killed.out" 2>"$OUT/killed.err" &
+KILLED=$!; pids+=($KILLED)
+"$BUILD/client/haptic/viscera-haptic" --trajectory "$SRC/assets/trajectories/push_hold_kidney.traj" "${common[@]}" \
+  --duration 60 >"$OUT/haptic.out" 2>"$OUT/haptic.log" &
+HAPTIC=$!; pids+=($HAPTIC)
+# The size-limited recorder starts once the probe presses and holds (the
+# server's threshold line), so that it fills up while commands and feedback
+# flow at 1 kHz, however loaded the machine: started with the session, its
+# SQLite WAL could reach the limit on the keyframe and the first batches
+# alone, before any contact (seen in the suite: 43 samples, no ToolCommand,
+# nothing to report); with a trajectory that ends, it could outlast the flow.
+await "$OUT/server.log" "ST crossed up" || fail "the probe never pressed the organ"
 # bash counts ulimit -f in 1024-byte blocks
 ( ulimit -f $LIMIT_KB; exec "$BUILD/client/recorder/viscera-recorder" "${common[@]}" --out "$OUT/full.db" --quiet ) \
   >"$OUT/full.out" 2>"$OUT/full.err" &
 FULL=$!; pids+=($FULL)
-"$BUILD/client/recorder/viscera-recorder" "${common[@]}" --out "$OUT/killed.db" --quiet \
-  >"$OUT/killed.out" 2>"$OUT/killed.err" &
-KILLED=$!; pids+=($KILLED)
-sleep 1.5
-"$BUILD/client/haptic/viscera-haptic" --trajectory "$SRC/assets/trajectories/palpate_kidney.traj" "${common[@]}" \
-  >"$OUT/haptic.out" 2>"$OUT/haptic.log" &
-HAPTIC=$!; pids+=($HAPTIC)
-wait $HAPTIC || fail "haptic client failed"
-# Killed while the session still runs (server publishing), after the
-# contact: what it recorded of the contact must survive the kill (only the
-# last uncommitted batch, at most 200 ms, is lost). Killing it mid-contact
-# would make the contact it keeps depend on the machine's load.
-sleep 0.5
-kill -9 $KILLED
-wait $KILLED 2>/dev/null || true
-# The full recorder has stopped by now (the session wrote far more than
-# the limit); give a loaded machine a few seconds more before calling it hung.
-for _ in $(seq 1 50); do kill -0 $FULL 2>/dev/null || break; sleep 0.2; done
+# It stops by itself at the limit (60 s at most, a safety stop, not a rate).
+for _ in $(seq 1 300); do kill -0 $FULL 2>/dev/null || break; sleep 0.2; done
 if kill -0 $FULL 2>/dev/null; then kill -INT $FULL; fail "the recorder did not stop at the file-size limit"; fi
 set +e; wait $FULL; rc=$?; set -e
+# The other recorder is killed while the session still runs and the probe
+# still presses, after at least the time the first one took to fill (so
+# more than a second of contact): what it committed of the contact must
+# survive the kill (only the last uncommitted batch, at most 200 ms, is lost).
+kill -0 $HAPTIC 2>/dev/null || fail "the trainee ended before the recorder filled up"
+kill -9 $KILLED
+wait $KILLED 2>/dev/null || true
+kill -INT $HAPTIC; wait $HAPTIC || fail "haptic client failed"
 kill -INT $SERVER; wait $SERVER || true
 pids=()
 cat "$OUT/full.err"
