@@ -21,7 +21,10 @@ command -v node >/dev/null && command -v npm >/dev/null || { echo "SKIP: node or
 NPM="$BUILD/tests/npm-mcap"
 if [ ! -d "$NPM/node_modules/@mcap/core" ] || [ ! -d "$NPM/node_modules/@foxglove/omgidl-serialization" ]; then
   mkdir -p "$NPM"; echo '{"private":true}' > "$NPM/package.json"
-  (cd "$NPM" && timeout 300 npm install --no-audit --no-fund --silent @mcap/core@2 @foxglove/omgidl-parser@1 \
+  # Without a reachable registry npm retries for minutes: ask it once, briefly.
+  (cd "$NPM" && timeout 30 npm ping) > "$NPM/install.log" 2>&1 \
+    || { echo "SKIP: the npm registry does not answer:"; tail -3 "$NPM/install.log"; exit 77; }
+  (cd "$NPM" && timeout 120 npm install --no-audit --no-fund --silent @mcap/core@2 @foxglove/omgidl-parser@1 \
     @foxglove/omgidl-serialization@1) > "$NPM/install.log" 2>&1 \
     || { echo "SKIP: npm could not install @mcap/core (no registry?):"; tail -3 "$NPM/install.log"; exit 77; }
 fi
