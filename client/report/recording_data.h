@@ -57,7 +57,7 @@ typedef struct rep_summary {
 typedef struct rep_recording {
   char path[512];
   char label[64];
-  char seat[128];     /* the partition this section covers, "" = the whole file */
+  char seat[128];      /* the partition this section covers, "" = the whole file */
   char identity[1024]; /* who trained: seat, station, the trainee's process */
   recfile_session_t session;
   char scene[72];
