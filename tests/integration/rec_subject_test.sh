@@ -27,12 +27,12 @@ REPORT="$BUILD/client/report/viscera-report"
 SCENE="$SRC/assets/scenes/default.yaml"; TRAJ="$SRC/assets/trajectories/palpate_kidney.traj"
 SEAT=lab/seat01 PLAIN=rec_subject/plain
 
-CYCLONEDDS_URI="$(as server-seat01)" "$SRV" --scene "$SCENE" --partition $SEAT --duration 9 \
+CYCLONEDDS_URI="$(as server-seat01)" "$SRV" --scene "$SCENE" --partition $SEAT --duration 11 \
   > "$OUT/server.log" 2>&1 & PIDS+=($!)
-CYCLONEDDS_URI="$(as recorder)" "$REC" --partition 'lab/*' --out "$OUT/secure.db" --duration 7 --quiet \
+CYCLONEDDS_URI="$(as recorder)" "$REC" --partition 'lab/*' --out "$OUT/secure.db" --duration 9 --quiet \
   > "$OUT/rec_secure.log" 2>&1 & REC_S=$!; PIDS+=($!)
-CYCLONEDDS_URI="$NET" "$SRV" --scene "$SCENE" --partition $PLAIN --duration 9 > "$OUT/server_plain.log" 2>&1 & PIDS+=($!)
-CYCLONEDDS_URI="$NET" "$REC" --partition $PLAIN --out "$OUT/plain.db" --duration 7 --quiet \
+CYCLONEDDS_URI="$NET" "$SRV" --scene "$SCENE" --partition $PLAIN --duration 11 > "$OUT/server_plain.log" 2>&1 & PIDS+=($!)
+CYCLONEDDS_URI="$NET" "$REC" --partition $PLAIN --out "$OUT/plain.db" --duration 9 --quiet \
   > "$OUT/rec_plain.log" 2>&1 & REC_P=$!; PIDS+=($!)
 sleep 1.5
 CYCLONEDDS_URI="$(as trainee-seat01)" "$HAP" --trajectory "$TRAJ" --partition $SEAT --station alice --duration 5 \
