@@ -14,6 +14,7 @@ PKGS=(
   libyaml-dev                               # scene files
   libcairo2-dev                             # plots in benchmarks and reports
   openssl                                   # DDS Security PKI (deploy/pki.sh)
+  libssl-dev                                # certificate subjects in recordings (common/dds/vdds_subject.c)
   libsdl2-dev                               # window viewer (--window, --drive)
   xvfb xauth                                # headless X server for the window test
   systemd                                   # systemd-analyze verify of the service units (test)

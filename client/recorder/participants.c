@@ -4,7 +4,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "dds/vdds_config.h"
 #include "dds/vdds_ident.h"
+#include "dds/vdds_subject.h"
 #include "vtime.h"
 
 struct participants {
@@ -15,6 +17,9 @@ struct participants {
   size_t nknown;
   uint64_t dropped;
   bool warned;
+  /* Subjects are kept only when this recorder authenticates its peers
+   * (vdds_subject.h): without security a GUID proves nothing. */
+  bool secure;
 };
 
 int participants_open(participants_t **out, dds_entity_t participant, verr_t *err) {
@@ -32,6 +37,7 @@ int participants_open(participants_t **out, dds_entity_t participant, verr_t *er
     free(p);
     return -1;
   }
+  p->secure = vdds_config_secure() != 0;
   *out = p;
   return 0;
 }
@@ -79,7 +85,16 @@ int participants_poll(participants_t *p, store_t *store, FILE *log, verr_t *err)
       if (bp->qos && dds_qget_userdata(bp->qos, &ud, &udsz) && ud) vdds_ident_sanitize(text, sizeof text, ud, udsz);
       dds_free(ud);
       bool has_role = vdds_ident_role(text, role, sizeof role) == 0;
+      char subject[VDDS_SUBJECT_TEXT_MAX] = "";
+      int sv = p->secure ? vdds_subject_verify(text, guid, subject, sizeof subject) : VDDS_SUBJECT_NONE;
+      if (sv == VDDS_SUBJECT_MISMATCH && log)
+        fprintf(log, "recorder: a participant announced a certificate subject its authenticated GUID does not match;"
+                     " not stored\n");
+      /* The subject's hex is stored as text once, in its own column. */
+      char *c = strstr(text, " cert=");
+      if (c) *c = 0;
       ret = store_note_participant(store, guid, text, has_role ? role : NULL, false, now, err);
+      if (ret == 0 && sv == VDDS_SUBJECT_VERIFIED) ret = store_note_subject(store, guid, subject, err);
     }
     if (n > 0) dds_return_loan(p->reader, ptrs, n);
     if (ret < 0) return -1;

@@ -12,7 +12,10 @@
  * bytes replaced; at most PARTICIPANTS_MAX distinct participants are
  * stored, so a flood of fake participants cannot grow the file without
  * bound (the overflow is counted and reported once on the log).
- * The role is a claim (see vdds_ident.h). Not thread-safe. */
+ * The role is a claim (see vdds_ident.h). When the recorder runs with DDS
+ * Security, a participant's announced certificate subject is verified
+ * against its authenticated GUID and stored (vdds_subject.h says what that
+ * proves); without security no subject is stored. Not thread-safe. */
 #ifndef VISCERA_REC_PARTICIPANTS_H
 #define VISCERA_REC_PARTICIPANTS_H
 

@@ -178,7 +178,7 @@ static void print_session(const recfile_t *rf) {
 }
 
 static void print_participant(void *arg, const recfile_participant_t *p) {
-  (void)arg;
+  int *subjects = arg;
   char first[64], left[64];
   fmt_time(first, sizeof first, p->first_seen_wall_ns);
   if (p->left_wall_ns >= 0)
@@ -187,6 +187,10 @@ static void print_participant(void *arg, const recfile_participant_t *p) {
     snprintf(left, sizeof left, "(present at end)");
   printf("%-10s %-32s %-24s %-24s %s\n", p->role[0] ? p->role : "-", p->guid, first, left,
          p->user_data[0] ? p->user_data : "(no user data)");
+  if (p->subject[0]) {
+    printf("%-10s subject: %s\n", "", p->subject);
+    (*subjects)++;
+  }
 }
 
 /* Who took part: an optional table (recordings made before it existed
@@ -194,7 +198,8 @@ static void print_participant(void *arg, const recfile_participant_t *p) {
 static int print_participants(recfile_t *rf, const char *path) {
   printf("\nparticipants (roles are each process's own claim, see vdds_ident.h):\n");
   printf("%-10s %-32s %-24s %-24s %s\n", "role", "guid", "first seen", "left", "user data");
-  int n = recfile_participants(rf, print_participant, NULL);
+  int subjects = 0;
+  int n = recfile_participants(rf, print_participant, &subjects);
   if (n == -1) {
     printf("(not recorded: this recording predates participant metadata)\n");
   } else if (n == -2) {
@@ -202,6 +207,11 @@ static int print_participants(recfile_t *rf, const char *path) {
     return -1;
   } else {
     printf("participants: %d\n", n);
+    /* What a subject proves: common/dds/vdds_subject.h. */
+    if (subjects)
+      printf("certificate subjects: %d, each verified against the participant's authenticated GUID\n", subjects);
+    else
+      printf("certificate subjects: none (the recorder did not run with DDS Security, or the file predates them)\n");
   }
   return 0;
 }

@@ -289,13 +289,14 @@ static void summarise(rep_recording_t *r) {
 
 /* Who trained in this section: its seat (partition) and, per ToolCommand
  * writer (the trainee's hands), the station and process its participant
- * announced (a claim, vdds_ident.h; authenticated only with DDS Security). */
+ * announced (a claim, vdds_ident.h) and, under DDS Security, its
+ * certificate subject as the recorder verified it (vdds_subject.h). */
 static void describe_identity(rep_recording_t *r, recfile_t *rf, const load_ctx_t *c) {
   size_t len = (size_t)snprintf(r->identity, sizeof r->identity, "seat %s",
                                 c->seat ? c->seat : (r->session.partition[0] ? r->session.partition : "?"));
   const recfile_topic_t *cmd = recfile_topic_by_name(rf, "viscera_ToolCommand");
   int shown = 0;
-  for (size_t i = 0; cmd && i < c->nwriters && len + 96 < sizeof r->identity; i++) {
+  for (size_t i = 0; cmd && i < c->nwriters && len + 256 < sizeof r->identity; i++) {
     const rec_writer_t *w = &c->writers[i];
     if (w->topic_id != cmd->id || (c->seat && strcmp(w->partitions, c->seat) != 0)) continue;
     char station[40] = "", host[64] = "?", pid[16] = "?";
@@ -303,9 +304,15 @@ static void describe_identity(rep_recording_t *r, recfile_t *rf, const load_ctx_
       snprintf(station, sizeof station, "anonymous");
     rec_ident_field(w->participant, "host", host, sizeof host);
     rec_ident_field(w->participant, "pid", pid, sizeof pid);
-    /* no commas: the CSV's readers split naively */
-    len += (size_t)snprintf(r->identity + len, sizeof r->identity - len, "; station %s (%s on %s pid %s)", station,
-                            w->role[0] ? w->role : "client", host, pid);
+    /* no commas: the CSV's readers split naively (the subject's commas
+     * become '/', its RFC 2253 separators) */
+    char subject[160];
+    snprintf(subject, sizeof subject, "%s", w->subject[0] ? w->subject : "none: not secure");
+    for (char *q = subject; *q; q++)
+      if (*q == ',') *q = '/';
+    len +=
+        (size_t)snprintf(r->identity + len, sizeof r->identity - len, "; station %s (%s on %s pid %s; certificate %s)",
+                         station, w->role[0] ? w->role : "client", host, pid, subject);
     shown++;
   }
   if (!shown && len + 40 < sizeof r->identity)

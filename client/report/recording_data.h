@@ -57,8 +57,8 @@ typedef struct rep_summary {
 typedef struct rep_recording {
   char path[512];
   char label[64];
-  char seat[128];     /* the partition this section covers, "" = the whole file */
-  char identity[512]; /* who trained: seat, station, the trainee's process */
+  char seat[128];      /* the partition this section covers, "" = the whole file */
+  char identity[1024]; /* who trained: seat, station, the trainee's process */
   recfile_session_t session;
   char scene[72];
   double physics_dt;

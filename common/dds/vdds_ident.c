@@ -5,6 +5,9 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "dds/vdds_config.h"
+#include "dds/vdds_subject.h"
+
 static char g_role[VDDS_ROLE_MAX] = "unknown";
 static int g_tool = -1;
 static char g_station[VDDS_ROLE_MAX] = "";
@@ -53,6 +56,15 @@ size_t vdds_ident_self(char *out, size_t cap) {
   if (g_station[0] && n < cap) {
     int k = snprintf(out + n, cap - n, " station=%s", g_station);
     if (k > 0) n = n + (size_t)k < cap ? n + (size_t)k : cap - 1;
+  }
+  /* Under DDS Security, the certificate's subject (DER, hex) that a secure
+   * reader checks against this participant's GUID (vdds_subject.h). Only
+   * whole: a cut token would not verify anyway. */
+  uint8_t der[VDDS_SUBJECT_DER_MAX];
+  size_t dn = vdds_config_secure() ? vdds_subject_self(der) : 0;
+  if (dn && n + 6 + 2 * dn < cap) {
+    n += (size_t)snprintf(out + n, cap - n, " cert=");
+    for (size_t i = 0; i < dn; i++) n += (size_t)snprintf(out + n, cap - n, "%02x", der[i]);
   }
   return n;
 }

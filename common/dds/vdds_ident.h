@@ -4,7 +4,9 @@
  * text.
  *
  * Format (one line, at most VDDS_IDENT_MAX-1 bytes, printable ASCII):
- *   "viscera role=<role> [tool=<n> ]host=<hostname> pid=<pid>[ station=<name>]"
+ *   "viscera role=<role> [tool=<n> ]host=<hostname> pid=<pid>[ station=<name>][ cert=<hex>]"
+ * cert= is present only under DDS Security: the DER subject of the
+ * process's certificate, which secure readers verify (vdds_subject.h).
  * Every main calls vdds_set_role() (and the haptic client vdds_set_tool())
  * before creating its participant; vdds_open() and the recorder/replay,
  * which create participants themselves, use vdds_participant_qos().
@@ -24,8 +26,9 @@
 
 #include <dds/dds.h>
 
-/* Bound of the announced text and of what readers keep of a peer's. */
-#define VDDS_IDENT_MAX 256
+/* Bound of the announced text and of what readers keep of a peer's
+ * (room for a hostname and a certificate subject). */
+#define VDDS_IDENT_MAX 512
 /* Bound of a role name; longer ones are truncated. */
 #define VDDS_ROLE_MAX 32
 

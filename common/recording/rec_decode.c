@@ -11,21 +11,29 @@
 
 #include "recording/recording.h"
 #include "viscera_format1.h"
+#include "viscera_format2.h"
 
-/* The frozen format-1 twin of a compiled-in type (idl/viscera_format1.idl),
- * by the type's name after its module; NULL when there is none. */
-static const dds_topic_descriptor_t *format1_twin(const dds_topic_descriptor_t *desc) {
-  static const dds_topic_descriptor_t *const twins[] = {
-      &viscera_format1_SceneInfo_desc,   &viscera_format1_MeshState_desc,       &viscera_format1_MeshDelta_desc,
-      &viscera_format1_ToolCommand_desc, &viscera_format1_ContactFeedback_desc, &viscera_format1_SessionEvent_desc,
-      &viscera_format1_Metrics_desc,     &viscera_format1_SessionControl_desc,  &viscera_format1_ToolRole_desc,
-      &viscera_format1_ObjectState_desc, &viscera_format1_ToolMetrics_desc,     &viscera_format1_AppliedInput_desc,
-      &viscera_format1_SceneSource_desc};
+/* The frozen twins of a compiled-in type (idl/viscera_formatN.idl), newest
+ * format first, by the type's name after its module; NULL past the last.
+ * Only a twin whose C struct fits in the compiled one is taken (it reads
+ * into its prefix). */
+#define FORMAT_TWINS(m)                                                                                                \
+  {                                                                                                                    \
+    &m##_SceneInfo_desc, &m##_MeshState_desc, &m##_MeshDelta_desc, &m##_ToolCommand_desc, &m##_ContactFeedback_desc,   \
+        &m##_SessionEvent_desc, &m##_Metrics_desc, &m##_SessionControl_desc, &m##_ToolRole_desc,                       \
+        &m##_ObjectState_desc, &m##_ToolMetrics_desc, &m##_AppliedInput_desc, &m##_SceneSource_desc                    \
+  }
+enum { NFORMATS = 2, NTWINS = 13 };
+static const dds_topic_descriptor_t *format_twin(const dds_topic_descriptor_t *desc, int newest_first) {
+  static const dds_topic_descriptor_t *const twins[NFORMATS][NTWINS] = {FORMAT_TWINS(viscera_format2),
+                                                                        FORMAT_TWINS(viscera_format1)};
+  if (newest_first < 0 || newest_first >= NFORMATS) return NULL;
   const char *name = desc->m_typename ? strrchr(desc->m_typename, ':') : NULL;
   if (!name) return NULL;
-  for (size_t i = 0; i < sizeof twins / sizeof twins[0]; i++) {
-    const char *t = strrchr(twins[i]->m_typename, ':');
-    if (twins[i] != desc && !strcmp(t, name) && twins[i]->m_size <= desc->m_size) return twins[i];
+  const dds_topic_descriptor_t *const *list = twins[newest_first];
+  for (size_t i = 0; i < NTWINS; i++) {
+    const char *t = strrchr(list[i]->m_typename, ':');
+    if (list[i] != desc && !strcmp(t, name) && list[i]->m_size <= desc->m_size) return list[i];
   }
   return NULL;
 }
@@ -146,22 +154,30 @@ static int probe_row(void *arg, const recfile_row_t *row) {
 }
 
 /* A topic recorded before its type grew (fields appended at its end) holds
- * format-1 samples that the grown type does not read: when not one data row
- * decodes with the compiled type but one does with its frozen format-1 twin
- * (idl/viscera_format1.idl), the whole topic is read with the twin, into the
- * prefix of the compiled struct (the appended fields stay zero). Decided
- * per topic, never per sample, so a truncated sample of the compiled type
- * is not taken for an older one. Returns the twin's ops or NULL. */
-static const uint32_t *format1_ops(recfile_t *rf, int64_t topic_id, const dds_topic_descriptor_t *desc, void *sample) {
-  const dds_topic_descriptor_t *twin = format1_twin(desc);
-  if (!twin) return NULL;
+ * samples of an older format that the grown type does not read: when not
+ * one data row decodes with the compiled type, the frozen twins
+ * (idl/viscera_formatN.idl) are tried newest first, and the whole topic is
+ * read with the first one that decodes a row, into the prefix of the
+ * compiled struct (the appended fields stay zero). Newest first because an
+ * XCDR1 sample with more fields than a twin still decodes with it (the
+ * trailing bytes are ignored) and would lose what it appended. Decided per
+ * topic, never per sample, so a truncated sample of the compiled type is
+ * not taken for an older one. Returns the twin's ops or NULL. */
+static const uint32_t *older_format_ops(recfile_t *rf, int64_t topic_id, const dds_topic_descriptor_t *desc,
+                                        void *sample) {
   probe_ctx_t p = {desc, NULL, sample, false};
   recfile_scan_report_t r;
   recfile_scan(rf, topic_id, true, probe_row, &p, &r);
   if (p.found || r.rows == 0) return NULL;
-  p.ops = twin->m_ops;
-  recfile_scan(rf, topic_id, true, probe_row, &p, &r);
-  return p.found ? twin->m_ops : NULL;
+  for (int f = 0; f < NFORMATS; f++) {
+    const dds_topic_descriptor_t *twin = format_twin(desc, f);
+    /* the compiled type itself may be the newest format: skip identical ops */
+    if (!twin || twin->m_ops == desc->m_ops) continue;
+    p.ops = twin->m_ops;
+    recfile_scan(rf, topic_id, true, probe_row, &p, &r);
+    if (p.found) return twin->m_ops;
+  }
+  return NULL;
 }
 
 int rec_decode_topic(recfile_t *rf, const char *topic, const dds_topic_descriptor_t *desc, rec_decode_cb cb, void *arg,
@@ -174,7 +190,7 @@ int rec_decode_topic(recfile_t *rf, const char *topic, const dds_topic_descripto
   }
   decode_ctx_t c = {desc, NULL, calloc(1, desc->m_size ? desc->m_size : 1), cb, arg, rep};
   if (!c.sample) return -1;
-  c.ops = format1_ops(rf, t->id, desc, c.sample);
+  c.ops = older_format_ops(rf, t->id, desc, c.sample);
   recfile_scan(rf, t->id, true, on_row, &c, &rep->scan);
   free(c.sample);
   return 0;

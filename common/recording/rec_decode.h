@@ -53,10 +53,11 @@ typedef int (*rec_decode_cb)(void *arg, const void *sample, const recfile_row_t 
 /* Calls `cb` for every data sample of topic `topic` (e.g.
  * "viscera_ContactFeedback") that decodes with `desc`, in recording order,
  * salvaging around damage (recfile_scan). Dispose/unregister rows are
- * skipped. A topic recorded with an older version of the type (format 1,
- * before fields were appended to it: no row decodes with `desc`, rows do
- * with the frozen twin of idl/viscera_format1.idl) is read with that twin
- * into the prefix of desc's struct, the appended fields zero.
+ * skipped. A topic recorded with an older version of the type (format 1 or
+ * 2, before fields were appended to it: no row decodes with `desc`, rows do
+ * with a frozen twin, idl/viscera_format2.idl tried before
+ * idl/viscera_format1.idl) is read with that twin into the prefix of desc's
+ * struct, the appended fields zero.
  * Returns 0, or -1 when out of memory. */
 int rec_decode_topic(recfile_t *rf, const char *topic, const dds_topic_descriptor_t *desc, rec_decode_cb cb, void *arg,
                      rec_decode_report_t *rep);

@@ -67,6 +67,7 @@ int rec_writers_load(recfile_t *rf, rec_writer_t **out, size_t *n, verr_t *err) 
     for (size_t k = 0; k < pl.n; k++)
       if (strlen(x->guid) == 32 && strncmp(pl.p[k].guid, x->guid, 24) == 0) {
         snprintf(x->participant, sizeof x->participant, "%s", pl.p[k].user_data);
+        snprintf(x->subject, sizeof x->subject, "%s", pl.p[k].subject);
         snprintf(x->role, sizeof x->role, "%s", pl.p[k].role);
         break;
       }

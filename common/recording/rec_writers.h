@@ -23,6 +23,7 @@ typedef struct rec_writer {
   char partitions[256];  /* comma separated, as recorded ("" when none) */
   char participant[256]; /* USER_DATA of the owning participant, "" unknown */
   char role[32];         /* its role, "" unknown */
+  char subject[160];     /* its verified certificate subject, "" none (recfile.h) */
 } rec_writer_t;
 
 /* Every writer, ordered by id, into *out (*n of them; free(*out)).

@@ -357,9 +357,14 @@ int recfile_participants(recfile_t *rf, recfile_participant_cb cb, void *arg) {
   bool have = rc == SQLITE_OK && sqlite3_step(st) == SQLITE_ROW && sqlite3_column_int(st, 0) > 0;
   sqlite3_finalize(st);
   if (!have) return -1;
+  /* subject: a later column (recording.h); older files read it as NULL */
+  bool subject = sqlite3_prepare_v2(rf->db, "SELECT subject FROM participants LIMIT 0", -1, &st, NULL) == SQLITE_OK;
+  sqlite3_finalize(st);
   if (sqlite3_prepare_v2(rf->db,
-                         "SELECT guid, user_data, role, first_seen_wall_ns, last_seen_wall_ns, left_wall_ns"
-                         " FROM participants ORDER BY first_seen_wall_ns, guid",
+                         subject ? "SELECT guid, user_data, role, first_seen_wall_ns, last_seen_wall_ns, left_wall_ns,"
+                                   " subject FROM participants ORDER BY first_seen_wall_ns, guid"
+                                 : "SELECT guid, user_data, role, first_seen_wall_ns, last_seen_wall_ns, left_wall_ns,"
+                                   " NULL FROM participants ORDER BY first_seen_wall_ns, guid",
                          -1, &st, NULL) != SQLITE_OK) {
     sqlite3_finalize(st);
     return -2;
@@ -374,6 +379,7 @@ int recfile_participants(recfile_t *rf, recfile_participant_cb cb, void *arg) {
     p.first_seen_wall_ns = sqlite3_column_int64(st, 3);
     p.last_seen_wall_ns = sqlite3_column_int64(st, 4);
     p.left_wall_ns = sqlite3_column_type(st, 5) == SQLITE_NULL ? -1 : sqlite3_column_int64(st, 5);
+    copy_clean(p.subject, sizeof p.subject, st, 6);
     cb(arg, &p);
     n++;
   }

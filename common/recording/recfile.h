@@ -104,6 +104,7 @@ typedef struct recfile_participant {
   char role[32]; /* "" when none was announced */
   int64_t first_seen_wall_ns, last_seen_wall_ns;
   int64_t left_wall_ns; /* < 0: still present at the end */
+  char subject[160];    /* verified certificate subject, "" when none (not secure, or an older file) */
 } recfile_participant_t;
 typedef void (*recfile_participant_cb)(void *arg, const recfile_participant_t *p);
 /* Calls cb for each participant, in first-seen order. Returns the count,

@@ -35,7 +35,11 @@
  *               last seen wall time and the time it left (disposed or its
  *               lease expired; NULL if still there at the end). Added after
  *               format 1 shipped: files without this table stay valid and
- *               readers treat it as optional.
+ *               readers treat it as optional. `subject` (added later still,
+ *               NULL in older files) is the participant's certificate
+ *               subject (RFC 2253) when the recorder ran with DDS Security
+ *               and the announced subject matched the authenticated GUID
+ *               (vdds_subject.h); NULL otherwise.
  *   sample_kinds  lookup table naming the values of samples.kind.
  *   samples     one row per sample in the order the recorder stored it:
  *               topic, writer, source timestamp (writer's clock, ns), wall
@@ -126,7 +130,8 @@ typedef enum rec_kind { REC_KIND_DATA = 0, REC_KIND_DISPOSE = 1, REC_KIND_UNREGI
   " role TEXT,"                                                                                                        \
   " first_seen_wall_ns INTEGER NOT NULL,"                                                                              \
   " last_seen_wall_ns INTEGER NOT NULL,"                                                                               \
-  " left_wall_ns INTEGER);"                                                                                            \
+  " left_wall_ns INTEGER,"                                                                                             \
+  " subject TEXT);"                                                                                                    \
   "CREATE TABLE sample_kinds (id INTEGER PRIMARY KEY, name TEXT NOT NULL);"                                            \
   "INSERT INTO sample_kinds VALUES (0, 'data'), (1, 'dispose'), (2, 'unregister');"                                    \
   "CREATE TABLE samples ("                                                                                             \

@@ -25,7 +25,7 @@ struct store {
   sqlite3_stmt *ins_topic;
   sqlite3_stmt *ins_key;
   sqlite3_stmt *ins_writer;
-  sqlite3_stmt *ins_part, *left_part;
+  sqlite3_stmt *ins_part, *left_part, *subj_part;
   store_batch_limits_t limits;
   bool in_txn;
   uint64_t batch_start_ns;
@@ -225,7 +225,8 @@ int store_open(store_t **out, const char *path, bool force, const store_session_
               " role=excluded.role, last_seen_wall_ns=excluded.last_seen_wall_ns, left_wall_ns=NULL",
               &s->ins_part, err) < 0 ||
       prepare(s, "UPDATE participants SET last_seen_wall_ns=?1, left_wall_ns=?1 WHERE guid=?2 AND left_wall_ns IS NULL",
-              &s->left_part, err) < 0)
+              &s->left_part, err) < 0 ||
+      prepare(s, "UPDATE participants SET subject=?1 WHERE guid=?2", &s->subj_part, err) < 0)
     goto fail;
   *out = s;
   return 0;
@@ -236,6 +237,7 @@ fail:
   sqlite3_finalize(s->ins_writer);
   sqlite3_finalize(s->ins_part);
   sqlite3_finalize(s->left_part);
+  sqlite3_finalize(s->subj_part);
   sqlite3_close(s->db);
   free(s->path);
   free(s);
@@ -487,6 +489,15 @@ int store_note_participant(store_t *s, const uint8_t guid[16], const char *user_
   return step_reset(s, st, err, "cannot note participant");
 }
 
+int store_note_subject(store_t *s, const uint8_t guid[16], const char *subject, verr_t *err) {
+  if (begin_if_needed(s, err) < 0) return -1;
+  char hex[33];
+  store_guid_hex(guid, hex);
+  sqlite3_bind_text(s->subj_part, 1, subject, -1, SQLITE_STATIC);
+  sqlite3_bind_text(s->subj_part, 2, hex, -1, SQLITE_STATIC);
+  return step_reset(s, s->subj_part, err, "cannot note participant subject");
+}
+
 int store_close(store_t *s, int64_t end_wall_ns, verr_t *err) {
   int ret = store_commit(s, err);
   if (s->failed) {
@@ -521,6 +532,7 @@ int store_close(store_t *s, int64_t end_wall_ns, verr_t *err) {
   sqlite3_finalize(s->ins_writer);
   sqlite3_finalize(s->ins_part);
   sqlite3_finalize(s->left_part);
+  sqlite3_finalize(s->subj_part);
   /* After a failure the last connection's close still checkpoints the
    * WAL into the main file and removes it. */
   if (sqlite3_close(s->db) != SQLITE_OK && ret == 0) ret = verr_set(err, "%s: close failed", s->path);

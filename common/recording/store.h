@@ -82,6 +82,9 @@ int store_add_writer(store_t *s, int64_t topic_id, const uint8_t guid[16], const
  * Not alive (`left`): last seen and left time set to wall_ns. */
 int store_note_participant(store_t *s, const uint8_t guid[16], const char *user_data, const char *role, bool left,
                            int64_t wall_ns, verr_t *err);
+/* Sets the verified certificate subject of a participant already noted
+ * (column participants.subject; see vdds_subject.h for what is verified). */
+int store_note_subject(store_t *s, const uint8_t guid[16], const char *subject, verr_t *err);
 
 /* Appends one sample to the current batch (starting one if needed); commits
  * at once when the batch reaches its sample or byte limit. */

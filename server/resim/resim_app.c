@@ -228,6 +228,10 @@ int resim_app_run(const resim_options_t *o) {
   }
   int rc = 2;
   FILE *csv = NULL;
+  if (resim_resume(&rt, &rec, &err)) {
+    fprintf(stderr, "viscera-resim: %s: %s\n", o->rec_path, err.msg);
+    goto out;
+  }
   if (resim_check_scene(&rt, &rec, &err)) {
     fprintf(stderr, "viscera-resim: %s: refusing to re-simulate: %s\n", o->rec_path, err.msg);
     goto out;
@@ -257,6 +261,10 @@ int resim_app_run(const resim_options_t *o) {
     goto out;
   }
   double wall = (double)(vtime_mono_ns() - ctx.t0) * 1e-9;
+  if (rec.source.resumed)
+    printf("RESUMED step=%" PRIu64 " t=%.3f checkpoint_sha256=%s state_bytes=%zu\n", res.resumed_step,
+           (double)res.resumed_step * scene.dt, rec.source.resume_sha256[0] ? rec.source.resume_sha256 : "unknown",
+           rec.source.resume_len);
 
   print_schedules(&rt, &rec, &res);
   int compared = 0, beyond = print_organs(&rt, &rec, &res, &scene, tolerance, &compared);

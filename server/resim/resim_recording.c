@@ -403,11 +403,20 @@ static int on_source(void *arg, const void *sample, const recfile_row_t *row) {
   resim_source_t *src = &((load_ctx_t *)arg)->rec->source;
   const viscera_SceneSource *s = sample;
   char *text = strdup(s->text ? s->text : "");
-  if (!text) return ((load_ctx_t *)arg)->oom = 1;
+  unsigned char *resume = s->resume_state._length ? malloc(s->resume_state._length) : NULL;
+  if (!text || (s->resume_state._length && !resume)) {
+    free(text);
+    return ((load_ctx_t *)arg)->oom = 1;
+  }
+  if (resume) memcpy(resume, s->resume_state._buffer, s->resume_state._length);
   free(src->text);
+  free(src->resume);
   memset(src, 0, sizeof *src);
   src->have = 1;
   src->text = text;
+  src->resume = resume;
+  src->resume_len = s->resume_state._length;
+  snprintf(src->resume_sha256, sizeof src->resume_sha256, "%s", s->resume_sha256);
   snprintf(src->path, sizeof src->path, "%s", s->path);
   snprintf(src->text_sha256, sizeof src->text_sha256, "%s", s->text_sha256);
   for (uint32_t i = 0; i < s->meshes._length && i < SCENE_MAX_ORGANS; i++) {
@@ -525,6 +534,7 @@ void resim_recording_free(resim_recording_t *rec) {
   free(rec->objects);
   free(rec->metrics);
   free(rec->source.text);
+  free(rec->source.resume);
   for (size_t i = 0; i < rec->ndeltas; i++) {
     free(rec->deltas[i].idx);
     free(rec->deltas[i].dq);

@@ -128,6 +128,16 @@ typedef struct resim_source {
     uint64_t size;
   } meshes[SCENE_MAX_ORGANS];
   char version[65], compiler[129], build_flags[257], station[65];
+  /* A resumed session (SceneSource.resume_state): the state it started
+   * from (owned; NULL/0 from rest) and its checkpoint file's digest. */
+  unsigned char *resume;
+  size_t resume_len;
+  char resume_sha256[65];
+  /* Set by resim_resume (resim_run.h): restored, at which step, and where
+   * each tool's measures are in `resume` (training/measures_blob.h). */
+  int resumed;
+  uint64_t resumed_step;
+  size_t tool_at[SCENE_MAX_TOOLS];
 } resim_source_t;
 
 typedef struct resim_recording {

@@ -9,6 +9,8 @@
 
 #include "mesh_delta.h"
 #include "resim/resim_measures.h"
+#include "runtime/checkpoint_state.h"
+#include "training/measures_blob.h"
 
 int resim_check_scene(const runtime_t *rt, const resim_recording_t *rec, verr_t *err) {
   const scene_t *sc = &rt->scene;
@@ -542,6 +544,50 @@ static int run_scheduled(run_ctx_t *c) {
   return rc;
 }
 
+/* A resumed session (SceneSource.resume_state): where each tool's measures
+ * are in the state, checked as they are read. */
+static const char *resume_tool(void *ctx, state_blob_t *b, size_t t) {
+  resim_source_t *s = ctx;
+  s->tool_at[t] = b->at;
+  thr_tracker_t scratch = {0};
+  uint32_t grasps;
+  double grasp_time;
+  return measures_blob_get(b, &scratch, &grasps, &grasp_time);
+}
+
+int resim_resume(runtime_t *rt, resim_recording_t *rec, verr_t *err) {
+  resim_source_t *s = &rec->source;
+  if (!s->resume_len) return 0;
+  state_blob_t b = {.p = s->resume, .len = s->resume_len, .cap = s->resume_len};
+  ckpt_session_io_t io = {.ctx = s, .get_tool = resume_tool};
+  char what[200] = "";
+  verr_t e = {{0}};
+  int rc = ckpt_state_get(&b, rt, &io, what, sizeof what, &e);
+  if (rc != 1)
+    return verr_set(err,
+                    "the session resumed from a checkpoint (sha256 %s) whose recorded state cannot be restored: %s",
+                    s->resume_sha256[0] ? s->resume_sha256 : "unknown", rc == -1 ? what : e.msg);
+  s->resumed = 1;
+  s->resumed_step = rt->steps;
+  return 0;
+}
+
+/* The run starts where the server resumed: each tool's measures as it
+ * restored them (levels stay the scene's; no grasp is held), and the
+ * restored topologies followed from a scene built from rest (as the
+ * server's follow_topology after checkpoint_load). */
+static void start_resumed(run_ctx_t *c) {
+  resim_source_t *s = &c->rec->source;
+  for (size_t t = 0; t < c->rt->ntools; t++) {
+    state_blob_t b = {.p = s->resume, .len = s->resume_len, .cap = s->resume_len, .at = s->tool_at[t]};
+    measures_blob_get(&b, &c->measures.thr[t], &c->measures.grasps[t], &c->measures.grasp_time[t]);
+    c->measures.was_holding[t] = 0;
+  }
+  for (size_t i = 0; i < c->rt->norgans; i++) c->modelver[i] = 0;
+  follow(c);
+  c->res->resumed_step = s->resumed_step;
+}
+
 /* The recorded interaction events against the re-simulation's, in order. */
 static void compare_events(run_ctx_t *c) {
   resim_event_result_t *r = &c->res->events;
@@ -586,6 +632,7 @@ int resim_run(runtime_t *rt, resim_recording_t *rec, const resim_hooks_t *hooks,
   if (rec->nmetrics) qsort(rec->metrics, rec->nmetrics, sizeof *rec->metrics, cmp_metrics);
   for (size_t i = 0; i < rec->nmetrics; i++) rec->metrics[i].done = 0;
   resim_measures_init(&c->measures, rt);
+  if (rec->source.resumed) start_resumed(c);
   for (size_t i = 0; i < rec->nkeys; i++) rec->keys[i].done = 0;
   for (size_t i = 0; i < rec->ndeltas; i++) rec->deltas[i].done = 0;
   for (size_t i = 0; i < rec->nobjects; i++) rec->objects[i].done = 0;

@@ -62,7 +62,8 @@ typedef struct resim_result {
   int applied;                                     /* re-simulated from AppliedInput (else the rebuilt schedule) */
   uint64_t commands, releases, controls, rebuilds; /* applied inputs replayed */
   uint32_t epochs;                                 /* rebuilds the run went through */
-  int diverged;                                    /* the recording asked for a state the run could not reach */
+  uint64_t resumed_step; /* a resumed session: the step its recorded state starts at; 0 from rest */
+  int diverged;          /* the recording asked for a state the run could not reach */
   char divergence[VERR_MSG_LEN];
   resim_organ_result_t organs[SCENE_MAX_ORGANS];
   resim_object_result_t objects;
@@ -81,7 +82,15 @@ typedef struct resim_hooks {
 } resim_hooks_t;
 
 int resim_check_scene(const runtime_t *rt, const resim_recording_t *rec, verr_t *err);
-/* rt fresh from runtime_init; rec from resim_recording_load (its arrays
+/* A session resumed from a checkpoint (SceneSource.resume_state): restores
+ * its recorded state into `rt` (built from rest from the recording's
+ * scene), as the server did, and notes it in rec->source (resumed, the
+ * step, where the tools' measures are). Call before checking the scene
+ * against the recording and before resim_run. 0 when restored or nothing
+ * to restore; -1 with err when the state is refused. */
+int resim_resume(runtime_t *rt, resim_recording_t *rec, verr_t *err);
+
+/* rt fresh from runtime_init (and resim_resume); rec from resim_recording_load (its arrays
  * are sorted in place). With applied inputs (idl AppliedInput, issue 16)
  * every recorded tool command, release and SessionControl is re-applied
  * before the step the server took it (pause, rebuilds for RESET and

@@ -3,6 +3,7 @@
 
 #include "runtime/checkpoint_state.h"
 #include "state_blob.h"
+#include "training/measures_blob.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -68,21 +69,11 @@ typedef struct session_records {
   } role[SCENE_MAX_TOOLS];
 } session_records_t;
 
-/* Per tool: tracker measures, then tally (grasps, grasp_time). */
+/* Per tool: tracker measures, then tally (grasps, grasp_time), in the
+ * layout of training/measures_blob.h. */
 static void put_tool(void *ctx, buf_t *b, size_t t) {
   const session_saved_t *r = ctx;
-  const thr_tracker_t *tr = &r->tools[t].thr;
-  const tool_tally_t *tl = &r->tools[t].tally;
-  for (int k = 0; k < THR_COUNT; k++) {
-    sb_put_f64(b, tr->time_above[k]);
-    sb_put_u64(b, tr->crossings[k]);
-  }
-  sb_put_f64(b, tr->peak_force);
-  sb_put_f64(b, tr->contact_time);
-  sb_put_f64(b, tr->contact_force_integral);
-  sb_put_f64(b, tr->path_length);
-  sb_put_u64(b, tl->grasps);
-  sb_put_f64(b, tl->grasp_time);
+  measures_blob_put(b, &r->tools[t].thr, r->tools[t].tally.grasps, r->tools[t].tally.grasp_time);
 }
 
 /* nroles (0 when saved without roles, else ntools), per tool:
@@ -107,22 +98,12 @@ static const char *get_tool(void *ctx, buf_t *b, size_t t) {
   session_records_t *r = ctx;
   thr_tracker_t *tr = &r->tmp[t];
   *tr = r->tools[t].thr; /* levels and live state stay the scene's */
-  for (int k = 0; k < THR_COUNT; k++) {
-    tr->time_above[k] = sb_get_f64(b);
-    tr->crossings[k] = (uint32_t)sb_get_u64(b);
-  }
-  tr->peak_force = sb_get_f64(b);
-  tr->contact_time = sb_get_f64(b);
-  tr->contact_force_integral = sb_get_f64(b);
-  tr->path_length = sb_get_f64(b);
-  double sum = tr->peak_force + tr->contact_time + tr->contact_force_integral + tr->path_length;
-  for (int k = 0; k < THR_COUNT; k++) sum += tr->time_above[k];
-  if (!isfinite(sum) || tr->peak_force < 0 || tr->contact_time < 0 || tr->path_length < 0) return "bad tool measures";
-  uint64_t grasps = sb_get_u64(b);
-  double grasp_time = sb_get_f64(b);
-  if (grasps > UINT32_MAX || !isfinite(grasp_time) || grasp_time < 0) return "bad tool tally";
+  uint32_t grasps = 0;
+  double grasp_time = 0;
+  const char *bad = measures_blob_get(b, tr, &grasps, &grasp_time);
+  if (bad) return bad;
   /* Not holding now: a grasp is not restored, so the next one counts anew. */
-  r->tl[t] = (tool_tally_t){.grasps = (uint32_t)grasps, .grasp_time = grasp_time, .was_holding = 0};
+  r->tl[t] = (tool_tally_t){.grasps = grasps, .grasp_time = grasp_time, .was_holding = 0};
   return NULL;
 }
 
@@ -169,6 +150,12 @@ static int serialise(buf_t *b, const runtime_t *rt, const session_tool_t *tools,
   session_saved_t saved = {.tools = tools, .roles = roles};
   ckpt_session_io_t io = {.ctx = &saved, .put_tool = put_tool, .put_tail = put_tail};
   return ckpt_state_put(b, rt, &io, err);
+}
+
+int checkpoint_resume_state(state_blob_t *out, const runtime_t *rt, const session_tool_t *tools, verr_t *err) {
+  session_saved_t saved = {.tools = tools, .roles = NULL};
+  ckpt_session_io_t io = {.ctx = &saved, .put_tool = put_tool};
+  return ckpt_state_put(out, rt, &io, err);
 }
 
 static int write_atomic(const char *path, const unsigned char *p, size_t len, verr_t *err) {

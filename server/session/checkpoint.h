@@ -27,6 +27,7 @@
 #include "runtime/scene_runtime.h"
 #include "session/session_tool.h"
 #include "session/tool_roles.h"
+#include "state_blob.h"
 #include "verr.h"
 
 #include <stdint.h>
@@ -49,6 +50,15 @@ int checkpoint_save(const char *path, const runtime_t *rt, const session_tool_t 
  * when a topology restore failed midway), -2 when that rebuild failed too
  * (out of memory: rt is unusable). */
 int checkpoint_load(const char *path, runtime_t *rt, session_tool_t *tools, tool_roles_t *roles, verr_t *err);
+
+/* The state a resumed session runs from, for its recording (issue 16:
+ * SceneSource.resume_state, so viscera-resim starts where the server did):
+ * the core's state (runtime/checkpoint_state.h) with each tool's measures
+ * (training/measures_blob.h) and nothing else: no magic, no roles (the
+ * recorded AppliedInput carries their effect), no CRC (the recording's
+ * transport checks it). Appended to *out (the caller frees out->p); -1 with
+ * err as checkpoint_save. */
+int checkpoint_resume_state(state_blob_t *out, const runtime_t *rt, const session_tool_t *tools, verr_t *err);
 
 /* Periodic checkpoints from the physics loop without waiting on the disk:
  * submit() copies the state (no allocation once the buffers have grown;

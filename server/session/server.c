@@ -22,6 +22,7 @@
 #include "session/tool_metrics.h"
 #include "session/tool_roles.h"
 #include "session/writer_stations.h"
+#include "sha256.h"
 #include "dds/vdds_gate.h"
 #include "viscera.h"
 #include "vmath.h"
@@ -66,6 +67,10 @@ typedef struct server {
   size_t nstep_us;
   uint64_t publish_every, metrics_every; /* steps between frames, between metrics */
   server_stats_t *stats;
+  /* A resumed session: the state it resumed from and the checkpoint file's
+   * digest, recorded in SceneSource (checkpoint_resume_state). */
+  state_blob_t resume;
+  char resume_sha256[SHA256_HEX_LEN];
 } server_t;
 
 static uint64_t sim_ns(const server_t *s) { return (uint64_t)(s->rt.sim_time * 1e9); }
@@ -142,7 +147,13 @@ static void publish_scene_source(server_t *s) {
   viscera_SceneSource src;
   verr_t e;
   if (scene_source_fill(&src, &s->rt.scene, NULL, &e)) fprintf(stderr, "server: warning: %s\n", e.msg);
+  /* borrowed for the write only */
+  src.resume_state._buffer = s->resume.p;
+  src.resume_state._length = src.resume_state._maximum = (uint32_t)s->resume.len;
+  snprintf(src.resume_sha256, sizeof src.resume_sha256, "%s", s->resume_sha256);
   if (dds_write(s->w_source, &src) >= 0) s->stats->published[VT_SCENE_SOURCE]++;
+  src.resume_state._buffer = NULL;
+  src.resume_state._length = src.resume_state._maximum = 0;
   scene_source_free(&src);
 }
 
@@ -219,6 +230,7 @@ static int setup(server_t *s, const scene_t *scene, verr_t *err) {
 }
 
 static void teardown(server_t *s) {
+  free(s->resume.p);
   for (size_t i = 0; i < s->rt.norgans; i++) mesh_publisher_destroy(&s->pubs[i]);
   runtime_destroy(&s->rt);
   vdds_close(&s->dds); /* stops the listener before the watch goes */
@@ -962,6 +974,9 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
   char resumed[300] = "";
   if (opts->checkpoint) {
     verr_t e;
+    /* the digest of the file as it is loaded: the checkpointer rewrites it later */
+    uint64_t ckpt_size = 0;
+    if (sha256_file(opts->checkpoint, s.resume_sha256, &ckpt_size, &e)) s.resume_sha256[0] = 0;
     int r = checkpoint_load(opts->checkpoint, &s.rt, s.tool, &s.roles, &e);
     if (r == -2) {
       verr_set(err, "%s (cannot rebuild the scene after it)", e.msg);
@@ -985,7 +1000,15 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
                s.rt.sim_time, (unsigned long long)s.rt.steps);
       if (!opts->quiet) fprintf(stderr, "server: %s\n", resumed);
       follow_topology(&s); /* a restored cut: keyframes of its topology before anything else */
+      if (checkpoint_resume_state(&s.resume, &s.rt, s.tool, &e) || s.resume.bad) {
+        /* the session runs on; its recording cannot be re-simulated */
+        fprintf(stderr, "server: warning: the resumed state cannot be recorded: %s\n",
+                s.resume.bad ? "out of memory" : e.msg);
+        free(s.resume.p);
+        s.resume = (state_blob_t){0};
+      }
     }
+    if (r != 1) s.resume_sha256[0] = 0; /* from rest: nothing resumed */
     if (!(ckpt = checkpointer_start(opts->checkpoint, err))) {
       teardown(&s);
       return -1;
@@ -995,7 +1018,10 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
   publish_scene_info(&s);
   publish_scene_source(&s);
   publish_roles(&s);
-  for (size_t i = 0; i < s.rt.norgans; i++) mesh_publisher_keyframe(&s.pubs[i], s.rt.organs[i].model->surf_x, 0);
+  /* Stamped with the simulated time of the state: 0 from rest, the
+   * checkpoint's when resumed (a re-simulation matches frames by step). */
+  for (size_t i = 0; i < s.rt.norgans; i++)
+    mesh_publisher_keyframe(&s.pubs[i], s.rt.organs[i].model->surf_x, sim_ns(&s));
   publish_event(&s, viscera_EVENT_SESSION_STARTED, -1, -1, stats->resumed, resumed[0] ? resumed : scene->name);
 
   uint64_t dt_ns = (uint64_t)(scene->dt * 1e9);

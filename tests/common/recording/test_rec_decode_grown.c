@@ -1,11 +1,15 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* rec_decode (common/recording/rec_decode.h) in a LATER build whose types
- * have grown (grown_types.idl: a field appended to SessionEvent and to
- * ToolCommand): every SessionEvent and ToolCommand of the format-1
- * recording kept in tests/data (final types, XCDR1) still decodes, through
- * the frozen twin idl/viscera_format1.idl, with its recorded values and the
- * appended field zero; without the twin none would (a shorter XCDR1 sample
- * does not normalize against the grown type). Needs VISCERA_SOURCE_DIR. */
+ * have grown (grown_types.idl: a field appended to SessionEvent, to
+ * ToolCommand and to SceneSource): every SessionEvent and ToolCommand of the
+ * format-1 recording kept in tests/data (final types, XCDR1) still decodes,
+ * through the frozen twin idl/viscera_format1.idl, with its recorded values
+ * and the appended field zero; without the twin none would (a shorter XCDR1
+ * sample does not normalize against the grown type). The SceneSource of the
+ * format-2 recording (a resumed session) decodes through
+ * idl/viscera_format2.idl with its resume state whole: read with the
+ * format-1 twin it would decode too, without it (trailing bytes are
+ * ignored), so the newest twin must come first. Needs VISCERA_SOURCE_DIR. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -38,6 +42,39 @@ static int on_command(void *arg, const void *sample, const recfile_row_t *row) {
   return 0;
 }
 
+typedef struct source_tally {
+  int n, have_text;
+  uint32_t resume_len;
+  char resume_sha256[65];
+  uint64_t grown;
+} source_tally_t;
+
+static int on_source(void *arg, const void *sample, const recfile_row_t *row) {
+  (void)row;
+  source_tally_t *t = arg;
+  const viscera_SceneSource *s = sample;
+  t->n++;
+  t->have_text = s->text && strstr(s->text, "organs:") != NULL;
+  t->resume_len = s->resume_state._length;
+  snprintf(t->resume_sha256, sizeof t->resume_sha256, "%s", s->resume_sha256);
+  t->grown = s->grown_source;
+  return 0;
+}
+
+static void source_of(const char *src, const char *file, source_tally_t *t) {
+  char path[1024];
+  snprintf(path, sizeof path, "%s/tests/data/%s", src ? src : ".", file);
+  recfile_t *rf = NULL;
+  verr_t err;
+  memset(t, 0, sizeof *t);
+  CHECK(recfile_open(&rf, path, &err) == 0);
+  if (!rf) return;
+  rec_decode_report_t rep;
+  CHECK(rec_decode_topic(rf, "viscera_SceneSource", &viscera_SceneSource_desc, on_source, t, &rep) == 0);
+  CHECK(rep.undecodable == 0 && rep.decoded == 1);
+  recfile_close(rf);
+}
+
 int main(void) {
   const char *src = getenv("VISCERA_SOURCE_DIR");
   char path[1024];
@@ -59,5 +96,11 @@ int main(void) {
   CHECK(t.commands == 251 && t.seqs == 251);
   CHECK(t.grown == 0);
   recfile_close(rf);
+
+  source_tally_t s1, s2;
+  source_of(src, "session_applied_xcdr1.db", &s1); /* format 1: no resume fields */
+  CHECK(s1.n == 1 && s1.have_text && s1.resume_len == 0 && s1.resume_sha256[0] == 0 && s1.grown == 0);
+  source_of(src, "session_resumed_format2.db", &s2); /* format 2: resumed, its state whole */
+  CHECK(s2.n == 1 && s2.have_text && s2.resume_len == 96224 && strlen(s2.resume_sha256) == 64 && s2.grown == 0);
   return check_report("test_rec_decode_grown");
 }
