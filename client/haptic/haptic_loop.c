@@ -197,7 +197,7 @@ void haptic_loop_run(const haptic_loop_t *l) {
   tick_state_t s; /* 33 kB with the renderer's position ring: on the loop thread's stack */
   memset(&s, 0, sizeof s);
   s.own_station = o->station ? o->station : "";
-  contact_render_init(&s.render, 1.0 / o->rate, l->dev->max_force, HAPTIC_MAX_DAMPING);
+  contact_render_init(&s.render, 1.0 / o->rate, l->dev->max_force);
   uint64_t period_ns = (uint64_t)(1e9 / o->rate);
   double run_for = o->duration >= 0 ? o->duration : 1e300;
   uint64_t start = vtime_mono_ns(), next = start, prev_tick = 0;

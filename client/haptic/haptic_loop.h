@@ -32,12 +32,6 @@ typedef struct haptic_stats {
   uint64_t reanchored_ticks, plain_ticks; /* in contact: model re-anchored at the answered command, or not */
 } haptic_stats_t;
 
-/* N s/m: the passivity controller's damper bound. It acts by scaling the
- * rendered force down (never beyond zero), so the force it renders stays
- * within the device's force limit whatever the bound; the bound only keeps
- * it from reacting to velocity noise near rest (alpha |v| <= |f|). */
-#define HAPTIC_MAX_DAMPING 1e4
-
 typedef struct haptic_loop {
   const haptic_options_t *o;
   device_t *dev;

@@ -8,8 +8,7 @@
 # continuous). Judged from the client's own SUMMARY and force log:
 #   - peak force within 10 % of the 0 ms run's (the same trajectory),
 #   - no one-tick change above 0.1 N (step_n column, step_max_n),
-#   - the passivity observer's energy never above zero beyond what the
-#     one-tick prediction and the force ramp leave (energy_max_j <= 0.1 mJ),
+#   - the passivity observer's energy never above zero (energy_max_j <= 0),
 #   - no "server lost" (server_lost=0): the leases hold under the link.
 # Needs tests/network/sites.sh and prelude.sh (the two-site harness).
 # usage: haptic_palpation_test.sh BUILD SRC OUT
@@ -63,12 +62,10 @@ for setting in "d0:--delay 0" "d25:--delay 25 --jitter 5 --no-reorder --loss 2" 
     "$(awk -v l="$lat" 'BEGIN { print l / 1000 }')"
   awk -v p="$peak" -v r="$ref" 'BEGIN { exit !(p >= 0.9 * r && p <= 1.1 * r) }' || fail "$opts: peak $peak N vs $ref N"
   awk -v s="$step" 'BEGIN { exit !(s <= 0.1) }' || fail "$opts: one-tick change $step N"
-  # The controller predicts the next tick's work from this tick's velocity
-  # and may lower the force by at most the ramp's 0.08 N per tick (the
-  # smoothness target): a hand that accelerates leaves tens of microjoules
-  # it then dissipates (seen: 5-54 uJ at 50-100 ms, 5-10 % loss, under load;
-  # without the controller the plane model gains millijoules).
-  awk -v e="$en" 'BEGIN { exit !(e <= 1e-4) }' || fail "$opts: passivity observer at $en J"
+  # The controller budgets the whole rate-limited release of the force
+  # before it renders it (client/haptic/passivity.h); before it did, a hand
+  # that accelerated away left 5-54 uJ here under load.
+  awk -v e="$en" 'BEGIN { exit !(e <= 0) }' || fail "$opts: passivity observer at $en J"
   stall=$(server_stall_us "$OUT/$name-server.log") cstall=$(client_stall_us "$OUT/$name-haptic.log")
   if [ "$lost" != 0 ]; then
     awk -v s="${stall:-0}" -v c="${cstall:-0}" 'BEGIN { exit !(s > 150000 || c > 100000) }' \
