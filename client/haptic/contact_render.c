@@ -86,7 +86,7 @@ static void track_motion(contact_render_t *r, const double v[3], const double dx
   double T = r->period_s, vn = v3_norm(v), dt = vn > 1e-9 ? v3_norm(dx) / vn : T;
   if (!(dt > 0) || !isfinite(dt)) dt = T;
   r->tick_s = T + (r->tick_s - T) * exp(-dt / CONTACT_RENDER_TICK_MEMORY);
-  if (dt > r->tick_s) r->tick_s = dt;
+  if (dt > r->tick_s) r->tick_s = fmin(dt, CONTACT_RENDER_TICK_MAX);
   if (r->have_v && v3_isfinite(v)) {
     double a[3], w = fmin(1.0, dt / CONTACT_RENDER_ACCEL_TAU);
     v3_sub(a, v, r->v_prev);
@@ -130,7 +130,7 @@ double contact_render_output(contact_render_t *r, const double target[3], int cu
      * again, widened to CONTACT_RENDER_PASSIVE_STEP where the controller
      * asked for less. */
     ramp(r->f_prev, g, r->max_step, f);
-    if (control && passivity_control(&r->pc, v, r->accel, r->tick_s, r->max_step, f) < 1.0) {
+    if (control && passivity_control(&r->pc, v, r->accel, r->tick_s, CONTACT_RENDER_STALL_S, r->max_step, f) < 1.0) {
       double h[3];
       v3_copy(h, f);
       ramp(r->f_prev, h, CONTACT_RENDER_PASSIVE_STEP, f);

@@ -55,8 +55,15 @@
  * filtered over this: a scripted or sampled path jumps in velocity at its
  * samples, a spike the filter spreads without losing its mean. */
 #define CONTACT_RENDER_ACCEL_TAU 0.005
-/* s: a late tick is budgeted for this long after it (then decays to T). */
-#define CONTACT_RENDER_TICK_MEMORY 0.5
+/* s: a late tick is budgeted for this long after it (then decays to T), up
+ * to CONTACT_RENDER_TICK_MAX: a longer stall is a stalled client, not a
+ * tick to plan every release for (it would forbid any force). */
+#define CONTACT_RENDER_TICK_MEMORY 0.2
+#define CONTACT_RENDER_TICK_MAX 0.01
+/* s: the controller's reserve for the tick now being late (a loaded
+ * machine's loop, seen 1-5 ms): the force rendered now is budgeted as held
+ * this long. A longer stall of the client's loop can leave a few uJ. */
+#define CONTACT_RENDER_STALL_S 0.005
 /* s: how long a model is rendered without a new sample before it ramps out. */
 #define CONTACT_RENDER_HOLD_S 0.25
 /* m: the depth below which the press's secant stiffness is not estimated. */

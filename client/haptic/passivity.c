@@ -19,20 +19,21 @@ void passivity_init(passivity_t *p, double period_s) {
 /* N: the controller renders nothing rather than less than this. */
 #define PASSIVITY_MIN_FORCE 1e-4
 
-double passivity_owed(double m, double u, double a, double tick_s, double release_step) {
+double passivity_owed(double m, double u, double a, double tick_s, double hold_s, double release_step) {
   if (!(m > 0) || !(release_step > 0) || !isfinite(u) || !isfinite(a)) return 0;
-  double grow = a > 0 ? a * tick_s : 0, w = 0;
-  for (int k = 0; k < PASSIVITY_MAX_RELEASE_TICKS; k++) {
+  if (hold_s < tick_s) hold_s = tick_s;
+  double ap = a > 0 ? a : 0, u0 = u + ap * hold_s, w = u0 > 0 ? m * u0 * hold_s : 0;
+  for (int k = 1; k < PASSIVITY_MAX_RELEASE_TICKS; k++) {
     double mk = m - k * release_step;
     if (mk <= 0) break;
-    double uk = u + grow * (k + 1);
+    double uk = u + ap * (hold_s + k * tick_s);
     if (uk > 0) w += mk * uk * tick_s;
   }
   return w;
 }
 
-double passivity_control(passivity_t *p, const double v[3], const double a[3], double tick_s, double release_step,
-                         double f[3]) {
+double passivity_control(passivity_t *p, const double v[3], const double a[3], double tick_s, double hold_s,
+                         double release_step, double f[3]) {
   double m = v3_norm(f);
   if (!(m > 0) || !isfinite(m)) return 1;
   double d[3];
@@ -41,7 +42,7 @@ double passivity_control(passivity_t *p, const double v[3], const double a[3], d
   if (tick_s < p->period_s) tick_s = p->period_s;
   /* Within the budget with a relative margin for the rounding of the sums
    * (W is a sum of up to m / r products; E of every tick's). */
-  double owed = passivity_owed(m, u, acc, tick_s, release_step) * PASSIVITY_ROUNDING;
+  double owed = passivity_owed(m, u, acc, tick_s, hold_s, release_step) * PASSIVITY_ROUNDING;
   if (p->energy + owed <= 0) return 1;
   /* W grows with m: the largest m' in [0, m] within the budget, by
    * bisection (60 halvings reach the double's resolution). */
@@ -49,7 +50,7 @@ double passivity_control(passivity_t *p, const double v[3], const double a[3], d
   if (p->energy < 0)
     for (int i = 0; i < 60; i++) {
       double mid = 0.5 * (lo + hi);
-      if (p->energy + passivity_owed(mid, u, acc, tick_s, release_step) * PASSIVITY_ROUNDING <= 0)
+      if (p->energy + passivity_owed(mid, u, acc, tick_s, hold_s, release_step) * PASSIVITY_ROUNDING <= 0)
         lo = mid;
       else
         hi = mid;
@@ -58,7 +59,7 @@ double passivity_control(passivity_t *p, const double v[3], const double a[3], d
    * tick longer than budgeted, would still do (a little) work. */
   if (lo < PASSIVITY_MIN_FORCE) lo = 0;
   double s = lo / m;
-  p->dissipated += (owed - passivity_owed(lo, u, acc, tick_s, release_step) * PASSIVITY_ROUNDING) / PASSIVITY_ROUNDING;
+  p->dissipated += (owed - passivity_owed(lo, u, acc, tick_s, hold_s, release_step) * PASSIVITY_ROUNDING) / PASSIVITY_ROUNDING;
   p->active_ticks++;
   v3_scale(f, f, s);
   return s;

@@ -23,9 +23,12 @@
  * and 0.23 mJ above zero). So the controller budgets the whole release
  * before it lets a force through: with u_k the hand's speed along the force
  * k ticks ahead (its velocity plus its acceleration, when it grows, for
- * k + 1 ticks) and tau the tick's length (the longest of late), the energy
- * still owed by rendering |f| = m now is
- *   W(m) = sum_{k >= 0, m - k r > 0} (m - k r) max(u_k, 0) tau,
+ * the ticks until then) and tau the ticks' length (T, or the longest tick
+ * of late: a loaded machine's late tick holds the force longer), the
+ * energy still owed by rendering |f| = m now is
+ *   W(m) = m max(u_0, 0) h + sum_{k >= 1, m - k r > 0} (m - k r) max(u_k, 0) tau,
+ * h >= tau the longest the force now may be held (a reserve for this very
+ * tick being late, which no history predicts),
  * and the force passed is the largest m' <= m along f's own line with
  * E + W(m') <= 0. Its dissipative element is that scaling (the variable
  * damper alpha v of Ryu and Hannaford, along the force's line, that never
@@ -51,16 +54,19 @@ void passivity_init(passivity_t *p, double period_s);
 /* The energy (J) a force of magnitude m rendered now and then released at
  * release_step (N per tick) is predicted to put into a hand moving at u
  * (m/s, along the force; > 0 away from the wall) with acceleration a
- * (m/s^2, along the force; only a growth of u counts), ticks of tick_s. */
-double passivity_owed(double m, double u, double a, double tick_s, double release_step);
+ * (m/s^2, along the force; only a growth of u counts): the force is held
+ * now for hold_s (>= tick_s: the reserve for this tick being late), then
+ * released in ticks of tick_s. */
+double passivity_owed(double m, double u, double a, double tick_s, double hold_s, double release_step);
 
 /* The controller: f (in place) scaled down along its line, the least, so
  * that E + passivity_owed(|f|, ...) <= 0 (zero when even that cannot hold
  * E: then nothing more is put in). v the hand's velocity, a its
- * acceleration (m/s^2), tick_s the tick's length to budget (>= T). Returns
- * the scale (1: unchanged). Does not update E. */
-double passivity_control(passivity_t *p, const double v[3], const double a[3], double tick_s, double release_step,
-                         double f[3]);
+ * acceleration (m/s^2), tick_s the tick's length to budget (>= T), hold_s
+ * the longest this tick may last. Returns the scale (1: unchanged). Does
+ * not update E. */
+double passivity_control(passivity_t *p, const double v[3], const double a[3], double tick_s, double hold_s,
+                         double release_step, double f[3]);
 
 /* The observer: the force f was held while the hand moved by dx (m). */
 void passivity_observe(passivity_t *p, const double f[3], const double dx[3]);

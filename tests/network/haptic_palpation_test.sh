@@ -25,7 +25,7 @@ client_stall_us() { sed -n 's/^haptic: .* period median .* max \([0-9.]*\) us.*/
 export CYCLONEDDS_URI="file://$SRC/deploy/cyclonedds-site.xml"
 SEAT=hp/palp
 TRAJ="$OUT/palpate_smooth.traj"
-awk 'BEGIN { n = split("0.0 0.070 0.5 0.070 1.5 0.027 2.5 0.027 3.5 0.070 4.5 0.070", v, " ")
+awk 'BEGIN { n = split("0.0 0.070 0.5 0.070 2.0 0.027 3.0 0.027 4.0 0.070 5.0 0.070", v, " ")
   for (i = 1; i + 2 < n; i += 2) { t0 = v[i]; z0 = v[i + 1]; t1 = v[i + 2]; z1 = v[i + 3]
     for (t = t0; t < t1 - 1e-9; t += 0.01) { s = (t - t0) / (t1 - t0); w = s * s * (3 - 2 * s)
       printf "%.3f 0.012 0.004 %.6f\n", t, z0 + w * (z1 - z0) } }
