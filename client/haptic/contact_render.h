@@ -59,11 +59,11 @@
  * to CONTACT_RENDER_TICK_MAX: a longer stall is a stalled client, not a
  * tick to plan every release for (it would forbid any force). */
 #define CONTACT_RENDER_TICK_MEMORY 0.2
-#define CONTACT_RENDER_TICK_MAX 0.01
+#define CONTACT_RENDER_TICK_MAX 0.02
 /* s: the controller's reserve for the tick now being late (a loaded
- * machine's loop, seen 1-5 ms): the force rendered now is budgeted as held
+ * machine's loop, seen 1-65 ms at load 8): the force rendered now is budgeted as held
  * this long. A longer stall of the client's loop can leave a few uJ. */
-#define CONTACT_RENDER_STALL_S 0.005
+#define CONTACT_RENDER_STALL_S 0.02
 /* s: how long a model is rendered without a new sample before it ramps out. */
 #define CONTACT_RENDER_HOLD_S 0.25
 /* m: the depth below which the press's secant stiffness is not estimated. */
@@ -88,10 +88,10 @@ typedef struct contact_render {
   double step_tick;    /* N, this tick's change */
   uint64_t cuts;       /* forces zeroed at once (server lost) */
   uint64_t reanchored_ticks, plain_ticks;
-  double v_prev[3];  /* m/s, the hand's velocity last tick */
-  double accel[3];   /* m/s^2, its filtered acceleration */
-  double tick_s;     /* s, the tick length the controller budgets (recent longest) */
-  int have_v;        /* v_prev holds a velocity */
+  double v_prev[3]; /* m/s, the hand's velocity last tick */
+  double accel[3];  /* m/s^2, its filtered acceleration */
+  double tick_s;    /* s, the tick length the controller budgets (recent longest) */
+  int have_v;       /* v_prev holds a velocity */
   passivity_t pc;
 } contact_render_t;
 

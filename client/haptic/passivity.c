@@ -59,7 +59,8 @@ double passivity_control(passivity_t *p, const double v[3], const double a[3], d
    * tick longer than budgeted, would still do (a little) work. */
   if (lo < PASSIVITY_MIN_FORCE) lo = 0;
   double s = lo / m;
-  p->dissipated += (owed - passivity_owed(lo, u, acc, tick_s, hold_s, release_step) * PASSIVITY_ROUNDING) / PASSIVITY_ROUNDING;
+  p->dissipated +=
+      (owed - passivity_owed(lo, u, acc, tick_s, hold_s, release_step) * PASSIVITY_ROUNDING) / PASSIVITY_ROUNDING;
   p->active_ticks++;
   v3_scale(f, f, s);
   return s;

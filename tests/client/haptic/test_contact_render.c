@@ -250,14 +250,17 @@ int main(void) {
   for (size_t di = 0; di < 3; di++)
     for (int sampled = 0; sampled < 2; sampled++) {
       const trace_t *t = sampled ? &tr10 : &tr;
-      link_t lk = {.delay_ms = ldelays[di], .loss = 0.10, .stall_from = -1, .late = 0.02, .late_ms = 5,
+      link_t lk = {.delay_ms = ldelays[di],
+                   .loss = 0.10,
+                   .stall_from = -1,
+                   .late = 0.02,
+                   .late_ms = 5,
                    .seed = 31 + di * 2 + (uint64_t)sampled};
       result_t res;
       run(t, &lk, NULL, &res);
       double err = (res.peak - ref.peak) / ref.peak;
-      printf("%6d ms %5.0f%% late ticks, %s hand: peak %.3f N (%+.1f %%), step %.4f N, energy %.3g J\n",
-             ldelays[di], 100 * lk.loss, sampled ? "10 ms-sampled" : "smooth", res.peak, 100 * err, res.step_max,
-             res.energy_max);
+      printf("%6d ms %5.0f%% late ticks, %s hand: peak %.3f N (%+.1f %%), step %.4f N, energy %.3g J\n", ldelays[di],
+             100 * lk.loss, sampled ? "10 ms-sampled" : "smooth", res.peak, 100 * err, res.step_max, res.energy_max);
       if (ldelays[di] <= 100) CHECK(fabs(err) <= 0.10);
       CHECK(res.step_max <= 0.1 + 1e-12);
       CHECK(res.energy_max <= 0);
