@@ -24,7 +24,7 @@ void haptic_usage(FILE *f) {
           "  --station NAME      the station (person/seat) this device belongs to, announced with\n"
           "                      every command; a tool assigned to a station obeys only it\n"
           "                      (default: none, the anonymous station)\n"
-          "  --domain N          DDS domain id (default: $VISCERA_DOMAIN or 0)\n"
+          "  --domain N          DDS domain id (default: $VISCERA_DOMAIN or 0)\n" CLI_HELP_INSECURE
           "  --partition P       session partition (default: " VDDS_DEFAULT_PARTITION ")\n"
           "  --rate HZ           loop rate (default 1000)\n"
           "  --max-force N       device capability in newtons (default 4)\n"

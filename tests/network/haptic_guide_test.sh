@@ -28,6 +28,8 @@ server_stall_us() { sed -n 's/^server: .* step time median .* max \([0-9.]*\) us
 # means its DDS threads may have been too, past the lease.
 client_stall_us() { sed -n 's/^haptic: .* period median .* max \([0-9.]*\) us.*/\1/p' "$1" | tail -1; }
 export CYCLONEDDS_URI="file://$SRC/deploy/cyclonedds-site.xml"
+# The site file without DDS Security: every program refuses it unless told (issue 14 item 5).
+export VISCERA_INSECURE=1
 SEAT=hp/guide
 sine() { # sine FILE X0 PERIOD: 12 s of x = X0 + 0.01 sin(2 pi t / PERIOD) above the kidney
   awk -v x0="$2" -v p="$3" 'BEGIN { for (t = 0; t <= 12.0001; t += 0.01)

@@ -28,7 +28,8 @@ secure() { # secure NAME EMULATOR-OPTIONS...
   CYCLONEDDS_URI="$(as recorder)" run_in_site b "$BUILD/client/recorder/viscera-recorder" --partition 'lk/*' \
     --out "$OUT/$n-secure.db" --quiet > "$OUT/$n-rec-secure.log" 2>&1 &
   rs=$!; PIDS+=("$rs")
-  CYCLONEDDS_URI="$SITE" run_in_site b "$BUILD/client/recorder/viscera-recorder" --partition $SEAT \
+  # The eavesdropper: no identity, so it must say --insecure to start at all.
+  CYCLONEDDS_URI="$SITE" run_in_site b "$BUILD/client/recorder/viscera-recorder" --insecure --partition $SEAT \
     --out "$OUT/$n-plain.db" --quiet > "$OUT/$n-rec-plain.log" 2>&1 &
   rp=$!; PIDS+=("$rp")
   CYCLONEDDS_URI="$(as trainee-seat01)" run_in_site b timeout 60 "$BUILD/client/haptic/viscera-haptic" \
