@@ -106,10 +106,12 @@ static uint64_t read_feedback(const haptic_loop_t *l, tick_state_t *s, double t,
 }
 
 /* The round trip to a guiding peer (guide_force.h: the coupling's damping
- * grows with it): at least --guide-rtt, and twice our own smoothed round
- * trip to the server (the peer's commands cross the same link when the
- * server sits at the peer's site; when it sits at ours, --guide-rtt says). */
-static double guide_rtt(const haptic_loop_t *l, tick_state_t *s) {
+ * grows with it): at least --guide-rtt, twice our own smoothed round trip
+ * to the server (the peer's commands cross the same link when the server
+ * sits at the peer's site), and twice the peer's commands' one-way transit
+ * to us when known (guide_slot_transit: an instructor beside the server,
+ * whose own round trip is near zero while the trainee is a link away). */
+static double guide_rtt(const haptic_loop_t *l, tick_state_t *s, double peer_transit_s) {
   feedback_slot_t *fs = &l->h->slot;
   pthread_mutex_lock(&fs->lock);
   size_t n = fs->nlatency;
@@ -119,8 +121,9 @@ static double guide_rtt(const haptic_loop_t *l, tick_state_t *s) {
     s->rtt_samples = n;
     s->rtt_s = s->rtt_s > 0 ? s->rtt_s + 0.02 * (last_us * 1e-6 - s->rtt_s) : last_us * 1e-6;
   }
-  double own = 2.0 * s->rtt_s;
-  l->st->guide_rtt_s = own > l->o->guide_rtt ? own : l->o->guide_rtt;
+  double own = 2.0 * s->rtt_s, peer = peer_transit_s > 0 ? 2.0 * peer_transit_s : 0;
+  double rtt = own > peer ? own : peer;
+  l->st->guide_rtt_s = rtt > l->o->guide_rtt ? rtt : l->o->guide_rtt;
   return l->st->guide_rtt_s;
 }
 
@@ -154,7 +157,7 @@ static void render_force(const haptic_loop_t *l, tick_state_t *s, double t, uint
                        .max_force = l->dev->max_force,
                        .max_stiffness = l->dev->max_stiffness,
                        .period_s = 1.0 / o->rate,
-                       .rtt_s = guide_rtt(l, s)};
+                       .rtt_s = guide_rtt(l, s, gv.peer_transit_s)};
   memcpy(gin.x, pos, sizeof gin.x);
   memcpy(gin.v, vel, sizeof gin.v);
   memcpy(gin.peer, gv.peer, sizeof gin.peer);
