@@ -213,6 +213,15 @@ static void run(const trace_t *tr, const link_t *lk, const size_t *probe, result
 }
 
 int main(void) {
+  /* The controller's budget: 0.24 N released at 0.08 N per tick into a hand
+   * leaving at 1 cm/s is owed (0.24 + 0.16 + 0.08) N x 10 um; a hand that
+   * presses (u < 0) and does not turn owes nothing; held 20 ms, the first
+   * term is 20 times longer. */
+  CHECK_NEAR(passivity_owed(0.24, 0.01, 0, 1e-3, 1e-3, 0.08), 0.48 * 1e-5, 1e-15);
+  CHECK(passivity_owed(0.24, -0.01, 0, 1e-3, 1e-3, 0.08) == 0);
+  CHECK_NEAR(passivity_owed(0.24, 0.01, 0, 1e-3, 0.02, 0.08), (0.24 * 20 + 0.16 + 0.08) * 1e-5, 1e-15);
+  CHECK(passivity_owed(0.24, -0.01, 2.0, 1e-3, 1e-3, 0.08) == 0 &&
+        passivity_owed(0.24, -0.01, 10.0, 1e-3, 1e-3, 0.08) > 0); /* turns within the release, or not */
   static trace_t tr, tr10;
   if (!make_trace(&tr, 0) || !make_trace(&tr10, 0.01)) {
     CHECK(0);
