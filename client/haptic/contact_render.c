@@ -81,8 +81,8 @@ double contact_render_target(contact_render_t *r, const contact_model_t *m, cons
 }
 
 /* The hand's filtered acceleration and the tick length to budget, from
- * this tick's velocity v and displacement dx (dt = |dx| / |v|). */
-static void track_motion(contact_render_t *r, const double v[3], const double dx[3]) {
+ * this tick's velocity v and displacement dx (dt = |dx| / |v|). Returns dt. */
+static double track_motion(contact_render_t *r, const double v[3], const double dx[3]) {
   double T = r->period_s, vn = v3_norm(v), dt = vn > 1e-9 ? v3_norm(dx) / vn : T;
   if (!(dt > 0) || !isfinite(dt)) dt = T;
   r->tick_s = T + (r->tick_s - T) * exp(-dt / CONTACT_RENDER_TICK_MEMORY);
@@ -97,6 +97,7 @@ static void track_motion(contact_render_t *r, const double v[3], const double dx
     v3_copy(r->v_prev, v);
     r->have_v = 1;
   }
+  return dt;
 }
 
 /* Moves f_prev towards g by at most `step` (N) and returns the result in f. */
@@ -113,7 +114,13 @@ double contact_render_output(contact_render_t *r, const double target[3], int cu
   double before[3];
   v3_copy(before, r->f_prev);
   passivity_observe(&r->pc, r->f_prev, dx); /* last tick's force over the way the hand went since */
-  track_motion(r, v, dx);
+  if (track_motion(r, v, dx) > CONTACT_RENDER_STALL_S) {
+    double de = v3_dot(r->f_prev, dx);
+    if (isfinite(de)) r->stall_energy += de;
+    r->stall_ticks++;
+  }
+  if (r->pc.energy - r->stall_energy > r->energy_max_unstalled)
+    r->energy_max_unstalled = r->pc.energy - r->stall_energy;
   if (cut) {
     /* The server is gone: nothing to ramp towards, and a wall it no longer
      * computes must not stay under the hand. */

@@ -92,6 +92,11 @@ typedef struct contact_render {
   double accel[3];  /* m/s^2, its filtered acceleration */
   double tick_s;    /* s, the tick length the controller budgets (recent longest) */
   int have_v;       /* v_prev holds a velocity */
+  /* The work done over ticks longer than CONTACT_RENDER_STALL_S (the
+   * client's loop stalled: no controller can act within them), J, and the
+   * observer's largest value without it: what the controller answers for. */
+  double stall_energy, energy_max_unstalled;
+  uint64_t stall_ticks;
   passivity_t pc;
 } contact_render_t;
 

@@ -188,6 +188,9 @@ static void record_force(const haptic_loop_t *l, const tick_state_t *s, double t
   if (mag > st->peak_force) st->peak_force = mag;
   st->energy_max_j = s->render.pc.energy_max;
   st->energy_j = s->render.pc.energy;
+  st->stall_energy_j = s->render.stall_energy;
+  st->energy_max_unstalled_j = s->render.energy_max_unstalled;
+  st->stall_ticks = s->render.stall_ticks;
   st->step_max_n = s->render.step_max;
   if (l->csv)
     fprintf(l->csv, "%.4f,%.6f,%.6f,%.6f,%.5f,%.5f,%.5f,%d,%.7f,%.5f\n", t, pos[0], pos[1], pos[2], f[0], f[1], f[2],

@@ -26,6 +26,10 @@ typedef struct haptic_stats {
    * (N, cuts excluded), controller ticks, forces cut at a lost server,
    * liveliness losses and stale-feedback episodes. */
   double energy_max_j, energy_j, step_max_n;
+  /* Work done over ticks that stalled past the controller's reserve
+   * (contact_render.h), J, and the observer's largest value without it. */
+  double stall_energy_j, energy_max_unstalled_j;
+  uint64_t stall_ticks;
   double guide_rtt_s; /* the round trip the guiding coupling was damped for, s */
   uint64_t pc_ticks, cuts, server_lost, feedback_stale;
   uint64_t liveliness_blips;              /* liveliness lapses heard with feedback still arriving: kept */

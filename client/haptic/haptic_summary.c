@@ -62,9 +62,11 @@ void haptic_summary_print(const haptic_options_t *o, haptic_stats_t *st, haptic_
           st->reanchored_ticks, st->plain_ticks);
   /* Contact under delay (issue 14): scripts and the link benchmark read these. */
   printf("CONTACT step_max_n=%.4f server_lost=%" PRIu64 " liveliness_blips=%" PRIu64 " feedback_stale=%" PRIu64
-         " cuts=%" PRIu64 " controller_ticks=%" PRIu64 " guide_rtt_ms=%.1f energy_j=%.4g energy_max_j=%.4g\n",
+         " cuts=%" PRIu64 " controller_ticks=%" PRIu64 " guide_rtt_ms=%.1f energy_j=%.4g energy_max_j=%.4g"
+         " stall_ticks=%" PRIu64 " stall_energy_j=%.4g energy_max_unstalled_j=%.4g\n",
          st->step_max_n, st->server_lost, st->liveliness_blips, st->feedback_stale, st->cuts, st->pc_ticks,
-         st->guide_rtt_s * 1e3, st->energy_j, st->energy_max_j);
+         st->guide_rtt_s * 1e3, st->energy_j, st->energy_max_j, st->stall_ticks, st->stall_energy_j,
+         st->energy_max_unstalled_j);
   printf("SUMMARY ticks=%" PRIu64 " rate_hz=%.1f peak_force=%.4f contact_ticks=%" PRIu64 " latency_us_median=%.1f "
          "latency_us_p99=%.1f period_us_p99=%.1f jitter_us_p99=%.1f late_ticks=%" PRIu64 " guide_coupled_s=%.2f "
          "latency_us_mean=%.1f latency_samples=%zu\n",

@@ -121,6 +121,7 @@ static int make_trace(trace_t *tr, double sample_s) {
 
 typedef struct result {
   double peak, step_max, energy_max, plain_peak, plain_step;
+  uint64_t stall_ticks;
   double f_at[8]; /* force at probe ticks */
 } result_t;
 
@@ -208,6 +209,7 @@ static void run(const trace_t *tr, const link_t *lk, const size_t *probe, result
   }
   res->step_max = r.step_max;
   res->energy_max = r.pc.energy_max;
+  res->stall_ticks = r.stall_ticks;
   free(skip);
   free(arrive);
 }
@@ -222,6 +224,24 @@ int main(void) {
   CHECK_NEAR(passivity_owed(0.24, 0.01, 0, 1e-3, 0.02, 0.08), (0.24 * 20 + 0.16 + 0.08) * 1e-5, 1e-15);
   CHECK(passivity_owed(0.24, -0.01, 2.0, 1e-3, 1e-3, 0.08) == 0 &&
         passivity_owed(0.24, -0.01, 10.0, 1e-3, 1e-3, 0.08) > 0); /* turns within the release, or not */
+  {
+    /* A stalled loop: the hand presses a 1 N wall for 0.1 s (the observer
+     * banks 1 mJ), then one tick lasts 60 ms while it leaves at 5 cm/s with
+     * the force held: 3 mJ no controller could stop, counted apart so the
+     * rest is still judged <= 0. */
+    static contact_render_t r;
+    contact_render_init(&r, T_S, MAX_FORCE);
+    double g[3] = {0, 0, 1}, f[3], v[3] = {0, 0, -0.01}, dx[3] = {0, 0, -1e-5};
+    for (int i = 0; i < 100; i++) contact_render_output(&r, g, 0, 1, v, dx, f);
+    double v2[3] = {0, 0, 0.05}, dx2[3] = {0, 0, 0.05 * 0.06};
+    double f_held = f[2];
+    contact_render_output(&r, g, 0, 1, v2, dx2, f);
+    printf("stalled tick: force %.3f N held 60 ms, observer %.3g J, of which %.3g J in the stall; without it %.3g J\n",
+           f_held, r.pc.energy, r.stall_energy, r.energy_max_unstalled);
+    CHECK(f_held > 0.9 && r.stall_ticks == 1 && r.pc.energy_max > 0);
+    CHECK_NEAR(r.stall_energy, f_held * 0.003, 1e-12);
+    CHECK(r.energy_max_unstalled <= 0);
+  }
   static trace_t tr, tr10;
   if (!make_trace(&tr, 0) || !make_trace(&tr10, 0.01)) {
     CHECK(0);
@@ -272,7 +292,7 @@ int main(void) {
              100 * lk.loss, sampled ? "10 ms-sampled" : "smooth", res.peak, 100 * err, res.step_max, res.energy_max);
       if (ldelays[di] <= 100) CHECK(fabs(err) <= 0.10);
       CHECK(res.step_max <= 0.1 + 1e-12);
-      CHECK(res.energy_max <= 0);
+      CHECK(res.energy_max <= 0 && res.stall_ticks == 0);
     }
   /* The proxy lets go for 8 steps in the middle of the press (the tissue
    * moved away faster than the hand): no overshoot when contact resumes
