@@ -30,10 +30,11 @@ int cli_env_domain(verr_t *err) {
 static int build_options(const cli_spec_t *s, struct option *lo) {
   int n = 0;
   for (const struct option *o = s->options; o && o->name; o++) {
-    if (n >= CLI_MAX_OPTIONS - 6) return -1;
+    if (n >= CLI_MAX_OPTIONS - 7) return -1;
     lo[n++] = *o;
   }
   if (s->common & CLI_DOMAIN) lo[n++] = (struct option){"domain", required_argument, 0, CLI_OPT_DOMAIN};
+  if (s->common & CLI_DOMAIN) lo[n++] = (struct option){"insecure", no_argument, 0, CLI_OPT_INSECURE};
   if (s->common & CLI_PARTITION) lo[n++] = (struct option){"partition", required_argument, 0, CLI_OPT_PARTITION};
   if (s->common & CLI_QUIET) lo[n++] = (struct option){"quiet", no_argument, 0, CLI_OPT_QUIET};
   lo[n++] = (struct option){"help", no_argument, 0, CLI_OPT_HELP};
@@ -64,6 +65,15 @@ static int common_option(const cli_spec_t *s, const char *tag, int code, const c
   case CLI_OPT_QUIET:
     c->quiet = 1;
     return 0;
+  case CLI_OPT_INSECURE:
+    /* Read where the participant is created (dds/vdds_config.h), which
+     * this DDS-free layer does not reach: the environment carries it. */
+    c->insecure = 1;
+    if (setenv("VISCERA_INSECURE", "1", 1)) {
+      fprintf(stderr, "%s: cannot set VISCERA_INSECURE\n", tag);
+      return usage_status(s);
+    }
+    return 0;
   case CLI_OPT_HELP:
     s->usage(stdout);
     return 0;
@@ -79,8 +89,8 @@ static int common_option(const cli_spec_t *s, const char *tag, int code, const c
 static int is_common(const cli_spec_t *s, int code) {
   return (code == CLI_OPT_DOMAIN && (s->common & CLI_DOMAIN)) ||
          (code == CLI_OPT_PARTITION && (s->common & CLI_PARTITION)) ||
-         (code == CLI_OPT_QUIET && (s->common & CLI_QUIET)) || code == CLI_OPT_HELP || code == CLI_OPT_VERSION ||
-         code == '?' || code == ':';
+         (code == CLI_OPT_QUIET && (s->common & CLI_QUIET)) || (code == CLI_OPT_INSECURE && (s->common & CLI_DOMAIN)) ||
+         code == CLI_OPT_HELP || code == CLI_OPT_VERSION || code == '?' || code == ':';
 }
 
 int cli_parse(const cli_spec_t *s, int argc, char **argv, cli_common_t *c, void *ctx) {

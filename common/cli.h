@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* cli: the command-line options every viscera program shares, parsed in one
- * place: --domain N, --partition P, --quiet, -h/--help and --version.
+ * place: --domain N, --partition P, --quiet, --insecure, -h/--help and
+ * --version.
  *
  * A program describes itself in a cli_spec_t (its name, which common
  * options it takes, its own getopt_long options and a callback for them,
@@ -22,7 +23,7 @@
 /* Which common options a program takes (cli_spec_t.common). -h/--help and
  * --version are always taken. */
 enum {
-  CLI_DOMAIN = 1 << 0,     /* --domain N, N in 0..230 */
+  CLI_DOMAIN = 1 << 0,     /* --domain N, N in 0..230; and --insecure (a DDS program) */
   CLI_DOMAIN_ENV = 1 << 1, /* the default domain is $VISCERA_DOMAIN (else 0) */
   CLI_PARTITION = 1 << 2,  /* --partition P */
   CLI_QUIET = 1 << 3,      /* --quiet */
@@ -37,13 +38,23 @@ enum {
   CLI_OPT_QUIET = 'q',
   CLI_OPT_HELP = 'h',
   CLI_OPT_VERSION = 0x7f00,
+  CLI_OPT_INSECURE = 0x7f01,
 };
+
+/* --insecure: run on a non-loopback Cyclone configuration without DDS
+ * Security, which a DDS program otherwise refuses (dds/vdds_config.h). It
+ * sets VISCERA_INSECURE=1 in the process's environment, where the check at
+ * participant creation reads it. Its line for a program's --help: */
+#define CLI_HELP_INSECURE                                                                                              \
+  "  --insecure          allow a non-loopback CYCLONEDDS_URI without DDS Security (warns;\n"                           \
+  "                      same as VISCERA_INSECURE=1); refused without it\n"
 
 /* The values of the common options. */
 typedef struct cli_common {
   int domain;            /* 0..230; the default given to cli_parse unless CLI_DOMAIN_ENV */
   const char *partition; /* NULL when --partition was not given (or the default given) */
   int quiet;             /* --quiet given */
+  int insecure;          /* --insecure given (VISCERA_INSECURE=1 set) */
 } cli_common_t;
 
 /* A program's own option: `code` is the getopt code of its struct option,

@@ -163,6 +163,7 @@ echo "lab: seats $FIRST..$LAST on domain $VISCERA_DOMAIN, partitions $PREFIX/sea
 paste_env() { # the environment a pasted command needs, as shell words
   local e=""
   [ "$VISCERA_DOMAIN" = 0 ] || e="VISCERA_DOMAIN=$VISCERA_DOMAIN "
+  [ "${VISCERA_INSECURE:-0}" != 1 ] || e+="VISCERA_INSECURE=1 " # net_guard allowed it: the programs need it too
   if [ $SECURE = 1 ] || [ -n "${CYCLONEDDS_URI:-}" ]; then
     local u
     u="$(as "$1" 2>/dev/null)" || u="$NET"

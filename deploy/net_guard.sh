@@ -8,7 +8,9 @@
 # the loopback configuration (deploy/cyclonedds-loopback.xml: nothing leaves
 # the machine), or it names a DDS Security fragment (pki.sh's
 # identities/NAME/security.xml), or SECURE=1 (the script adds an identity per
-# process). Otherwise, with INSECURE=1, it prints a warning and returns 0;
+# process). Otherwise, with INSECURE=1, it prints a warning, exports
+# VISCERA_INSECURE=1 (every program the script starts would refuse the
+# configuration without it: common/dds/vdds_config.h) and returns 0;
 # without, it prints how to proceed (HOW, default: lab.sh's --secure and
 # --insecure) and returns 2.
 net_guard() {
@@ -25,5 +27,6 @@ net_guard() {
   fi
   echo "$script: WARNING: insecure: DDS Security is off on $uri; anyone on that network can read" \
     "every seat and drive its tools" >&2
+  export VISCERA_INSECURE=1
   return 0
 }

@@ -38,7 +38,7 @@ static void usage(FILE *f) {
              "  (STATION: a haptic client's --station name, 1..31 of A-Z a-z 0-9 _ . -)\n"
              "  start-task NAME|INDEX start (or restart) a task now, by its scene name or index;\n"
              "                        a restart replaces the earlier run (clock from now)\n"
-             "  --domain N            DDS domain id (default: $VISCERA_DOMAIN or 0)\n"
+             "  --domain N            DDS domain id (default: $VISCERA_DOMAIN or 0)\n" CLI_HELP_INSECURE
              "  --partition P         the seat's partition (default: " VDDS_DEFAULT_PARTITION ")\n"
              "  --station ID          this instructor console's number (SessionControl source_id, default\n"
              "                        1); not a haptic client's station name\n"

@@ -41,7 +41,7 @@ static void usage(FILE *f) {
           "  --window            show the dashboard live in a window (SDL2); PNGs then only with --out\n"
           "  --refresh-hz HZ     window refresh rate (default 15, 1..60)\n"
           "  --script-input F    window: timed keys and clicks from F (viewer's input script format)\n"
-          "  --domain N          DDS domain id (default: $VISCERA_DOMAIN or 0)\n"
+          "  --domain N          DDS domain id (default: $VISCERA_DOMAIN or 0)\n" CLI_HELP_INSECURE
           "  --help              this text\n"
           "  --version           print the version and exit\n"
           "window keys: 1-9 or a click on a tile: focus that seat; Tab / Shift+Tab: next / previous\n"

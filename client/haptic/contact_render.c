@@ -6,12 +6,13 @@
 
 #include "vmath.h"
 
-void contact_render_init(contact_render_t *r, double period_s, double max_force, double max_damping) {
+void contact_render_init(contact_render_t *r, double period_s, double max_force) {
   memset(r, 0, sizeof *r);
   r->period_s = period_s;
   r->max_step = CONTACT_RENDER_MAX_STEP;
   r->max_force = max_force;
-  passivity_init(&r->pc, period_s, max_damping);
+  r->tick_s = period_s;
+  passivity_init(&r->pc, period_s);
 }
 
 void contact_render_sent(contact_render_t *r, uint64_t seq, const double x[3]) {
@@ -79,11 +80,47 @@ double contact_render_target(contact_render_t *r, const contact_model_t *m, cons
   return mag;
 }
 
+/* The hand's filtered acceleration and the tick length to budget, from
+ * this tick's velocity v and displacement dx (dt = |dx| / |v|). Returns dt. */
+static double track_motion(contact_render_t *r, const double v[3], const double dx[3]) {
+  double T = r->period_s, vn = v3_norm(v), dt = vn > 1e-9 ? v3_norm(dx) / vn : T;
+  if (!(dt > 0) || !isfinite(dt)) dt = T;
+  r->tick_s = T + (r->tick_s - T) * exp(-dt / CONTACT_RENDER_TICK_MEMORY);
+  if (dt > r->tick_s) r->tick_s = fmin(dt, CONTACT_RENDER_TICK_MAX);
+  if (r->have_v && v3_isfinite(v)) {
+    double a[3], w = fmin(1.0, dt / CONTACT_RENDER_ACCEL_TAU);
+    v3_sub(a, v, r->v_prev);
+    v3_scale(a, a, 1.0 / dt);
+    for (int k = 0; k < 3; k++) r->accel[k] += w * (a[k] - r->accel[k]);
+  }
+  if (v3_isfinite(v)) {
+    v3_copy(r->v_prev, v);
+    r->have_v = 1;
+  }
+  return dt;
+}
+
+/* Moves f_prev towards g by at most `step` (N) and returns the result in f. */
+static void ramp(const double f_prev[3], const double g[3], double step, double f[3]) {
+  double d[3];
+  v3_sub(d, g, f_prev);
+  double n = v3_norm(d);
+  if (n > step) v3_scale(d, d, step / n);
+  v3_add(f, f_prev, d);
+}
+
 double contact_render_output(contact_render_t *r, const double target[3], int cut, int control, const double v[3],
                              const double dx[3], double f[3]) {
   double before[3];
   v3_copy(before, r->f_prev);
   passivity_observe(&r->pc, r->f_prev, dx); /* last tick's force over the way the hand went since */
+  if (track_motion(r, v, dx) > CONTACT_RENDER_STALL_S) {
+    double de = v3_dot(r->f_prev, dx);
+    if (isfinite(de)) r->stall_energy += de;
+    r->stall_ticks++;
+  }
+  if (r->pc.energy - r->stall_energy > r->energy_max_unstalled)
+    r->energy_max_unstalled = r->pc.energy - r->stall_energy;
   if (cut) {
     /* The server is gone: nothing to ramp towards, and a wall it no longer
      * computes must not stay under the hand. */
@@ -93,22 +130,21 @@ double contact_render_output(contact_render_t *r, const double target[3], int cu
     double g[3];
     v3_copy(g, target);
     if (!v3_isfinite(g)) v3_set(g, 0, 0, 0);
-    /* Released at max_step per tick, a force f still delivers about
-     * (f . v) T (|f| / (2 max_step) + 1) after the controller asks for
-     * less: the ramp's ticks, and the tick the force is held before the
-     * observer sees it. */
-    double fv = v3_dot(g, v);
-    double reserve = fv > 0 ? fv * r->period_s * (v3_norm(g) / (2 * r->max_step) + 1.0) : 0;
-    if (control) passivity_control(&r->pc, v, r->max_force, reserve, g);
+    double mag = v3_norm(g);
+    if (mag > r->max_force) v3_scale(g, g, r->max_force / mag);
+    /* The ramp first, then the controller on the force the hand will
+     * actually get (and the release it commits to), then the ramp's bound
+     * again, widened to CONTACT_RENDER_PASSIVE_STEP where the controller
+     * asked for less. */
+    ramp(r->f_prev, g, r->max_step, f);
+    if (control && passivity_control(&r->pc, v, r->accel, r->tick_s, CONTACT_RENDER_STALL_S, r->max_step, f) < 1.0) {
+      double h[3];
+      v3_copy(h, f);
+      ramp(r->f_prev, h, CONTACT_RENDER_PASSIVE_STEP, f);
+    }
     double d[3];
-    v3_sub(d, g, r->f_prev);
-    double step = v3_norm(d);
-    if (step > r->max_step) v3_scale(d, d, r->max_step / step);
-    v3_add(f, r->f_prev, d);
-    double mag = v3_norm(f);
-    if (mag > r->max_force) v3_scale(f, f, r->max_force / mag);
     v3_sub(d, f, r->f_prev);
-    step = v3_norm(d);
+    double step = v3_norm(d);
     if (step > r->step_max) r->step_max = step;
   }
   v3_sub(before, f, before);

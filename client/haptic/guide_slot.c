@@ -102,6 +102,7 @@ int guide_slot_command(guide_slot_t *s, const char *station, const float pos[3],
   }
   if (slot < 0) slot = empty >= 0 ? empty : oldest;
   guide_station_pos_t *e = &s->pos[slot];
+  if (!e->arrival_mono_ns || strcmp(e->station, station)) e->transit_s = -1; /* a new station */
   snprintf(e->station, sizeof e->station, "%s", station);
   for (int k = 0; k < 3; k++) e->pos[k] = pos[k];
   e->arrival_mono_ns = now ? now : 1;
@@ -110,8 +111,21 @@ int guide_slot_command(guide_slot_t *s, const char *station, const float pos[3],
   return 0;
 }
 
+void guide_slot_transit(guide_slot_t *s, const char *station, double transit_s) {
+  if (!(transit_s > 0) || !(transit_s < GUIDE_TRANSIT_MAX_S)) return;
+  pthread_mutex_lock(&s->lock);
+  for (int i = 0; i < GUIDE_SLOT_STATIONS; i++) {
+    guide_station_pos_t *e = &s->pos[i];
+    if (!e->arrival_mono_ns || strcmp(e->station, station)) continue;
+    e->transit_s = e->transit_s < 0 ? transit_s : e->transit_s + GUIDE_TRANSIT_GAIN * (transit_s - e->transit_s);
+    break;
+  }
+  pthread_mutex_unlock(&s->lock);
+}
+
 void guide_slot_read(guide_slot_t *s, const char *own, uint64_t now, guide_view_t *out) {
   memset(out, 0, sizeof *out);
+  out->peer_transit_s = -1;
   pthread_mutex_lock(&s->lock);
   out->role = s->role;
   guide_side_t side = guide_side_of(&s->role, own);
@@ -125,6 +139,7 @@ void guide_slot_read(guide_slot_t *s, const char *own, uint64_t now, guide_view_
     out->have_peer = 1;
     memcpy(out->peer, best->pos, sizeof out->peer);
     out->peer_age_s = now > best->arrival_mono_ns ? (double)(now - best->arrival_mono_ns) * 1e-9 : 0.0;
+    out->peer_transit_s = best->transit_s;
     memcpy(out->peer_station, best->station, sizeof out->peer_station);
   }
   pthread_mutex_unlock(&s->lock);
@@ -158,6 +173,7 @@ static void on_command(dds_entity_t reader, void *arg) {
   dds_sample_info_t infos[GUIDE_TAKE];
   int n = dds_take(reader, samples, infos, GUIDE_TAKE, GUIDE_TAKE);
   uint64_t now = vtime_mono_ns();
+  int64_t wall = vtime_wall_ns();
   for (int i = 0; i < n; i++) {
     const viscera_ToolCommand *c = samples[i];
     if (!infos[i].valid_data || c->tool_id != s->tool_id) continue;
@@ -169,7 +185,8 @@ static void on_command(dds_entity_t reader, void *arg) {
     }
     char station[GUIDE_STATION_MAX];
     station_of(s, reader, infos[i].publication_handle, station);
-    guide_slot_command(s, station, c->position, now);
+    if (guide_slot_command(s, station, c->position, now) == 0)
+      guide_slot_transit(s, station, (double)(wall - infos[i].source_timestamp) * 1e-9);
   }
   if (n > 0) dds_return_loan(reader, samples, n);
 }

@@ -41,6 +41,7 @@ typedef struct guide_station_pos {
   char station[GUIDE_STATION_MAX];
   double pos[3];
   uint64_t arrival_mono_ns; /* 0: empty entry */
+  double transit_s;         /* smoothed one-way transit of its commands, s; < 0: unknown */
 } guide_station_pos_t;
 
 typedef struct guide_handle_station {
@@ -77,6 +78,7 @@ typedef struct guide_view {
   int have_peer;
   double peer[3];
   double peer_age_s;
+  double peer_transit_s; /* the peer's commands' one-way transit (guide_slot_transit), s; < 0: unknown */
   char peer_station[GUIDE_STATION_MAX];
 } guide_view_t;
 
@@ -86,6 +88,19 @@ void guide_slot_destroy(guide_slot_t *s);
  * slot; own_writer is our ToolCommand writer (its samples are skipped).
  * Returns 0, or -1 with err set. */
 int guide_slot_attach(guide_slot_t *s, vdds_t *v, dds_entity_t own_writer, verr_t *err);
+
+/* One command of `station` took transit_s (s) from its writer to us: its
+ * source timestamp against our wall clock, so only as good as the two
+ * machines' clock agreement (NTP: a few ms). Smoothed per station
+ * (GUIDE_TRANSIT_GAIN); values outside (0, GUIDE_TRANSIT_MAX_S) are
+ * ignored (clocks apart, or a replayed sample). The guiding coupling damps
+ * for twice it when that is more than its own round trip to the server
+ * (haptic_loop.c): an instructor beside the server sees its own round trip
+ * near zero, but the trainee's commands cross the link. Call after
+ * guide_slot_command for the same sample. */
+#define GUIDE_TRANSIT_GAIN 0.05
+#define GUIDE_TRANSIT_MAX_S 1.0
+void guide_slot_transit(guide_slot_t *s, const char *station, double transit_s);
 
 /* Applies one ToolRole (listeners call these; unit tests may too). A role
  * for another tool is ignored (0); a refused one returns -1; else 1. */

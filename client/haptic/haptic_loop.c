@@ -106,10 +106,12 @@ static uint64_t read_feedback(const haptic_loop_t *l, tick_state_t *s, double t,
 }
 
 /* The round trip to a guiding peer (guide_force.h: the coupling's damping
- * grows with it): at least --guide-rtt, and twice our own smoothed round
- * trip to the server (the peer's commands cross the same link when the
- * server sits at the peer's site; when it sits at ours, --guide-rtt says). */
-static double guide_rtt(const haptic_loop_t *l, tick_state_t *s) {
+ * grows with it): at least --guide-rtt, twice our own smoothed round trip
+ * to the server (the peer's commands cross the same link when the server
+ * sits at the peer's site), and twice the peer's commands' one-way transit
+ * to us when known (guide_slot_transit: an instructor beside the server,
+ * whose own round trip is near zero while the trainee is a link away). */
+static double guide_rtt(const haptic_loop_t *l, tick_state_t *s, double peer_transit_s) {
   feedback_slot_t *fs = &l->h->slot;
   pthread_mutex_lock(&fs->lock);
   size_t n = fs->nlatency;
@@ -119,8 +121,9 @@ static double guide_rtt(const haptic_loop_t *l, tick_state_t *s) {
     s->rtt_samples = n;
     s->rtt_s = s->rtt_s > 0 ? s->rtt_s + 0.02 * (last_us * 1e-6 - s->rtt_s) : last_us * 1e-6;
   }
-  double own = 2.0 * s->rtt_s;
-  l->st->guide_rtt_s = own > l->o->guide_rtt ? own : l->o->guide_rtt;
+  double own = 2.0 * s->rtt_s, peer = peer_transit_s > 0 ? 2.0 * peer_transit_s : 0;
+  double rtt = own > peer ? own : peer;
+  l->st->guide_rtt_s = rtt > l->o->guide_rtt ? rtt : l->o->guide_rtt;
   return l->st->guide_rtt_s;
 }
 
@@ -154,7 +157,7 @@ static void render_force(const haptic_loop_t *l, tick_state_t *s, double t, uint
                        .max_force = l->dev->max_force,
                        .max_stiffness = l->dev->max_stiffness,
                        .period_s = 1.0 / o->rate,
-                       .rtt_s = guide_rtt(l, s)};
+                       .rtt_s = guide_rtt(l, s, gv.peer_transit_s)};
   memcpy(gin.x, pos, sizeof gin.x);
   memcpy(gin.v, vel, sizeof gin.v);
   memcpy(gin.peer, gv.peer, sizeof gin.peer);
@@ -185,6 +188,9 @@ static void record_force(const haptic_loop_t *l, const tick_state_t *s, double t
   if (mag > st->peak_force) st->peak_force = mag;
   st->energy_max_j = s->render.pc.energy_max;
   st->energy_j = s->render.pc.energy;
+  st->stall_energy_j = s->render.stall_energy;
+  st->energy_max_unstalled_j = s->render.energy_max_unstalled;
+  st->stall_ticks = s->render.stall_ticks;
   st->step_max_n = s->render.step_max;
   if (l->csv)
     fprintf(l->csv, "%.4f,%.6f,%.6f,%.6f,%.5f,%.5f,%.5f,%d,%.7f,%.5f\n", t, pos[0], pos[1], pos[2], f[0], f[1], f[2],
@@ -197,7 +203,7 @@ void haptic_loop_run(const haptic_loop_t *l) {
   tick_state_t s; /* 33 kB with the renderer's position ring: on the loop thread's stack */
   memset(&s, 0, sizeof s);
   s.own_station = o->station ? o->station : "";
-  contact_render_init(&s.render, 1.0 / o->rate, l->dev->max_force, HAPTIC_MAX_DAMPING);
+  contact_render_init(&s.render, 1.0 / o->rate, l->dev->max_force);
   uint64_t period_ns = (uint64_t)(1e9 / o->rate);
   double run_for = o->duration >= 0 ? o->duration : 1e300;
   uint64_t start = vtime_mono_ns(), next = start, prev_tick = 0;

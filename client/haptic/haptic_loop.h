@@ -26,17 +26,15 @@ typedef struct haptic_stats {
    * (N, cuts excluded), controller ticks, forces cut at a lost server,
    * liveliness losses and stale-feedback episodes. */
   double energy_max_j, energy_j, step_max_n;
+  /* Work done over ticks that stalled past the controller's reserve
+   * (contact_render.h), J, and the observer's largest value without it. */
+  double stall_energy_j, energy_max_unstalled_j;
+  uint64_t stall_ticks;
   double guide_rtt_s; /* the round trip the guiding coupling was damped for, s */
   uint64_t pc_ticks, cuts, server_lost, feedback_stale;
   uint64_t liveliness_blips;              /* liveliness lapses heard with feedback still arriving: kept */
   uint64_t reanchored_ticks, plain_ticks; /* in contact: model re-anchored at the answered command, or not */
 } haptic_stats_t;
-
-/* N s/m: the passivity controller's damper bound. It acts by scaling the
- * rendered force down (never beyond zero), so the force it renders stays
- * within the device's force limit whatever the bound; the bound only keeps
- * it from reacting to velocity noise near rest (alpha |v| <= |f|). */
-#define HAPTIC_MAX_DAMPING 1e4
 
 typedef struct haptic_loop {
   const haptic_options_t *o;

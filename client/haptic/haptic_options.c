@@ -24,7 +24,7 @@ void haptic_usage(FILE *f) {
           "  --station NAME      the station (person/seat) this device belongs to, announced with\n"
           "                      every command; a tool assigned to a station obeys only it\n"
           "                      (default: none, the anonymous station)\n"
-          "  --domain N          DDS domain id (default: $VISCERA_DOMAIN or 0)\n"
+          "  --domain N          DDS domain id (default: $VISCERA_DOMAIN or 0)\n" CLI_HELP_INSECURE
           "  --partition P       session partition (default: " VDDS_DEFAULT_PARTITION ")\n"
           "  --rate HZ           loop rate (default 1000)\n"
           "  --max-force N       device capability in newtons (default 4)\n"
@@ -34,7 +34,8 @@ void haptic_usage(FILE *f) {
           "  --duration S        stop after S s (default: end of the trajectory + 0.5 s)\n"
           "  --force-csv FILE    write t,x,y,z,fx,fy,fz,in_contact,energy_j,step_n per tick\n"
           "  --guide-rtt S       guiding hand: round trip to the peer station, s, at least (default 0;\n"
-          "                      the client also takes twice its own round trip to the server)\n"
+          "                      the client also takes twice its own round trip to the server, and\n"
+          "                      twice the peer's commands' transit from their source timestamps)\n"
           "  --rt-priority N     run the loop thread (only it) SCHED_FIFO at priority N (1..99) with\n"
           "                      memory locked (needs root, CAP_SYS_NICE or LimitRTPRIO; if refused:\n"
           "                      a warning naming the reason, normal priority)\n"

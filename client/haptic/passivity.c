@@ -6,32 +6,64 @@
 
 #include "vmath.h"
 
-void passivity_init(passivity_t *p, double period_s, double max_damping) {
+void passivity_init(passivity_t *p, double period_s) {
   memset(p, 0, sizeof *p);
   p->period_s = period_s;
-  p->max_damping = max_damping;
 }
 
-double passivity_control(passivity_t *p, const double v[3], double max_force, double reserve, double f[3]) {
-  double vv = v3_dot(v, v), fv = v3_dot(f, v);
-  double e_pred = p->energy + fv * p->period_s + reserve;
-  if (!(e_pred > 0) || !(fv > 0) || !(vv > 1e-12) || !isfinite(vv)) return 0;
-  /* The damper alpha v, applied along the force's own line: the force is
-   * scaled down by s so that its power f.v drops by alpha |v|^2. A damper
-   * may not reverse the force (pull the hand into a wall it pushes out of),
-   * so s stops at 0; the device's damping limit bounds alpha. */
-  double alpha = e_pred / (p->period_s * vv);
-  if (alpha > p->max_damping) alpha = p->max_damping;
-  double s = 1.0 - alpha * vv / fv;
-  if (s < 0) s = 0;
-  double g[3];
-  v3_scale(g, f, s);
-  double mag = v3_norm(g);
-  if (mag > max_force && mag > 0) v3_scale(g, g, max_force / mag);
-  p->dissipated += (fv - v3_dot(g, v)) * p->period_s;
+/* The release of m in steps of r ends within this many ticks (m <= a
+ * device's force, r >= 1 mN): the sum is bounded. */
+#define PASSIVITY_MAX_RELEASE_TICKS 10000
+
+#define PASSIVITY_ROUNDING (1.0 + 1e-6)
+/* N: the controller renders nothing rather than less than this. */
+#define PASSIVITY_MIN_FORCE 1e-4
+
+double passivity_owed(double m, double u, double a, double tick_s, double hold_s, double release_step) {
+  if (!(m > 0) || !(release_step > 0) || !isfinite(u) || !isfinite(a)) return 0;
+  if (hold_s < tick_s) hold_s = tick_s;
+  double ap = a > 0 ? a : 0, u0 = u + ap * hold_s, w = u0 > 0 ? m * u0 * hold_s : 0;
+  for (int k = 1; k < PASSIVITY_MAX_RELEASE_TICKS; k++) {
+    double mk = m - k * release_step;
+    if (mk <= 0) break;
+    double uk = u + ap * (hold_s + k * tick_s);
+    if (uk > 0) w += mk * uk * tick_s;
+  }
+  return w;
+}
+
+double passivity_control(passivity_t *p, const double v[3], const double a[3], double tick_s, double hold_s,
+                         double release_step, double f[3]) {
+  double m = v3_norm(f);
+  if (!(m > 0) || !isfinite(m)) return 1;
+  double d[3];
+  v3_scale(d, f, 1.0 / m);
+  double u = v3_dot(v, d), acc = a ? v3_dot(a, d) : 0;
+  if (tick_s < p->period_s) tick_s = p->period_s;
+  /* Within the budget with a relative margin for the rounding of the sums
+   * (W is a sum of up to m / r products; E of every tick's). */
+  double owed = passivity_owed(m, u, acc, tick_s, hold_s, release_step) * PASSIVITY_ROUNDING;
+  if (p->energy + owed <= 0) return 1;
+  /* W grows with m: the largest m' in [0, m] within the budget, by
+   * bisection (60 halvings reach the double's resolution). */
+  double lo = 0, hi = m;
+  if (p->energy < 0)
+    for (int i = 0; i < 60; i++) {
+      double mid = 0.5 * (lo + hi);
+      if (p->energy + passivity_owed(mid, u, acc, tick_s, hold_s, release_step) * PASSIVITY_ROUNDING <= 0)
+        lo = mid;
+      else
+        hi = mid;
+    }
+  /* A force below any device's resolution buys nothing and, held over a
+   * tick longer than budgeted, would still do (a little) work. */
+  if (lo < PASSIVITY_MIN_FORCE) lo = 0;
+  double s = lo / m;
+  p->dissipated +=
+      (owed - passivity_owed(lo, u, acc, tick_s, hold_s, release_step) * PASSIVITY_ROUNDING) / PASSIVITY_ROUNDING;
   p->active_ticks++;
-  v3_copy(f, g);
-  return (1.0 - s) * fv / vv;
+  v3_scale(f, f, s);
+  return s;
 }
 
 void passivity_observe(passivity_t *p, const double f[3], const double dx[3]) {

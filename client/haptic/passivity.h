@@ -12,38 +12,61 @@
  * the force held during the tick times the hand's displacement in it (exact
  * for a force held over the tick, whatever the tick's length), so E <= 0 at
  * every tick means the rendered environment has given back no more than the
- * hand put in: passive. When the force about to be rendered would make E
- * positive over the next tick (E + f . v T), the controller adds a variable
- * damper
- *   f' = f - alpha v,  alpha = E_pred / (T |v|^2),
- * the damping that dissipates exactly the excess, bounded by the device's
- * damping limit (max_damping) and its force limit, and never reversing the
- * force (it stops at zero rather than pull the hand into a wall). A bounded
- * damper may leave E above zero for some ticks; the excess is carried and
- * dissipated on the following ticks (energy_max reports the worst). */
+ * hand put in: passive.
+ *
+ * The controller. A force whose change per tick is bounded (contact_render.c
+ * ramps every change) cannot be withdrawn at once: a force f rendered now
+ * keeps doing work while it is released, f, f - r, f - 2r, ... (r the
+ * release step per tick). Predicting one tick ahead and then lowering the
+ * force at the ramp's rate leaves that tail unbudgeted, and a hand that
+ * accelerates away from the wall makes it larger still (issue 14: 5-54 uJ
+ * and 0.23 mJ above zero). So the controller budgets the whole release
+ * before it lets a force through: with u_k the hand's speed along the force
+ * k ticks ahead (its velocity plus its acceleration, when it grows, for
+ * the ticks until then) and tau the ticks' length (T, or the longest tick
+ * of late: a loaded machine's late tick holds the force longer), the
+ * energy still owed by rendering |f| = m now is
+ *   W(m) = m max(u_0, 0) h + sum_{k >= 1, m - k r > 0} (m - k r) max(u_k, 0) tau,
+ * h >= tau the longest the force now may be held (a reserve for this very
+ * tick being late, which no history predicts),
+ * and the force passed is the largest m' <= m along f's own line with
+ * E + W(m') <= 0. Its dissipative element is that scaling (the variable
+ * damper alpha v of Ryu and Hannaford, along the force's line, that never
+ * reverses the force: it stops at zero rather than pull the hand into a
+ * wall). The caller lets the force fall faster than its ramp when the
+ * controller asks (contact_render.h: CONTACT_RENDER_PASSIVE_STEP), which
+ * leaves a margin for what the prediction misses. */
 #ifndef VISCERA_PASSIVITY_H
 #define VISCERA_PASSIVITY_H
 
 #include <stdint.h>
 
 typedef struct passivity {
-  double period_s;    /* T */
-  double max_damping; /* N s/m, the controller's damper bound */
-  double energy;      /* E, J: <= 0 is passive */
-  double energy_max;  /* largest E seen after a tick, J (starts at 0) */
-  double dissipated;  /* J removed by the controller */
+  double period_s;   /* T, the nominal tick */
+  double energy;     /* E, J: <= 0 is passive */
+  double energy_max; /* largest E seen after a tick, J (starts at 0) */
+  double dissipated; /* J of predicted work the controller withheld */
   uint64_t active_ticks;
 } passivity_t;
 
-void passivity_init(passivity_t *p, double period_s, double max_damping);
+void passivity_init(passivity_t *p, double period_s);
 
-/* The controller: the force f (in place) corrected so that rendering it at
- * velocity v keeps E + reserve <= 0 where the damper bound allows; |f|
- * stays within max_force. reserve (J, >= 0) is energy the caller will
- * still deliver whatever the controller asks now (a rate-limited force
- * cannot drop at once: contact_render.c), so the damper starts early
- * enough. Returns the damping used (0 when none). Does not update E. */
-double passivity_control(passivity_t *p, const double v[3], double max_force, double reserve, double f[3]);
+/* The energy (J) a force of magnitude m rendered now and then released at
+ * release_step (N per tick) is predicted to put into a hand moving at u
+ * (m/s, along the force; > 0 away from the wall) with acceleration a
+ * (m/s^2, along the force; only a growth of u counts): the force is held
+ * now for hold_s (>= tick_s: the reserve for this tick being late), then
+ * released in ticks of tick_s. */
+double passivity_owed(double m, double u, double a, double tick_s, double hold_s, double release_step);
+
+/* The controller: f (in place) scaled down along its line, the least, so
+ * that E + passivity_owed(|f|, ...) <= 0 (zero when even that cannot hold
+ * E: then nothing more is put in). v the hand's velocity, a its
+ * acceleration (m/s^2), tick_s the tick's length to budget (>= T), hold_s
+ * the longest this tick may last. Returns the scale (1: unchanged). Does
+ * not update E. */
+double passivity_control(passivity_t *p, const double v[3], const double a[3], double tick_s, double hold_s,
+                         double release_step, double f[3]);
 
 /* The observer: the force f was held while the hand moved by dx (m). */
 void passivity_observe(passivity_t *p, const double f[3], const double dx[3]);

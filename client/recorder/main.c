@@ -19,7 +19,7 @@ static void usage(FILE *f) {
              "\n"
              "  -o, --out FILE.db     recording to create (required)\n"
              "  -f, --force           overwrite FILE.db if it exists\n"
-             "  -d, --domain N        DDS domain id 0..230 (default: $VISCERA_DOMAIN, else 0)\n"
+             "  -d, --domain N        DDS domain id 0..230 (default: $VISCERA_DOMAIN, else 0)\n" CLI_HELP_INSECURE
              "  -p, --partition P     partition to record; fnmatch-style patterns such as\n"
              "                        'lab1/*' record several sessions (default: viscera/local)\n"
              "  -t, --duration S      stop after S seconds (default: until SIGINT/SIGTERM)\n"

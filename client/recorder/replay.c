@@ -27,7 +27,7 @@
 static void usage(FILE *f) {
   fprintf(f, "usage: viscera-replay FILE.db [--domain N] [--partition P] [--speed X] [--seek S] [--pause-at S]\n"
              "                      [--loop] [--quiet]\n"
-             "  --domain N      DDS domain to publish in (default: the recorded one)\n"
+             "  --domain N      DDS domain to publish in (default: the recorded one)\n" CLI_HELP_INSECURE
              "  --partition P   partition to publish in (default: the recorded one, if not a pattern)\n"
              "  --speed X       playback speed factor, > 0 (default 1)\n"
              "  --seek S        skip the first S seconds (transient-local state is still sent)\n"

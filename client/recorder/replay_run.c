@@ -264,7 +264,13 @@ static int open_recording(replay_t *r) {
 static int publish_all(replay_t *r) {
   verr_t err;
   int status = 0;
-  vdds_config_default(); /* no CYCLONEDDS_URI: the loopback configuration */
+  /* The loopback configuration by default; off loopback, DDS Security or
+   * an explicit --insecure (vdds_config.h). */
+  if (vdds_config_prepare(stderr, "replay", &err)) {
+    fprintf(stderr, "replay: %s\n", err.msg);
+    status = 1;
+    goto out;
+  }
   dds_qos_t *ppq = vdds_participant_qos();
   r->pp = dds_create_participant((dds_domainid_t)r->o.domain, ppq, NULL);
   if (ppq) dds_delete_qos(ppq);

@@ -177,11 +177,12 @@ int rec_session_open(rec_session_t **out, const rec_session_opts_t *opts, const 
   char host[256] = "";
   if (gethostname(host, sizeof host - 1) != 0) host[0] = 0;
   store_session_t meta = {opts->scene, opts->partition, opts->domain, vtime_wall_ns(), host, recorder_version};
-  if (store_open(&s->store, opts->out, opts->force, &meta, err) < 0) {
+  /* The loopback configuration by default; off loopback, DDS Security or
+   * an explicit --insecure (vdds_config.h): refused before any file. */
+  if (vdds_config_prepare(stderr, "recorder", err) || store_open(&s->store, opts->out, opts->force, &meta, err) < 0) {
     free(s);
     return -1;
   }
-  vdds_config_default(); /* no CYCLONEDDS_URI: the loopback configuration */
   dds_qos_t *pq = vdds_participant_qos();
   s->participant = dds_create_participant((dds_domainid_t)opts->domain, pq, NULL);
   if (pq) dds_delete_qos(pq);

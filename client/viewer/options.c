@@ -17,7 +17,7 @@ void options_usage(FILE *f, const char *prog) {
           "Offscreen viewer: subscribes to a viscera scene over DDS and writes lit, shaded\n"
           "PNG frames of the organs and tools, with an index in DIR/frames.csv.\n"
           "\n"
-          "  --domain N         DDS domain id 0..230 (default: $VISCERA_DOMAIN, else 0)\n"
+          "  --domain N         DDS domain id 0..230 (default: $VISCERA_DOMAIN, else 0)\n" CLI_HELP_INSECURE
           "  --partition P      session partition (default " VDDS_DEFAULT_PARTITION ")\n"
           "  --out DIR          output directory, created if missing (default ./frames)\n"
           "  --interval-ms MS   write a frame every MS ms of wall time once a keyframe\n"

@@ -95,8 +95,9 @@ dds_qos_t *vdds_topic_qos(vdds_topic_id_t t) { return make_qos(TOPICS[t].qos, TO
 
 int vdds_open(vdds_t *v, dds_domainid_t domain, const char *partition, verr_t *err) {
   memset(v, 0, sizeof *v);
-  vdds_config_default(); /* no CYCLONEDDS_URI: the loopback configuration, like the scripts */
-  vdds_config_warn_insecure(stderr, "viscera", NULL); /* off loopback and not secure */
+  /* The loopback configuration by default; off loopback, DDS Security or
+   * an explicit --insecure (vdds_config.h). */
+  if (vdds_config_prepare(stderr, "viscera", err)) return -1;
   /* USER_DATA announces role, host and pid (vdds_ident.h), so recorders
    * and operators can tell the participants of a session apart. */
   dds_qos_t *pq = vdds_participant_qos();

@@ -69,20 +69,31 @@ int vdds_config_loopback(void) {
   return loop;
 }
 
-int vdds_config_warn_insecure(FILE *f, const char *tag, int *warned) {
-  if ((warned && *warned) || vdds_config_loopback() || vdds_config_secure()) return 0;
+int vdds_config_check_insecure(FILE *f, const char *tag, int *warned, verr_t *err) {
+  if (vdds_config_loopback() || vdds_config_secure()) return 0;
   const char *uri = getenv("CYCLONEDDS_URI");
   const char *ins = getenv("VISCERA_INSECURE");
-  if (ins && !strcmp(ins, "1"))
-    fprintf(f, "%s: WARNING: insecure (VISCERA_INSECURE=1): DDS Security is off on %s\n", tag, uri);
-  else
+  if (!ins || strcmp(ins, "1")) {
+    verr_set(err,
+             "refusing to start: DDS Security is off and CYCLONEDDS_URI (%s) is not the loopback configuration: "
+             "anyone on that network could read this session and drive its tools. Add an identity from "
+             "deploy/pki.sh to it (deploy/lab.sh --secure), or pass --insecure (or set VISCERA_INSECURE=1) to run "
+             "without DDS Security",
+             uri);
+    return -1;
+  }
+  if (!warned || !*warned)
     fprintf(f,
-            "%s: WARNING: DDS Security is off and CYCLONEDDS_URI (%s) is not the loopback configuration: anyone on "
-            "that network can read this session and drive its tools. Use identities from deploy/pki.sh (deploy/lab.sh "
-            "--secure), or set VISCERA_INSECURE=1 to say this is intended.\n",
+            "%s: WARNING: insecure (--insecure or VISCERA_INSECURE=1): DDS Security is off on %s; anyone on that "
+            "network can read this session and drive its tools\n",
             tag, uri);
   if (warned) *warned = 1;
-  return 1;
+  return 0;
+}
+
+int vdds_config_prepare(FILE *f, const char *tag, verr_t *err) {
+  vdds_config_default(); /* no CYCLONEDDS_URI: the loopback configuration, like the scripts */
+  return vdds_config_check_insecure(f, tag, NULL, err);
 }
 
 int vdds_matched_writers(dds_entity_t reader) {

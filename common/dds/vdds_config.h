@@ -24,6 +24,8 @@
 #include <stdint.h>
 #include <stdio.h>
 
+#include "verr.h"
+
 #define VDDS_LOOPBACK_CONFIG "deploy/cyclonedds-loopback.xml"
 #define VDDS_NOTHING_SEEN_S 5.0
 
@@ -42,14 +44,20 @@ int vdds_config_secure(void);
  * default, vdds_config_default). */
 int vdds_config_loopback(void);
 
-/* Off loopback, secure by default (issue 14): when the configuration is
- * neither loopback nor secure, writes a warning naming the configuration
- * and what anyone on that network can do to f (once per process: the
- * caller keeps `warned`), unless $VISCERA_INSECURE is 1 (the explicit
- * choice deploy/net_guard.sh also honours), in which case the warning is
- * one line saying so. Returns 1 when it warned. The deploy scripts refuse
- * such a configuration outright; a program started by hand warns. */
-int vdds_config_warn_insecure(FILE *f, const char *tag, int *warned);
+/* Off loopback, secure by default (issue 14). When the configuration is
+ * neither loopback nor secure, a program refuses to start unless told the
+ * choice is intended: --insecure (common/cli.c, every DDS program) or
+ * $VISCERA_INSECURE=1 (which --insecure sets; deploy/net_guard.sh honours
+ * the same). Returns 0 when the process may go on: loopback, secure, or
+ * allowed, in which case a warning naming the configuration is written to
+ * f (once per process: the caller keeps `warned`, NULL: always). Returns -1
+ * with err naming the configuration and the ways on otherwise. */
+int vdds_config_check_insecure(FILE *f, const char *tag, int *warned, verr_t *err);
+
+/* What every DDS participant of viscera is created after: the default
+ * configuration (vdds_config_default), then vdds_config_check_insecure.
+ * 0 to go on, -1 with err (refused). */
+int vdds_config_prepare(FILE *f, const char *tag, verr_t *err);
 
 /* Publications (writers) matched by `reader` now; 0 on error. */
 int vdds_matched_writers(dds_entity_t reader);

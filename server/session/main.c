@@ -12,7 +12,7 @@
 static void usage(FILE *f) {
   fprintf(f, "usage: viscera-server --scene FILE [options]\n"
              "  --scene FILE        scene file (YAML, see assets/scenes/README.md)\n"
-             "  --domain N          DDS domain id 0..230 (default: $VISCERA_DOMAIN or 0)\n"
+             "  --domain N          DDS domain id 0..230 (default: $VISCERA_DOMAIN or 0)\n" CLI_HELP_INSECURE
              "  --partition P       session partition (default: " VDDS_DEFAULT_PARTITION ")\n"
              "  --duration S        stop after S seconds (default: run until SIGINT/SIGTERM)\n"
              "  --tool-timeout S    release a tool after S s without commands (default 0.5)\n"

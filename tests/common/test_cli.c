@@ -121,6 +121,21 @@ int main(void) {
   CHECK(parse(&env, &c, &o, out, sizeof out, (char *)NULL) == 2 && strstr(out, "test-prog: VISCERA_DOMAIN='300'"));
   unsetenv("VISCERA_DOMAIN");
 
+  /* --insecure (a DDS program: CLI_DOMAIN): flagged and passed on in the
+   * environment, where the participant's start-up check reads it
+   * (dds/vdds_config.h); a program without DDS does not take it. */
+  unsetenv("VISCERA_INSECURE");
+  c = (cli_common_t){.domain = 5};
+  CHECK(parse(&SPEC, &c, &o, out, sizeof out, (char *)NULL) == CLI_RUN && c.insecure == 0);
+  CHECK(getenv("VISCERA_INSECURE") == NULL);
+  CHECK(parse(&SPEC, &c, &o, out, sizeof out, "--insecure", (char *)NULL) == CLI_RUN && c.insecure == 1);
+  CHECK(getenv("VISCERA_INSECURE") && !strcmp(getenv("VISCERA_INSECURE"), "1"));
+  unsetenv("VISCERA_INSECURE");
+  cli_spec_t nodds = SPEC;
+  nodds.common = CLI_QUIET;
+  c = (cli_common_t){.domain = 5};
+  CHECK(parse(&nodds, &c, &o, out, sizeof out, "--insecure", (char *)NULL) == 2 && getenv("VISCERA_INSECURE") == NULL);
+
   /* --help and --version: exit 0, on stdout. */
   CHECK(parse(&SPEC, &c, &o, out, sizeof out, "--help", (char *)NULL) == 0 && strstr(out, "usage: test-prog"));
   CHECK(parse(&SPEC, &c, &o, out, sizeof out, "--version", (char *)NULL) == 0);

@@ -22,6 +22,8 @@ LAN="file://$SRC/deploy/cyclonedds-lan.xml"
 # Tracing is added as a second configuration fragment; the LAN file is used unchanged.
 TRACE='<CycloneDDS><Domain Id="any"><Tracing><Category>config,discovery</Category><OutputFile>'"$OUT"'/trace-${CYCLONEDDS_PID}.log</OutputFile></Tracing></Domain></CycloneDDS>'
 export VISCERA_IFACE=lo
+# The LAN file without DDS Security: refused unless told (issue 14 item 5; insecure_start).
+export VISCERA_INSECURE=1
 
 # 1. Commands and feedback over the LAN configuration.
 CYCLONEDDS_URI="$LAN,$TRACE" "$SRV" --scene "$SCENE" --partition $SEAT > "$OUT/server.log" 2>&1 &

@@ -21,7 +21,11 @@
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/prelude.sh"
 net_sites lk1
+# A hand's press (prelude.sh): still pressing when contact reaches the client over the link.
+smooth_press "$OUT/press.traj"
 export CYCLONEDDS_URI="file://$SRC/deploy/cyclonedds-site.xml"
+# The site file without DDS Security: every program refuses it unless told (issue 14 item 5).
+export VISCERA_INSECURE=1
 SEAT=lk/seat01
 
 palpate() { # palpate NAME EMULATOR-OPTIONS...: one session through the link
@@ -31,7 +35,7 @@ palpate() { # palpate NAME EMULATOR-OPTIONS...: one session through the link
   run_in_site a "$BUILD/server/viscera-server" --scene "$SRC/assets/scenes/default.yaml" --partition $SEAT \
     > "$OUT/$name-server.out" 2> "$OUT/$name-server.log" &
   srv=$!; PIDS+=("$srv")
-  run_in_site b timeout 60 "$BUILD/client/haptic/viscera-haptic" --trajectory "$SRC/assets/trajectories/palpate_kidney.traj" \
+  run_in_site b timeout 60 "$BUILD/client/haptic/viscera-haptic" --trajectory "$OUT/press.traj" \
     --partition $SEAT --rate 100 --wait-server 15 --quiet > "$OUT/$name-haptic.out" 2> "$OUT/$name-haptic.log" \
     || fail "$name: haptic client failed"
   kill -INT "$srv"; wait "$srv" || fail "$name: server exited with an error"

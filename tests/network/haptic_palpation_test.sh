@@ -8,8 +8,10 @@
 # continuous). Judged from the client's own SUMMARY and force log:
 #   - peak force within 10 % of the 0 ms run's (the same trajectory),
 #   - no one-tick change above 0.1 N (step_n column, step_max_n),
-#   - the passivity observer's energy never above zero beyond what the
-#     one-tick prediction and the force ramp leave (energy_max_j <= 0.1 mJ),
+#   - the passivity observer's energy never above zero (energy_max_j <= 0;
+#     when the client's own loop stalled past the controller's 20 ms
+#     reserve, the work over those ticks is counted apart and the rest must
+#     be <= 0: energy_max_unstalled_j),
 #   - no "server lost" (server_lost=0): the leases hold under the link.
 # Needs tests/network/sites.sh and prelude.sh (the two-site harness).
 # usage: haptic_palpation_test.sh BUILD SRC OUT
@@ -24,13 +26,11 @@ server_stall_us() { sed -n 's/^server: .* step time median .* max \([0-9.]*\) us
 # means its DDS threads may have been too, past the lease.
 client_stall_us() { sed -n 's/^haptic: .* period median .* max \([0-9.]*\) us.*/\1/p' "$1" | tail -1; }
 export CYCLONEDDS_URI="file://$SRC/deploy/cyclonedds-site.xml"
+# The site file without DDS Security: every program refuses it unless told (issue 14 item 5).
+export VISCERA_INSECURE=1
 SEAT=hp/palp
 TRAJ="$OUT/palpate_smooth.traj"
-awk 'BEGIN { n = split("0.0 0.070 0.5 0.070 1.5 0.027 2.5 0.027 3.5 0.070 4.5 0.070", v, " ")
-  for (i = 1; i + 2 < n; i += 2) { t0 = v[i]; z0 = v[i + 1]; t1 = v[i + 2]; z1 = v[i + 3]
-    for (t = t0; t < t1 - 1e-9; t += 0.01) { s = (t - t0) / (t1 - t0); w = s * s * (3 - 2 * s)
-      printf "%.3f 0.012 0.004 %.6f\n", t, z0 + w * (z1 - z0) } }
-  printf "%.3f 0.012 0.004 %.6f\n", v[n - 1], v[n] }' > "$TRAJ"
+smooth_press "$TRAJ"
 
 palpate() { # palpate NAME EMULATOR-OPTIONS...
   local name="$1" srv
@@ -61,14 +61,30 @@ for setting in "d0:--delay 0" "d25:--delay 25 --jitter 5 --no-reorder --loss 2" 
   err=$(awk -v p="$peak" -v r="$ref" 'BEGIN { printf "%.1f", 100 * (p - r) / r }')
   printf "%-28s %8.3f %7s %8.4f %11.3g %6s %7.0f ms\n" "$opts" "$peak" "$err" "$step" "$en" "$lost" \
     "$(awk -v l="$lat" 'BEGIN { print l / 1000 }')"
-  awk -v p="$peak" -v r="$ref" 'BEGIN { exit !(p >= 0.9 * r && p <= 1.1 * r) }' || fail "$opts: peak $peak N vs $ref N"
+  # When the first contact sample reached the client only after the hand
+  # had stopped (2.0 s; a loaded machine stalled the feedback), the hand put
+  # no energy into the wall and the controller must withhold the force.
+  first=$(awk -F, 'NR > 1 && $8 == 1 { print $1; exit }' "$OUT/$name-force.csv")
+  if awk -v t="${first:-0}" 'BEGIN { exit !(t >= 2.0) }'; then
+    echo "note: the first contact sample arrived at $first s, after the hand stopped (2.0 s): force withheld"
+    awk -v p="$peak" 'BEGIN { exit !(p == 0) }' || fail "$opts: $peak N rendered on a hand that put no energy in"
+  else
+    awk -v p="$peak" -v r="$ref" 'BEGIN { exit !(p >= 0.9 * r && p <= 1.1 * r) }' || fail "$opts: peak $peak N vs $ref N"
+  fi
   awk -v s="$step" 'BEGIN { exit !(s <= 0.1) }' || fail "$opts: one-tick change $step N"
-  # The controller predicts the next tick's work from this tick's velocity
-  # and may lower the force by at most the ramp's 0.08 N per tick (the
-  # smoothness target): a hand that accelerates leaves tens of microjoules
-  # it then dissipates (seen: 5-54 uJ at 50-100 ms, 5-10 % loss, under load;
-  # without the controller the plane model gains millijoules).
-  awk -v e="$en" 'BEGIN { exit !(e <= 1e-4) }' || fail "$opts: passivity observer at $en J"
+  # The controller budgets the whole rate-limited release of the force
+  # before it renders it (client/haptic/passivity.h); before it did, a hand
+  # that accelerated away left 5-54 uJ here under load.
+  # A tick of the client's own loop longer than the controller's 20 ms
+  # reserve (a loaded machine descheduled it: seen 0.4-0.8 s at load 14)
+  # holds the force while the scripted hand moves on; the client counts that
+  # work apart (stall_energy_j), and the rest must still be <= 0.
+  if ! awk -v e="$en" 'BEGIN { exit !(e <= 0) }'; then
+    st=$(field "$o" stall_ticks) se=$(field "$o" stall_energy_j) eu=$(field "$o" energy_max_unstalled_j)
+    awk -v s="${st:-0}" -v u="${eu:-1}" 'BEGIN { exit !(s > 0 && u <= 0) }' \
+      || fail "$opts: passivity observer at $en J (stalled ticks ${st:-?}, ${se:-?} J in them, ${eu:-?} J without)"
+    echo "note: observer at $en J, all of it over $st stalled tick(s) of the client's loop ($se J); without them $eu J (machine load)"
+  fi
   stall=$(server_stall_us "$OUT/$name-server.log") cstall=$(client_stall_us "$OUT/$name-haptic.log")
   if [ "$lost" != 0 ]; then
     awk -v s="${stall:-0}" -v c="${cstall:-0}" 'BEGIN { exit !(s > 150000 || c > 100000) }' \

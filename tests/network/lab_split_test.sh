@@ -36,18 +36,18 @@ grep -q "is not the loopback configuration: run with --secure.*--insecure" "$OUT
   || fail "lab.sh did not say why it refused: $(cat "$OUT/refused.txt")"
 
 split() { # split NAME insecure|secure EMULATOR-OPTIONS...
-  local n="$1" mode="$2" la lb dash q seat sa=(--insecure) sb=(--insecure) dash_uri="$LAN"
+  local n="$1" mode="$2" la lb dash q seat sa=(--insecure) sb=(--insecure) dash_uri="$LAN" dash_opt=(--insecure)
   shift 2
   if [ "$mode" = secure ]; then
     sa=(--secure --pki "$OUT/pki-a") sb=(--secure --pki "$OUT/pki-b")
-    dash_uri="$LAN,file://$OUT/pki-b/identities/observer/security.xml"
+    dash_uri="$LAN,file://$OUT/pki-b/identities/observer/security.xml" dash_opt=()
   fi
   link_start --duration 60 --seed 19 "$@" || fail "$n: emulator did not start"
   run_in_site a "${LAB[@]}" "${sa[@]}" --seats 2 --duration 13 --out "$OUT/$n-a" > "$OUT/$n-lab-a.txt" 2>&1 &
   la=$!; PIDS+=("$la")
   run_in_site b "${LAB[@]}" "${sb[@]}" --first 3 --seats 2 --no-record --duration 12 --out "$OUT/$n-b" > "$OUT/$n-lab-b.txt" 2>&1 &
   lb=$!; PIDS+=("$lb")
-  CYCLONEDDS_URI="$dash_uri" run_in_site b "$BUILD/client/dashboard/viscera-dashboard" --prefix lab --seats 4 --out "$OUT/$n-dash" \
+  CYCLONEDDS_URI="$dash_uri" run_in_site b "$BUILD/client/dashboard/viscera-dashboard" "${dash_opt[@]}" --prefix lab --seats 4 --out "$OUT/$n-dash" \
     --interval-ms 500 --duration 11 > "$OUT/$n-dashboard.log" 2>&1 &
   dash=$!; PIDS+=("$dash")
   wait "$dash" || fail "$n: dashboard failed"

@@ -17,6 +17,8 @@ set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/prelude.sh"
 net_sites lk2
 export CYCLONEDDS_URI="file://$SRC/deploy/cyclonedds-site.xml"
+# The site file without DDS Security: every program refuses it unless told (issue 14 item 5).
+export VISCERA_INSECURE=1
 SEAT=lk/late
 
 late_join() { # late_join NAME EMULATOR-OPTIONS...

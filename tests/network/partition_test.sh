@@ -21,6 +21,8 @@ set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/prelude.sh"
 net_sites lk3
 export CYCLONEDDS_URI="file://$SRC/deploy/cyclonedds-site.xml"
+# The site file without DDS Security: every program refuses it unless told (issue 14 item 5).
+export VISCERA_INSECURE=1
 SEAT=lk/part
 TRAJ="$OUT/press_release_press.traj"
 printf '%s\n' "# t x y z: press, release during the partition, press after the heal" \

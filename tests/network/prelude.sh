@@ -32,3 +32,19 @@ net_sites() {
 }
 # A key=value field from a SUMMARY-style line of FILE: field FILE KEY.
 field() { sed -n "s/.*[ :]$2=\([-0-9.e+]*\).*/\1/p" "$1" | tail -1; }
+# smooth_press FILE: the kidney palpation as a hand makes it (haptic client
+# --trajectory): 3.5 cm above the top, pressed 8 mm in 1.5 s, held 1 s, let go;
+# smoothstep between the points (velocity continuous), sampled every 10 ms.
+# The press is slow enough that over a link of up to 100 ms one way the first
+# contact sample reaches the client while the hand still presses: a hand that
+# has stopped before it arrives has put no energy into the wall, and the
+# client's passivity controller (client/haptic/passivity.h, observer <= 0 at
+# every tick) may then not push it back out (palpate_kidney.traj's press ends
+# 0.18 s after the surface).
+smooth_press() {
+  awk 'BEGIN { n = split("0.0 0.070 0.5 0.070 2.0 0.027 3.0 0.027 4.0 0.070 5.0 0.070", v, " ")
+    for (i = 1; i + 2 < n; i += 2) { t0 = v[i]; z0 = v[i + 1]; t1 = v[i + 2]; z1 = v[i + 3]
+      for (t = t0; t < t1 - 1e-9; t += 0.01) { s = (t - t0) / (t1 - t0); w = s * s * (3 - 2 * s)
+        printf "%.3f 0.012 0.004 %.6f\n", t, z0 + w * (z1 - z0) } }
+    printf "%.3f 0.012 0.004 %.6f\n", v[n - 1], v[n] }' > "$1"
+}

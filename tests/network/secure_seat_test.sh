@@ -12,6 +12,8 @@ set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/prelude.sh"
 command -v openssl >/dev/null || { echo "SKIP: openssl missing (deploy/install_deps.sh installs it)"; exit 77; }
 net_sites lk4
+# A hand's press (prelude.sh): still pressing when contact reaches the client over the link.
+smooth_press "$OUT/press.traj"
 SITE="file://$SRC/deploy/cyclonedds-site.xml"
 bash "$SRC/deploy/pki.sh" "$OUT/pki" --seats 1 --prefix lk > "$OUT/pki.txt" 2>&1 || fail "pki.sh failed"
 as() { echo "$SITE,file://$OUT/pki/identities/$1/security.xml"; }
@@ -28,11 +30,12 @@ secure() { # secure NAME EMULATOR-OPTIONS...
   CYCLONEDDS_URI="$(as recorder)" run_in_site b "$BUILD/client/recorder/viscera-recorder" --partition 'lk/*' \
     --out "$OUT/$n-secure.db" --quiet > "$OUT/$n-rec-secure.log" 2>&1 &
   rs=$!; PIDS+=("$rs")
-  CYCLONEDDS_URI="$SITE" run_in_site b "$BUILD/client/recorder/viscera-recorder" --partition $SEAT \
+  # The eavesdropper: no identity, so it must say --insecure to start at all.
+  CYCLONEDDS_URI="$SITE" run_in_site b "$BUILD/client/recorder/viscera-recorder" --insecure --partition $SEAT \
     --out "$OUT/$n-plain.db" --quiet > "$OUT/$n-rec-plain.log" 2>&1 &
   rp=$!; PIDS+=("$rp")
   CYCLONEDDS_URI="$(as trainee-seat01)" run_in_site b timeout 60 "$BUILD/client/haptic/viscera-haptic" \
-    --trajectory "$SRC/assets/trajectories/palpate_kidney.traj" --partition $SEAT --wait-server 20 --quiet \
+    --trajectory "$OUT/press.traj" --partition $SEAT --wait-server 20 --quiet \
     > "$OUT/$n-haptic.out" 2> "$OUT/$n-haptic.log" || fail "$n: the secure trainee failed"
   kill -INT "$srv"; wait "$srv" || fail "$n: server exited with an error"
   sleep 1

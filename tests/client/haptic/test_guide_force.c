@@ -292,6 +292,17 @@ static void test_slot(void) {
   CHECK(v.have_peer && strcmp(v.peer_station, "bob") == 0);
   CHECK_NEAR(v.peer[0], 0.03, 1e-7);
   CHECK_NEAR(v.peer_age_s, 0.05, 1e-12);
+  /* The peer's transit (source timestamp to our clock): unknown at first,
+   * then the first value, then smoothed; clocks apart are ignored. */
+  CHECK(v.peer_transit_s < 0);
+  guide_slot_transit(&s, "bob", 0.100);
+  guide_slot_transit(&s, "bob", -0.5);                    /* the writer's clock ahead of ours */
+  guide_slot_transit(&s, "bob", GUIDE_TRANSIT_MAX_S + 1); /* or far behind */
+  guide_slot_read(&s, "alice", 51000000, &v);
+  CHECK_NEAR(v.peer_transit_s, 0.100, 1e-12);
+  guide_slot_transit(&s, "bob", 0.200);
+  guide_slot_read(&s, "alice", 51000000, &v);
+  CHECK_NEAR(v.peer_transit_s, 0.100 + GUIDE_TRANSIT_GAIN * 0.100, 1e-12);
   guide_slot_read(&s, "bob", 51000000, &v);
   CHECK(v.have_peer && strcmp(v.peer_station, "carol") == 0);
   /* Once assigned to alice, carol is nobody's peer. */
@@ -312,7 +323,7 @@ static void test_slot(void) {
   CHECK(!v.have_peer); /* bob's entry was the stalest */
   guide_slot_command(&s, "bob", pb, 7000000);
   guide_slot_read(&s, "alice", 7000000, &v);
-  CHECK(v.have_peer && v.peer_age_s == 0);
+  CHECK(v.have_peer && v.peer_age_s == 0 && v.peer_transit_s < 0); /* a new entry: transit unknown again */
   /* The server disposed the role: nobody is coupled. */
   guide_slot_role_lost(&s);
   guide_slot_read(&s, "alice", 7000000, &v);

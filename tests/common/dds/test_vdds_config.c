@@ -65,32 +65,44 @@ int main(void) {
   CHECK(strstr(t, "DDS Security on") != NULL && strstr(t, "do not accept this identity") != NULL);
   unlink(sec);
   unlink(plain);
-  /* Off loopback and not secure: a warning (issue 14 item 5); loopback,
-   * secure or unset: none; VISCERA_INSECURE=1: one line saying so. */
+  /* Off loopback and not secure: refused, naming the file and the way on
+   * (issue 14 item 5); loopback, secure or unset: allowed silently;
+   * VISCERA_INSECURE=1 (what --insecure sets): allowed with a warning. */
   {
-    char out[1024];
+    char out[1024] = "";
     FILE *f;
     int warned = 0;
+    verr_t e = {{0}};
     unsetenv("VISCERA_INSECURE");
     setenv("CYCLONEDDS_URI", "file:///opt/viscera/deploy/cyclonedds-loopback.xml", 1);
     CHECK(vdds_config_loopback() == 1);
-    CHECK(vdds_config_warn_insecure(stderr, "t", NULL) == 0);
+    CHECK(vdds_config_check_insecure(stderr, "t", NULL, &e) == 0);
     setenv("CYCLONEDDS_URI", "file:///opt/viscera/deploy/cyclonedds-lan.xml", 1);
     CHECK(vdds_config_loopback() == 0);
     f = fmemopen(out, sizeof out, "w");
-    CHECK(f && vdds_config_warn_insecure(f, "t", &warned) == 1 && warned == 1);
+    CHECK(f && vdds_config_check_insecure(f, "t", &warned, &e) == -1 && warned == 0);
     if (f) fclose(f);
-    CHECK(strstr(out, "DDS Security is off") && strstr(out, "cyclonedds-lan.xml") && strstr(out, "VISCERA_INSECURE=1"));
-    CHECK(vdds_config_warn_insecure(stderr, "t", &warned) == 0); /* once */
+    CHECK(out[0] == 0); /* refused: the message is the caller's to print */
+    CHECK(strstr(e.msg, "refusing to start") && strstr(e.msg, "DDS Security is off") &&
+          strstr(e.msg, "/opt/viscera/deploy/cyclonedds-lan.xml") && strstr(e.msg, "--insecure") &&
+          strstr(e.msg, "VISCERA_INSECURE=1") && strstr(e.msg, "deploy/pki.sh"));
+    CHECK(vdds_config_prepare(stderr, "t", &e) == -1); /* the path every participant takes */
+    setenv("VISCERA_INSECURE", "0", 1);
+    CHECK(vdds_config_check_insecure(stderr, "t", NULL, &e) == -1);
     setenv("VISCERA_INSECURE", "1", 1);
     f = fmemopen(out, sizeof out, "w");
-    CHECK(f && vdds_config_warn_insecure(f, "t", NULL) == 1);
+    CHECK(f && vdds_config_check_insecure(f, "t", &warned, &e) == 0 && warned == 1);
     if (f) fclose(f);
-    CHECK(strstr(out, "insecure (VISCERA_INSECURE=1)") != NULL);
+    CHECK(strstr(out, "t: WARNING: insecure") && strstr(out, "cyclonedds-lan.xml"));
+    out[0] = 0;
+    f = fmemopen(out, sizeof out, "w");
+    CHECK(f && vdds_config_check_insecure(f, "t", &warned, &e) == 0); /* warned once */
+    if (f) fclose(f);
+    CHECK(out[0] == 0);
     unsetenv("VISCERA_INSECURE");
     setenv("CYCLONEDDS_URI", "file:///x/cyclonedds-loopback.xml,<CycloneDDS><Domain><Security/></Domain></CycloneDDS>",
            1);
-    CHECK(vdds_config_loopback() == 0 && vdds_config_warn_insecure(stderr, "t", NULL) == 0);
+    CHECK(vdds_config_loopback() == 0 && vdds_config_check_insecure(stderr, "t", NULL, &e) == 0);
   }
   return check_report("test_vdds_config");
 }
