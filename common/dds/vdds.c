@@ -32,6 +32,7 @@ static const struct {
     [VT_TOOL_ROLE] = {"viscera_ToolRole", &viscera_ToolRole_desc, QOS_STATE},
     [VT_APPLIED_INPUT] = {"viscera_AppliedInput", &viscera_AppliedInput_desc, QOS_LOG},
     [VT_SCENE_SOURCE] = {"viscera_SceneSource", &viscera_SceneSource_desc, QOS_STATE},
+    [VT_MESH_KEY_CHUNK] = {"viscera_MeshKeyChunk", &viscera_MeshKeyChunk_desc, QOS_STATE},
 };
 
 const char *vdds_topic_name(vdds_topic_id_t t) { return t < VT_COUNT ? TOPICS[t].name : "?"; }

@@ -49,6 +49,13 @@ typedef struct mesh_publisher {
   uint32_t *idx;
   int16_t *dq;
   dds_entity_t w_state, w_delta; /* 0: encode only (benchmarks) */
+  /* Keyframe chunks (dds/key_chunks.h), set after init; 0: none. Every
+   * keyframe is also written as its compact encoding in single-datagram
+   * MeshKeyChunk samples, which survive a lossy link (issue 14); MeshState
+   * stays the keyframe of record (recordings, re-simulation). */
+  dds_entity_t w_chunk;
+  uint32_t chunks_written;       /* chunks of the last set (their slots are live) */
+  uint64_t chunk_sets, chunk_samples, chunk_payload_bytes, chunk_failures;
   /* Counters. */
   uint64_t frames, keyframes, delta_payload_bytes, keyframe_payload_bytes, retopos;
   long last_count; /* vertices in the last delta */
@@ -61,6 +68,10 @@ typedef struct mesh_publisher {
   uint32_t *written_idx; /* cap_verts */
   int16_t *written_dq;   /* 3 cap_verts */
 } mesh_publisher_t;
+
+/* zlib level of the keyframe chunks: the fastest, since a keyframe is
+ * encoded in the physics loop (the kidney: about 0.5 ms). */
+#define MESH_PUBLISHER_CHUNK_LEVEL 1
 
 int mesh_publisher_init(mesh_publisher_t *mp, uint32_t organ_id, size_t nverts, const uint32_t *tris, size_t ntris,
                         float quant, dds_entity_t w_state, dds_entity_t w_delta, verr_t *err);

@@ -36,6 +36,7 @@ typedef struct server {
   runtime_t rt;
   vdds_t dds;
   dds_entity_t w_scene, w_state, w_delta, w_feedback, w_event, w_metrics, r_cmd, r_control;
+  dds_entity_t w_chunk; /* keyframes in single-datagram chunks (dds/key_chunks.h) */
   dds_entity_t w_objects, w_tool_metrics, w_role, w_applied, w_source;
   mesh_publisher_t pubs[SCENE_MAX_ORGANS];
   /* Each tool's session record (session_tool.h: measures, intake,
@@ -196,7 +197,8 @@ static int setup(server_t *s, const scene_t *scene, verr_t *err) {
   s->w_role = vdds_writer(&s->dds, VT_TOOL_ROLE, err);
   s->w_applied = vdds_writer(&s->dds, VT_APPLIED_INPUT, err);
   s->w_source = vdds_writer(&s->dds, VT_SCENE_SOURCE, err);
-  if (s->w_scene < 0 || s->w_state < 0 || s->w_delta < 0 || s->w_feedback < 0 || s->w_event < 0 || s->w_metrics < 0 ||
+  s->w_chunk = vdds_writer(&s->dds, VT_MESH_KEY_CHUNK, err);
+  if (s->w_chunk < 0 || s->w_scene < 0 || s->w_state < 0 || s->w_delta < 0 || s->w_feedback < 0 || s->w_event < 0 || s->w_metrics < 0 ||
       s->r_cmd < 0 || s->r_control < 0 || s->w_objects < 0 || s->w_tool_metrics < 0 || s->w_role < 0 ||
       s->w_applied < 0 || s->w_source < 0)
     return -1;
@@ -210,6 +212,7 @@ static int setup(server_t *s, const scene_t *scene, verr_t *err) {
                             (float)scene->quant_step, s->w_state, s->w_delta, err))
       return -1;
     s->pubs[i].keepalive_ns = (uint64_t)(scene->publish_keepalive * 1e9);
+    s->pubs[i].w_chunk = s->w_chunk;
   }
   s->step_us = calloc(STEP_RING, sizeof(double));
   s->step_cpu_us = calloc(STEP_RING, sizeof(double));
@@ -1047,6 +1050,7 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
   stats->published[VT_APPLIED_INPUT] = s.ai.published;
   for (size_t i = 0; i < s.rt.norgans; i++) {
     stats->published[VT_MESH_STATE] += s.pubs[i].keyframes;
+    stats->published[VT_MESH_KEY_CHUNK] += s.pubs[i].chunk_samples;
     stats->published[VT_MESH_DELTA] += s.pubs[i].frames;
     stats->deltas_skipped += s.pubs[i].skipped;
   }
