@@ -182,8 +182,9 @@ int key_chunk_check(const key_chunk_t *c, uint32_t max_organs, verr_t *err) {
   if (c->organ_id >= max_organs) return verr_set(err, "organ_id %u out of range (0..%u)", c->organ_id, max_organs - 1);
   if (c->count == 0 || c->count > KEY_CHUNKS_MAX || c->index >= c->count)
     return verr_set(err, "chunk %u of %u (1..%u chunks)", c->index, c->count, KEY_CHUNKS_MAX);
-  if ((uint64_t)c->organ_id * KEY_CHUNKS_MAX + c->index != c->slot)
-    return verr_set(err, "slot %u is not organ %u chunk %u", c->slot, c->organ_id, c->index);
+  uint64_t first = (uint64_t)c->organ_id * KEY_CHUNKS_MAX + c->index;
+  if (c->slot != first && !(2 * c->count <= KEY_CHUNKS_MAX && c->slot == first + c->count))
+    return verr_set(err, "slot %u is not organ %u chunk %u (nor its copy)", c->slot, c->organ_id, c->index);
   if (key_chunk_count(c->total_bytes) != c->count)
     return verr_set(err, "%u chunks for %u bytes (%u needed)", c->count, c->total_bytes,
                     key_chunk_count(c->total_bytes));
@@ -295,8 +296,12 @@ int key_chunks_write(int32_t w, uint32_t organ_id, uint32_t topology_version, ui
   s.count = count;
   s.total_bytes = (uint32_t)len;
   key_digest(blob, len, s.digest);
-  for (uint32_t i = 0; i < count; i++) {
-    s.slot = organ_id * KEY_CHUNKS_MAX + i;
+  /* Two copies when they fit: all of the first, then all of the second, so
+   * a burst of losses rarely takes both copies of a chunk. */
+  uint32_t copies = 2 * count <= KEY_CHUNKS_MAX ? KEY_CHUNK_COPIES : 1, slots = copies * count;
+  for (uint32_t j = 0; j < slots; j++) {
+    uint32_t i = j % count;
+    s.slot = organ_id * KEY_CHUNKS_MAX + j;
     s.index = i;
     s.offset = i * KEY_CHUNK_DATA_MAX;
     s.data._buffer = (uint8_t *)blob + s.offset;
@@ -307,10 +312,10 @@ int key_chunks_write(int32_t w, uint32_t organ_id, uint32_t topology_version, ui
   /* A shorter set leaves the old set's last slots in the history: a late
    * joiner would get them too (they are refused as another set, but cost
    * bytes on the link). */
-  for (uint32_t i = count; i < *written; i++) {
-    s.slot = organ_id * KEY_CHUNKS_MAX + i;
+  for (uint32_t j = slots; j < *written; j++) {
+    s.slot = organ_id * KEY_CHUNKS_MAX + j;
     (void)dds_unregister_instance(w, &s);
   }
-  *written = count;
-  return (int)count;
+  *written = slots;
+  return (int)slots;
 }
