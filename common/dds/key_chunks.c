@@ -108,7 +108,8 @@ static int parse_body(const uint8_t *b, size_t n, size_t nverts, size_t ntris, f
     uint32_t u = prev[i % 3] + d;
     prev[i % 3] = u;
     memcpy(&pos[i], &u, 4);
-    if (!isfinite(pos[i])) return verr_set(err, "keyframe decode: vertex %zu coordinate %zu is not finite", i / 3, i % 3);
+    if (!isfinite(pos[i]))
+      return verr_set(err, "keyframe decode: vertex %zu coordinate %zu is not finite", i / 3, i % 3);
   }
   size_t at = 4 * nv;
   int64_t last = 0;
@@ -189,7 +190,8 @@ int key_chunk_check(const key_chunk_t *c, uint32_t max_organs, verr_t *err) {
     return verr_set(err, "%u chunks for %u bytes (%u needed)", c->count, c->total_bytes,
                     key_chunk_count(c->total_bytes));
   uint64_t off = (uint64_t)c->index * KEY_CHUNK_DATA_MAX;
-  if (c->offset != off) return verr_set(err, "chunk %u at offset %u, not %llu", c->index, c->offset, (unsigned long long)off);
+  if (c->offset != off)
+    return verr_set(err, "chunk %u at offset %u, not %llu", c->index, c->offset, (unsigned long long)off);
   uint64_t want = c->total_bytes - off < KEY_CHUNK_DATA_MAX ? c->total_bytes - off : KEY_CHUNK_DATA_MAX;
   if (c->len != want)
     return verr_set(err, "chunk %u holds %zu bytes, not %llu", c->index, c->len, (unsigned long long)want);
@@ -249,8 +251,8 @@ int key_assembly_add(key_assembly_t *a, const key_chunk_t *c, uint32_t max_organ
   if (memcmp(d, a->digest, KEY_DIGEST_LEN)) {
     a->digest_failures++;
     a->refused++;
-    return verr_set(err, "topology %u keyframe %u: the %u chunks' digest does not match their content", c->topology_version,
-                    c->keyframe_seq, a->count);
+    return verr_set(err, "topology %u keyframe %u: the %u chunks' digest does not match their content",
+                    c->topology_version, c->keyframe_seq, a->count);
   }
   a->done = 1;
   a->done_topology_version = a->topology_version;
@@ -282,7 +284,8 @@ void key_chunk_from_wire(const struct viscera_MeshKeyChunk *s, key_chunk_t *c) {
 }
 
 int key_chunks_write(int32_t w, uint32_t organ_id, uint32_t topology_version, uint32_t keyframe_seq,
-                     uint64_t sim_time_ns, const uint8_t *blob, size_t len, uint32_t *written, verr_t *err) {
+                     uint64_t sim_time_ns, const uint8_t *blob, size_t len, uint32_t copies, uint32_t *written,
+                     verr_t *err) {
   uint32_t count = key_chunk_count(len);
   if (count == 0 || organ_id >= UINT32_MAX / KEY_CHUNKS_MAX)
     return verr_set(err, "organ %u: an encoded keyframe of %zu bytes does not fit %u chunks", organ_id, len,
@@ -298,14 +301,16 @@ int key_chunks_write(int32_t w, uint32_t organ_id, uint32_t topology_version, ui
   key_digest(blob, len, s.digest);
   /* Two copies when they fit: all of the first, then all of the second, so
    * a burst of losses rarely takes both copies of a chunk. */
-  uint32_t copies = 2 * count <= KEY_CHUNKS_MAX ? KEY_CHUNK_COPIES : 1, slots = copies * count;
+  if (copies < 1 || copies > 2 || 2 * count > KEY_CHUNKS_MAX) copies = 1;
+  uint32_t slots = copies * count;
   for (uint32_t j = 0; j < slots; j++) {
     uint32_t i = j % count;
     s.slot = organ_id * KEY_CHUNKS_MAX + j;
     s.index = i;
     s.offset = i * KEY_CHUNK_DATA_MAX;
     s.data._buffer = (uint8_t *)blob + s.offset;
-    s.data._length = s.data._maximum = (uint32_t)(len - s.offset < KEY_CHUNK_DATA_MAX ? len - s.offset : KEY_CHUNK_DATA_MAX);
+    s.data._length = s.data._maximum =
+        (uint32_t)(len - s.offset < KEY_CHUNK_DATA_MAX ? len - s.offset : KEY_CHUNK_DATA_MAX);
     dds_return_t rc = dds_write(w, &s);
     if (rc < 0) return verr_set(err, "organ %u: writing keyframe chunk %u failed: %s", organ_id, i, dds_strretcode(rc));
   }

@@ -41,7 +41,7 @@
  * organ_id * KEY_CHUNKS_MAX + index. A keyframe that does not fit is
  * published as MeshState only. */
 #define KEY_CHUNKS_MAX 1024u
-/* Copies of each chunk written (when 2 * count <= KEY_CHUNKS_MAX; else 1):
+/* Copies of each chunk the server writes (when 2 * count <= KEY_CHUNKS_MAX; else 1):
  * copy 1 of chunk i is in slot organ_id * KEY_CHUNKS_MAX + count + i. Why:
  * at 5 % loss a 15-chunk set loses at least one chunk more often than not
  * (54 %), which costs a repair round trip; with two copies, 4 %. The
@@ -126,13 +126,14 @@ void key_assembly_free(key_assembly_t *a);
 struct viscera_MeshKeyChunk;
 /* A received sample as a key_chunk_t (borrows its data). */
 void key_chunk_from_wire(const struct viscera_MeshKeyChunk *s, key_chunk_t *c);
-/* Writes an encoded keyframe as its chunks (KEY_CHUNK_COPIES copies when
- * they fit) with writer w, then unregisters the slots [slots, *written) a
+/* Writes an encoded keyframe as its chunks (copies: 1, or 2 when they fit;
+ * KEY_CHUNK_COPIES is the product's choice) with writer w, then unregisters the slots [slots, *written) a
  * previous, longer set of this organ left in the writer's transient-local
  * history, so a late joiner gets one set. *written becomes the number of
  * samples (slots) written. Returns that number, or -1 with err (a set too
  * large for KEY_CHUNKS_MAX is not written: -1 too). */
 int key_chunks_write(int32_t w, uint32_t organ_id, uint32_t topology_version, uint32_t keyframe_seq,
-                     uint64_t sim_time_ns, const uint8_t *blob, size_t len, uint32_t *written, verr_t *err);
+                     uint64_t sim_time_ns, const uint8_t *blob, size_t len, uint32_t copies, uint32_t *written,
+                     verr_t *err);
 
 #endif

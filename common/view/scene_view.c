@@ -305,6 +305,9 @@ int scene_view_open(scene_view_t *sv, int domain, const char *partition, scene_v
     *rds[i].rd = rds[i].gate ? vdds_reader_gated(&sv->dds, rds[i].topic, rds[i].gate, SERVER_DEPTH,
                                                  rds[i].max_instances, NULL, err)
                              : vdds_reader(&sv->dds, rds[i].topic, err);
+    /* Keyframe chunks are optional (vdds.c: not permitted by an older PKI):
+     * keyframes then come as MeshState only. */
+    if (*rds[i].rd < 0 && rds[i].topic == VT_MESH_KEY_CHUNK) *rds[i].rd = 0;
     if (*rds[i].rd < 0) {
       vdds_close(&sv->dds);
       return -1;
@@ -413,6 +416,7 @@ int scene_view_poll(scene_view_t *sv, verr_t *err) {
                {sv->rd_object, h_object, NULL, "ObjectState", FROM_SERVER, &sv->gate_object}};
   int total = 0;
   for (size_t i = 0; i < sizeof order / sizeof order[0]; i++) {
+    if (order[i].rd == 0) continue; /* an optional reader not created */
     int n = take_all(sv, order[i].rd, order[i].h, order[i].gone, order[i].name, order[i].src, order[i].gate, err);
     if (n < 0) return -1;
     total += n;

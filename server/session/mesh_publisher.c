@@ -64,7 +64,7 @@ static int write_chunks(mesh_publisher_t *mp, uint64_t sim_time_ns) {
     return 0;
   }
   int n = key_chunks_write(mp->w_chunk, mp->organ_id, mp->topology_version, mp->keyframe_seq, sim_time_ns, blob, len,
-                           &mp->chunks_written, &err);
+                           mp->chunk_copies ? mp->chunk_copies : KEY_CHUNK_COPIES, &mp->chunks_written, &err);
   free(blob);
   if (n < 0) {
     mp->chunk_failures++;

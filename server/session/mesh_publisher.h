@@ -54,7 +54,8 @@ typedef struct mesh_publisher {
    * MeshKeyChunk samples, which survive a lossy link (issue 14); MeshState
    * stays the keyframe of record (recordings, re-simulation). */
   dds_entity_t w_chunk;
-  uint32_t chunks_written;       /* chunks of the last set (their slots are live) */
+  uint32_t chunk_copies;   /* 1 or 2 (set with w_chunk; 0 = KEY_CHUNK_COPIES) */
+  uint32_t chunks_written; /* chunks of the last set (their slots are live) */
   uint64_t chunk_sets, chunk_samples, chunk_payload_bytes, chunk_failures;
   /* Counters. */
   uint64_t frames, keyframes, delta_payload_bytes, keyframe_payload_bytes, retopos;

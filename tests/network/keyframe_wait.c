@@ -101,11 +101,10 @@ static void poll_once(dds_entity_t rs, dds_entity_t rd, dds_entity_t rc, uint64_
 }
 
 int main(int argc, char **argv) {
-  static const struct option opts[] = {
-      {"partition", required_argument, 0, 'p'},
-      {"duration", required_argument, 0, 'd'},
-      {"path", required_argument, 0, 'k'},
-      {0, 0, 0, 0}};
+  static const struct option opts[] = {{"partition", required_argument, 0, 'p'},
+                                       {"duration", required_argument, 0, 'd'},
+                                       {"path", required_argument, 0, 'k'},
+                                       {0, 0, 0, 0}};
   const char *partition = NULL, *path = "both";
   double duration = 10;
   for (int c; (c = getopt_long(argc, argv, "", opts, NULL)) != -1;) {
@@ -143,8 +142,7 @@ int main(int argc, char **argv) {
     dds_sleepfor(DDS_MSECS(1));
   }
   printf("KEYFRAME matched_ms=%.1f keyframe_ms=%.1f wait_ms=%.1f keyframe_bytes=%" PRIu64 " deltas=%" PRIu64
-         " delta_bytes=%" PRIu64 " state_ms=%.1f chunks_ms=%.1f chunks=%" PRIu64 " chunk_bytes=%" PRIu64
-         " path=%s\n",
+         " delta_bytes=%" PRIu64 " state_ms=%.1f chunks_ms=%.1f chunks=%" PRIu64 " chunk_bytes=%" PRIu64 " path=%s\n",
          c.matched_ms, c.key_ms, c.key_ms >= 0 && c.matched_ms >= 0 ? c.key_ms - c.matched_ms : -1.0, c.key_bytes,
          c.deltas, c.delta_bytes, c.state_ms, c.chunks_ms, c.chunks, c.chunk_bytes, path);
   vdds_close(&dds);

@@ -70,19 +70,35 @@ static uint32_t cut(const uint8_t *blob, size_t len, uint32_t organ, uint32_t se
 
 /* One field of a sound chunk damaged at a time; each refused, naming it. */
 static void chunk_refusals(const key_chunk_t *good) {
-  static const char *const want[] = {"organ_id", "chunk 0 of 0", "chunk 5 of 5", "chunk 0 of 5000", "is not organ",
-                                     "chunks for", "offset",       "holds"};
+  static const char *const want[] = {"organ_id",     "chunk 0 of 0", "chunk 5 of 5", "chunk 0 of 5000",
+                                     "is not organ", "chunks for",   "offset",       "holds"};
   for (int i = 0; i < 8; i++) {
     key_chunk_t c = *good;
     switch (i) {
-    case 0: c.organ_id = 16, c.slot = 16 * KEY_CHUNKS_MAX + c.index; break;
-    case 1: c.count = 0, c.index = 0; break;
-    case 2: c.count = 5, c.index = 5; break;
-    case 3: c.count = 5000, c.index = 0; break;
-    case 4: c.slot = c.slot + 1; break;
-    case 5: c.total_bytes = 100; break;
-    case 6: c.offset = c.offset + 7; break;
-    default: c.len = 10; break;
+    case 0:
+      c.organ_id = 16, c.slot = 16 * KEY_CHUNKS_MAX + c.index;
+      break;
+    case 1:
+      c.count = 0, c.index = 0;
+      break;
+    case 2:
+      c.count = 5, c.index = 5;
+      break;
+    case 3:
+      c.count = 5000, c.index = 0;
+      break;
+    case 4:
+      c.slot = c.slot + 1;
+      break;
+    case 5:
+      c.total_bytes = 100;
+      break;
+    case 6:
+      c.offset = c.offset + 7;
+      break;
+    default:
+      c.len = 10;
+      break;
     }
     verr_t err;
     int rc = key_chunk_check(&c, 16, &err);
