@@ -41,13 +41,15 @@
  * organ_id * KEY_CHUNKS_MAX + index. A keyframe that does not fit is
  * published as MeshState only. */
 #define KEY_CHUNKS_MAX 1024u
-/* Copies of each chunk the server writes (when 2 * count <= KEY_CHUNKS_MAX; else 1):
- * copy 1 of chunk i is in slot organ_id * KEY_CHUNKS_MAX + count + i. Why:
- * at 5 % loss a 15-chunk set loses at least one chunk more often than not
- * (54 %), which costs a repair round trip; with two copies, 4 %. The
- * encoded kidney is 16 kB, so both copies are still less than half of one
- * MeshState (72 kB). */
-#define KEY_CHUNK_COPIES 2u
+/* Copies of each chunk the server writes (2 only when 2 * count <=
+ * KEY_CHUNKS_MAX): copy 1 of chunk i is in slot organ_id * KEY_CHUNKS_MAX +
+ * count + i, and receivers accept either. One by default: at 100 ms one way
+ * a second copy did not shorten the wait measurably (3 interleaved runs each
+ * at 5 and 10 % loss: median 470 ms with one, 484 ms with two, load 15-21),
+ * because the wait is mostly the handshake before a late joiner gets the
+ * history (0 % loss: 370-460 ms), not the repair of lost chunks.
+ * VISCERA_KEY_CHUNK_COPIES=2 in the server's environment writes two. */
+#define KEY_CHUNK_COPIES 1u
 #define KEY_BLOB_MAX (KEY_CHUNK_DATA_MAX * KEY_CHUNKS_MAX)
 /* Largest keyframe decoded (as organ_state.h accepts). */
 #define KEY_MAX_VERTS (1u << 22)

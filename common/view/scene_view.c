@@ -300,11 +300,14 @@ int scene_view_open(scene_view_t *sv, int domain, const char *partition, scene_v
              {&sv->rd_cmd, VT_TOOL_COMMAND, &sv->gate_cmd, SCENE_VIEW_MAX_TOOLS},
              {&sv->rd_contact, VT_CONTACT_FEEDBACK, &sv->gate_contact, SCENE_VIEW_MAX_TOOLS},
              {&sv->rd_object, VT_OBJECT_STATE, &sv->gate_object, SCENE_VIEW_MAX_OBJECTS},
-             {&sv->rd_chunk, VT_MESH_KEY_CHUNK, &sv->gate_chunk, SCENE_VIEW_MAX_ORGANS * KEY_CHUNKS_MAX}};
+             {&sv->rd_chunk, VT_MESH_KEY_CHUNK, &sv->gate_chunk, SCENE_VIEW_MAX_ORGANS * KEY_CHUNKS_MAX},
+             {&sv->rd_chunk_live, VT_MESH_KEY_CHUNK, &sv->gate_chunk, -SCENE_VIEW_MAX_ORGANS * KEY_CHUNKS_MAX}};
   for (size_t i = 0; i < sizeof rds / sizeof rds[0]; i++) {
-    *rds[i].rd = rds[i].gate ? vdds_reader_gated(&sv->dds, rds[i].topic, rds[i].gate, SERVER_DEPTH,
-                                                 rds[i].max_instances, NULL, err)
-                             : vdds_reader(&sv->dds, rds[i].topic, err);
+    /* A negative bound marks the live-only (volatile) reader. */
+    int live = rds[i].max_instances < 0, bound = live ? -rds[i].max_instances : rds[i].max_instances;
+    *rds[i].rd = rds[i].gate
+                     ? vdds_reader_gated_live(&sv->dds, rds[i].topic, rds[i].gate, SERVER_DEPTH, bound, live, NULL, err)
+                     : vdds_reader(&sv->dds, rds[i].topic, err);
     /* Keyframe chunks are optional (vdds.c: not permitted by an older PKI):
      * keyframes then come as MeshState only. */
     if (*rds[i].rd < 0 && rds[i].topic == VT_MESH_KEY_CHUNK) *rds[i].rd = 0;
@@ -408,6 +411,7 @@ int scene_view_poll(scene_view_t *sv, verr_t *err) {
     source_t src;
     vdds_gate_t *gate;
   } order[] = {{sv->rd_scene, h_scene, NULL, "SceneInfo", SCENE_INFO, NULL},
+               {sv->rd_chunk_live, h_chunk, NULL, "MeshKeyChunk", FROM_SERVER, &sv->gate_chunk},
                {sv->rd_chunk, h_chunk, NULL, "MeshKeyChunk", FROM_SERVER, &sv->gate_chunk},
                {sv->rd_state, h_state, NULL, "MeshState", FROM_SERVER, &sv->gate_state},
                {sv->rd_delta, h_delta, NULL, "MeshDelta", FROM_SERVER, &sv->gate_delta},

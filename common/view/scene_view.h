@@ -5,7 +5,10 @@
  * MeshDelta (the organ meshes, see organ_state.h), ToolCommand (tool tip),
  * ContactFeedback (contact, proxy, force) and ObjectState (stones).
  * Keyframes come both as MeshState and as MeshKeyChunk sets
- * (dds/key_chunks.h), which a lossy link delivers sooner; see below.
+ * (dds/key_chunks.h), which a lossy link delivers sooner; see below. The
+ * chunks have two readers: a transient-local one (the writer's history,
+ * two round trips after discovery) and a volatile one, which takes the set
+ * the server writes again when it sees a new chunk reader (one way).
  * scene_view_poll() takes what has arrived without blocking; the readers are keep-last 1 per instance,
  * so polling at the viewer's pace loses nothing that would be drawn.
  *
@@ -86,6 +89,7 @@ typedef void (*scene_view_log_fn)(void *ctx, const char *msg);
 typedef struct scene_view {
   vdds_t dds;
   dds_entity_t rd_scene, rd_state, rd_delta, rd_cmd, rd_contact, rd_object, rd_chunk;
+  dds_entity_t rd_chunk_live; /* volatile: the set the server writes again when this viewer matched */
   int have_scene;
   char scene_name[65];
   sv_organ_t organs[SCENE_VIEW_MAX_ORGANS];

@@ -70,9 +70,20 @@ static int write_chunks(mesh_publisher_t *mp, uint64_t sim_time_ns) {
     mp->chunk_failures++;
     return 0;
   }
+  mp->key_sim_time_ns = sim_time_ns;
   mp->chunk_sets++;
   mp->chunk_samples += (uint64_t)n;
   mp->chunk_payload_bytes += len;
+  return 0;
+}
+
+int mesh_publisher_rechunk(mesh_publisher_t *mp) {
+  if (mp->broken || !mp->w_chunk || !mp->keyframe_seq || !mp->chunks_written) return -1;
+  uint64_t sets = mp->chunk_sets;
+  write_chunks(mp, mp->key_sim_time_ns);
+  if (mp->chunk_sets == sets) return -1;
+  mp->chunk_sets = sets;
+  mp->chunk_rewrites++;
   return 0;
 }
 

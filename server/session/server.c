@@ -36,7 +36,8 @@ typedef struct server {
   runtime_t rt;
   vdds_t dds;
   dds_entity_t w_scene, w_state, w_delta, w_feedback, w_event, w_metrics, r_cmd, r_control;
-  dds_entity_t w_chunk; /* keyframes in single-datagram chunks (dds/key_chunks.h) */
+  dds_entity_t w_chunk;   /* keyframes in single-datagram chunks (dds/key_chunks.h) */
+  uint32_t chunk_readers; /* readers of w_chunk matched so far (total_count) */
   dds_entity_t w_objects, w_tool_metrics, w_role, w_applied, w_source;
   mesh_publisher_t pubs[SCENE_MAX_ORGANS];
   /* Each tool's session record (session_tool.h: measures, intake,
@@ -219,9 +220,9 @@ static int setup(server_t *s, const scene_t *scene, verr_t *err) {
       return -1;
     s->pubs[i].keepalive_ns = (uint64_t)(scene->publish_keepalive * 1e9);
     s->pubs[i].w_chunk = s->w_chunk;
-    /* Benchmarks only (tests/bench/link_bench.sh): one copy of each chunk, to compare. */
+    /* Benchmarks only: two copies of each chunk, to compare (dds/key_chunks.h). */
     const char *copies = getenv("VISCERA_KEY_CHUNK_COPIES");
-    s->pubs[i].chunk_copies = copies && !strcmp(copies, "1") ? 1 : 0;
+    s->pubs[i].chunk_copies = copies && !strcmp(copies, "2") ? 2 : 0;
   }
   s->step_us = calloc(STEP_RING, sizeof(double));
   s->step_cpu_us = calloc(STEP_RING, sizeof(double));
@@ -785,8 +786,20 @@ static void publish_tool_metrics(server_t *s) {
   }
 }
 
+/* A reader of the keyframe chunks matched since the last frame (a late
+ * joiner): the current keyframes go to it as new samples, one way
+ * (mesh_publisher_rechunk). */
+static void rechunk_for_new_readers(server_t *s) {
+  dds_publication_matched_status_t st;
+  if (!s->w_chunk || dds_get_publication_matched_status(s->w_chunk, &st) < 0 || st.total_count == s->chunk_readers)
+    return;
+  s->chunk_readers = st.total_count;
+  for (size_t i = 0; i < s->rt.norgans; i++) mesh_publisher_rechunk(&s->pubs[i]);
+}
+
 static void publish_frames(server_t *s) {
   publish_objects(s);
+  rechunk_for_new_readers(s);
   for (size_t i = 0; i < s->rt.norgans; i++)
     mesh_publisher_frame(&s->pubs[i], s->rt.organs[i].model->surf_x, sim_ns(s));
 }

@@ -3,7 +3,8 @@
  * takes once the server's writer is matched (issue 14: a keyframe must
  * survive a lossy link). Subscribes to MeshDelta and, by --path, to
  * MeshState (state: a viewer before keyframe chunks), MeshKeyChunk
- * (chunks) or both (both: today's viewer, the default), and prints at exit:
+ * (chunks: a transient-local and a volatile reader, as the viewer) or both
+ * (both: today's viewer, the default), and prints at exit:
  *   KEYFRAME matched_ms=M keyframe_ms=K wait_ms=K-M keyframe_bytes=B deltas=N delta_bytes=D
  *            state_ms=S chunks_ms=C chunks=N chunk_bytes=E path=P
  * (times from start; K the first keyframe by either path, S by MeshState,
@@ -71,7 +72,7 @@ static void take_chunks(dds_entity_t rc, uint64_t t0, counts_t *c) {
   if (k > 0) dds_return_loan(rc, samples, k);
 }
 
-static void poll_once(dds_entity_t rs, dds_entity_t rd, dds_entity_t rc, uint64_t t0, counts_t *c) {
+static void poll_once(dds_entity_t rs, dds_entity_t rd, dds_entity_t rc, dds_entity_t rl, uint64_t t0, counts_t *c) {
   /* Matched: the first keyframe reader (of the paths asked for) that sees the server's writer. */
   dds_subscription_matched_status_t ms;
   if (c->matched_ms < 0 && ((rs > 0 && dds_get_subscription_matched_status(rs, &ms) == 0 && ms.current_count > 0) ||
@@ -88,6 +89,7 @@ static void poll_once(dds_entity_t rs, dds_entity_t rd, dds_entity_t rc, uint64_
     c->key_bytes = (uint64_t)s->positions._length * 4 + (uint64_t)s->triangles._length * 4;
   }
   if (k > 0) dds_return_loan(rs, samples, k);
+  if (rl > 0) take_chunks(rl, t0, c);
   if (rc > 0) take_chunks(rc, t0, c);
   memset(samples, 0, sizeof samples);
   k = dds_take(rd, samples, infos, 16, 16);
@@ -129,8 +131,16 @@ int main(int argc, char **argv) {
   int want_state = strcmp(path, "chunks") != 0, want_chunks = strcmp(path, "state") != 0;
   dds_entity_t rd = vdds_reader(&dds, VT_MESH_DELTA, &err);
   dds_entity_t rs = rd < 0 || !want_state ? 0 : vdds_reader(&dds, VT_MESH_STATE, &err);
-  dds_entity_t rc = rd < 0 || rs < 0 || !want_chunks ? 0 : vdds_reader(&dds, VT_MESH_KEY_CHUNK, &err);
-  if (rs < 0 || rd < 0 || rc < 0) {
+  /* Chunks as the viewer takes them (view/scene_view.c): a transient-local
+   * reader and a volatile one for the set the server writes again. */
+  dds_entity_t rc = 0, rl = 0;
+  for (int live = 0; live < 2 && rd >= 0 && rs >= 0 && want_chunks; live++) {
+    dds_qos_t *q = vdds_topic_qos(VT_MESH_KEY_CHUNK);
+    if (live) dds_qset_durability(q, DDS_DURABILITY_VOLATILE);
+    *(live ? &rl : &rc) = dds_create_reader(dds.subscriber, dds.topics[VT_MESH_KEY_CHUNK], q, NULL);
+    dds_delete_qos(q);
+  }
+  if (rs < 0 || rd < 0 || rc < 0 || rl < 0) {
     fprintf(stderr, "keyframe_wait: %s\n", err.msg);
     return 1;
   }
@@ -138,7 +148,7 @@ int main(int argc, char **argv) {
   c.matched_ms = c.key_ms = c.state_ms = c.chunks_ms = -1;
   uint64_t t0 = vtime_mono_ns();
   while ((double)(vtime_mono_ns() - t0) * 1e-9 < duration) {
-    poll_once(rs, rd, rc, t0, &c);
+    poll_once(rs, rd, rc, rl, t0, &c);
     dds_sleepfor(DDS_MSECS(1));
   }
   printf("KEYFRAME matched_ms=%.1f keyframe_ms=%.1f wait_ms=%.1f keyframe_bytes=%" PRIu64 " deltas=%" PRIu64
