@@ -294,20 +294,25 @@ int scene_view_open(scene_view_t *sv, int domain, const char *partition, scene_v
     vdds_topic_id_t topic;
     vdds_gate_t *gate;
     int max_instances;
-  } rds[] = {{&sv->rd_scene, VT_SCENE_INFO, NULL, 0},
-             {&sv->rd_state, VT_MESH_STATE, &sv->gate_state, SCENE_VIEW_MAX_ORGANS},
-             {&sv->rd_delta, VT_MESH_DELTA, &sv->gate_delta, SCENE_VIEW_MAX_ORGANS},
-             {&sv->rd_cmd, VT_TOOL_COMMAND, &sv->gate_cmd, SCENE_VIEW_MAX_TOOLS},
-             {&sv->rd_contact, VT_CONTACT_FEEDBACK, &sv->gate_contact, SCENE_VIEW_MAX_TOOLS},
-             {&sv->rd_object, VT_OBJECT_STATE, &sv->gate_object, SCENE_VIEW_MAX_OBJECTS},
-             {&sv->rd_chunk, VT_MESH_KEY_CHUNK, &sv->gate_chunk, SCENE_VIEW_MAX_ORGANS * KEY_CHUNKS_MAX},
-             {&sv->rd_chunk_live, VT_MESH_KEY_CHUNK, &sv->gate_chunk, -SCENE_VIEW_MAX_ORGANS * KEY_CHUNKS_MAX}};
+    int depth; /* samples per instance; 0: SERVER_DEPTH */
+    int live;  /* volatile (dds/vdds_gate.h vdds_reader_gated_live) */
+  } rds[] = {{&sv->rd_scene, VT_SCENE_INFO, NULL, 0, 0, 0},
+             {&sv->rd_state, VT_MESH_STATE, &sv->gate_state, SCENE_VIEW_MAX_ORGANS, 0, 0},
+             {&sv->rd_delta, VT_MESH_DELTA, &sv->gate_delta, SCENE_VIEW_MAX_ORGANS, 0, 0},
+             {&sv->rd_cmd, VT_TOOL_COMMAND, &sv->gate_cmd, SCENE_VIEW_MAX_TOOLS, 0, 0},
+             {&sv->rd_contact, VT_CONTACT_FEEDBACK, &sv->gate_contact, SCENE_VIEW_MAX_TOOLS, 0, 0},
+             {&sv->rd_object, VT_OBJECT_STATE, &sv->gate_object, SCENE_VIEW_MAX_OBJECTS, 0, 0},
+             /* Chunks: 16,384 slots of at most 1.1 kB; 2 per slot bounds what a
+              * flood can hold before its writer is judged to about 36 MB per
+              * reader, and still lets one impostor's sample sit beside the
+              * server's. */
+             {&sv->rd_chunk, VT_MESH_KEY_CHUNK, &sv->gate_chunk, SCENE_VIEW_MAX_ORGANS * KEY_CHUNKS_MAX, 2, 0},
+             {&sv->rd_chunk_live, VT_MESH_KEY_CHUNK, &sv->gate_chunk, SCENE_VIEW_MAX_ORGANS * KEY_CHUNKS_MAX, 2, 1}};
   for (size_t i = 0; i < sizeof rds / sizeof rds[0]; i++) {
-    /* A negative bound marks the live-only (volatile) reader. */
-    int live = rds[i].max_instances < 0, bound = live ? -rds[i].max_instances : rds[i].max_instances;
-    *rds[i].rd = rds[i].gate
-                     ? vdds_reader_gated_live(&sv->dds, rds[i].topic, rds[i].gate, SERVER_DEPTH, bound, live, NULL, err)
-                     : vdds_reader(&sv->dds, rds[i].topic, err);
+    *rds[i].rd = rds[i].gate ? vdds_reader_gated_live(&sv->dds, rds[i].topic, rds[i].gate,
+                                                      rds[i].depth ? rds[i].depth : SERVER_DEPTH, rds[i].max_instances,
+                                                      rds[i].live, NULL, err)
+                             : vdds_reader(&sv->dds, rds[i].topic, err);
     /* Keyframe chunks are optional (vdds.c: not permitted by an older PKI):
      * keyframes then come as MeshState only. */
     if (*rds[i].rd < 0 && rds[i].topic == VT_MESH_KEY_CHUNK) *rds[i].rd = 0;
