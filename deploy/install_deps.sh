@@ -11,6 +11,7 @@ PKGS=(
   libassimp-dev                             # mesh import
   libpng-dev                                # PNG frames
   libsqlite3-dev sqlite3                    # recordings
+  zlib1g-dev                                # keyframe chunks: deflate (common/dds/key_chunks.c)
   libyaml-dev                               # scene files
   libcairo2-dev                             # plots in benchmarks and reports
   openssl                                   # DDS Security PKI (deploy/pki.sh)

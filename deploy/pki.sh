@@ -60,7 +60,7 @@ make_ca "$ORG permissions CA" permissions_ca
 NOW="$(date -u +%Y-%m-%dT%H:%M:%S)"
 UNTIL="$(date -u -d "+$DAYS days" +%Y-%m-%dT%H:%M:%S)"
 ALL_TOPICS='<topic>viscera_*</topic>'
-STATE_TOPICS='<topic>viscera_SceneInfo</topic><topic>viscera_MeshState</topic><topic>viscera_MeshDelta</topic><topic>viscera_ContactFeedback</topic><topic>viscera_SessionEvent</topic><topic>viscera_Metrics</topic><topic>viscera_ObjectState</topic><topic>viscera_ToolMetrics</topic><topic>viscera_ToolRole</topic><topic>viscera_AppliedInput</topic><topic>viscera_SceneSource</topic>'
+STATE_TOPICS='<topic>viscera_SceneInfo</topic><topic>viscera_MeshState</topic><topic>viscera_MeshKeyChunk</topic><topic>viscera_MeshDelta</topic><topic>viscera_ContactFeedback</topic><topic>viscera_SessionEvent</topic><topic>viscera_Metrics</topic><topic>viscera_ObjectState</topic><topic>viscera_ToolMetrics</topic><topic>viscera_ToolRole</topic><topic>viscera_AppliedInput</topic><topic>viscera_SceneSource</topic>'
 INPUT_TOPICS='<topic>viscera_ToolCommand</topic><topic>viscera_SessionControl</topic>'
 
 # grant NAME PUB_TOPICS PUB_PARTITION SUB_TOPICS SUB_PARTITION

@@ -8,6 +8,7 @@
 #include "capture.h"
 #include "discovery.h"
 #include "participants.h"
+#include "dds/vdds.h"
 #include "dds/vdds_config.h"
 #include "dds/vdds_ident.h"
 #include "recording/store.h"
@@ -67,6 +68,10 @@ static void add_writer_to(rec_session_t *s, capture_t *c, const disc_writer_t *w
 
 static void on_writer(void *arg, const disc_writer_t *w) {
   rec_session_t *s = arg;
+  /* Keyframe chunks are a transport copy of MeshState's keyframes for lossy
+   * links (dds/key_chunks.h): MeshState is the keyframe of record, so a
+   * recording keeps the format every reader knows and no keyframe twice. */
+  if (strcmp(w->topic_name, vdds_topic_name(VT_MESH_KEY_CHUNK)) == 0) return;
   capture_t *c = find_capture(s, w->topic_name);
   if (c) {
     add_writer_to(s, c, w);

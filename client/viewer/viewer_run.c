@@ -135,7 +135,12 @@ int viewer_run(const viewer_opts_t *o) {
       vdds_explain_nothing_seen(stderr, "viewer", "no server publishes a scene here", o->domain, o->partition,
                                 VDDS_NOTHING_SEEN_S);
     if (!have_cam && scene_view_any_keyframe(&sv)) {
-      if (!first_key_ns) first_key_ns = now;
+      if (!first_key_ns) {
+        first_key_ns = now;
+        if (!o->quiet)
+          printf("viewer: first keyframe %.1f ms after start, as %s\n", (double)(sv.first_key_mono_ns - t0) * 1e-6,
+                 sv.keys_from_chunks ? "chunks (MeshKeyChunk)" : "MeshState");
+      }
       double bmin[3], bmax[3];
       if ((scene_view_complete(&sv) || now - first_key_ns >= KEYFRAME_GRACE_NS) &&
           scene_view_key_bounds(&sv, bmin, bmax) == 0 && camera_frame(&cam, bmin, bmax, o->width, o->height) == 0) {
@@ -179,9 +184,10 @@ int viewer_run(const viewer_opts_t *o) {
     }
   }
   unsigned long rejected = sv.rejected, ignored = sv.ignored;
+  unsigned long keys_chunks = sv.keys_from_chunks, keys_state = sv.keys_from_state, keys_dup = sv.keys_duplicate;
   uint64_t gated = vdds_gate_dropped(&sv.gate_state) + vdds_gate_dropped(&sv.gate_delta) +
                    vdds_gate_dropped(&sv.gate_cmd) + vdds_gate_dropped(&sv.gate_contact) +
-                   vdds_gate_dropped(&sv.gate_object);
+                   vdds_gate_dropped(&sv.gate_object) + vdds_gate_dropped(&sv.gate_chunk);
   scene_view_close(&sv);
   render_close(r);
   if (frame_log_close(&fl, &err)) {
@@ -189,6 +195,8 @@ int viewer_run(const viewer_opts_t *o) {
     status = 1;
   }
   printf("viewer: %ld frames written to %s\n", fl.frames, o->out_dir);
-  printf("SUMMARY frames=%ld rejected=%lu ignored=%lu gate_dropped=%" PRIu64 "\n", fl.frames, rejected, ignored, gated);
+  printf("SUMMARY frames=%ld rejected=%lu ignored=%lu gate_dropped=%" PRIu64
+         " keyframes_chunks=%lu keyframes_state=%lu keyframes_duplicate=%lu\n",
+         fl.frames, rejected, ignored, gated, keys_chunks, keys_state, keys_dup);
   return status;
 }

@@ -27,8 +27,9 @@ typedef enum vdds_topic_id {
   VT_OBJECT_STATE,
   VT_TOOL_METRICS,
   VT_TOOL_ROLE,
-  VT_APPLIED_INPUT, /* issue 16: what the server applied, per loop iteration */
-  VT_SCENE_SOURCE,  /* issue 16: the scene text, mesh hashes and build identity */
+  VT_APPLIED_INPUT,  /* issue 16: what the server applied, per loop iteration */
+  VT_SCENE_SOURCE,   /* issue 16: the scene text, mesh hashes and build identity */
+  VT_MESH_KEY_CHUNK, /* issue 14: keyframes in single-datagram chunks (dds/key_chunks.h) */
   VT_COUNT
 } vdds_topic_id_t;
 

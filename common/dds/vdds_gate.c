@@ -108,9 +108,15 @@ dds_entity_t vdds_gated_topic(vdds_t *v, vdds_topic_id_t t, vdds_gate_t *g, verr
 
 dds_entity_t vdds_reader_gated(vdds_t *v, vdds_topic_id_t t, vdds_gate_t *g, int depth, int max_instances,
                                const dds_listener_t *l, verr_t *err) {
+  return vdds_reader_gated_live(v, t, g, depth, max_instances, 0, l, err);
+}
+
+dds_entity_t vdds_reader_gated_live(vdds_t *v, vdds_topic_id_t t, vdds_gate_t *g, int depth, int max_instances,
+                                    int live_only, const dds_listener_t *l, verr_t *err) {
   dds_entity_t tp = vdds_gated_topic(v, t, g, err);
   if (tp < 0) return tp;
   dds_qos_t *q = vdds_topic_qos(t);
+  if (live_only) dds_qset_durability(q, DDS_DURABILITY_VOLATILE);
   if (depth > 0) dds_qset_history(q, DDS_HISTORY_KEEP_LAST, depth);
   if (max_instances > 0) dds_qset_resource_limits(q, DDS_LENGTH_UNLIMITED, max_instances, DDS_LENGTH_UNLIMITED);
   dds_entity_t r = dds_create_reader(v->subscriber, tp, q, l);

@@ -86,5 +86,10 @@ dds_entity_t vdds_gated_topic(vdds_t *v, vdds_topic_id_t t, vdds_gate_t *g, verr
  * participant's other readers and its writers of t are not filtered. */
 dds_entity_t vdds_reader_gated(vdds_t *v, vdds_topic_id_t t, vdds_gate_t *g, int depth, int max_instances,
                                const dds_listener_t *l, verr_t *err);
+/* The same; live_only != 0 makes it volatile (no history from writers it
+ * matches, only their new samples), e.g. a second reader of keyframe chunks
+ * that takes the set a server writes again for it (dds/key_chunks.h). */
+dds_entity_t vdds_reader_gated_live(vdds_t *v, vdds_topic_id_t t, vdds_gate_t *g, int depth, int max_instances,
+                                    int live_only, const dds_listener_t *l, verr_t *err);
 
 #endif

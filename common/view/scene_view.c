@@ -2,11 +2,13 @@
 #include "view/scene_view.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
 
 #include "viscera.h"
+#include "vtime.h"
 
 /* Samples taken per dds_take call; the loop repeats until a reader is empty. */
 #define TAKE_BATCH 16
@@ -104,20 +106,84 @@ static void on_scene_info(scene_view_t *sv, const viscera_SceneInfo *s) {
   }
 }
 
+/* Whether a keyframe that arrived by one path (from_chunks) should replace
+ * the drawn one: not when it is the drawn keyframe again (the other path's
+ * copy), nor when it is older and the drawn one came by the other path (the
+ * slower copy of a keyframe already replaced). Otherwise yes, whatever its
+ * numbers: a restarted server starts again at 0. */
+static int key_wanted(scene_view_t *sv, const sv_organ_t *o, int from_chunks, uint32_t topo, uint32_t seq,
+                      const float *pos, size_t npos, const uint32_t *tris, size_t ntri_idx) {
+  const organ_state_t *m = &o->mesh;
+  if (!m->have_key) return 1;
+  if (m->topology_version == topo && m->keyframe_seq == seq && m->nverts * 3 == npos && m->ntris * 3 == ntri_idx &&
+      !memcmp(m->key, pos, npos * sizeof *pos) && !memcmp(m->tris, tris, ntri_idx * sizeof *tris)) {
+    sv->keys_duplicate++;
+    return 0;
+  }
+  if (o->key_from_chunks != from_chunks &&
+      (topo < m->topology_version || (topo == m->topology_version && seq < m->keyframe_seq))) {
+    sv->keys_duplicate++;
+    return 0;
+  }
+  return 1;
+}
+
+/* A keyframe from either path; returns 1 when drawn. */
+static int set_key(scene_view_t *sv, uint32_t organ, int from_chunks, uint32_t topo, uint32_t seq, uint64_t t_ns,
+                   const float *pos, size_t npos, const uint32_t *tris, size_t ntri_idx) {
+  sv_organ_t *o = &sv->organs[organ];
+  const char *what = from_chunks ? "MeshKeyChunk" : "MeshState";
+  if (!key_wanted(sv, o, from_chunks, topo, seq, pos, npos, tris, ntri_idx)) return 0;
+  verr_t err;
+  int rc = organ_state_set_keyframe(&o->mesh, topo, seq, t_ns, pos, npos, tris, ntri_idx, &err);
+  if (rc < 0) {
+    reject(sv, "%s organ %u (topology %u keyframe %u): %s", what, organ, topo, seq, err.msg);
+    return 0;
+  }
+  if (rc > 0) reject(sv, "MeshDelta organ %u kept for keyframe %u: %s", organ, seq, err.msg);
+  o->key_from_chunks = from_chunks;
+  if (from_chunks)
+    sv->keys_from_chunks++;
+  else
+    sv->keys_from_state++;
+  if (!sv->first_key_mono_ns) sv->first_key_mono_ns = vtime_mono_ns();
+  return 1;
+}
+
 static void on_mesh_state(scene_view_t *sv, const viscera_MeshState *s) {
   if (s->organ_id >= SCENE_VIEW_MAX_ORGANS) {
     reject(sv, "MeshState: organ_id %u out of range (0..%d)", s->organ_id, SCENE_VIEW_MAX_ORGANS - 1);
     return;
   }
+  set_key(sv, s->organ_id, 0, s->topology_version, s->keyframe_seq, s->sim_time_ns, s->positions._buffer,
+          s->positions._length, s->triangles._buffer, s->triangles._length);
+}
+
+/* A chunk: kept in its organ's assembly; a complete, sound set is decoded
+ * and drawn like a MeshState. */
+static void on_key_chunk(scene_view_t *sv, const viscera_MeshKeyChunk *s) {
+  key_chunk_t c;
+  key_chunk_from_wire(s, &c);
   verr_t err;
-  int rc = organ_state_set_keyframe(&sv->organs[s->organ_id].mesh, s->topology_version, s->keyframe_seq, s->sim_time_ns,
-                                    s->positions._buffer, s->positions._length, s->triangles._buffer,
-                                    s->triangles._length, &err);
-  if (rc < 0)
-    reject(sv, "MeshState organ %u (topology %u keyframe %u): %s", s->organ_id, s->topology_version, s->keyframe_seq,
+  if (c.organ_id >= SCENE_VIEW_MAX_ORGANS) {
+    reject(sv, "MeshKeyChunk slot %u: organ_id %u out of range (0..%d)", c.slot, c.organ_id, SCENE_VIEW_MAX_ORGANS - 1);
+    return;
+  }
+  key_assembly_t *a = &sv->organs[c.organ_id].chunks;
+  int rc = key_assembly_add(a, &c, SCENE_VIEW_MAX_ORGANS, &err);
+  if (rc < 0) reject(sv, "MeshKeyChunk organ %u slot %u: %s", c.organ_id, c.slot, err.msg);
+  if (rc <= 0) return;
+  float *pos;
+  uint32_t *tris;
+  size_t nv, nt;
+  if (key_decode(a->buf, a->total_bytes, &pos, &nv, &tris, &nt, &err)) {
+    reject(sv, "MeshKeyChunk organ %u (topology %u keyframe %u): %s", c.organ_id, a->topology_version, a->keyframe_seq,
            err.msg);
-  else if (rc > 0)
-    reject(sv, "MeshDelta organ %u kept for keyframe %u: %s", s->organ_id, s->keyframe_seq, err.msg);
+    return;
+  }
+  set_key(sv, c.organ_id, 1, a->topology_version, a->keyframe_seq, a->sim_time_ns, pos, 3 * nv, tris, 3 * nt);
+  free(pos);
+  free(tris);
 }
 
 static void on_mesh_delta(scene_view_t *sv, const viscera_MeshDelta *s) {
@@ -217,6 +283,7 @@ int scene_view_open(scene_view_t *sv, int domain, const char *partition, scene_v
   vdds_gate_init(&sv->gate_cmd, SCENE_VIEW_MAX_TOOLS, NULL, NULL);
   vdds_gate_init(&sv->gate_contact, SCENE_VIEW_MAX_TOOLS, NULL, NULL);
   vdds_gate_init(&sv->gate_object, SCENE_VIEW_MAX_OBJECTS, NULL, NULL);
+  vdds_gate_init(&sv->gate_chunk, SCENE_VIEW_MAX_ORGANS * KEY_CHUNKS_MAX, NULL, NULL);
   if (vdds_open(&sv->dds, (dds_domainid_t)domain, partition, err)) return -1;
   if (seat_server_open(&sv->server, sv->dds.participant, err)) {
     vdds_close(&sv->dds);
@@ -227,16 +294,28 @@ int scene_view_open(scene_view_t *sv, int domain, const char *partition, scene_v
     vdds_topic_id_t topic;
     vdds_gate_t *gate;
     int max_instances;
-  } rds[] = {{&sv->rd_scene, VT_SCENE_INFO, NULL, 0},
-             {&sv->rd_state, VT_MESH_STATE, &sv->gate_state, SCENE_VIEW_MAX_ORGANS},
-             {&sv->rd_delta, VT_MESH_DELTA, &sv->gate_delta, SCENE_VIEW_MAX_ORGANS},
-             {&sv->rd_cmd, VT_TOOL_COMMAND, &sv->gate_cmd, SCENE_VIEW_MAX_TOOLS},
-             {&sv->rd_contact, VT_CONTACT_FEEDBACK, &sv->gate_contact, SCENE_VIEW_MAX_TOOLS},
-             {&sv->rd_object, VT_OBJECT_STATE, &sv->gate_object, SCENE_VIEW_MAX_OBJECTS}};
+    int depth; /* samples per instance; 0: SERVER_DEPTH */
+    int live;  /* volatile (dds/vdds_gate.h vdds_reader_gated_live) */
+  } rds[] = {{&sv->rd_scene, VT_SCENE_INFO, NULL, 0, 0, 0},
+             {&sv->rd_state, VT_MESH_STATE, &sv->gate_state, SCENE_VIEW_MAX_ORGANS, 0, 0},
+             {&sv->rd_delta, VT_MESH_DELTA, &sv->gate_delta, SCENE_VIEW_MAX_ORGANS, 0, 0},
+             {&sv->rd_cmd, VT_TOOL_COMMAND, &sv->gate_cmd, SCENE_VIEW_MAX_TOOLS, 0, 0},
+             {&sv->rd_contact, VT_CONTACT_FEEDBACK, &sv->gate_contact, SCENE_VIEW_MAX_TOOLS, 0, 0},
+             {&sv->rd_object, VT_OBJECT_STATE, &sv->gate_object, SCENE_VIEW_MAX_OBJECTS, 0, 0},
+             /* Chunks: 16,384 slots of at most 1.1 kB; 2 per slot bounds what a
+              * flood can hold before its writer is judged to about 36 MB per
+              * reader, and still lets one impostor's sample sit beside the
+              * server's. */
+             {&sv->rd_chunk, VT_MESH_KEY_CHUNK, &sv->gate_chunk, SCENE_VIEW_MAX_ORGANS * KEY_CHUNKS_MAX, 2, 0},
+             {&sv->rd_chunk_live, VT_MESH_KEY_CHUNK, &sv->gate_chunk, SCENE_VIEW_MAX_ORGANS * KEY_CHUNKS_MAX, 2, 1}};
   for (size_t i = 0; i < sizeof rds / sizeof rds[0]; i++) {
-    *rds[i].rd = rds[i].gate ? vdds_reader_gated(&sv->dds, rds[i].topic, rds[i].gate, SERVER_DEPTH,
-                                                 rds[i].max_instances, NULL, err)
+    *rds[i].rd = rds[i].gate ? vdds_reader_gated_live(&sv->dds, rds[i].topic, rds[i].gate,
+                                                      rds[i].depth ? rds[i].depth : SERVER_DEPTH, rds[i].max_instances,
+                                                      rds[i].live, NULL, err)
                              : vdds_reader(&sv->dds, rds[i].topic, err);
+    /* Keyframe chunks are optional (vdds.c: not permitted by an older PKI):
+     * keyframes then come as MeshState only. */
+    if (*rds[i].rd < 0 && rds[i].topic == VT_MESH_KEY_CHUNK) *rds[i].rd = 0;
     if (*rds[i].rd < 0) {
       vdds_close(&sv->dds);
       return -1;
@@ -248,9 +327,13 @@ int scene_view_open(scene_view_t *sv, int domain, const char *partition, scene_v
 void scene_view_close(scene_view_t *sv) {
   vdds_close(&sv->dds);
   seat_server_close(&sv->server);
-  vdds_gate_t *gates[] = {&sv->gate_state, &sv->gate_delta, &sv->gate_cmd, &sv->gate_contact, &sv->gate_object};
+  vdds_gate_t *gates[] = {&sv->gate_state,   &sv->gate_delta,  &sv->gate_cmd,
+                          &sv->gate_contact, &sv->gate_object, &sv->gate_chunk};
   for (size_t i = 0; i < sizeof gates / sizeof gates[0]; i++) vdds_gate_destroy(gates[i]);
-  for (int i = 0; i < SCENE_VIEW_MAX_ORGANS; i++) organ_state_free(&sv->organs[i].mesh);
+  for (int i = 0; i < SCENE_VIEW_MAX_ORGANS; i++) {
+    organ_state_free(&sv->organs[i].mesh);
+    key_assembly_free(&sv->organs[i].chunks);
+  }
 }
 
 /* A tool whose writer is gone (haptic client quit, server stopped) would
@@ -315,6 +398,7 @@ static int take_all(scene_view_t *sv, dds_entity_t rd, handler_fn handle, handle
 
 static void h_scene(scene_view_t *sv, const void *s) { on_scene_info(sv, s); }
 static void h_state(scene_view_t *sv, const void *s) { on_mesh_state(sv, s); }
+static void h_chunk(scene_view_t *sv, const void *s) { on_key_chunk(sv, s); }
 static void h_delta(scene_view_t *sv, const void *s) { on_mesh_delta(sv, s); }
 static void h_cmd(scene_view_t *sv, const void *s) { on_tool_command(sv, s); }
 static void h_contact(scene_view_t *sv, const void *s) { on_contact(sv, s); }
@@ -332,6 +416,8 @@ int scene_view_poll(scene_view_t *sv, verr_t *err) {
     source_t src;
     vdds_gate_t *gate;
   } order[] = {{sv->rd_scene, h_scene, NULL, "SceneInfo", SCENE_INFO, NULL},
+               {sv->rd_chunk_live, h_chunk, NULL, "MeshKeyChunk", FROM_SERVER, &sv->gate_chunk},
+               {sv->rd_chunk, h_chunk, NULL, "MeshKeyChunk", FROM_SERVER, &sv->gate_chunk},
                {sv->rd_state, h_state, NULL, "MeshState", FROM_SERVER, &sv->gate_state},
                {sv->rd_delta, h_delta, NULL, "MeshDelta", FROM_SERVER, &sv->gate_delta},
                {sv->rd_cmd, h_cmd, h_tool_gone, "ToolCommand", FROM_ANYONE, &sv->gate_cmd},
@@ -339,6 +425,7 @@ int scene_view_poll(scene_view_t *sv, verr_t *err) {
                {sv->rd_object, h_object, NULL, "ObjectState", FROM_SERVER, &sv->gate_object}};
   int total = 0;
   for (size_t i = 0; i < sizeof order / sizeof order[0]; i++) {
+    if (order[i].rd == 0) continue; /* an optional reader not created */
     int n = take_all(sv, order[i].rd, order[i].h, order[i].gone, order[i].name, order[i].src, order[i].gate, err);
     if (n < 0) return -1;
     total += n;

@@ -4,6 +4,11 @@
  * Subscribes to SceneInfo (organ colours, tool sizes), MeshState and
  * MeshDelta (the organ meshes, see organ_state.h), ToolCommand (tool tip),
  * ContactFeedback (contact, proxy, force) and ObjectState (stones).
+ * Keyframes come both as MeshState and as MeshKeyChunk sets
+ * (dds/key_chunks.h), which a lossy link delivers sooner; see below. The
+ * chunks have two readers: a transient-local one (the writer's history,
+ * two round trips after discovery) and a volatile one, which takes the set
+ * the server writes again when it sees a new chunk reader (one way).
  * scene_view_poll() takes what has arrived without blocking; the readers are keep-last 1 per instance,
  * so polling at the viewer's pace loses nothing that would be drawn.
  *
@@ -27,6 +32,7 @@
 
 #include <stdint.h>
 
+#include "dds/key_chunks.h"
 #include "dds/seat_server.h"
 #include "dds/vdds.h"
 #include "dds/vdds_gate.h"
@@ -50,6 +56,8 @@ typedef struct sv_organ {
   char name[65];
   float rgb[3]; /* linear RGB, 0..1 */
   organ_state_t mesh;
+  key_assembly_t chunks; /* the keyframe chunk set being collected */
+  int key_from_chunks;   /* the drawn keyframe came as chunks (1) or as MeshState (0) */
 } sv_organ_t;
 
 typedef struct sv_tool {
@@ -80,7 +88,8 @@ typedef void (*scene_view_log_fn)(void *ctx, const char *msg);
 
 typedef struct scene_view {
   vdds_t dds;
-  dds_entity_t rd_scene, rd_state, rd_delta, rd_cmd, rd_contact, rd_object;
+  dds_entity_t rd_scene, rd_state, rd_delta, rd_cmd, rd_contact, rd_object, rd_chunk;
+  dds_entity_t rd_chunk_live; /* volatile: the set the server writes again when this viewer matched */
   int have_scene;
   char scene_name[65];
   sv_organ_t organs[SCENE_VIEW_MAX_ORGANS];
@@ -89,7 +98,12 @@ typedef struct scene_view {
   unsigned long rejected;
   unsigned long ignored; /* samples of server topics not from the seat's server */
   seat_server_t server;
-  vdds_gate_t gate_state, gate_delta, gate_cmd, gate_contact, gate_object;
+  vdds_gate_t gate_state, gate_delta, gate_cmd, gate_contact, gate_object, gate_chunk;
+  /* Keyframes (issue 14): each comes twice, as MeshState and as chunks
+   * (MeshKeyChunk); the first to arrive is drawn. A second copy with the
+   * same content, or an older one by the other path, is skipped. */
+  unsigned long keys_from_state, keys_from_chunks, keys_duplicate;
+  uint64_t first_key_mono_ns; /* vtime_mono_ns() when the first keyframe was drawn, 0 before */
   scene_view_log_fn log;
   void *log_ctx;
 } scene_view_t;

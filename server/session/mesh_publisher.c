@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "dds/key_chunks.h"
 #include "mesh_delta.h"
 #include "viscera.h"
 #include "vtime.h"
@@ -52,6 +53,40 @@ void mesh_publisher_destroy(mesh_publisher_t *mp) {
   memset(mp, 0, sizeof *mp);
 }
 
+/* The current keyframe as chunks. A failure (a keyframe too large for the
+ * chunks, out of memory) is counted and leaves MeshState alone to carry it. */
+static int write_chunks(mesh_publisher_t *mp, uint64_t sim_time_ns) {
+  uint8_t *blob;
+  size_t len;
+  verr_t err;
+  if (key_encode(mp->key, mp->nverts, mp->tris, mp->ntris, MESH_PUBLISHER_CHUNK_LEVEL, &blob, &len, &err)) {
+    mp->chunk_failures++;
+    return 0;
+  }
+  int n = key_chunks_write(mp->w_chunk, mp->organ_id, mp->topology_version, mp->keyframe_seq, sim_time_ns, blob, len,
+                           mp->chunk_copies ? mp->chunk_copies : KEY_CHUNK_COPIES, &mp->chunks_written, &err);
+  free(blob);
+  if (n < 0) {
+    mp->chunk_failures++;
+    return 0;
+  }
+  mp->key_sim_time_ns = sim_time_ns;
+  mp->chunk_sets++;
+  mp->chunk_samples += (uint64_t)n;
+  mp->chunk_payload_bytes += len;
+  return 0;
+}
+
+int mesh_publisher_rechunk(mesh_publisher_t *mp) {
+  if (mp->broken || !mp->w_chunk || !mp->keyframe_seq || !mp->chunks_written) return -1;
+  uint64_t sets = mp->chunk_sets;
+  write_chunks(mp, mp->key_sim_time_ns);
+  if (mp->chunk_sets == sets) return -1;
+  mp->chunk_sets = sets;
+  mp->chunk_rewrites++;
+  return 0;
+}
+
 int mesh_publisher_keyframe(mesh_publisher_t *mp, const double *x, uint64_t sim_time_ns) {
   if (mp->broken) return -1;
   for (size_t i = 0; i < 3 * mp->nverts; i++) mp->key[i] = (float)x[i];
@@ -72,7 +107,8 @@ int mesh_publisher_keyframe(mesh_publisher_t *mp, const double *x, uint64_t sim_
   s.triangles._buffer = (uint32_t *)mp->tris;
   s.triangles._length = s.triangles._maximum = (uint32_t)(3 * mp->ntris);
   dds_return_t rc = dds_write(mp->w_state, &s);
-  return rc < 0 ? -1 : 0;
+  if (rc < 0) return -1;
+  return mp->w_chunk ? write_chunks(mp, sim_time_ns) : 0;
 }
 
 int mesh_publisher_frame(mesh_publisher_t *mp, const double *x, uint64_t sim_time_ns) {

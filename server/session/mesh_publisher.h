@@ -49,6 +49,16 @@ typedef struct mesh_publisher {
   uint32_t *idx;
   int16_t *dq;
   dds_entity_t w_state, w_delta; /* 0: encode only (benchmarks) */
+  /* Keyframe chunks (dds/key_chunks.h), set after init; 0: none. Every
+   * keyframe is also written as its compact encoding in single-datagram
+   * MeshKeyChunk samples, which survive a lossy link (issue 14); MeshState
+   * stays the keyframe of record (recordings, re-simulation). */
+  dds_entity_t w_chunk;
+  uint32_t chunk_copies;   /* 1 or 2 (set with w_chunk; 0 = KEY_CHUNK_COPIES) */
+  uint32_t chunks_written; /* chunks of the last set (their slots are live) */
+  uint64_t chunk_sets, chunk_samples, chunk_payload_bytes, chunk_failures;
+  uint64_t key_sim_time_ns; /* of the current keyframe */
+  uint64_t chunk_rewrites;  /* sets written again for new readers (mesh_publisher_rechunk) */
   /* Counters. */
   uint64_t frames, keyframes, delta_payload_bytes, keyframe_payload_bytes, retopos;
   long last_count; /* vertices in the last delta */
@@ -62,6 +72,10 @@ typedef struct mesh_publisher {
   int16_t *written_dq;   /* 3 cap_verts */
 } mesh_publisher_t;
 
+/* zlib level of the keyframe chunks: the fastest, since a keyframe is
+ * encoded in the physics loop (the kidney: about 0.5 ms). */
+#define MESH_PUBLISHER_CHUNK_LEVEL 1
+
 int mesh_publisher_init(mesh_publisher_t *mp, uint32_t organ_id, size_t nverts, const uint32_t *tris, size_t ntris,
                         float quant, dds_entity_t w_state, dds_entity_t w_delta, verr_t *err);
 void mesh_publisher_destroy(mesh_publisher_t *mp);
@@ -71,6 +85,15 @@ int mesh_publisher_keyframe(mesh_publisher_t *mp, const double *x, uint64_t sim_
  * of range. Returns 1 if a keyframe was published, 0 for a delta (written,
  * or skipped as a quiet frame: see above), -1 on error. */
 int mesh_publisher_frame(mesh_publisher_t *mp, const double *x, uint64_t sim_time_ns);
+/* Writes the current keyframe's chunks again, as new samples, for readers
+ * that matched since it was written (the server calls it when the chunk
+ * writer's matched count grew). Why: a transient-local late joiner gets the
+ * history only after a heartbeat and its request, two round trips after it
+ * found the writer; a new sample goes to every matched reader at once, one
+ * way. Readers that hold the set ignore the repeat (same numbers and
+ * digest). Returns 0, or -1 when nothing was written (no chunk writer, no
+ * keyframe yet, or a failure: counted). */
+int mesh_publisher_rechunk(mesh_publisher_t *mp);
 /* Wire payload of the last delta (indices + components + fixed fields), bytes. */
 size_t mesh_publisher_last_delta_bytes(const mesh_publisher_t *mp);
 /* Wire payload of a keyframe of the current surface, bytes. */

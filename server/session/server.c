@@ -37,6 +37,8 @@ typedef struct server {
   runtime_t rt;
   vdds_t dds;
   dds_entity_t w_scene, w_state, w_delta, w_feedback, w_event, w_metrics, r_cmd, r_control;
+  dds_entity_t w_chunk;   /* keyframes in single-datagram chunks (dds/key_chunks.h) */
+  uint32_t chunk_readers; /* readers of w_chunk matched so far (total_count) */
   dds_entity_t w_objects, w_tool_metrics, w_role, w_applied, w_source;
   mesh_publisher_t pubs[SCENE_MAX_ORGANS];
   /* Each tool's session record (session_tool.h: measures, intake,
@@ -207,6 +209,13 @@ static int setup(server_t *s, const scene_t *scene, verr_t *err) {
   s->w_role = vdds_writer(&s->dds, VT_TOOL_ROLE, err);
   s->w_applied = vdds_writer(&s->dds, VT_APPLIED_INPUT, err);
   s->w_source = vdds_writer(&s->dds, VT_SCENE_SOURCE, err);
+  s->w_chunk = vdds_writer(&s->dds, VT_MESH_KEY_CHUNK, err);
+  if (s->w_chunk < 0) {
+    /* Permissions made by an older deploy/pki.sh do not grant this topic:
+     * keyframes then go as MeshState only (slower over a lossy link). */
+    fprintf(stderr, "server: keyframe chunks off (%s); keyframes go as MeshState only\n", err->msg);
+    s->w_chunk = 0;
+  }
   if (s->w_scene < 0 || s->w_state < 0 || s->w_delta < 0 || s->w_feedback < 0 || s->w_event < 0 || s->w_metrics < 0 ||
       s->r_cmd < 0 || s->r_control < 0 || s->w_objects < 0 || s->w_tool_metrics < 0 || s->w_role < 0 ||
       s->w_applied < 0 || s->w_source < 0)
@@ -221,6 +230,10 @@ static int setup(server_t *s, const scene_t *scene, verr_t *err) {
                             (float)scene->quant_step, s->w_state, s->w_delta, err))
       return -1;
     s->pubs[i].keepalive_ns = (uint64_t)(scene->publish_keepalive * 1e9);
+    s->pubs[i].w_chunk = s->w_chunk;
+    /* Benchmarks only: two copies of each chunk, to compare (dds/key_chunks.h). */
+    const char *copies = getenv("VISCERA_KEY_CHUNK_COPIES");
+    s->pubs[i].chunk_copies = copies && !strcmp(copies, "2") ? 2 : 0;
   }
   s->step_us = calloc(STEP_RING, sizeof(double));
   s->step_cpu_us = calloc(STEP_RING, sizeof(double));
@@ -785,8 +798,20 @@ static void publish_tool_metrics(server_t *s) {
   }
 }
 
+/* A reader of the keyframe chunks matched since the last frame (a late
+ * joiner): the current keyframes go to it as new samples, one way
+ * (mesh_publisher_rechunk). */
+static void rechunk_for_new_readers(server_t *s) {
+  dds_publication_matched_status_t st;
+  if (!s->w_chunk || dds_get_publication_matched_status(s->w_chunk, &st) < 0 || st.total_count == s->chunk_readers)
+    return;
+  s->chunk_readers = st.total_count;
+  for (size_t i = 0; i < s->rt.norgans; i++) mesh_publisher_rechunk(&s->pubs[i]);
+}
+
 static void publish_frames(server_t *s) {
   publish_objects(s);
+  rechunk_for_new_readers(s);
   for (size_t i = 0; i < s->rt.norgans; i++)
     mesh_publisher_frame(&s->pubs[i], s->rt.organs[i].model->surf_x, sim_ns(s));
 }
@@ -1073,6 +1098,7 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
   stats->published[VT_APPLIED_INPUT] = s.ai.published;
   for (size_t i = 0; i < s.rt.norgans; i++) {
     stats->published[VT_MESH_STATE] += s.pubs[i].keyframes;
+    stats->published[VT_MESH_KEY_CHUNK] += s.pubs[i].chunk_samples;
     stats->published[VT_MESH_DELTA] += s.pubs[i].frames;
     stats->deltas_skipped += s.pubs[i].skipped;
   }

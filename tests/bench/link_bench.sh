@@ -24,11 +24,15 @@
 #     force; tests/network/prelude.sh smooth_press writes a hand's slower press)
 #   --config FILE: the Cyclone configuration of the sites (default
 #     deploy/cyclonedds-site.xml; e.g. deploy/cyclonedds-lan.xml to compare)
+#   --kw-path state|chunks|both: the keyframes the late subscriber takes
+#     (default both, as today's viewer; state: as a viewer before keyframe
+#     chunks, to compare). The CSV's last two columns are the waits of each
+#     path from the same match: MeshState, and the MeshKeyChunk set whole.
 # Output: OUT/link.csv, OUT/link_table.md, OUT/*.png (default out/link).
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 BUILD="$ROOT/build" OUT="$ROOT/out/link" DELAYS="0 25 50 100 200" LOSSES="0 2 5 10"
-CONFIG="$ROOT/deploy/cyclonedds-site.xml"
+CONFIG="$ROOT/deploy/cyclonedds-site.xml" KW_PATH=both
 TRAJ="$ROOT/assets/trajectories/palpate_kidney.traj"
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -38,6 +42,7 @@ while [ $# -gt 0 ]; do
     --delays) DELAYS="$2"; shift 2 ;;
     --losses) LOSSES="$2"; shift 2 ;;
     --trajectory) TRAJ="$(cd "$(dirname "$2")" && pwd)/$(basename "$2")"; shift 2 ;;
+    --kw-path) KW_PATH="$2"; shift 2 ;;
     --config) CONFIG="$(cd "$(dirname "$2")" && pwd)/$(basename "$2")"; shift 2 ;;
     *) echo "link_bench: unknown option '$1'" >&2; exit 2 ;;
   esac
@@ -50,7 +55,7 @@ PIDS=()
 source "$ROOT/tests/network/sites.sh"
 export LINK_EMU="$BUILD/tests/network/link_emu"
 sites_require || exit $?
-sites_up lk6 "$OUT/run" || { echo "link_bench: could not make the sites" >&2; exit 1; }
+sites_up "${LINK_SITES_PFX:-lk6}" "$OUT/run" || { echo "link_bench: could not make the sites" >&2; exit 1; }
 trap 'for p in "${PIDS[@]}"; do kill -9 "$p" 2>/dev/null || true; done; sites_down quiet' EXIT
 export VISCERA_DOMAIN="${VISCERA_DOMAIN:-221}"
 # The site (or --config) file without DDS Security: refused unless told (issue 14 item 5).
@@ -69,7 +74,7 @@ force_step() {
     a = $5; b = $6; c = $7; have = 1 } END { printf "%.3f", m }' "$1"
 }
 
-echo "delay_ms,jitter_ms,loss_pct,reorder,peak_force_n,peak_error_pct,max_step_n,energy_j,applied_pct,keyframe_ms,seat_kbps,viewer_kbps" \
+echo "delay_ms,jitter_ms,loss_pct,reorder,peak_force_n,peak_error_pct,max_step_n,energy_j,applied_pct,keyframe_ms,seat_kbps,viewer_kbps,keyframe_state_ms,keyframe_chunks_ms" \
   > "$OUT/link.csv"
 REF_PEAK=""
 # run NAME LOOPBACK(0|1) DELAY LOSS REORDER(yes|no)
@@ -88,7 +93,7 @@ run() {
     --wait-server 20 --quiet --force-csv "$OUT/run/$n-force.csv" > "$OUT/run/$n-haptic.out" 2> "$OUT/run/$n-haptic.log" &
   hap=$!; PIDS+=("$hap")
   sleep 2
-  CYCLONEDDS_URI="$uri" run_in_site $site "$BUILD/tests/network/keyframe_wait" --partition $SEAT --duration 4 \
+  CYCLONEDDS_URI="$uri" run_in_site $site "$BUILD/tests/network/keyframe_wait" --partition $SEAT --duration 4 --path "$KW_PATH" \
     > "$OUT/run/$n-keyframe.out" 2>&1 &
   kw=$!; PIDS+=("$kw")
   wait "$hap" || true
@@ -96,7 +101,7 @@ run() {
   kill -INT "$srv"; wait "$srv" || true
   PIDS=()
   link_stop > /dev/null
-  local ticks rate peak app energy step kf dur seat_b view_b
+  local ticks rate peak app energy step kf dur seat_b view_b kfs kfc m
   ticks=$(field "$OUT/run/$n-haptic.out" ticks); rate=$(field "$OUT/run/$n-haptic.out" rate_hz)
   peak=$(field "$OUT/run/$n-haptic.out" peak_force)
   # The passivity observer's largest energy over the run (<= 0: passive), when the client reports one.
@@ -105,6 +110,10 @@ run() {
   app=$(sed -n 's/^server: \([0-9]*\) tool commands applied.*/\1/p' "$OUT/run/$n-server.log")
   step=$(force_step "$OUT/run/$n-force.csv")
   kf=$(field "$OUT/run/$n-keyframe.out" wait_ms)
+  # Each path's wait from the same match (-1: not taken or never).
+  m=$(field "$OUT/run/$n-keyframe.out" matched_ms)
+  kfs=$(awk -v m="${m:--1}" -v t="$(field "$OUT/run/$n-keyframe.out" state_ms)" 'BEGIN { print (m >= 0 && t >= 0 ? t - m : -1) }')
+  kfc=$(awk -v m="${m:--1}" -v t="$(field "$OUT/run/$n-keyframe.out" chunks_ms)" 'BEGIN { print (m >= 0 && t >= 0 ? t - m : -1) }')
   dur=$(awk -v t="${ticks:-0}" -v r="${rate:-0}" 'BEGIN { print (r > 0 ? t / r : 0) }')
   # Site b: the trainee is participant 0 (ports BASE+10/11), the late subscriber 1 (BASE+12/13).
   seat_b=$(($(port_bytes 'a->b' $((BASE + 10)) $((BASE + 11))) + $(link_count 'b->a' bytes_out)))
@@ -112,9 +121,9 @@ run() {
   [ -n "$REF_PEAK" ] || REF_PEAK="$peak"
   awk -v d="$delay" -v j="$jitter" -v l="$loss" -v r="$reorder" -v p="${peak:-nan}" -v ref="${REF_PEAK:-nan}" \
     -v s="$step" -v e="${energy:-nan}" -v a="${app:-0}" -v t="${ticks:-0}" -v k="${kf:--1}" -v sb="$seat_b" \
-    -v vb="$view_b" -v du="$dur" -v lo="$lo" 'BEGIN {
-      printf "%s,%s,%s,%s,%.3f,%.1f,%s,%s,%.1f,%s,%s,%s\n", (lo ? "loopback" : d), j, l, r, p, 100 * (p - ref) / ref, s, e,
-        (t > 0 ? 100 * a / t : 0), k, (lo || du <= 0 ? "nan" : sprintf("%.1f", sb * 8 / 1000 / du)), (lo ? "nan" : sprintf("%.1f", vb * 8 / 1000 / 4)) }' >> "$OUT/link.csv"
+    -v vb="$view_b" -v du="$dur" -v lo="$lo" -v ks="$kfs" -v kc="$kfc" 'BEGIN {
+      printf "%s,%s,%s,%s,%.3f,%.1f,%s,%s,%.1f,%s,%s,%s,%s,%s\n", (lo ? "loopback" : d), j, l, r, p, 100 * (p - ref) / ref, s, e,
+        (t > 0 ? 100 * a / t : 0), k, (lo || du <= 0 ? "nan" : sprintf("%.1f", sb * 8 / 1000 / du)), (lo ? "nan" : sprintf("%.1f", vb * 8 / 1000 / 4)), ks, kc }' >> "$OUT/link.csv"
   tail -1 "$OUT/link.csv"
 }
 
@@ -128,9 +137,9 @@ for d in $DELAYS; do
   done
 done
 load=$(uptime | sed 's/.*load average: //')
-awk -F, -v load="$load" -v cfg="$(basename "$CONFIG")" 'NR == 1 { print "| one way (ms) | jitter | loss % | reorder | peak force (N) | vs loopback | largest step (N) | observer energy max (J) | commands applied | keyframe (ms) | seat kbit/s | viewer kbit/s |";
-    print "|---|---|---|---|---|---|---|---|---|---|---|---|"; next }
-  { printf "| %s | %s | %s | %s | %s | %+.0f %% | %s | %s | %s %% | %s | %s | %s |\n", $1, $2, $3, $4, $5, $6, $7, ($8 == "nan" ? "-" : $8), $9, $10, ($11 == "nan" ? "-" : sprintf("%.0f", $11)), ($12 == "nan" ? "-" : sprintf("%.0f", $12)) }
-  END { printf "\nconfiguration %s; load average at the end: %s\n", cfg, load }' "$OUT/link.csv" > "$OUT/link_table.md"
+awk -F, -v load="$load" -v cfg="$(basename "$CONFIG")" -v kp="$KW_PATH" 'NR == 1 { print "| one way (ms) | jitter | loss % | reorder | peak force (N) | vs loopback | largest step (N) | observer energy max (J) | commands applied | keyframe (ms) | MeshState / chunks (ms) | seat kbit/s | viewer kbit/s |";
+    print "|---|---|---|---|---|---|---|---|---|---|---|---|---|"; next }
+  { printf "| %s | %s | %s | %s | %s | %+.0f %% | %s | %s | %s %% | %s | %s / %s | %s | %s |\n", $1, $2, $3, $4, $5, $6, $7, ($8 == "nan" ? "-" : $8), $9, $10, ($13 < 0 ? "-" : $13), ($14 < 0 ? "-" : $14), ($11 == "nan" ? "-" : sprintf("%.0f", $11)), ($12 == "nan" ? "-" : sprintf("%.0f", $12)) }
+  END { printf "\nconfiguration %s; late subscriber takes keyframes: %s; load average at the end: %s\n", cfg, kp, load }' "$OUT/link.csv" > "$OUT/link_table.md"
 cat "$OUT/link_table.md"
 "$BUILD/tests/bench/link_plot" "$OUT/link.csv" "$OUT" || echo "link_bench: no plots (link_plot failed)" >&2
