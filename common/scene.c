@@ -34,7 +34,7 @@
 static const char *const scene_models[] = {"mass_spring_surface", "mass_spring_tet",     "molecular", "pbd", "xpbd",
                                            "vertex_based",        "adaptive_mass_spring"};
 static const char *const scene_integrators[] = {"symplectic_euler", "explicit_euler", "verlet", "rk4",
-                                                "implicit_euler"};
+                                                "implicit_euler",   "implicit_pcg"};
 static const char *const scene_tool_kinds[] = {"probe", "grasper", "scalpel", "extractor", "syringe"};
 static const char *const scene_object_kinds[] = {"stone"};
 static const char *const scene_task_kinds[] = {"stone_removal", "palpate_target", "grasp_pull"};
@@ -740,6 +740,9 @@ static int parse_organ(const ctx_t *c, const node_t *n, size_t idx, const char *
   if (v[O_INTEGRATOR] && get_choice(c, v[O_INTEGRATOR], fp, scene_integrators, COUNT(scene_integrators), o->integrator,
                                     sizeof o->integrator))
     return -1;
+  /* implicit_pcg is built for a small fixed CG budget per step (integrator.h);
+   * solver.cg_max_iterations, when given, overrides it. */
+  if (!strcmp(o->integrator, "implicit_pcg")) o->solver.cg_max_iterations = SCENE_PCG_ITERATIONS;
   if (v[O_SOLVER]) {
     join(fp, sizeof fp, path, "solver");
     if (parse_solver(c, v[O_SOLVER], fp, &o->solver)) return -1;

@@ -154,7 +154,7 @@ model_t *model_molecular_create(const model_params_t *p, verr_t *err) {
   }
   mol->user = &mm->m;
   mol->fs.pre_substep = mm_pre_substep;
-  mol->definite_jacobian = kind == INT_IMPLICIT_EULER;
+  mol->definite_jacobian = kind == INT_IMPLICIT_EULER || kind == INT_IMPLICIT_PCG;
   if (cfg->fixed_below_set) molecular_fix_below(mol, cfg->fixed_below);
   size_t n = mol->n;
   if (model_guard_reserve(&mm->guard, n)) {
