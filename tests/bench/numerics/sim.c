@@ -326,8 +326,7 @@ double bbox_diag(const double *x, size_t n) {
   double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
   for (size_t i = 0; i < n; i++)
     for (int k = 0; k < 3; k++) lo[k] = fmin(lo[k], x[3 * i + k]), hi[k] = fmax(hi[k], x[3 * i + k]);
-  return sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-              (hi[2] - lo[2]) * (hi[2] - lo[2]));
+  return sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) + (hi[2] - lo[2]) * (hi[2] - lo[2]));
 }
 
 /* ---- context helpers ------------------------------------------------------------------ */
@@ -412,8 +411,7 @@ void nb_plot(nb_t *nb, plot_t *p, const char *name) {
   char path[1200];
   snprintf(path, sizeof path, "%s/%s", nb->out, name);
   verr_t err;
-  if (plot_write_png(p, path, &err))
-    nb_progress("plot not written: %s", err.msg);
+  if (plot_write_png(p, path, &err)) nb_progress("plot not written: %s", err.msg);
   else {
     nb->nplots++;
     nb_progress("wrote %s", path);
@@ -424,19 +422,12 @@ double nb_dt(int k) { return 1.0 / (30.0 * (double)(1u << k)); }
 
 const char *integ_label(integrator_kind_t k) {
   switch (k) {
-  case INT_EXPLICIT_EULER:
-    return "explicit Euler";
-  case INT_SYMPLECTIC_EULER:
-    return "symplectic Euler";
-  case INT_VERLET:
-    return "Verlet";
-  case INT_RK4:
-    return "RK4";
-  case INT_IMPLICIT_EULER:
-    return "implicit Euler";
-  case INT_IMPLICIT_PCG:
-    return "implicit PCG (live)";
-  default:
-    return "?";
+  case INT_EXPLICIT_EULER: return "explicit Euler";
+  case INT_SYMPLECTIC_EULER: return "symplectic Euler";
+  case INT_VERLET: return "Verlet";
+  case INT_RK4: return "RK4";
+  case INT_IMPLICIT_EULER: return "implicit Euler";
+  case INT_IMPLICIT_PCG: return "implicit PCG (live)";
+  default: return "?";
   }
 }
