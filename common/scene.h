@@ -188,6 +188,9 @@ typedef struct scene {
    * unless this long passed (server/session/mesh_publisher.h); 0 (the default)
    * writes every frame. */
   double publish_keepalive;
+  /* physics.integrator: the integrator of every organ that names none
+   * ("" when not given: organs default to symplectic_euler). */
+  char integrator[32];
   size_t norgans;             /* >= 1 */
   scene_organ_t organs[SCENE_MAX_ORGANS];
   size_t ntools;

@@ -34,6 +34,7 @@
 
 #include "check.h"
 #include "runtime/scene_runtime.h"
+#include "scene.h"
 #include "test_runtime.h"
 #include "vmath.h"
 
@@ -139,7 +140,26 @@ static void check_case(const press_result_t *r, int settle) {
   CHECK(r->release_speed_end < r->release_speed0 || r->release_speed0 == 0);
 }
 
+/* physics.integrator selects the scheme of every organ that names none,
+ * with implicit_pcg's own CG budget; an organ's key wins. */
+static void scene_selects(void) {
+  static scene_t sc;
+  verr_t err;
+  const char *yaml = "scene: s\nphysics: {dt: 0.001, integrator: implicit_pcg}\norgans:\n"
+                     "  - {name: a, mesh: a.obj}\n  - {name: b, mesh: b.obj, integrator: verlet}\n"
+                     "  - {name: c, mesh: c.obj, solver: {cg_max_iterations: 3}}\n";
+  CHECK(scene_load_string(yaml, "s.yaml", NULL, &sc, &err) == 0);
+  CHECK(!strcmp(sc.organs[0].integrator, "implicit_pcg"));
+  CHECK(sc.organs[0].solver.cg_max_iterations == SCENE_PCG_ITERATIONS);
+  CHECK(!strcmp(sc.organs[1].integrator, "verlet"));
+  CHECK(!strcmp(sc.organs[2].integrator, "implicit_pcg") && sc.organs[2].solver.cg_max_iterations == 3);
+  CHECK(scene_load_string("scene: s\nphysics: {integrator: backward}\norgans:\n  - {name: a, mesh: a.obj}\n", "s.yaml",
+                          NULL, &sc, &err) != 0);
+  printf("scene: physics.integrator refused a wrong name: %s\n", err.msg);
+}
+
 int main(void) {
+  scene_selects();
   const char *p400 = "radius: 0.003, stiffness: 400, max_force: 4";
   const char *p40k = "radius: 0.003, stiffness: 40000, max_force: 40";
   press_result_t def = run_case("default", "implicit_pcg", 0.15, 30, "", p400, 0.001);
