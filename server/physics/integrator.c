@@ -318,6 +318,8 @@ static void pcg_mul(force_system_t *s, double h, const double *y, double *out) {
  * tissue and tool stiffness; for a node of mass m, tissue stiffness kt and
  * tool stiffness k the step's amplification stays below 1 for any h, kt and
  * k). */
+#define PCG_V_FLOOR 1e-8 /* m/s, see the stop test */
+
 static void implicit_pcg(integrator_t *it, force_system_t *s, double h) {
   double *b = it->buf[0], *dv = it->buf[1], *r = it->buf[2], *p = it->buf[3], *q = it->buf[4], *z = it->buf[5],
          *dinv = it->buf[6];
@@ -354,10 +356,17 @@ static void implicit_pcg(integrator_t *it, force_system_t *s, double h) {
    * test is on the preconditioned residual r.z against b.D^-1 b. */
   double bz = 0;
   for (size_t c = 0; c < n3; c++) bz += b[c] * b[c] * dinv[c];
+  /* Relative to b, with an absolute floor: at rest b is round-off and a
+   * relative test would spend the whole budget on it. r.D^-1 r is about
+   * sum m e^2 for a velocity error e, so the floor is an RMS error of
+   * PCG_V_FLOOR m/s (100x below the settling tests' 1e-6 m/s); a b below
+   * it is taken as dv = 0 without a product. */
+  double mfree = 0;
+  for (size_t i = 0; i < n; i++) mfree += s->inv_mass[i] == 0 ? 0 : s->mass[i];
   if (!isfinite(bz)) { /* let it reach the state: the caller's check rolls back */
     for (size_t c = 0; c < n3; c++) dv[c] = b[c];
     it->last_cg_residual = NAN;
-  } else if (bz > 0) {
+  } else if (bz > 0 && bz > mfree * PCG_V_FLOOR * PCG_V_FLOOR) {
     /* Warm start: dv = alpha d, d the last dv, r = b - alpha A d. */
     double dd = dot_free(s, dv, dv), alpha = 0;
     if (dd > 0) {
@@ -373,7 +382,7 @@ static void implicit_pcg(integrator_t *it, force_system_t *s, double h) {
       p[c] = z[c];
       rz += r[c] * z[c];
     }
-    const double stop = it->cg_tolerance * it->cg_tolerance * bz;
+    const double stop = fmax(it->cg_tolerance * it->cg_tolerance * bz, mfree * PCG_V_FLOOR * PCG_V_FLOOR);
     int iter = 0;
     while (iter < it->cg_max_iterations && rz > stop) {
       pcg_mul(s, h, p, q);
