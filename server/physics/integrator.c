@@ -369,7 +369,8 @@ static void implicit_pcg(integrator_t *it, force_system_t *s, double h) {
   } else if (bz > 0 && bz > mfree * PCG_V_FLOOR * PCG_V_FLOOR) {
     /* Warm start: dv = alpha d, d the last dv, r = b - alpha A d. */
     double dd = dot_free(s, dv, dv), alpha = 0;
-    if (dd > 0) {
+    if (!isfinite(dd)) memset(dv, 0, n3 * sizeof(double)); /* a rolled-back step's NaN */
+    if (dd > 0 && isfinite(dd)) {
       pcg_mul(s, h, dv, q);
       double dad = dot_free(s, dv, q), bd = dot_free(s, b, dv);
       alpha = dad > 0 && bd > 0 && isfinite(dad) ? bd / dad : 0;
