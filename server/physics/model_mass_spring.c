@@ -36,6 +36,11 @@
  * of more (they are not resolved at that h either way). Requested
  * sub-steps (solver.substeps) keep the full damping.
  *
+ * implicit_pcg (integrator.h, issue 17.3) is one step per scene step: the
+ * tool springs implicit as under symplectic Euler (correct_v after the
+ * solve), the spring pass fused with the Jacobian (physics/ms_linear.h),
+ * no energy guard (docs/numerics.md §10).
+ *
  * Implicit Euler is one linearised step (integrator.h), which is blind to
  * what the linearisation misses: a flat cloth let go under gravity has no
  * out-of-plane stiffness at rest, so one 33 ms step moves its nodes straight
@@ -114,10 +119,8 @@ static void correct_v(force_system_t *s, double h) {
 }
 
 /* implicit_pcg: the fused force and Jacobian pass (physics/ms_linear.h).
- * After a topology change the cache may be short by the springs a cut
- * added until ms_commit_nodes reserved them; the integrator's fallback
- * (forces and stiffness_mul) would then need the callbacks cleared, so
- * the cache is always reserved before the springs change (see there). */
+ * The cache holds every spring: ms_commit_nodes reserves it before a cut
+ * changes the springs. */
 static void linearize(force_system_t *s, double h, double *rhs, double *diag) {
   ms_model_t *mm = s->ctx;
   ms_linear_rhs(&mm->lin, &mm->ms, h, rhs, diag);
