@@ -34,7 +34,7 @@
 static const char *const scene_models[] = {"mass_spring_surface", "mass_spring_tet",     "molecular", "pbd", "xpbd",
                                            "vertex_based",        "adaptive_mass_spring"};
 static const char *const scene_integrators[] = {"symplectic_euler", "explicit_euler", "verlet", "rk4",
-                                                "implicit_euler"};
+                                                "implicit_euler",   "implicit_pcg"};
 static const char *const scene_tool_kinds[] = {"probe", "grasper", "scalpel", "extractor", "syringe"};
 static const char *const scene_object_kinds[] = {"stone"};
 static const char *const scene_task_kinds[] = {"stone_removal", "palpate_target", "grasp_pull"};
@@ -396,14 +396,25 @@ static int missing(const ctx_t *c, const node_t *owner, const char *prefix, cons
 
 /* ---- the schema -------------------------------------------------------- */
 
-enum { P_DT, P_PUBLISH_HZ, P_QUANT_STEP, P_GRAVITY, P_SLEEP_SPEED, P_SLEEP_AFTER, P_PUBLISH_KEEPALIVE, P_NKEYS };
+enum {
+  P_DT,
+  P_PUBLISH_HZ,
+  P_QUANT_STEP,
+  P_GRAVITY,
+  P_SLEEP_SPEED,
+  P_SLEEP_AFTER,
+  P_PUBLISH_KEEPALIVE,
+  P_INTEGRATOR,
+  P_NKEYS
+};
 static const char *const physics_keys[P_NKEYS] = {[P_DT] = "dt",
                                                   [P_PUBLISH_HZ] = "publish_hz",
                                                   [P_QUANT_STEP] = "quant_step",
                                                   [P_GRAVITY] = "gravity",
                                                   [P_SLEEP_SPEED] = "sleep_speed",
                                                   [P_SLEEP_AFTER] = "sleep_after",
-                                                  [P_PUBLISH_KEEPALIVE] = "publish_keepalive"};
+                                                  [P_PUBLISH_KEEPALIVE] = "publish_keepalive",
+                                                  [P_INTEGRATOR] = "integrator"};
 
 enum {
   M_MASS,
@@ -583,6 +594,10 @@ static int parse_physics(const ctx_t *c, const node_t *n, scene_t *s) {
   if (opt_number(c, v[P_PUBLISH_KEEPALIVE], "physics", "publish_keepalive", "physics.publish_keepalive",
                  &s->publish_keepalive))
     return -1;
+  /* The integrator of every organ that names none (issue 17.3). */
+  if (v[P_INTEGRATOR] && get_choice(c, v[P_INTEGRATOR], "physics.integrator", scene_integrators,
+                                    COUNT(scene_integrators), s->integrator, sizeof s->integrator))
+    return -1;
   /* Fewer than two steps of stillness is no evidence of rest. */
   if (v[P_SLEEP_AFTER] && s->sleep_after < 2 * s->dt)
     return field_err(c, v[P_SLEEP_AFTER], "physics.sleep_after", "must be at least two steps (2 dt)");
@@ -711,6 +726,7 @@ static int parse_organ(const ctx_t *c, const node_t *n, size_t idx, const char *
   char path[64], fp[128];
   snprintf(path, sizeof path, "organs[%zu]", idx);
   organ_defaults(o);
+  if (s->integrator[0]) snprintf(o->integrator, sizeof o->integrator, "%s", s->integrator);
   o->line = n->line;
   if (get_fields(c, n, path, organ_keys, O_NKEYS, v)) return -1;
   if (!v[O_NAME]) return missing(c, n, path, "name");
@@ -740,6 +756,9 @@ static int parse_organ(const ctx_t *c, const node_t *n, size_t idx, const char *
   if (v[O_INTEGRATOR] && get_choice(c, v[O_INTEGRATOR], fp, scene_integrators, COUNT(scene_integrators), o->integrator,
                                     sizeof o->integrator))
     return -1;
+  /* implicit_pcg is built for a small fixed CG budget per step (integrator.h);
+   * solver.cg_max_iterations, when given, overrides it. */
+  if (!strcmp(o->integrator, "implicit_pcg")) o->solver.cg_max_iterations = SCENE_PCG_ITERATIONS;
   if (v[O_SOLVER]) {
     join(fp, sizeof fp, path, "solver");
     if (parse_solver(c, v[O_SOLVER], fp, &o->solver)) return -1;

@@ -47,13 +47,16 @@ typedef struct scene_material {
   int refine_levels;     /* [2] */
 } scene_material_t;
 
+/* Default CG iteration cap of the integrator implicit_pcg (one step per ms). */
+#define SCENE_PCG_ITERATIONS 10
+
 /* Model-specific settings (key `solver:` and extra `material:` keys in the
  * scene file). Each model reads only its own fields; defaults in brackets. */
 typedef struct scene_solver {
   int substeps;          /* sub-steps per scene step; 0 = automatic from the stability bound [0] */
   int iterations;        /* PBD/XPBD constraint iterations per sub-step [10] */
   double cg_tolerance;   /* implicit Euler: relative CG residual [1e-3] */
-  int cg_max_iterations; /* implicit Euler [200] */
+  int cg_max_iterations; /* implicit Euler [200]; implicit_pcg [SCENE_PCG_ITERATIONS] */
   double tet_size;       /* m, target tetrahedron edge when a volume mesh is built [0: auto] */
 } scene_solver_t;
 
@@ -185,6 +188,9 @@ typedef struct scene {
    * unless this long passed (server/session/mesh_publisher.h); 0 (the default)
    * writes every frame. */
   double publish_keepalive;
+  /* physics.integrator: the integrator of every organ that names none
+   * ("" when not given: organs default to symplectic_euler). */
+  char integrator[32];
   size_t norgans;             /* >= 1 */
   scene_organ_t organs[SCENE_MAX_ORGANS];
   size_t ntools;

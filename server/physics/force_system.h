@@ -27,10 +27,17 @@ struct force_system {
    * so it must set the external forces (contact hooks), not add to them;
    * may be NULL. */
   void (*pre_substep)(force_system_t *s);
-  /* Optional (NULL: none), symplectic Euler only: called between the kick
+  /* Optional (NULL: none), symplectic Euler and implicit_pcg: called between the kick
    * (s->v holds v + h M^-1 F) and the drift, to correct the velocities for
    * forces integrated implicitly (physics/coupling.h). */
   void (*correct_v)(force_system_t *s, double h);
+  /* Optional (NULL: implicit_pcg falls back to forces and stiffness_mul),
+   * implicit_pcg only. linearize writes rhs = h (F(x, v) - h K v) at the
+   * current state and diag, the diagonal of A' = h^2 K + h C, and keeps
+   * what linear_mul needs to apply A = M + A' (out = A y, every node; the
+   * integrator masks the fixed ones) until the next call. */
+  void (*linearize)(force_system_t *s, double h, double *rhs, double *diag);
+  void (*linear_mul)(force_system_t *s, const double *y, double *out);
   void *ctx; /* the owning model */
 };
 

@@ -38,11 +38,13 @@ static const char *const NAMES[INT_COUNT] = {[INT_EXPLICIT_EULER] = "explicit_eu
                                              [INT_SYMPLECTIC_EULER] = "symplectic_euler",
                                              [INT_VERLET] = "verlet",
                                              [INT_RK4] = "rk4",
-                                             [INT_IMPLICIT_EULER] = "implicit_euler"};
+                                             [INT_IMPLICIT_EULER] = "implicit_euler",
+                                             [INT_IMPLICIT_PCG] = "implicit_pcg"};
 
 /* Scratch arrays each scheme needs (3n doubles each). */
 static const int NBUF[INT_COUNT] = {
-    [INT_EXPLICIT_EULER] = 1, [INT_SYMPLECTIC_EULER] = 1, [INT_VERLET] = 1, [INT_RK4] = 5, [INT_IMPLICIT_EULER] = 7};
+    [INT_EXPLICIT_EULER] = 1, [INT_SYMPLECTIC_EULER] = 1, [INT_VERLET] = 1, [INT_RK4] = 5,
+    [INT_IMPLICIT_EULER] = 7, [INT_IMPLICIT_PCG] = 7};
 
 int integrator_parse(const char *name) {
   if (!name) return -1;
@@ -57,8 +59,9 @@ int integrator_init(integrator_t *it, integrator_kind_t kind, size_t n, double c
                     verr_t *err) {
   memset(it, 0, sizeof *it);
   if ((unsigned)kind >= INT_COUNT) return verr_set(err, "integrator: unknown kind %d", (int)kind);
-  if (kind == INT_IMPLICIT_EULER && (!(cg_tolerance > 0 && cg_tolerance < 1) || cg_max_iterations < 1))
-    return verr_set(err, "implicit_euler: cg_tolerance must be in (0, 1) and cg_max_iterations >= 1 (got %g, %d)",
+  if ((kind == INT_IMPLICIT_EULER || kind == INT_IMPLICIT_PCG) &&
+      (!(cg_tolerance > 0 && cg_tolerance < 1) || cg_max_iterations < 1))
+    return verr_set(err, "%s: cg_tolerance must be in (0, 1) and cg_max_iterations >= 1 (got %g, %d)", NAMES[kind],
                     cg_tolerance, cg_max_iterations);
   if (n > ((size_t)-1) / (3 * sizeof(double)) - 1) return verr_set(err, "integrator: %zu nodes is too many", n);
   it->kind = kind;
@@ -278,6 +281,146 @@ static void implicit_euler(integrator_t *it, force_system_t *s, double h) {
   }
 }
 
+/* ---- implicit_pcg ------------------------------------------------------- */
+
+/* out = A y = (M + A') y, from the force system's cache (every node) or
+ * from stiffness_mul (fixed nodes 0). y must be 0 on the fixed nodes; the
+ * caller ignores out there (its r and z are masked by dinv = 0). */
+static void pcg_mul(force_system_t *s, double h, const double *y, double *out) {
+  if (s->linear_mul) {
+    s->linear_mul(s, y, out);
+    return;
+  }
+  s->stiffness_mul(s, s->x, h * h, h, y, out);
+  for (size_t i = 0; i < s->n; i++) {
+    double m = s->mass[i];
+    for (int k = 0; k < 3; k++) {
+      size_t c = 3 * i + k;
+      out[c] = s->inv_mass[i] == 0 ? 0 : out[c] + m * y[c];
+    }
+  }
+}
+
+/* The linearised backward-Euler step of implicit_euler with what makes it
+ * cheap enough for one step per millisecond (integrator.h):
+ *   - rhs, the Jacobian blocks and their diagonal in one pass over the
+ *     springs (force_system_t.linearize) where the model offers it;
+ *   - Jacobi preconditioner 1 / (m + diag A'): the stiff, high-frequency
+ *     modes that a few iterations must get right are nearly local;
+ *   - warm start from the last step's dv (buf[1] is kept between steps),
+ *     scaled by the exact line search alpha = b.d / d.A d along it, so the
+ *     start is never worse (in the A-norm CG minimises) than dv = 0, and a
+ *     dv that no longer points anywhere useful (contact released, topology
+ *     changed) costs one product, not a bad step;
+ *   - at most cg_max_iterations (stopping earlier at cg_tolerance).
+ * The tool springs are not in A: after the solve, correct_v takes them
+ * implicitly with the rank-one solve of coupling.h (a splitting of the
+ * tissue and tool stiffness; for a node of mass m, tissue stiffness kt and
+ * tool stiffness k the step's amplification stays below 1 for any h, kt and
+ * k). */
+#define PCG_V_FLOOR 1e-8 /* m/s, see the stop test */
+
+static void implicit_pcg(integrator_t *it, force_system_t *s, double h) {
+  double *b = it->buf[0], *dv = it->buf[1], *r = it->buf[2], *p = it->buf[3], *q = it->buf[4], *z = it->buf[5],
+         *dinv = it->buf[6];
+  const size_t n = s->n, n3 = 3 * n;
+  it->last_cg_iterations = 0;
+  it->last_cg_residual = 0;
+  if (!s->stiffness_mul && !s->linearize) {
+    symplectic_euler(it, s, h);
+    return;
+  }
+  if (s->linearize) {
+    s->linearize(s, h, b, dinv);
+  } else { /* b = h F - h^2 K v; diag of A' unknown: mass only */
+    for (size_t c = 0; c < n3; c++) p[c] = s->inv_mass[c / 3] == 0 ? 0 : s->v[c];
+    s->forces(s, s->x, s->v, b);
+    s->stiffness_mul(s, s->x, h * h, 0, p, q);
+    for (size_t c = 0; c < n3; c++) {
+      b[c] = h * b[c] - q[c];
+      dinv[c] = 0;
+    }
+  }
+  for (size_t i = 0; i < n; i++)
+    for (int k = 0; k < 3; k++) {
+      size_t c = 3 * i + k;
+      if (s->inv_mass[i] == 0) {
+        b[c] = dv[c] = dinv[c] = 0;
+      } else {
+        double d = s->mass[i] + dinv[c];
+        dinv[c] = d > 0 ? 1.0 / d : s->inv_mass[i];
+      }
+    }
+  /* Fixed nodes: b = 0 and dinv = 0 there, so z, p and dv stay 0; r may
+   * pick up A's rows there but only enters through z (masked). The stop
+   * test is on the preconditioned residual r.z against b.D^-1 b. */
+  double bz = 0;
+  for (size_t c = 0; c < n3; c++) bz += b[c] * b[c] * dinv[c];
+  /* Relative to b, with an absolute floor: at rest b is round-off and a
+   * relative test would spend the whole budget on it. r.D^-1 r is about
+   * sum m e^2 for a velocity error e, so the floor is an RMS error of
+   * PCG_V_FLOOR m/s (100x below the settling tests' 1e-6 m/s); a b below
+   * it is taken as dv = 0 without a product. */
+  double mfree = 0;
+  for (size_t i = 0; i < n; i++) mfree += s->inv_mass[i] == 0 ? 0 : s->mass[i];
+  if (!isfinite(bz)) { /* let it reach the state: the caller's check rolls back */
+    for (size_t c = 0; c < n3; c++) dv[c] = b[c];
+    it->last_cg_residual = NAN;
+  } else if (bz > 0 && bz > mfree * PCG_V_FLOOR * PCG_V_FLOOR) {
+    /* Warm start: dv = alpha d, d the last dv, r = b - alpha A d. */
+    double dd = dot_free(s, dv, dv), alpha = 0;
+    if (!isfinite(dd)) memset(dv, 0, n3 * sizeof(double)); /* a rolled-back step's NaN */
+    if (dd > 0 && isfinite(dd)) {
+      pcg_mul(s, h, dv, q);
+      double dad = dot_free(s, dv, q), bd = dot_free(s, b, dv);
+      alpha = dad > 0 && bd > 0 && isfinite(dad) ? bd / dad : 0;
+    }
+    double rz = 0;
+    for (size_t c = 0; c < n3; c++) {
+      dv[c] *= alpha;
+      r[c] = alpha != 0 ? b[c] - alpha * q[c] : b[c];
+      z[c] = r[c] * dinv[c];
+      p[c] = z[c];
+      rz += r[c] * z[c];
+    }
+    const double stop = fmax(it->cg_tolerance * it->cg_tolerance * bz, mfree * PCG_V_FLOOR * PCG_V_FLOOR);
+    int iter = 0;
+    while (iter < it->cg_max_iterations && rz > stop) {
+      pcg_mul(s, h, p, q);
+      double pq = 0;
+      for (size_t c = 0; c < n3; c++) pq += p[c] * q[c]; /* p = 0 on fixed nodes */
+      if (!(pq > 0)) break;                              /* no curvature left (or NaN): keep what there is */
+      double a = rz / pq, rz_new = 0;
+      for (size_t c = 0; c < n3; c++) {
+        dv[c] += a * p[c];
+        r[c] -= a * q[c];
+        z[c] = r[c] * dinv[c];
+        rz_new += r[c] * z[c];
+      }
+      iter++;
+      double beta = rz_new / rz;
+      rz = rz_new;
+      if (iter < it->cg_max_iterations && rz > stop)
+        for (size_t c = 0; c < n3; c++) p[c] = z[c] + beta * p[c];
+    }
+    it->last_cg_iterations = iter;
+    it->last_cg_residual = sqrt(rz / bz);
+    it->cg_iterations_total += (uint64_t)iter;
+  } else {
+    memset(dv, 0, n3 * sizeof(double));
+  }
+  it->implicit_steps++;
+  for (size_t i = 0; i < n; i++) {
+    if (s->inv_mass[i] == 0) continue;
+    for (int k = 0; k < 3; k++) s->v[3 * i + k] += dv[3 * i + k];
+  }
+  if (s->correct_v) s->correct_v(s, h);
+  for (size_t i = 0; i < n; i++) {
+    if (s->inv_mass[i] == 0) continue;
+    for (int k = 0; k < 3; k++) s->x[3 * i + k] += h * s->v[3 * i + k];
+  }
+}
+
 void integrator_substep(integrator_t *it, force_system_t *s, double h) {
   if (s->pre_substep) s->pre_substep(s);
   switch (it->kind) {
@@ -295,6 +438,9 @@ void integrator_substep(integrator_t *it, force_system_t *s, double h) {
     break;
   case INT_IMPLICIT_EULER:
     implicit_euler(it, s, h);
+    break;
+  case INT_IMPLICIT_PCG:
+    implicit_pcg(it, s, h);
     break;
   default:
     break;
@@ -356,7 +502,7 @@ static double first_unstable(int (*stable)(double, double, double), double lk, d
 double integrator_stable_dt(integrator_kind_t k, double lambda_k, double lambda_c) {
   double lk = fmax(lambda_k, 0), lc = fmax(lambda_c, 0);
   if (!isfinite(lk) || !isfinite(lc)) return 0;
-  if (k == INT_IMPLICIT_EULER) return INFINITY;
+  if (k == INT_IMPLICIT_EULER || k == INT_IMPLICIT_PCG) return INFINITY;
   if (lk == 0 && lc == 0) return INFINITY;
   switch (k) {
   case INT_EXPLICIT_EULER:
@@ -390,7 +536,7 @@ int integrator_choose_substeps(integrator_kind_t kind, double dt, int requested,
     *substeps = requested;
     return 0;
   }
-  if (kind == INT_IMPLICIT_EULER) {
+  if (kind == INT_IMPLICIT_EULER || kind == INT_IMPLICIT_PCG) {
     *substeps = 1;
     return 0;
   }

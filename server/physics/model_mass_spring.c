@@ -36,6 +36,11 @@
  * of more (they are not resolved at that h either way). Requested
  * sub-steps (solver.substeps) keep the full damping.
  *
+ * implicit_pcg (integrator.h, issue 17.3) is one step per scene step: the
+ * tool springs implicit as under symplectic Euler (correct_v after the
+ * solve), the spring pass fused with the Jacobian (physics/ms_linear.h),
+ * no energy guard (docs/numerics.md §10).
+ *
  * Implicit Euler is one linearised step (integrator.h), which is blind to
  * what the linearisation misses: a flat cloth let go under gravity has no
  * out-of-plane stiffness at rest, so one 33 ms step moves its nodes straight
@@ -67,6 +72,7 @@
 #include "physics/model_guard.h"
 #include "physics/model_mass_spring.h"
 #include "physics/model_volume.h"
+#include "physics/ms_linear.h"
 #include "state_blob.h"
 #include "tet_mesh.h"
 #include "vmath.h"
@@ -97,7 +103,8 @@ typedef struct ms_model {
   double lam_k;
   int refining, refine_count;
   double refine_lambda;
-  coupling_set_t cpl; /* symplectic Euler: the tool springs of the sub-step (implicit) */
+  coupling_set_t cpl; /* symplectic Euler, implicit_pcg: the tool springs of the sub-step (implicit) */
+  ms_linear_t lin;    /* implicit_pcg: the step's Jacobian blocks */
 } ms_model_t;
 
 static void embed(ms_model_t *mm) {
@@ -109,6 +116,19 @@ static void embed(ms_model_t *mm) {
 static void correct_v(force_system_t *s, double h) {
   ms_model_t *mm = s->ctx;
   coupling_set_apply(&mm->cpl, mm->ms.inv_mass, h, mm->ms.v);
+}
+
+/* implicit_pcg: the fused force and Jacobian pass (physics/ms_linear.h).
+ * The cache holds every spring: ms_commit_nodes reserves it before a cut
+ * changes the springs. */
+static void linearize(force_system_t *s, double h, double *rhs, double *diag) {
+  ms_model_t *mm = s->ctx;
+  ms_linear_rhs(&mm->lin, &mm->ms, h, rhs, diag);
+}
+
+static void linear_mul(force_system_t *s, const double *y, double *out) {
+  ms_model_t *mm = s->ctx;
+  ms_linear_mul(&mm->lin, &mm->ms, y, out);
 }
 
 /* Before every sub-step: external forces are valid for one sub-step only;
@@ -194,6 +214,7 @@ static void ms_destroy(model_t *m) {
   }
   model_guard_free(&mm->guard);
   coupling_set_free(&mm->cpl);
+  ms_linear_free(&mm->lin);
   free(mm->surf_buf);
   free(mm->surf_rest_buf);
   free(mm->tris);
@@ -347,9 +368,10 @@ static model_t *ms_create(const model_params_t *p, int tet, verr_t *err) {
   }
   mm->tet = tet;
   mm->dt = p->dt;
-  /* Symplectic Euler takes the tool springs implicitly (coupling.h): the
-   * sub-steps then follow the tissue alone. */
-  mm->tool_stiffness = kind == INT_SYMPLECTIC_EULER ? 0 : p->tool_stiffness;
+  /* Symplectic Euler and implicit_pcg take the tool springs implicitly
+   * (coupling.h): the sub-steps then follow the tissue alone. */
+  int coupled = kind == INT_SYMPLECTIC_EULER || kind == INT_IMPLICIT_PCG;
+  mm->tool_stiffness = coupled ? 0 : p->tool_stiffness;
   mm->requested_substeps = cfg->solver.substeps;
   const mesh_t *s = p->surface;
   ms_params_t mp = {.mass = cfg->material.mass,
@@ -374,7 +396,7 @@ static model_t *ms_create(const model_params_t *p, int tet, verr_t *err) {
   }
   mm->ms.fs.ctx = mm;
   mm->ms.fs.pre_substep = pre_substep;
-  if (kind == INT_SYMPLECTIC_EULER) {
+  if (coupled) {
     mm->ms.fs.correct_v = correct_v;
     mm->m.implicit_tools = 1;
     if (coupling_set_init(&mm->cpl, 256, 8192, err)) {
@@ -382,8 +404,16 @@ static model_t *ms_create(const model_params_t *p, int tet, verr_t *err) {
       return NULL;
     }
   }
+  if (kind == INT_IMPLICIT_PCG) {
+    if (ms_linear_reserve(&mm->lin, mm->ms.nsprings, err)) {
+      ms_destroy(&mm->m);
+      return NULL;
+    }
+    mm->ms.fs.linearize = linearize;
+    mm->ms.fs.linear_mul = linear_mul;
+  }
   /* Conjugate gradients need a definite matrix (see mass_spring.h). */
-  mm->ms.definite_jacobian = kind == INT_IMPLICIT_EULER;
+  mm->ms.definite_jacobian = kind == INT_IMPLICIT_EULER || kind == INT_IMPLICIT_PCG;
   if (cfg->fixed_below_set) mass_spring_fix_below(&mm->ms, cfg->fixed_below);
 
   size_t n = mm->ms.n;
@@ -447,6 +477,15 @@ model_t *model_mass_spring_tet_create(const model_params_t *p, verr_t *err) { re
 
 mass_spring_t *model_mass_spring_surface_system(model_t *m) {
   return m && m->ops == &SURFACE_OPS ? &((ms_model_t *)m)->ms : NULL;
+}
+
+int model_mass_spring_cg_counts(const model_t *m, uint64_t *iterations, uint64_t *steps) {
+  if (!m || (m->ops != &SURFACE_OPS && m->ops != &TET_OPS)) return -1;
+  const ms_model_t *mm = (const ms_model_t *)m;
+  if (mm->it.kind != INT_IMPLICIT_PCG) return -1;
+  *iterations = mm->it.cg_iterations_total;
+  *steps = mm->it.implicit_steps;
+  return 0;
 }
 
 /* realloc that keeps *p on failure; NULL stays NULL. */
@@ -544,6 +583,9 @@ static int ms_commit_nodes(model_t *m, size_t n, const uint32_t *old_to_new, siz
     mm->tris = t;
     mm->tri_cap = cap;
   }
+  /* implicit_pcg: room for every spring the new surface can have (its
+   * unique edges, at most 3 per triangle) before the springs change. */
+  if (mm->ms.fs.linearize && ms_linear_reserve(&mm->lin, 3 * ntris, err)) return -1;
   if (mass_spring_set_surface_topology(&mm->ms, n, tris, ntris, err)) return -1;
   memcpy(mm->tris, tris, 3 * ntris * sizeof(uint32_t));
   model_guard_save(&mm->guard, mm->ms.x, mm->ms.v, n, NULL);

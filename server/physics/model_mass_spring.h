@@ -41,4 +41,9 @@
  * (mass_spring_tet included: its surface is embedded, not simulated). */
 mass_spring_t *model_mass_spring_surface_system(model_t *m);
 
+/* implicit_pcg diagnostics of a mass-spring model (surface or tet): the
+ * conjugate-gradient iterations and implicit steps since creation. 0, or
+ * -1 for another model or integrator. */
+int model_mass_spring_cg_counts(const model_t *m, uint64_t *iterations, uint64_t *steps);
+
 #endif

@@ -41,6 +41,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "physics/coupling.h"
 #include "physics/integrator.h"
 #include "physics/model.h"
 #include "physics/model_guard.h"
@@ -53,7 +54,16 @@ typedef struct mol_model {
   molecular_t mol;
   integrator_t it;
   model_guard_t guard; /* the last finite state */
+  coupling_set_t cpl;  /* symplectic Euler, implicit_pcg: the sub-step's tool springs (implicit) */
 } mol_model_t;
+
+/* Between kick and drift: the declared tool springs implicitly
+ * (physics/coupling.h), as in the mass-spring models. */
+static void mm_correct_v(force_system_t *s, double h) {
+  molecular_t *mol = s->ctx;
+  mol_model_t *mm = (mol_model_t *)mol->user;
+  coupling_set_apply(&mm->cpl, mol->inv_mass, h, mol->v);
+}
 
 /* Integrators call this before every force evaluation (twice per Verlet
  * sub-step, four times per RK4 one), so external forces are set afresh each
@@ -62,7 +72,11 @@ static void mm_pre_substep(force_system_t *s) {
   molecular_t *mol = s->ctx;
   model_t *m = mol->user;
   memset(mol->f_ext, 0, 3 * mol->n * sizeof(double));
+  mol_model_t *mm = (mol_model_t *)m;
+  coupling_set_clear(&mm->cpl);
   if (m->hook) m->hook(m, m->hook_ctx);
+  /* Without a tool spring the integrator keeps its fused loop. */
+  if (m->implicit_tools) s->correct_v = mm->cpl.n ? mm_correct_v : NULL;
 }
 
 static int mm_step(model_t *m, double h) {
@@ -84,6 +98,7 @@ static void mm_destroy(model_t *m) {
   integrator_destroy(&mm->it);
   molecular_destroy(&mm->mol);
   model_guard_free(&mm->guard);
+  coupling_set_free(&mm->cpl);
   free(mm);
 }
 
@@ -97,6 +112,19 @@ static void mm_add_surface_force(model_t *m, uint32_t i, const double f[3]) {
   for (int k = 0; k < 3; k++) mol->f_ext[3 * (size_t)i + k] += f[k];
 }
 
+/* A tool spring (model.h): the surface is the node set. */
+static void mm_add_surface_coupling(model_t *m, double k, size_t nw, const uint32_t *wi, const double *w, size_t nb,
+                                    const uint32_t *bi, const double *b) {
+  mol_model_t *mm = (mol_model_t *)m;
+  if (!m->implicit_tools) return;
+  coupling_begin(&mm->cpl, k);
+  for (size_t j = 0; j < nw; j++)
+    if (wi[j] < mm->mol.n) coupling_push_w(&mm->cpl, wi[j], w[j]);
+  for (size_t l = 0; l < nb; l++)
+    if (bi[l] < mm->mol.n) coupling_push_b(&mm->cpl, bi[l], b[l]);
+  coupling_end(&mm->cpl);
+}
+
 static const model_ops_t MOL_OPS = {
     .name = "molecular",
     .step = mm_step,
@@ -104,6 +132,7 @@ static const model_ops_t MOL_OPS = {
     .energy = mm_energy,
     .error_estimate = mm_error,
     .add_surface_force = mm_add_surface_force,
+    .add_surface_coupling = mm_add_surface_coupling,
 };
 
 /* Stable dt and sub-steps (file comment). */
@@ -111,9 +140,11 @@ static int choose_substeps(mol_model_t *mm, const model_params_t *p, integrator_
   const scene_organ_t *cfg = p->cfg;
   const molecular_t *mol = &mm->mol;
   double lk, lc;
-  if (molecular_rest_lambdas(mol, p->tool_stiffness, &lk, &lc)) return verr_set(err, "out of memory");
+  /* Tool springs taken implicitly (coupling.h) stay out of the bound. */
+  double tool = mm->m.implicit_tools ? 0 : p->tool_stiffness;
+  if (molecular_rest_lambdas(mol, tool, &lk, &lc)) return verr_set(err, "out of memory");
   double m_node = mol->p.mass / (double)mol->n;
-  double lk0 = (mol->p.home_stiffness + p->tool_stiffness) / m_node, lc0 = mol->p.home_damping / m_node;
+  double lk0 = (mol->p.home_stiffness + tool) / m_node, lc0 = mol->p.home_damping / m_node;
   return integrator_choose_substeps(kind, p->dt, cfg->solver.substeps, lk, lc, lk0, lc0,
                                     "lower angle_k, bond_k, stretch_bend_k, damping or tool stiffness, raise the "
                                     "mass, or use implicit_euler (explicit_euler needs damping)",
@@ -154,7 +185,16 @@ model_t *model_molecular_create(const model_params_t *p, verr_t *err) {
   }
   mol->user = &mm->m;
   mol->fs.pre_substep = mm_pre_substep;
-  mol->definite_jacobian = kind == INT_IMPLICIT_EULER;
+  mol->definite_jacobian = kind == INT_IMPLICIT_EULER || kind == INT_IMPLICIT_PCG;
+  /* Symplectic Euler and implicit_pcg take the tool springs implicitly
+   * (issue 17.1): the sub-steps then follow the tissue alone. */
+  if (kind == INT_SYMPLECTIC_EULER || kind == INT_IMPLICIT_PCG) {
+    mm->m.implicit_tools = 1;
+    if (coupling_set_init(&mm->cpl, 256, 8192, err)) {
+      mm_destroy(&mm->m);
+      return NULL;
+    }
+  }
   if (cfg->fixed_below_set) molecular_fix_below(mol, cfg->fixed_below);
   size_t n = mol->n;
   if (model_guard_reserve(&mm->guard, n)) {

@@ -45,6 +45,15 @@ static double vbm_error(const model_t *m) { return vb_max_edge_strain(&((const v
 
 static void vbm_add_force(model_t *m, uint32_t i, const double f[3]) { vb_add_force(&((vb_model_t *)m)->vb, i, f); }
 
+/* Tool springs implicitly (vertex_based.h vb_add_coupling): only the
+ * stiffness matters to this model, the force itself came through
+ * add_surface_force. */
+static void vbm_add_coupling(model_t *m, double k, size_t nw, const uint32_t *wi, const double *w, size_t nb,
+                             const uint32_t *bi, const double *b) {
+  (void)nw, (void)wi, (void)w, (void)nb, (void)bi, (void)b;
+  if (m->implicit_tools) vb_add_coupling(&((vb_model_t *)m)->vb, k);
+}
+
 static const model_ops_t vb_ops = {
     .name = "vertex_based",
     .step = vbm_step,
@@ -52,6 +61,7 @@ static const model_ops_t vb_ops = {
     .energy = vbm_energy,
     .error_estimate = vbm_error,
     .add_surface_force = vbm_add_force,
+    .add_surface_coupling = vbm_add_coupling,
 };
 
 model_t *model_vertex_based_create(const model_params_t *p, verr_t *err) {
@@ -66,7 +76,7 @@ model_t *model_vertex_based_create(const model_params_t *p, verr_t *err) {
                     .home_stiffness = mat->home_stiffness,
                     .home_damping = mat->home_damping,
                     .slope = {mat->slope_m1, mat->slope_m2, mat->slope_m3},
-                    .tool_stiffness = p->tool_stiffness};
+                    .tool_stiffness = 0}; /* every tool spring is declared: implicit (issue 17.1) */
   verr_t e;
   if (vb_create(&vm->vb, p->surface, &vp, &e)) {
     free(vm);
@@ -76,6 +86,7 @@ model_t *model_vertex_based_create(const model_params_t *p, verr_t *err) {
   if (cfg->fixed_below_set) vb_fix_below(&vm->vb, cfg->fixed_below);
   model_t *m = &vm->base;
   m->ops = &vb_ops;
+  m->implicit_tools = 1;
   m->error_kind = "max_edge_strain";
   m->nnodes = m->nsurf = vm->vb.n;
   m->x = m->surf_x = vm->vb.x;

@@ -201,6 +201,10 @@ double vb_stable_dt(const vb_t *vb) {
   return (c + sqrt(c * c + 4 * m * (g - k))) / (g - k);
 }
 
+void vb_add_coupling(vb_t *vb, double k) {
+  if (k > 0 && isfinite(k)) vb->coupling_k += k;
+}
+
 void vb_add_force(vb_t *vb, uint32_t i, const double f[3]) {
   if (i >= vb->n) return;
   v3_add(vb->f_sum, vb->f_sum, f);
@@ -252,7 +256,9 @@ static void substep(vb_t *vb, double h) {
     if (!vb->fixed[t]) {
       activate(vb, t);
       v3_scale(d, u, vb->p.slope[0]);
-      integrate(vb, t, d, h, denom);
+      /* d = slope_m1 F / k_home with F = F0 - g h v' (the declared tool
+       * springs at the step's end): h^2 slope_m1 g joins the denominator. */
+      integrate(vb, t, d, h, denom + h * h * vb->p.slope[0] * vb->coupling_k);
       vb->is_active[t] = 2;
       updates++;
     }
@@ -301,6 +307,7 @@ int vb_step(vb_t *vb, double h, int substeps, vb_pre_fn pre, void *ctx) {
     v3_set(vb->f_sum, 0, 0, 0);
     vb->touched = UINT32_MAX;
     vb->touched_mag = 0;
+    vb->coupling_k = 0;
     if (pre) pre(ctx);
     substep(vb, hs);
   }

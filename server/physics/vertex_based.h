@@ -63,6 +63,9 @@ typedef struct vb {
   double f_sum[3];
   uint32_t touched; /* node with the largest single applied force, UINT32_MAX if none */
   double touched_mag;
+  /* Tool stiffness declared by vb_add_coupling for the current sub-step
+   * (N/m, summed): the touched node takes it implicitly (vertex_based.c). */
+  double coupling_k;
   /* Statistics of the last vb_step. */
   uint32_t last_touched;    /* touched node of the last sub-step that had contact, or UINT32_MAX */
   size_t last_node_updates; /* node integrations summed over the sub-steps */
@@ -98,6 +101,13 @@ double vb_stable_dt(const vb_t *vb);
 /* Force f (N) at node i for the current sub-step (cleared by every sub-step).
  * The node receiving the largest single force is the touched node; the sum
  * of all forces of the sub-step is the F of eq. 4.2-4.4. */
+/* Declares that the forces added this sub-step include a tool spring of
+ * stiffness k (N/m) (issue 17.1). The touched node's backward-Euler update
+ * then takes slope_m1 * k in its denominator: the loop force -> indentation
+ * -> force is implicit, so the step is stable for any tool stiffness; at
+ * rest nothing changes (same equilibrium, same felt stiffness). Create
+ * with p.tool_stiffness 0 when every tool spring is declared. */
+void vb_add_coupling(vb_t *vb, double k);
 void vb_add_force(vb_t *vb, uint32_t i, const double f[3]);
 
 typedef void (*vb_pre_fn)(void *ctx);

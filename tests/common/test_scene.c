@@ -229,7 +229,7 @@ static void test_wrong_types(void) {
                    "(got 'fem')"));
   CHECK(fails_with(HEAD "    integrator: leapfrog\n", "t.yaml:5:",
                    "organs[0].integrator': must be one of: symplectic_euler, explicit_euler, verlet, rk4, "
-                   "implicit_euler (got 'leapfrog')"));
+                   "implicit_euler, implicit_pcg (got 'leapfrog')"));
   CHECK(fails_with(HEAD "    model: fem\n",
                    "mass_spring_surface, mass_spring_tet, molecular, pbd, xpbd, vertex_based, "
                    "adaptive_mass_spring (got 'fem')",

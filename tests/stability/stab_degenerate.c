@@ -11,7 +11,8 @@
 #include "physics/mass_spring.h"
 #include "stab_util.h"
 
-static const char *const INTEGRATORS[] = {"explicit_euler", "symplectic_euler", "verlet", "rk4", "implicit_euler"};
+static const char *const INTEGRATORS[] = {"explicit_euler", "symplectic_euler", "verlet", "rk4",
+                                          "implicit_euler", "implicit_pcg"};
 
 /* Forces and both Jacobian products finite at the current state. */
 static int finite_everywhere(mass_spring_t *ms) {
@@ -37,7 +38,7 @@ static int finite_everywhere(mass_spring_t *ms) {
  * rollback, finite throughout. Returns how many integrators passed. */
 static int step_all(const mesh_t *mesh, const char *model, void (*setup)(model_t *)) {
   int passed = 0;
-  for (size_t k = 0; k < 5; k++) {
+  for (size_t k = 0; k < sizeof INTEGRATORS / sizeof INTEGRATORS[0]; k++) {
     char extra[400];
     snprintf(extra, sizeof extra,
              "    model: %s\n    integrator: %s\n    solver: {tet_size: 0.005}\n"
@@ -91,7 +92,7 @@ int main(void) {
   double lk, lc;
   CHECK(mass_spring_eigen_bounds(&ms, 0, &lk, &lc) == 0 && isfinite(lk) && isfinite(lc) && lk > 0);
   mass_spring_destroy(&ms);
-  CHECK(step_all(&patch, "mass_spring_surface", nothing) == 5);
+  CHECK(step_all(&patch, "mass_spring_surface", nothing) == (int)(sizeof INTEGRATORS / sizeof INTEGRATORS[0]));
   mesh_free(&patch);
 
   /* Two vertices moved onto each other (octahedron 0 onto 2). */
@@ -103,7 +104,7 @@ int main(void) {
   for (size_t c = 0; c < 18; c++) ms.v[c] = stab_rand();
   CHECK(finite_everywhere(&ms));
   mass_spring_destroy(&ms);
-  CHECK(step_all(&oct, "mass_spring_surface", onto_neighbour) == 5);
+  CHECK(step_all(&oct, "mass_spring_surface", onto_neighbour) == (int)(sizeof INTEGRATORS / sizeof INTEGRATORS[0]));
 
   /* The same in a tetrahedral mesh: a node onto a neighbour. */
   mesh_t box;
@@ -121,7 +122,7 @@ int main(void) {
   tet_embedding_free(&emb);
   /* The model builds the same tetrahedra (same surface, same size), so the
    * node pair is the same. */
-  CHECK(step_all(&box, "mass_spring_tet", tet_onto_neighbour) == 5);
+  CHECK(step_all(&box, "mass_spring_tet", tet_onto_neighbour) == (int)(sizeof INTEGRATORS / sizeof INTEGRATORS[0]));
   mesh_free(&box);
   mesh_free(&oct);
   printf("zero-length springs: forces, Jacobians and 5 integrators x 3 meshes finite\n");

@@ -65,7 +65,7 @@ static double run(const char *what, model_t *m, push_t *push, int push_steps) {
 }
 
 int main(void) {
-  static const char *const integrators[] = {"implicit_euler", "symplectic_euler"};
+  static const char *const integrators[] = {"implicit_euler", "symplectic_euler", "implicit_pcg"};
   verr_t err;
 
   /* Cloth: flat in x-y; the two corners of the first row sit 1 mm lower and
@@ -75,6 +75,9 @@ int main(void) {
   stab_grid(&cloth, 10, 0.01);
   cloth.pos[2] = cloth.pos[3 * 9 + 2] = -1e-3;
   const double g_cloth[3] = {0, 0, 9.81};
+  /* implicit_pcg (no energy guard) is left out of the cloth: one
+   * linearised 33 ms step of a flat sheet with no out-of-plane stiffness
+   * gains energy (docs/numerics.md §10); it runs the bar below. */
   for (int i = 0; i < 2; i++) {
     char extra[512];
     snprintf(extra, sizeof extra,
@@ -108,7 +111,7 @@ int main(void) {
     if (d < best) best = d, push.vertex = (uint32_t)i;
   }
   const double g_bar[3] = {-9.81, 0, 0};
-  for (int i = 0; i < 2; i++) {
+  for (int i = 0; i < 3; i++) {
     char extra[512];
     snprintf(extra, sizeof extra,
              "    model: mass_spring_tet\n    integrator: %s\n    fixed_below: 0.005\n    solver: {tet_size: 0.005}\n"

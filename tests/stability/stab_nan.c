@@ -21,7 +21,8 @@
 #include "stab_util.h"
 #include "test_runtime.h"
 
-static const char *const INTEGRATORS[] = {"explicit_euler", "symplectic_euler", "verlet", "rk4", "implicit_euler"};
+static const char *const INTEGRATORS[] = {"explicit_euler", "symplectic_euler", "verlet", "rk4",
+                                          "implicit_euler", "implicit_pcg"};
 
 typedef struct bad_hook {
   int calls, poison_at; /* poison the call with this index (0-based), -1: never */
@@ -143,7 +144,7 @@ static void runtime_case(void) {
 int main(void) {
   mesh_t box;
   stab_box(&box, 3, 3, 3, 0.03, 0.03, 0.03);
-  for (size_t k = 0; k < 5; k++) {
+  for (size_t k = 0; k < sizeof INTEGRATORS / sizeof INTEGRATORS[0]; k++) {
     one_model(&box, "mass_spring_surface", INTEGRATORS[k]);
     one_model(&box, "mass_spring_tet", INTEGRATORS[k]);
   }

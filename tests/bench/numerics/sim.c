@@ -427,6 +427,7 @@ const char *integ_label(integrator_kind_t k) {
   case INT_VERLET: return "Verlet";
   case INT_RK4: return "RK4";
   case INT_IMPLICIT_EULER: return "implicit Euler";
+  case INT_IMPLICIT_PCG: return "implicit PCG (live)";
   default: return "?";
   }
 }
