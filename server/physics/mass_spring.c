@@ -480,8 +480,8 @@ void mass_spring_springs_changed(mass_spring_t *ms) {
 /* Pass 1: g rows of every spring; returns how many are dead (zero length:
  * live lane +0.0, else -0.0, whose sign bit pass 2 can blend on). */
 __attribute__((target("avx2"))) static size_t ms_gather_rows(const mass_spring_t *ms, const double *restrict x,
-                                                              const double *restrict v, double *restrict g,
-                                                              double damping) {
+                                                             const double *restrict v, double *restrict g,
+                                                             double damping) {
   const ms_spring_t *restrict sp = ms->springs;
   const double *restrict kscale = ms->k_scale;
   const size_t ns = ms->nsprings;
@@ -547,8 +547,8 @@ __attribute__((target("avx2"))) static size_t ms_gather_rows(const mass_spring_t
 /* Pass 2: node terms, then each node's events (see above). `blend`: some
  * spring is dead and must be skipped, as the scalar loop skips it. */
 __attribute__((target("avx2"))) static void ms_gather_nodes(const mass_spring_t *ms, const double *restrict x,
-                                                               const double *restrict v, double *restrict f,
-                                                               const double *restrict g, int blend) {
+                                                            const double *restrict v, double *restrict f,
+                                                            const double *restrict g, int blend) {
   const struct ms_gather *gi = &ms->gather;
   const uint32_t *restrict off = gi->off, *restrict ev = gi->ev;
   const double *restrict xr = ms->x_rest, *restrict fext = ms->f_ext, *restrict mass = ms->mass;
@@ -560,8 +560,8 @@ __attribute__((target("avx2"))) static void ms_gather_nodes(const mass_spring_t 
   for (size_t k = 0; k < n; k++) {
     const size_t c = 3 * k;
     __m256d acc = _mm256_add_pd(_mm256_maskload_pd(fext + c, m3), _mm256_mul_pd(_mm256_set1_pd(mass[k]), grav));
-    acc = _mm256_sub_pd(acc, _mm256_mul_pd(hk, _mm256_sub_pd(_mm256_maskload_pd(x + c, m3),
-                                                             _mm256_maskload_pd(xr + c, m3))));
+    acc = _mm256_sub_pd(
+        acc, _mm256_mul_pd(hk, _mm256_sub_pd(_mm256_maskload_pd(x + c, m3), _mm256_maskload_pd(xr + c, m3))));
     acc = _mm256_sub_pd(acc, _mm256_mul_pd(hc, _mm256_maskload_pd(v + c, m3)));
     if (fres) acc = _mm256_add_pd(acc, _mm256_maskload_pd(fres + c, m3));
     if (k < nv) {

@@ -139,8 +139,7 @@ static int organ(const char *name, int repeats, int calls) {
     v[c] = 0.01 * (test_rng_uniform(&rng) - 0.5);
     y[c] = test_rng_uniform(&rng) - 0.5;
   }
-  printf("%s: %zu nodes, %zu springs; best of %d x %d calls, ns per spring\n", name, ms.n, ms.nsprings, repeats,
-         calls);
+  printf("%s: %zu nodes, %zu springs; best of %d x %d calls, ns per spring\n", name, ms.n, ms.nsprings, repeats, calls);
   printf("%-10s %-14s %8s %8s %8s\n", "springs", "function", "old", "new", "new/old");
   for (int order = 0; order < 2; order++) {
     if (order == 1) /* Fisher-Yates: runs of equal i of length ~1 */

@@ -118,7 +118,7 @@ static void compare(const char *label, const mass_spring_t *ms, const double *x,
     printf("%-34s simd (%s) against scalar rel diff %.3g\n", label,
            mass_spring_simd_available() ? "AVX2 gather" : "not available here: scalar twice", e);
     CHECK(!mass_spring_simd_available() || ms->gather.g); /* the gather loop ran, not its fallback */
-    mass_spring_forces_path(ms, x, v, got, 2); /* the AVX2 scatter loop */
+    mass_spring_forces_path(ms, x, v, got, 2);            /* the AVX2 scatter loop */
     CHECK(memcmp(got, alt, m * sizeof *alt) == 0);
     free(alt);
   }
