@@ -124,7 +124,8 @@ static int list_leaves(aabb_tree_t *t) {
   t->dirty = malloc(t->nleaves * sizeof *t->dirty);
   t->leaf_mark = calloc(t->nleaves, 1);
   t->node_mark = calloc(t->nnodes ? t->nnodes : 1, 1);
-  if (!t->vleaf_off || !t->vleaf || !t->xr || !t->dirty || !t->leaf_mark || !t->node_mark) return -1;
+  t->vmoved = malloc((t->nverts ? t->nverts : 1) * sizeof *t->vmoved);
+  if (!t->vleaf_off || !t->vleaf || !t->xr || !t->dirty || !t->leaf_mark || !t->node_mark || !t->vmoved) return -1;
   for (size_t i = 0; i < nref; i++) t->vleaf_off[t->leaf_vidx[i] + 1]++;
   for (size_t v = 0; v < t->nverts; v++) t->vleaf_off[v + 1] += t->vleaf_off[v];
   for (size_t l = 0; l < t->nleaves; l++)
@@ -227,6 +228,7 @@ void aabb_tree_destroy(aabb_tree_t *t) {
   free(t->dirty);
   free(t->leaf_mark);
   free(t->node_mark);
+  free(t->vmoved);
   memset(t, 0, sizeof *t);
 }
 
@@ -244,7 +246,7 @@ static inline float float_up(double v) { return fabs(v) < INFINITY ? (float)(v +
  * and padded, into its parent's slot (or the root box for the only leaf).
  * The ternaries compile to branch-free min/max and skip NaN coordinates:
  * such a triangle can never win a query, exactly as in a brute-force scan. */
-static void leaf_box(aabb_tree_t *t, size_t l) {
+static void leaf_box(aabb_tree_t *t, size_t l, int mark) {
   const double *xr = t->xr;
   double l0 = INFINITY, l1 = INFINITY, l2 = INFINITY, h0 = -INFINITY, h1 = -INFINITY, h2 = -INFINITY;
   for (uint32_t i = t->leaf_voff[l]; i < t->leaf_voff[l + 1]; i++) {
@@ -275,50 +277,17 @@ static void leaf_box(aabb_tree_t *t, size_t l) {
   }
   /* Its path up, marked for the internal pass (stops at a marked node:
    * the rest of the path is marked already). */
+  if (!mark) return;
   for (uint32_t u = parent >> 1; u != UINT32_MAX && !t->node_mark[u]; u = t->nodes[u].parent) t->node_mark[u] = 1;
 }
 
-void aabb_tree_refit(aabb_tree_t *t, const double *x) {
-  t->x = x;
-  size_t ndirty = 0;
-  if (t->full) {
-    memcpy(t->xr, x, 3 * t->nverts * sizeof *t->xr);
-    for (size_t l = 0; l < t->nleaves; l++) t->dirty[ndirty++] = (uint32_t)l;
-    t->full = 0;
-  } else {
-    /* A vertex has moved when some coordinate left [xr - m, xr + m]; the
-     * negated test also takes NaN and infinite coordinates as moved. */
-    const double m = t->margin;
-    double *xr = t->xr;
-    for (size_t v = 0; v < t->nverts; v++) {
-      const double *p = x + 3 * v;
-      double *r = xr + 3 * v;
-      if (fabs(p[0] - r[0]) <= m && fabs(p[1] - r[1]) <= m && fabs(p[2] - r[2]) <= m) continue;
-      r[0] = p[0];
-      r[1] = p[1];
-      r[2] = p[2];
-      for (uint32_t i = t->vleaf_off[v]; i < t->vleaf_off[v + 1]; i++) {
-        uint32_t l = t->vleaf[i];
-        if (t->leaf_mark[l]) continue;
-        t->leaf_mark[l] = 1;
-        t->dirty[ndirty++] = l;
-      }
-    }
-  }
-  t->refit_leaves = ndirty;
-  t->refit_nodes = 0;
-  if (!ndirty) return;
-  for (size_t i = 0; i < ndirty; i++) {
-    t->leaf_mark[t->dirty[i]] = 0;
-    leaf_box(t, t->dirty[i]);
-  }
-  if (!t->nnodes) return;
-  /* Then the marked internal nodes, bottom-up. Pre-order layout: a node's
-   * children have larger indices, so one backward sweep sees every child
-   * before its parent. */
+/* Internal nodes bottom-up: all of them, or only the marked ones (marks
+ * cleared). Pre-order layout: a node's children have larger indices, so
+ * one backward sweep sees every child before its parent. */
+static size_t sweep_nodes(aabb_tree_t *t, int all) {
   size_t nodes = 0;
   for (size_t i = t->nnodes; i-- > 0;) {
-    if (!t->node_mark[i]) continue;
+    if (!all && !t->node_mark[i]) continue;
     t->node_mark[i] = 0;
     nodes++;
     aabb_node_t *n = &t->nodes[i];
@@ -332,12 +301,61 @@ void aabb_tree_refit(aabb_tree_t *t, const double *x) {
       }
     }
   }
-  t->refit_nodes = nodes;
   const aabb_node_t *r = &t->nodes[0];
   for (int k = 0; k < 3; k++) {
     t->lo[k] = r->lo[k][0] < r->lo[k][1] ? r->lo[k][0] : r->lo[k][1];
     t->hi[k] = r->hi[k][0] > r->hi[k][1] ? r->hi[k][0] : r->hi[k][1];
   }
+  return nodes;
+}
+
+void aabb_tree_refit(aabb_tree_t *t, const double *x) {
+  t->x = x;
+  t->refit_leaves = t->refit_nodes = 0;
+  int full = t->full;
+  size_t nmoved = 0;
+  if (!full) {
+    /* A vertex has moved when some coordinate left [xr - m, xr + m]; the
+     * negated test also takes NaN and infinite coordinates as moved. At
+     * rest the branch is always predicted: one compare per vertex. */
+    const double m = t->margin, *xr = t->xr;
+    uint32_t *moved = t->vmoved;
+    for (size_t v = 0; v < t->nverts; v++) {
+      const double *p = x + 3 * v, *r = xr + 3 * v;
+      if (fabs(p[0] - r[0]) <= m && fabs(p[1] - r[1]) <= m && fabs(p[2] - r[2]) <= m) continue;
+      moved[nmoved++] = (uint32_t)v;
+      if (nmoved * 8 > t->nverts) break; /* the sweep below: no need to look further */
+    }
+    if (!nmoved) return;
+    /* Most of the organ moved: marking leaf by leaf would cost more than
+     * the plain sweep over everything. */
+    full = nmoved * 8 > t->nverts;
+  }
+  if (full) {
+    memcpy(t->xr, x, 3 * t->nverts * sizeof *t->xr);
+    for (size_t l = 0; l < t->nleaves; l++) leaf_box(t, l, 0);
+    t->full = 0;
+    t->refit_leaves = t->nleaves;
+    if (t->nnodes) t->refit_nodes = sweep_nodes(t, 1);
+    return;
+  }
+  size_t ndirty = 0;
+  for (size_t a = 0; a < nmoved; a++) {
+    uint32_t v = t->vmoved[a];
+    memcpy(t->xr + 3 * (size_t)v, x + 3 * (size_t)v, 3 * sizeof *t->xr);
+    for (uint32_t i = t->vleaf_off[v]; i < t->vleaf_off[v + 1]; i++) {
+      uint32_t l = t->vleaf[i];
+      if (t->leaf_mark[l]) continue;
+      t->leaf_mark[l] = 1;
+      t->dirty[ndirty++] = l;
+    }
+  }
+  for (size_t i = 0; i < ndirty; i++) {
+    t->leaf_mark[t->dirty[i]] = 0;
+    leaf_box(t, t->dirty[i], 1);
+  }
+  t->refit_leaves = ndirty;
+  if (t->nnodes) t->refit_nodes = sweep_nodes(t, 0);
 }
 
 /* ---- nearest point -------------------------------------------------------- */

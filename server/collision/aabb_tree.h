@@ -90,6 +90,7 @@ typedef struct aabb_tree {
   uint32_t *vleaf_off, *vleaf;
   uint32_t *dirty;                      /* nleaves: scratch list of the leaves a refit recomputes */
   unsigned char *leaf_mark, *node_mark; /* nleaves, nnodes: scratch flags, zero between refits */
+  uint32_t *vmoved;                     /* nverts: scratch, the vertices a refit found moved */
   int full;                             /* the next refit recomputes every box (after build or a margin change) */
   /* What the last refit did: leaf boxes and internal nodes recomputed. */
   size_t refit_leaves, refit_nodes;
@@ -107,7 +108,8 @@ void aabb_tree_destroy(aabb_tree_t *t);
  * boxes of vertices that moved more than the margin along some axis since
  * their boxes were computed (NaN and infinite coordinates count as moved),
  * and the nodes above them. O(vertices) compares plus O(moved leaves x
- * depth) boxes; no allocation. */
+ * depth) boxes; when more than an eighth of the vertices moved, every box
+ * (the plain bottom-up sweep, cheaper then). No allocation. */
 void aabb_tree_refit(aabb_tree_t *t, const double *x);
 
 /* The build's margin: this fraction of the mean triangle edge length at the
