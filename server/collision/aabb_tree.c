@@ -40,9 +40,12 @@ static void select_kth(uint32_t *idx, const double *cent, int axis, ptrdiff_t b,
       }
     }
     /* Now [lo, j] <= p, [i, hi] >= p and everything strictly between equals p. */
-    if (k <= j) hi = j;
-    else if (k >= i) lo = i;
-    else break;
+    if (k <= j)
+      hi = j;
+    else if (k >= i)
+      lo = i;
+    else
+      break;
   }
 #undef KEY
 }
@@ -78,7 +81,10 @@ static uint32_t build_node(build_ctx_t *c, size_t b, size_t e, int level) {
   uint32_t right = build_node(c, mid, e, level + 1);
   t->nodes[self].child[0] = left;
   t->nodes[self].child[1] = right;
-  t->nodes[self].unused[0] = t->nodes[self].unused[1] = 0;
+  t->nodes[self].parent = UINT32_MAX; /* set by the caller for all but the root */
+  t->nodes[self].unused = 0;
+  if (!(left & AABB_LEAF)) t->nodes[left].parent = self;
+  if (!(right & AABB_LEAF)) t->nodes[right].parent = self;
   return self;
 }
 
@@ -107,8 +113,26 @@ static int list_leaves(aabb_tree_t *t) {
   for (size_t i = 0; i < t->nnodes; i++)
     for (uint32_t c = 0; c < 2; c++)
       if (t->nodes[i].child[c] & AABB_LEAF) add_leaf(t, t->nodes[i].child[c], (uint32_t)i << 1 | c);
-  uint32_t *shrunk = realloc(t->leaf_vidx, (t->leaf_voff[t->nleaves] ? t->leaf_voff[t->nleaves] : 1) * sizeof *shrunk);
+  size_t nref = t->leaf_voff[t->nleaves];
+  uint32_t *shrunk = realloc(t->leaf_vidx, (nref ? nref : 1) * sizeof *shrunk);
   if (shrunk) t->leaf_vidx = shrunk;
+  /* Each vertex's leaves (counting sort of the leaf lists by vertex), and
+   * refit's scratch. */
+  t->vleaf_off = calloc(t->nverts + 1, sizeof *t->vleaf_off);
+  t->vleaf = malloc((nref ? nref : 1) * sizeof *t->vleaf);
+  t->xr = malloc(3 * t->nverts * sizeof *t->xr);
+  t->dirty = malloc(t->nleaves * sizeof *t->dirty);
+  t->leaf_mark = calloc(t->nleaves, 1);
+  t->node_mark = calloc(t->nnodes ? t->nnodes : 1, 1);
+  t->vmoved = malloc((t->nverts ? t->nverts : 1) * sizeof *t->vmoved);
+  if (!t->vleaf_off || !t->vleaf || !t->xr || !t->dirty || !t->leaf_mark || !t->node_mark || !t->vmoved) return -1;
+  for (size_t i = 0; i < nref; i++) t->vleaf_off[t->leaf_vidx[i] + 1]++;
+  for (size_t v = 0; v < t->nverts; v++) t->vleaf_off[v + 1] += t->vleaf_off[v];
+  for (size_t l = 0; l < t->nleaves; l++)
+    for (uint32_t i = t->leaf_voff[l]; i < t->leaf_voff[l + 1]; i++)
+      t->vleaf[t->vleaf_off[t->leaf_vidx[i]]++] = (uint32_t)l;
+  for (size_t v = t->nverts; v > 0; v--) t->vleaf_off[v] = t->vleaf_off[v - 1]; /* back to starts */
+  t->vleaf_off[0] = 0;
   return 0;
 }
 
@@ -177,8 +201,18 @@ int aabb_tree_build(aabb_tree_t *t, const double *x, size_t nverts, const uint32
   double mag = 0;
   for (int k = 0; k < 3; k++) mag = fmax(mag, fmax(fabs(lo[k]), fabs(hi[k])));
   t->pad = 1e-10 * (mag + v3_dist(lo, hi));
+  double edges = 0;
+  for (size_t i = 0; i < ntris; i++)
+    for (int v = 0; v < 3; v++)
+      edges += v3_dist(x + 3 * (size_t)tris[3 * i + (size_t)v], x + 3 * (size_t)tris[3 * i + (size_t)(v + 1) % 3]);
+  aabb_tree_set_margin(t, AABB_TREE_MARGIN_EDGE * edges / (3.0 * (double)ntris));
   aabb_tree_refit(t, x);
   return 0;
+}
+
+void aabb_tree_set_margin(aabb_tree_t *t, double margin) {
+  t->margin = margin >= 0 && isfinite(margin) ? margin : 0;
+  t->full = 1;
 }
 
 void aabb_tree_destroy(aabb_tree_t *t) {
@@ -188,6 +222,13 @@ void aabb_tree_destroy(aabb_tree_t *t) {
   free(t->leaf_parent);
   free(t->leaf_voff);
   free(t->leaf_vidx);
+  free(t->vleaf_off);
+  free(t->vleaf);
+  free(t->xr);
+  free(t->dirty);
+  free(t->leaf_mark);
+  free(t->node_mark);
+  free(t->vmoved);
   memset(t, 0, sizeof *t);
 }
 
@@ -201,44 +242,54 @@ void aabb_tree_destroy(aabb_tree_t *t) {
 static inline float float_down(double v) { return fabs(v) < INFINITY ? (float)(v - fabs(v) * 1.2e-7) : (float)v; }
 static inline float float_up(double v) { return fabs(v) < INFINITY ? (float)(v + fabs(v) * 1.2e-7) : (float)v; }
 
-void aabb_tree_refit(aabb_tree_t *t, const double *x) {
-  t->x = x;
-  /* Leaves first: each one's box from its distinct vertices, padded and
-   * rounded outward, into its parent. The ternaries compile to branch-free
-   * min/max, and skip NaN coordinates: such a triangle can never win a
-   * query, exactly as in a brute-force scan. */
-  for (size_t l = 0; l < t->nleaves; l++) {
-    double l0 = INFINITY, l1 = INFINITY, l2 = INFINITY, h0 = -INFINITY, h1 = -INFINITY, h2 = -INFINITY;
-    for (uint32_t i = t->leaf_voff[l]; i < t->leaf_voff[l + 1]; i++) {
-      const double *p = x + 3 * (size_t)t->leaf_vidx[i];
-      double p0 = p[0], p1 = p[1], p2 = p[2];
-      l0 = p0 < l0 ? p0 : l0;
-      l1 = p1 < l1 ? p1 : l1;
-      l2 = p2 < l2 ? p2 : l2;
-      h0 = p0 > h0 ? p0 : h0;
-      h1 = p1 > h1 ? p1 : h1;
-      h2 = p2 > h2 ? p2 : h2;
-    }
-    double lo[3] = {l0 - t->pad, l1 - t->pad, l2 - t->pad}, hi[3] = {h0 + t->pad, h1 + t->pad, h2 + t->pad};
-    uint32_t parent = t->leaf_parent[l];
-    if (parent == UINT32_MAX) { /* the only leaf: its box is the root's */
-      for (int k = 0; k < 3; k++) {
-        t->lo[k] = lo[k];
-        t->hi[k] = hi[k];
-      }
-      return;
-    }
-    aabb_node_t *n = &t->nodes[parent >> 1];
-    int c = (int)(parent & 1);
-    for (int k = 0; k < 3; k++) {
-      n->lo[k][c] = float_down(lo[k]);
-      n->hi[k][c] = float_up(hi[k]);
-    }
+/* Recomputes leaf l's box from its vertices' xr, fattened by the margin
+ * and padded, into its parent's slot (or the root box for the only leaf).
+ * The ternaries compile to branch-free min/max and skip NaN coordinates:
+ * such a triangle can never win a query, exactly as in a brute-force scan. */
+static void leaf_box(aabb_tree_t *t, size_t l, int mark) {
+  const double *xr = t->xr;
+  double l0 = INFINITY, l1 = INFINITY, l2 = INFINITY, h0 = -INFINITY, h1 = -INFINITY, h2 = -INFINITY;
+  for (uint32_t i = t->leaf_voff[l]; i < t->leaf_voff[l + 1]; i++) {
+    const double *p = xr + 3 * (size_t)t->leaf_vidx[i];
+    double p0 = p[0], p1 = p[1], p2 = p[2];
+    l0 = p0 < l0 ? p0 : l0;
+    l1 = p1 < l1 ? p1 : l1;
+    l2 = p2 < l2 ? p2 : l2;
+    h0 = p0 > h0 ? p0 : h0;
+    h1 = p1 > h1 ? p1 : h1;
+    h2 = p2 > h2 ? p2 : h2;
   }
-  /* Then the internal children, bottom-up. Pre-order layout: a node's
-   * children have larger indices, so one backward sweep sees every child
-   * before its parent. */
+  double g = t->margin + t->pad;
+  double lo[3] = {l0 - g, l1 - g, l2 - g}, hi[3] = {h0 + g, h1 + g, h2 + g};
+  uint32_t parent = t->leaf_parent[l];
+  if (parent == UINT32_MAX) { /* the only leaf: its box is the root's */
+    for (int k = 0; k < 3; k++) {
+      t->lo[k] = lo[k];
+      t->hi[k] = hi[k];
+    }
+    return;
+  }
+  aabb_node_t *n = &t->nodes[parent >> 1];
+  int c = (int)(parent & 1);
+  for (int k = 0; k < 3; k++) {
+    n->lo[k][c] = float_down(lo[k]);
+    n->hi[k][c] = float_up(hi[k]);
+  }
+  /* Its path up, marked for the internal pass (stops at a marked node:
+   * the rest of the path is marked already). */
+  if (!mark) return;
+  for (uint32_t u = parent >> 1; u != UINT32_MAX && !t->node_mark[u]; u = t->nodes[u].parent) t->node_mark[u] = 1;
+}
+
+/* Internal nodes bottom-up: all of them, or only the marked ones (marks
+ * cleared). Pre-order layout: a node's children have larger indices, so
+ * one backward sweep sees every child before its parent. */
+static size_t sweep_nodes(aabb_tree_t *t, int all) {
+  size_t nodes = 0;
   for (size_t i = t->nnodes; i-- > 0;) {
+    if (!all && !t->node_mark[i]) continue;
+    t->node_mark[i] = 0;
+    nodes++;
     aabb_node_t *n = &t->nodes[i];
     for (int c = 0; c < 2; c++) {
       uint32_t ref = n->child[c];
@@ -255,6 +306,56 @@ void aabb_tree_refit(aabb_tree_t *t, const double *x) {
     t->lo[k] = r->lo[k][0] < r->lo[k][1] ? r->lo[k][0] : r->lo[k][1];
     t->hi[k] = r->hi[k][0] > r->hi[k][1] ? r->hi[k][0] : r->hi[k][1];
   }
+  return nodes;
+}
+
+void aabb_tree_refit(aabb_tree_t *t, const double *x) {
+  t->x = x;
+  t->refit_leaves = t->refit_nodes = 0;
+  int full = t->full;
+  size_t nmoved = 0;
+  if (!full) {
+    /* A vertex has moved when some coordinate left [xr - m, xr + m]; the
+     * negated test also takes NaN and infinite coordinates as moved. At
+     * rest the branch is always predicted: one compare per vertex. */
+    const double m = t->margin, *xr = t->xr;
+    uint32_t *moved = t->vmoved;
+    for (size_t v = 0; v < t->nverts; v++) {
+      const double *p = x + 3 * v, *r = xr + 3 * v;
+      if (fabs(p[0] - r[0]) <= m && fabs(p[1] - r[1]) <= m && fabs(p[2] - r[2]) <= m) continue;
+      moved[nmoved++] = (uint32_t)v;
+      if (nmoved * 8 > t->nverts) break; /* the sweep below: no need to look further */
+    }
+    if (!nmoved) return;
+    /* Most of the organ moved: marking leaf by leaf would cost more than
+     * the plain sweep over everything. */
+    full = nmoved * 8 > t->nverts;
+  }
+  if (full) {
+    memcpy(t->xr, x, 3 * t->nverts * sizeof *t->xr);
+    for (size_t l = 0; l < t->nleaves; l++) leaf_box(t, l, 0);
+    t->full = 0;
+    t->refit_leaves = t->nleaves;
+    if (t->nnodes) t->refit_nodes = sweep_nodes(t, 1);
+    return;
+  }
+  size_t ndirty = 0;
+  for (size_t a = 0; a < nmoved; a++) {
+    uint32_t v = t->vmoved[a];
+    memcpy(t->xr + 3 * (size_t)v, x + 3 * (size_t)v, 3 * sizeof *t->xr);
+    for (uint32_t i = t->vleaf_off[v]; i < t->vleaf_off[v + 1]; i++) {
+      uint32_t l = t->vleaf[i];
+      if (t->leaf_mark[l]) continue;
+      t->leaf_mark[l] = 1;
+      t->dirty[ndirty++] = l;
+    }
+  }
+  for (size_t i = 0; i < ndirty; i++) {
+    t->leaf_mark[t->dirty[i]] = 0;
+    leaf_box(t, t->dirty[i], 1);
+  }
+  t->refit_leaves = ndirty;
+  if (t->nnodes) t->refit_nodes = sweep_nodes(t, 0);
 }
 
 /* ---- nearest point -------------------------------------------------------- */
@@ -285,8 +386,10 @@ static inline void prefetch_children(const aabb_tree_t *t, const aabb_node_t *n)
 #if defined(__GNUC__)
   for (int c = 0; c < 2; c++) {
     uint32_t r = n->child[c];
-    if (r & AABB_LEAF) __builtin_prefetch(t->tri_v + 3 * (size_t)AABB_LEAF_FIRST(r));
-    else __builtin_prefetch(&t->nodes[r]);
+    if (r & AABB_LEAF)
+      __builtin_prefetch(t->tri_v + 3 * (size_t)AABB_LEAF_FIRST(r));
+    else
+      __builtin_prefetch(&t->nodes[r]);
   }
 #else
   (void)t;

@@ -12,9 +12,14 @@
  * for a query to fetch (leaves of 2 and of 4 measured the same on the liver).
  *
  * The topology never changes after the build: while the organ deforms only
- * the boxes are recomputed, bottom-up in one backward pass over the flat
- * node array (aabb_tree_refit, O(nodes + vertices)). That is exact but lets
- * boxes of a strongly deformed mesh overlap more, so queries slow down
+ * the boxes are recomputed (aabb_tree_refit). Leaf boxes are fattened by a
+ * margin around the vertex positions they were last computed from; refit
+ * checks every vertex against its own last position and recomputes only
+ * the leaves of vertices that moved beyond the margin, and the internal
+ * nodes on their paths to the root. A resting organ's refit then touches
+ * no box at all, a probed one only the dent's paths (docs/methods.md A
+ * §3.1). The boxes still contain every triangle, so queries stay exact;
+ * strongly deformed meshes let boxes overlap more, so queries slow down
  * gracefully rather than fail; rebuild (destroy + build) after a topology
  * change such as a cut.
  *
@@ -44,7 +49,7 @@
  * (bits 28-30). Leaves are not nodes of their own: their boxes sit in the
  * parent, so a leaf costs no extra memory fetch. */
 #define AABB_LEAF 0x80000000u
-#define AABB_LEAF_FIRST(ref) ((ref) & 0x0fffffffu)
+#define AABB_LEAF_FIRST(ref) ((ref)&0x0fffffffu)
 #define AABB_LEAF_COUNT(ref) (((ref) >> 28) & 7u)
 
 typedef struct aabb_node {
@@ -53,13 +58,14 @@ typedef struct aabb_node {
    * boxes from this one 64-byte line, and float halves the tree's memory. */
   float lo[3][2], hi[3][2];
   uint32_t child[2];
-  uint32_t unused[2];
+  uint32_t parent; /* the node holding this one's box, UINT32_MAX for the root */
+  uint32_t unused;
 } aabb_node_t;
 
 typedef struct aabb_tree {
-  aabb_node_t *nodes; /* internal nodes in pre-order (children after parents), 64-byte aligned */
-  size_t nnodes;      /* 0 when every triangle fits in one leaf */
-  uint32_t root;      /* node 0, or the only leaf */
+  aabb_node_t *nodes;  /* internal nodes in pre-order (children after parents), 64-byte aligned */
+  size_t nnodes;       /* 0 when every triangle fits in one leaf */
+  uint32_t root;       /* node 0, or the only leaf */
   double lo[3], hi[3]; /* the root's box */
   size_t ntris, nverts;
   uint32_t *tri_id; /* ntris: original triangle index of each leaf slot */
@@ -72,9 +78,22 @@ typedef struct aabb_tree {
   uint32_t *leaf_parent; /* nleaves */
   uint32_t *leaf_voff;   /* nleaves + 1: ranges of leaf_vidx */
   uint32_t *leaf_vidx;
-  const double *x;  /* 3 per vertex: positions of the last build or refit (not owned) */
-  double pad;       /* m added around every leaf box, see aabb_tree_build */
-  int depth;        /* levels of boxes, root = 1, leaves included */
+  const double *x; /* 3 per vertex: positions of the last build or refit (not owned) */
+  double pad;      /* m added around every leaf box, see aabb_tree_build */
+  int depth;       /* levels of boxes, root = 1, leaves included */
+  /* Refit over what moved: each leaf box holds every one of its vertices'
+   * xr +- margin (max norm), so a vertex whose position is still within
+   * margin of its xr needs no box changed. vleaf_off/vleaf: the leaves of
+   * each vertex (CSR, nverts + 1 offsets). */
+  double margin; /* m, see aabb_tree_set_margin */
+  double *xr;    /* 3 per vertex: the position each vertex's leaf boxes were computed from */
+  uint32_t *vleaf_off, *vleaf;
+  uint32_t *dirty;                      /* nleaves: scratch list of the leaves a refit recomputes */
+  unsigned char *leaf_mark, *node_mark; /* nleaves, nnodes: scratch flags, zero between refits */
+  uint32_t *vmoved;                     /* nverts: scratch, the vertices a refit found moved */
+  int full;                             /* the next refit recomputes every box (after build or a margin change) */
+  /* What the last refit did: leaf boxes and internal nodes recomputed. */
+  size_t refit_leaves, refit_nodes;
 } aabb_tree_t;
 
 /* Builds the tree over triangles `tris` (3 per triangle, indices < nverts)
@@ -84,15 +103,29 @@ typedef struct aabb_tree {
 int aabb_tree_build(aabb_tree_t *t, const double *x, size_t nverts, const uint32_t *tris, size_t ntris, verr_t *err);
 void aabb_tree_destroy(aabb_tree_t *t);
 
-/* Recomputes every box from positions x (the same vertex count; may be the
- * build's array after it changed or another array). Bottom-up, no allocation. */
+/* Makes the boxes contain positions x (the same vertex count; may be the
+ * build's array after it changed or another array): recomputes the leaf
+ * boxes of vertices that moved more than the margin along some axis since
+ * their boxes were computed (NaN and infinite coordinates count as moved),
+ * and the nodes above them. O(vertices) compares plus O(moved leaves x
+ * depth) boxes; when more than an eighth of the vertices moved, every box
+ * (the plain bottom-up sweep, cheaper then). No allocation. */
 void aabb_tree_refit(aabb_tree_t *t, const double *x);
 
+/* The build's margin: this fraction of the mean triangle edge length at the
+ * build. A vertex resting or creeping below it costs one compare per refit;
+ * a larger margin lets boxes overlap more (a nearest query near the
+ * surface visits a few more leaves). */
+#define AABB_TREE_MARGIN_EDGE 0.1
+/* Sets the margin (m, >= 0; 0 gives tight boxes recomputed on any motion);
+ * the next refit recomputes every box. */
+void aabb_tree_set_margin(aabb_tree_t *t, double margin);
+
 typedef struct aabb_nearest {
-  uint32_t tri;    /* original triangle index */
-  double bary[3];  /* of the nearest point in that triangle (sum 1) */
+  uint32_t tri;   /* original triangle index */
+  double bary[3]; /* of the nearest point in that triangle (sum 1) */
   double point[3];
-  double dist2;    /* squared distance from the query point */
+  double dist2; /* squared distance from the query point */
   /* Seed 003 §4.1's penetration test on the nearest triangle: the query point
    * makes an angle over 90 degrees with the outward normal seen from the
    * triangle's centroid, i.e. it lies behind the triangle's plane. */
@@ -113,8 +146,8 @@ enum {
 };
 
 typedef struct aabb_hit {
-  uint32_t tri;     /* original triangle index */
-  double t;         /* segment parameter in [0, 1] */
+  uint32_t tri; /* original triangle index */
+  double t;     /* segment parameter in [0, 1] */
   double bary[3];
   double point[3];
   /* Seed 000 §3.1 contact point: the triangle's vertex nearest the

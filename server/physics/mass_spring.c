@@ -95,6 +95,7 @@ static int ms_make_springs(mass_spring_t *ms, uint32_t *edges, size_t ne, verr_t
     sp->rest = v3_dist(ms->x_rest + 3 * i, ms->x_rest + 3 * j);
   }
   free(edges);
+  mass_spring_springs_changed(ms);
   return 0;
 }
 
@@ -227,6 +228,9 @@ void mass_spring_destroy(mass_spring_t *ms) {
   free(ms->springs);
   free(ms->k_scale);
   free(ms->f_res);
+  free(ms->gather.off);
+  free(ms->gather.ev);
+  free(ms->gather.g);
   memset(ms, 0, sizeof *ms);
 }
 
@@ -411,6 +415,187 @@ __attribute__((target("avx2"))) static void ms_spring_forces_avx2(const mass_spr
 }
 #endif
 
+/* The gather form of the AVX2 loop. The scatter loop above spends most
+ * of its time in the scalar read-modify-write of f_j after the 4-wide
+ * arithmetic. Here pass 1 computes every spring's force g (the same
+ * vector arithmetic) and stores it as one row (g0, g1, g2, live) per
+ * spring, in spring order: contiguous stores, no scatter. Pass 2 walks the
+ * nodes in order, computes the node terms, and gathers each node's springs
+ * from the gather index: its events in the order the scalar loop applies
+ * them (f_j -= g at spring s; a run of springs with i = this node summed
+ * from zero, then added, at the run's end), one 4-wide load and subtract
+ * or add per event. Same operations in the same order per component, so
+ * the forces are the scalar loop's bit for bit (test_ms_forces). */
+#define MS_RUN 0x80000000u
+
+void mass_spring_springs_changed(mass_spring_t *ms) {
+  struct ms_gather *g = &ms->gather;
+  free(g->off);
+  free(g->ev);
+  free(g->g);
+  memset(g, 0, sizeof *g);
+  const ms_spring_t *sp = ms->springs;
+  size_t ns = ms->nsprings, nv = 0, nruns = 0;
+  if (!sp || !ns || ns >= MS_RUN) return;
+  for (size_t s = 0; s < ns; s++) {
+    nv = sp[s].i >= nv ? (size_t)sp[s].i + 1 : nv;
+    nv = sp[s].j >= nv ? (size_t)sp[s].j + 1 : nv;
+    nruns += s == 0 || sp[s].i != sp[s - 1].i;
+  }
+  g->off = calloc(nv + 2, sizeof *g->off);
+  g->ev = malloc((ns + 2 * nruns) * sizeof *g->ev);
+  g->g = aligned_alloc(32, 4 * ns * sizeof *g->g);
+  if (!g->off || !g->ev || !g->g) {
+    free(g->off);
+    free(g->ev);
+    free(g->g);
+    memset(g, 0, sizeof *g);
+    return;
+  }
+  /* Counts at off[k + 2], prefix sums make off[k + 1] node k's start,
+   * which then serves as its cursor: filled, off[k] is node k's start.
+   * Filled in the scalar loop's order: a run's event when the run ends
+   * (before the next spring's f_j), a spring's f_j at the spring. */
+  for (size_t s = 0; s < ns; s++) {
+    g->off[sp[s].j + 2]++;
+    if (s == 0 || sp[s].i != sp[s - 1].i) g->off[sp[s].i + 2] += 2;
+  }
+  for (size_t k = 2; k < nv + 2; k++) g->off[k] += g->off[k - 1];
+  size_t rb = 0;
+  for (size_t s = 0; s <= ns; s++) {
+    if (s > 0 && (s == ns || sp[s].i != sp[s - 1].i)) {
+      uint32_t k = sp[s - 1].i;
+      g->ev[g->off[k + 1]++] = MS_RUN | (uint32_t)rb;
+      g->ev[g->off[k + 1]++] = (uint32_t)s;
+      rb = s;
+    }
+    if (s < ns) g->ev[g->off[sp[s].j + 1]++] = (uint32_t)s;
+  }
+  g->springs = sp;
+  g->nsprings = ns;
+  g->nv = nv;
+}
+
+#ifdef MS_HAVE_AVX2_PATH
+/* Pass 1: g rows of every spring; returns how many are dead (zero length:
+ * live lane +0.0, else -0.0, whose sign bit pass 2 can blend on). */
+__attribute__((target("avx2"))) static size_t ms_gather_rows(const mass_spring_t *ms, const double *restrict x,
+                                                             const double *restrict v, double *restrict g,
+                                                             double damping) {
+  const ms_spring_t *restrict sp = ms->springs;
+  const double *restrict kscale = ms->k_scale;
+  const size_t ns = ms->nsprings;
+  const __m256d stiff = _mm256_set1_pd(ms->p.stiffness), damp = _mm256_set1_pd(damping);
+  const __m256d one = _mm256_set1_pd(1.0), tiny = _mm256_set1_pd(MS_TINY), nzero = _mm256_set1_pd(-0.0);
+  const __m256i m3 = _mm256_set_epi64x(0, -1, -1, -1);
+  size_t s = 0, dead = 0;
+  for (; s + 4 <= ns; s += 4) {
+    __m256d dr[4], dvr[4];
+    for (int q = 0; q < 4; q++) {
+      const size_t i3 = 3 * (size_t)sp[s + q].i, j3 = 3 * (size_t)sp[s + q].j;
+      dr[q] = _mm256_sub_pd(_mm256_maskload_pd(x + j3, m3), _mm256_maskload_pd(x + i3, m3));
+      dvr[q] = _mm256_sub_pd(_mm256_maskload_pd(v + j3, m3), _mm256_maskload_pd(v + i3, m3));
+    }
+    __m256d d0, d1, d2, dv0, dv1, dv2;
+    transpose3(dr, &d0, &d1, &d2);
+    transpose3(dvr, &dv0, &dv1, &dv2);
+    const __m256d len = _mm256_sqrt_pd(
+        _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(d0, d0), _mm256_mul_pd(d1, d1)), _mm256_mul_pd(d2, d2)));
+    const __m256d live = _mm256_cmp_pd(len, tiny, _CMP_NLE_UQ);
+    const __m256d inv = _mm256_div_pd(one, len);
+    const __m256d dvd =
+        _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(dv0, d0), _mm256_mul_pd(dv1, d1)), _mm256_mul_pd(dv2, d2));
+    const __m256d rest = _mm256_set_pd(sp[s + 3].rest, sp[s + 2].rest, sp[s + 1].rest, sp[s].rest);
+    const __m256d k = kscale ? _mm256_mul_pd(stiff, _mm256_loadu_pd(kscale + s)) : stiff;
+    const __m256d mag = _mm256_and_pd(live, _mm256_mul_pd(_mm256_add_pd(_mm256_mul_pd(k, _mm256_sub_pd(len, rest)),
+                                                                        _mm256_mul_pd(_mm256_mul_pd(damp, dvd), inv)),
+                                                          inv));
+    const __m256d c0 = _mm256_mul_pd(mag, d0), c1 = _mm256_mul_pd(mag, d1), c2 = _mm256_mul_pd(mag, d2);
+    const __m256d c3 = _mm256_and_pd(live, nzero);
+    dead += 4 - (size_t)__builtin_popcount((unsigned)_mm256_movemask_pd(live));
+    /* Columns back to one row per spring. */
+    const __m256d t0 = _mm256_unpacklo_pd(c0, c1), t1 = _mm256_unpackhi_pd(c0, c1);
+    const __m256d t2 = _mm256_unpacklo_pd(c2, c3), t3 = _mm256_unpackhi_pd(c2, c3);
+    _mm256_store_pd(g + 4 * s, _mm256_permute2f128_pd(t0, t2, 0x20));
+    _mm256_store_pd(g + 4 * s + 4, _mm256_permute2f128_pd(t1, t3, 0x20));
+    _mm256_store_pd(g + 4 * s + 8, _mm256_permute2f128_pd(t0, t2, 0x31));
+    _mm256_store_pd(g + 4 * s + 12, _mm256_permute2f128_pd(t1, t3, 0x31));
+  }
+  for (; s < ns; s++) { /* the remainder, scalar: the same operations */
+    const double *xi = x + 3 * (size_t)sp[s].i, *xj = x + 3 * (size_t)sp[s].j;
+    const double *vi = v + 3 * (size_t)sp[s].i, *vj = v + 3 * (size_t)sp[s].j;
+    const double d0 = xj[0] - xi[0], d1 = xj[1] - xi[1], d2 = xj[2] - xi[2];
+    const double len = sqrt(d0 * d0 + d1 * d1 + d2 * d2);
+    double *row = g + 4 * s;
+    if (len <= MS_TINY) {
+      row[0] = row[1] = row[2] = row[3] = 0;
+      dead++;
+      continue;
+    }
+    const double inv = 1.0 / len;
+    const double dvd = (vj[0] - vi[0]) * d0 + (vj[1] - vi[1]) * d1 + (vj[2] - vi[2]) * d2;
+    const double k = kscale ? ms->p.stiffness * kscale[s] : ms->p.stiffness;
+    const double mag = (k * (len - sp[s].rest) + damping * dvd * inv) * inv;
+    row[0] = mag * d0;
+    row[1] = mag * d1;
+    row[2] = mag * d2;
+    row[3] = -0.0;
+  }
+  return dead;
+}
+
+/* Pass 2: node terms, then each node's events (see above). `blend`: some
+ * spring is dead and must be skipped, as the scalar loop skips it. */
+__attribute__((target("avx2"))) static void ms_gather_nodes(const mass_spring_t *ms, const double *restrict x,
+                                                            const double *restrict v, double *restrict f,
+                                                            const double *restrict g, int blend) {
+  const struct ms_gather *gi = &ms->gather;
+  const uint32_t *restrict off = gi->off, *restrict ev = gi->ev;
+  const double *restrict xr = ms->x_rest, *restrict fext = ms->f_ext, *restrict mass = ms->mass;
+  const double *restrict fres = ms->f_res;
+  const __m256i m3 = _mm256_set_epi64x(0, -1, -1, -1);
+  const __m256d grav = _mm256_set_pd(0, ms->p.gravity[2], ms->p.gravity[1], ms->p.gravity[0]);
+  const __m256d hk = _mm256_set1_pd(ms->p.home_stiffness), hc = _mm256_set1_pd(ms->p.home_damping);
+  const size_t n = ms->n, nv = gi->nv;
+  for (size_t k = 0; k < n; k++) {
+    const size_t c = 3 * k;
+    __m256d acc = _mm256_add_pd(_mm256_maskload_pd(fext + c, m3), _mm256_mul_pd(_mm256_set1_pd(mass[k]), grav));
+    acc = _mm256_sub_pd(
+        acc, _mm256_mul_pd(hk, _mm256_sub_pd(_mm256_maskload_pd(x + c, m3), _mm256_maskload_pd(xr + c, m3))));
+    acc = _mm256_sub_pd(acc, _mm256_mul_pd(hc, _mm256_maskload_pd(v + c, m3)));
+    if (fres) acc = _mm256_add_pd(acc, _mm256_maskload_pd(fres + c, m3));
+    if (k < nv) {
+      const uint32_t *e = ev + off[k], *end = ev + off[k + 1];
+      while (e < end) {
+        const uint32_t q = *e++;
+        if (q & MS_RUN) {
+          const uint32_t re = *e++;
+          __m256d r = _mm256_setzero_pd();
+          for (uint32_t s = q & ~MS_RUN; s < re; s++) {
+            const __m256d gs = _mm256_load_pd(g + 4 * (size_t)s);
+            r = blend ? _mm256_blendv_pd(r, _mm256_add_pd(r, gs), _mm256_permute4x64_pd(gs, 0xff))
+                      : _mm256_add_pd(r, gs);
+          }
+          acc = _mm256_add_pd(acc, r);
+        } else {
+          const __m256d gs = _mm256_load_pd(g + 4 * (size_t)q);
+          acc = blend ? _mm256_blendv_pd(acc, _mm256_sub_pd(acc, gs), _mm256_permute4x64_pd(gs, 0xff))
+                      : _mm256_sub_pd(acc, gs);
+        }
+      }
+    }
+    _mm256_maskstore_pd(f + c, m3, acc);
+  }
+}
+#endif
+#undef MS_RUN
+
+/* The gather index matches the springs (and nodes) it was built for. */
+static int ms_gather_usable(const mass_spring_t *ms) {
+  const struct ms_gather *g = &ms->gather;
+  return g->g && g->springs == ms->springs && g->nsprings == ms->nsprings && g->nv <= ms->n;
+}
+
 int mass_spring_simd_available(void) {
 #ifdef MS_HAVE_AVX2_PATH
   return __builtin_cpu_supports("avx2") ? 1 : 0;
@@ -424,6 +609,14 @@ void mass_spring_forces(const mass_spring_t *ms, const double *x, const double *
 }
 
 void mass_spring_forces_path(const mass_spring_t *ms, const double *x, const double *v, double *f, int simd) {
+  const double damping = ms->p.damping * ms->damping_scale; /* mass_spring.h: damping_scale */
+#ifdef MS_HAVE_AVX2_PATH
+  if (simd == 1 && ms_gather_usable(ms) && mass_spring_simd_available()) {
+    size_t dead = ms_gather_rows(ms, x, v, ms->gather.g, damping);
+    ms_gather_nodes(ms, x, v, f, ms->gather.g, dead > 0);
+    return;
+  }
+#endif
   /* Node terms. The parameters are copied to locals and the arrays are
    * restrict-qualified: through plain pointers every store to f could alias
    * ms->p, so the compiler reloaded gravity and the home coefficients per
@@ -434,7 +627,6 @@ void mass_spring_forces_path(const mass_spring_t *ms, const double *x, const dou
   double *restrict ff = f;
   const double g0 = ms->p.gravity[0], g1 = ms->p.gravity[1], g2 = ms->p.gravity[2];
   const double hk = ms->p.home_stiffness, hc = ms->p.home_damping;
-  const double damping = ms->p.damping * ms->damping_scale; /* mass_spring.h: damping_scale */
   const size_t n = ms->n;
   for (size_t i = 0; i < n; i++) {
     const size_t c = 3 * i;
@@ -445,7 +637,7 @@ void mass_spring_forces_path(const mass_spring_t *ms, const double *x, const dou
   if (fres)
     for (size_t c = 0; c < 3 * n; c++) ff[c] += fres[c];
 #ifdef MS_HAVE_AVX2_PATH
-  if (simd) {
+  if (simd && mass_spring_simd_available()) {
     ms_spring_forces_avx2(ms, x, v, f, damping);
     return;
   }

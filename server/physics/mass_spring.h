@@ -84,6 +84,18 @@ typedef struct mass_spring {
   double *f_res; /* 3n or NULL: constant nodal forces (residual stress, docs/methods.md D eq. 4), in forces() and
                     potential() */
   size_t cap;    /* node capacity of the node arrays (>= n) */
+  /* The AVX2 force loop's gather index (mass_spring.c): for every node, the
+   * springs that act on it in the order the scalar loop adds them, built
+   * from the springs by whatever builds them (and by
+   * mass_spring_springs_changed); used only while springs, nsprings and
+   * the node range still match what it was built for. g: scratch, 4
+   * doubles per spring. NULL members: no index (the scatter loop runs). */
+  struct ms_gather {
+    const ms_spring_t *springs;
+    size_t nsprings, nv; /* nv: 1 + the largest node index of a spring */
+    uint32_t *off, *ev;  /* nv + 1 offsets into ev */
+    double *g;
+  } gather;
 } mass_spring_t;
 
 /* Springs from the unique edges of the triangles of `surface` (nodes = its
@@ -115,14 +127,20 @@ size_t mass_spring_fix_below(mass_spring_t *ms, double z);
  * f_res and f_ext. Forces stay finite for coincident nodes (a zero-length spring
  * has no direction and pushes nothing). */
 void mass_spring_forces(const mass_spring_t *ms, const double *x, const double *v, double *f);
-/* The same through a chosen spring loop: simd 1 the AVX2 loop (when the
- * processor has AVX2, else the scalar one), 0 the scalar loop. Both give
- * the same forces bit for bit (same operations in the same order, no fused
- * multiply-add); mass_spring_forces takes the AVX2 loop whenever
- * mass_spring_simd_available() (checked at run time, the build needs no
- * -mavx2). For the tests and benchmarks that compare the two. */
+/* The same through a chosen spring loop: simd 1 the AVX2 gather loop (the
+ * scatter one without a gather index), 2 the AVX2 scatter loop, 0 the
+ * scalar loop; without AVX2 in the processor always the scalar one. All
+ * give the same forces bit for bit (same operations in the same order per
+ * component, no fused multiply-add); mass_spring_forces takes simd 1
+ * whenever mass_spring_simd_available() (checked at run time, the build
+ * needs no -mavx2). For the tests and benchmarks that compare them. */
 void mass_spring_forces_path(const mass_spring_t *ms, const double *x, const double *v, double *f, int simd);
 int mass_spring_simd_available(void);
+/* Code that rewrites springs[] in place (order, ends) calls this after, so
+ * the AVX2 loop's gather index follows (it allocates; on OOM the AVX2 loop
+ * falls back to scattering, same forces). Whatever replaces the array
+ * through mass_spring_create_* / set_surface_topology needs no call. */
+void mass_spring_springs_changed(mass_spring_t *ms);
 
 /* out = (a K(x) + b C(x)) y, as described above. */
 void mass_spring_stiffness_mul(const mass_spring_t *ms, const double *x, double a, double b, const double *y,

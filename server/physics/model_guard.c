@@ -29,7 +29,15 @@ void model_guard_free(model_guard_t *g) {
 int model_state_finite(const double *x, const double *v, size_t n, const uint32_t *idx) {
   double sum = 0;
   if (!idx) {
-    for (size_t c = 0; c < 3 * n; c++) sum += x[c] + v[c];
+    /* Eight independent sums: one chain of dependent adds cost a step
+     * about 5 % (a sum of 6n terms, one add latency each); NaN and
+     * infinities reach the total whatever the grouping. */
+    double a[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+    size_t m = 3 * n, c = 0;
+    for (; c + 8 <= m; c += 8)
+      for (int k = 0; k < 8; k++) a[k] += x[c + (size_t)k] + v[c + (size_t)k];
+    for (; c < m; c++) sum += x[c] + v[c];
+    for (int k = 0; k < 8; k++) sum += a[k];
     return isfinite(sum);
   }
   for (size_t a = 0; a < n; a++) {

@@ -7,7 +7,9 @@
  * (400 N/m, the bench_server setting) through the product's runtime; the
  * probe comes down over the organ's highest vertex until it holds 1 N, is
  * held 0.5 s (the organ comes to rest, stab_settle), then `steps` steps are
- * timed one by one (median and p99 of the wall time per 1 ms step).
+ * timed one by one (median and p99 of the wall time per 1 ms step, and
+ * the median of the thread's CPU time per step, which a busy machine
+ * inflates less).
  * Bullet: a btSoftBody from the same rest surface (bullet_soft.h: links on
  * the edges, pose matching, 2 iterations, damping 0.05, same mass and
  * gravity), the probe's contact patch pinned where viscera holds it (the
@@ -41,7 +43,7 @@ static double load_average(void) {
 }
 
 typedef struct side {
-  vstats_summary_t t;
+  vstats_summary_t t, cpu; /* wall and thread CPU us per step */
   double dent, speed;
 } side_t;
 
@@ -72,7 +74,8 @@ static int run_organ(const char *organ, int steps) {
     runtime_step(&rt);
   }
   bullet_soft_t *b = bullet_soft_create(m->surf_rest, m->nsurf, m->surf_tris, m->nsurf_tris, 0.15, sc.gravity, 2, 0.05);
-  double *t = malloc(2 * (size_t)steps * sizeof *t), *tb = t ? t + steps : NULL;
+  double *t = malloc(4 * (size_t)steps * sizeof *t), *tb = t ? t + steps : NULL;
+  double *c = t ? t + 2 * steps : NULL, *cb = t ? t + 3 * steps : NULL;
   if (!b || !t) {
     bullet_soft_destroy(b);
     free(t);
@@ -89,29 +92,34 @@ static int run_organ(const char *organ, int steps) {
   for (int s0 = 0; s0 < steps; s0 += 50) {
     int s1 = s0 + 50 < steps ? s0 + 50 : steps;
     for (int s = s0; s < s1; s++) {
-      uint64_t t0 = vtime_mono_ns();
+      uint64_t t0 = vtime_mono_ns(), c0 = vtime_thread_cpu_ns();
       runtime_set_tool(&rt, 0, p, 100);
       runtime_step(&rt);
+      c[s] = (double)(vtime_thread_cpu_ns() - c0) * 1e-3;
       t[s] = (double)(vtime_mono_ns() - t0) * 1e-3;
     }
     for (int s = s0; s < s1; s++) {
-      uint64_t t0 = vtime_mono_ns();
+      uint64_t t0 = vtime_mono_ns(), c0 = vtime_thread_cpu_ns();
       bullet_soft_step(b, sc.dt);
+      cb[s] = (double)(vtime_thread_cpu_ns() - c0) * 1e-3;
       tb[s] = (double)(vtime_mono_ns() - t0) * 1e-3;
     }
   }
   vis.t = vstats_summarise(t, (size_t)steps);
+  vis.cpu = vstats_summarise(c, (size_t)steps);
   vis.dent = v3_dist(m->surf_x + 3 * top, m->surf_rest + 3 * top);
   for (size_t i = 0; i < 3 * m->nsurf; i++) vis.speed = fmax(vis.speed, fabs(m->v[i]));
   double force = v3_norm(rt.tools[0].force);
   bul.t = vstats_summarise(tb, (size_t)steps);
+  bul.cpu = vstats_summarise(cb, (size_t)steps);
   double q[3];
   bullet_soft_node(b, (uint32_t)top, q);
   bul.dent = v3_dist(q, m->surf_rest + 3 * top);
   bul.speed = bullet_soft_max_speed(b);
-  printf("%-12s %6zu %4d %9.1f %9.1f %9.1f %9.1f %7.2f %8.3f %8.3f %7.3f %9.1e %9.1e %5.2f\n", organ, m->nsurf,
-         m->substeps, vis.t.median, vis.t.p99, bul.t.median, bul.t.p99, vis.t.median / bul.t.median, vis.dent * 1e3,
-         bul.dent * 1e3, force, vis.speed, bul.speed, load_average());
+  printf("%-12s %6zu %4d %9.1f %9.1f %9.1f %9.1f %7.2f %8.1f %8.1f %7.2f %8.3f %8.3f %7.3f %9.1e %9.1e %5.2f\n", organ,
+         m->nsurf, m->substeps, vis.t.median, vis.t.p99, bul.t.median, bul.t.p99, vis.t.median / bul.t.median,
+         vis.cpu.median, bul.cpu.median, vis.cpu.median / bul.cpu.median, vis.dent * 1e3, bul.dent * 1e3, force,
+         vis.speed, bul.speed, load_average());
   bullet_soft_destroy(b);
   free(t);
   runtime_destroy(&rt);
@@ -121,10 +129,11 @@ static int run_organ(const char *organ, int steps) {
 int main(int argc, char **argv) {
   int quick = argc > 1 && !strcmp(argv[1], "--quick");
   printf("viscera mass_spring_surface (symplectic Euler, 1 ms steps) against Bullet %d-byte btSoftBody "
-         "(2 iterations, damping 0.05), same dent; wall us per 1 ms step\n",
+         "(2 iterations, damping 0.05), same dent; wall us per 1 ms step (median, p99), thread CPU us (median)\n",
          bullet_soft_scalar_bytes());
-  printf("%-12s %6s %4s %9s %9s %9s %9s %7s %8s %8s %7s %9s %9s %5s\n", "organ", "verts", "sub", "vis_med", "vis_p99",
-         "bul_med", "bul_p99", "vis/bul", "dent_mm", "bul_mm", "force_N", "vis_v", "bul_v", "load");
+  printf("%-12s %6s %4s %9s %9s %9s %9s %7s %8s %8s %7s %8s %8s %7s %9s %9s %5s\n", "organ", "verts", "sub", "vis_med",
+         "vis_p99", "bul_med", "bul_p99", "vis/bul", "vis_cpu", "bul_cpu", "cpu_v/b", "dent_mm", "bul_mm", "force_N",
+         "vis_v", "bul_v", "load");
   static const char *organs[] = {"kidney", "gallbladder"};
   int rc = 0;
   for (int k = 0; k < (quick ? 1 : 2); k++) rc |= run_organ(organs[k], quick ? 50 : 2000);

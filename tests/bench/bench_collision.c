@@ -3,8 +3,8 @@
  * feature on the 23,522-vertex liver <= 1 us median; the thesis of docs/methods.md B
  * reports 1.35 us).
  *
- * For each generated organ: AABB tree build and refit, node grid build and
- * rebuild. On the liver: the nearest surface point to random points near the
+ * For each generated organ: AABB tree build and refit (at rest, and with
+ * every vertex moved), node grid build and rebuild. On the liver: the nearest surface point to random points near the
  * surface (a random point of a random triangle moved along its normal by up
  * to 0, 2 or 5 mm; the mean edge is 1.8 mm), and along a sliding path like a
  * haptic proxy's, per query median and p99, also after a deformation and
@@ -41,8 +41,7 @@ static FILE *csv;
 static void row(const char *organ, const char *what, double *samples_us, size_t n, double batch_mean_us) {
   vstats_summary_t s = vstats_summarise(samples_us, n);
   printf("  %-12s %-34s %9zu %10.3f %10.3f %10.3f %10.3f\n", organ, what, s.n, s.median, s.p99, s.max, batch_mean_us);
-  if (csv)
-    fprintf(csv, "%s,%s,%zu,%.4f,%.4f,%.4f,%.4f\n", organ, what, s.n, s.median, s.p99, s.max, batch_mean_us);
+  if (csv) fprintf(csv, "%s,%s,%zu,%.4f,%.4f,%.4f,%.4f\n", organ, what, s.n, s.median, s.p99, s.max, batch_mean_us);
 }
 
 static void header(const char *title) {
@@ -167,8 +166,8 @@ static void bench_proxy(const char *organ, const mesh_t *m, aabb_tree_t *tree, i
     v3_cross(n, e1, e2);
     for (int j = 0; j < 3; j++) v3_axpy(nrm + 3 * v[j], n, 1.0);
   }
-  proxy_surface_t scan = {.x = m->pos, .tris = m->tris, .ntris = m->ntris, .max_edge = 3 * max_edge_of(m),
-                          .x_rest = m->pos};
+  proxy_surface_t scan = {
+      .x = m->pos, .tris = m->tris, .ntris = m->ntris, .max_edge = 3 * max_edge_of(m), .x_rest = m->pos};
   proxy_surface_t withtree = scan;
   withtree.tree = tree;
   size_t n = 0;
@@ -218,8 +217,10 @@ int main(int argc, char **argv) {
   const char *csv_path = NULL;
   int quick = 0;
   for (int i = 2; i < argc; i++) {
-    if (!strcmp(argv[i], "--quick")) quick = 1;
-    else csv_path = argv[i];
+    if (!strcmp(argv[i], "--quick"))
+      quick = 1;
+    else
+      csv_path = argv[i];
   }
   csv = csv_path ? fopen(csv_path, "w") : NULL;
   if (csv_path && !csv) {
@@ -263,7 +264,20 @@ int main(int argc, char **argv) {
       aabb_tree_refit(&t, m->pos);
       samples[r] = (double)(vtime_mono_ns() - t0) * 1e-3;
     }
-    row(ORGANS[oi], "tree refit", samples, (size_t)reps, NAN);
+    row(ORGANS[oi], "tree refit, at rest", samples, (size_t)reps, NAN);
+    /* Every vertex moved beyond the margin: alternate with a shifted copy. */
+    double *xs = malloc(3 * m->nverts * sizeof *xs);
+    if (xs) {
+      for (size_t c = 0; c < 3 * m->nverts; c++) xs[c] = m->pos[c] + 1e-3;
+      for (int r = 0; r < reps; r++) {
+        uint64_t t0 = vtime_mono_ns();
+        aabb_tree_refit(&t, (r & 1) ? m->pos : xs);
+        samples[r] = (double)(vtime_mono_ns() - t0) * 1e-3;
+      }
+      row(ORGANS[oi], "tree refit, every vertex moved", samples, (size_t)reps, NAN);
+      aabb_tree_refit(&t, m->pos);
+      free(xs);
+    }
     aabb_tree_destroy(&t);
     node_grid_t g;
     for (int r = 0; r < reps; r++) {

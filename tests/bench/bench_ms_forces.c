@@ -7,7 +7,10 @@
  * scene's organ) with springs as built (sorted by i) and shuffled. Prints a
  * table; the best of several repeats is reported (the machine may be
  * shared). The "forces avx2" rows compare the scalar spring loop (old
- * column) with the AVX2 one (new column) of mass_spring_forces_path.
+ * column) with the AVX2 one (new column) of mass_spring_forces_path, the
+ * "avx2 gather" rows the AVX2 scatter loop (old) with the AVX2 gather loop
+ * (new, the default). Without --quick also on the gallbladder (5,393
+ * nodes, 16,173 springs).
  * usage: bench_ms_forces [--quick] */
 #include <math.h>
 #include <stdio.h>
@@ -88,6 +91,9 @@ static void forces_scalar(const mass_spring_t *ms, const double *x, const double
 static void forces_simd(const mass_spring_t *ms, const double *x, const double *v, double *f) {
   mass_spring_forces_path(ms, x, v, f, 1);
 }
+static void forces_scatter(const mass_spring_t *ms, const double *x, const double *v, double *f) {
+  mass_spring_forces_path(ms, x, v, f, 2);
+}
 
 /* Best over `repeats` of the mean ns per spring of `calls` calls. */
 static double time_forces(forces_fn fn, const mass_spring_t *ms, const double *x, const double *v, double *f,
@@ -114,11 +120,9 @@ static double time_kmul(kmul_fn fn, const mass_spring_t *ms, const double *x, co
   return best;
 }
 
-int main(int argc, char **argv) {
-  int quick = argc > 1 && strcmp(argv[1], "--quick") == 0;
-  int repeats = quick ? 2 : 15, calls = quick ? 20 : 400;
+static int organ(const char *name, int repeats, int calls) {
   mesh_t mesh;
-  if (test_mesh_load("kidney.obj", &mesh)) return 1;
+  if (test_mesh_load(name, &mesh)) return 1;
   verr_t err;
   mass_spring_t ms;
   ms_params_t p = {.mass = 0.15, .stiffness = 400, .damping = 0.8, .home_stiffness = 5, .gravity = {0, 0, -9.81}};
@@ -135,7 +139,7 @@ int main(int argc, char **argv) {
     v[c] = 0.01 * (test_rng_uniform(&rng) - 0.5);
     y[c] = test_rng_uniform(&rng) - 0.5;
   }
-  printf("kidney: %zu nodes, %zu springs; best of %d x %d calls, ns per spring\n", ms.n, ms.nsprings, repeats, calls);
+  printf("%s: %zu nodes, %zu springs; best of %d x %d calls, ns per spring\n", name, ms.n, ms.nsprings, repeats, calls);
   printf("%-10s %-14s %8s %8s %8s\n", "springs", "function", "old", "new", "new/old");
   for (int order = 0; order < 2; order++) {
     if (order == 1) /* Fisher-Yates: runs of equal i of length ~1 */
@@ -145,6 +149,7 @@ int main(int argc, char **argv) {
         ms.springs[s] = ms.springs[r];
         ms.springs[r] = t;
       }
+    if (order == 1) mass_spring_springs_changed(&ms);
     const char *label = order ? "shuffled" : "as built";
     double fo = time_forces(old_forces, &ms, x, v, f, repeats, calls);
     double fn = time_forces(mass_spring_forces, &ms, x, v, f, repeats, calls);
@@ -154,6 +159,9 @@ int main(int argc, char **argv) {
     double fv = time_forces(forces_simd, &ms, x, v, f, repeats, calls);
     printf("%-10s %-14s %8.2f %8.2f %8.2f%s\n", label, "forces avx2", fs, fv, fv / fs,
            mass_spring_simd_available() ? "" : " (no AVX2 here: scalar twice)");
+    /* The AVX2 scatter loop (old column) against the gather one (new). */
+    double fsc = time_forces(forces_scatter, &ms, x, v, f, repeats, calls);
+    printf("%-10s %-14s %8.2f %8.2f %8.2f\n", label, "avx2 gather", fsc, fv, fv / fsc);
     double ko = time_kmul(old_stiffness_mul, &ms, x, y, f, repeats, calls);
     double kn = time_kmul(mass_spring_stiffness_mul, &ms, x, y, f, repeats, calls);
     printf("%-10s %-14s %8.2f %8.2f %8.2f\n", label, "stiffness_mul", ko, kn, kn / ko);
@@ -166,4 +174,12 @@ int main(int argc, char **argv) {
   mass_spring_destroy(&ms);
   mesh_free(&mesh);
   return 0;
+}
+
+int main(int argc, char **argv) {
+  int quick = argc > 1 && strcmp(argv[1], "--quick") == 0;
+  int repeats = quick ? 2 : 15, calls = quick ? 20 : 400;
+  int rc = organ("kidney.obj", repeats, calls);
+  if (!quick) rc |= organ("gallbladder.obj", repeats, calls / 3);
+  return rc;
 }
