@@ -14,6 +14,10 @@
 # step start, uniformly phased) + the DDS round trip measured by Cyclone's
 # ddsperf ping/pong on the same machine (when installed; else stated).
 # Prints one row per run and a table of mean of means; states the load.
+# HAPTIC_RATE=HZ (environment) runs the client's loop at HZ instead of
+# 1000 (e.g. 999: its phase against the server's steps then sweeps the whole
+# millisecond once a second, so every run averages over all phases and the
+# run-to-run spread of a fixed random phase, about 300 us, goes away).
 # RT_PRIORITY=N (environment) runs both 1 kHz loops SCHED_FIFO at N (their
 # --rt-priority: the loop threads only, DDS threads stay normal), as
 # deploy/bench.sh does; unset, both run at normal priority.
@@ -23,8 +27,9 @@ NEW="$1"; OLD="$2"; SRC="$3"; OUT="$4"; RUNS="${5:-10}"; SECS="${6:-3}"
 D="${VISCERA_DOMAIN:-228}"
 export CYCLONEDDS_URI="${CYCLONEDDS_URI:-file://$SRC/deploy/cyclonedds-loopback.xml}"
 mkdir -p "$OUT"
-rt=()
+rt=() hrate=()
 [ -n "${RT_PRIORITY:-}" ] && rt=(--rt-priority "$RT_PRIORITY")
+[ -n "${HAPTIC_RATE:-}" ] && hrate=(--rate "$HAPTIC_RATE")
 pids=()
 cleanup() { for p in "${pids[@]}"; do kill -9 "$p" 2>/dev/null || true; done; }
 trap cleanup EXIT
@@ -37,7 +42,7 @@ one() { # BUILD TAG RUN: prints latency_us_mean latency_us_median
   sleep 1.2
   sleep "$(printf '0.%06d' $((RANDOM % 1000)))"
   "$NEW/client/haptic/viscera-haptic" --trajectory "$SRC/assets/trajectories/palpate_kidney.traj" --domain "$D" \
-    --partition "$part" --duration "$SECS" "${rt[@]}" >"$OUT/$tag$i.haptic.out" 2>"$OUT/$tag$i.haptic.log" || true
+    --partition "$part" --duration "$SECS" "${rt[@]}" "${hrate[@]}" >"$OUT/$tag$i.haptic.out" 2>"$OUT/$tag$i.haptic.log" || true
   kill -INT $s; wait $s 2>/dev/null || true
   pids=()
   local sum; sum=$(grep '^SUMMARY ' "$OUT/$tag$i.haptic.out" || true)
