@@ -318,6 +318,44 @@ __attribute__((target("avx2"))) static inline void transpose3(const __m256d r[4]
   *c2 = _mm256_permute2f128_pd(t0, t2, 0x31);
 }
 
+/* Springs sp[0..3]: their direction d (j - i, unnormalised, one vector per
+ * component), which of them are live (longer than MS_TINY; a zero-length
+ * spring pushes nothing, NaN stays live, as in the scalar test) and the force
+ * magnitude per unit of d, (k (len - rest) + c (dv . d) / len) / len: the
+ * scalar loop's operations in its order, 4 lanes at once. Shared by the
+ * scatter and the gather loop, so both stay bit-identical to the scalar one.
+ * kscale: the 4 springs' stiffness factors, or NULL. */
+__attribute__((target("avx2"))) static inline __m256d spring4(const ms_spring_t *restrict sp, const double *restrict x,
+                                                              const double *restrict v, const double *restrict kscale,
+                                                              __m256d stiff, __m256d damp, __m256d *d0, __m256d *d1,
+                                                              __m256d *d2, __m256d *live) {
+  const __m256i m3 = _mm256_set_epi64x(0, -1, -1, -1);
+  const __m256d one = _mm256_set1_pd(1.0), tiny = _mm256_set1_pd(MS_TINY);
+  /* Each end's (x, y, z) as one masked 4-wide load (the fourth lane is not
+   * read: no access past the array), the differences row by row, then a 4x4
+   * transpose into one vector per component. */
+  __m256d dr[4], dvr[4];
+  for (int q = 0; q < 4; q++) {
+    const size_t i3 = 3 * (size_t)sp[q].i, j3 = 3 * (size_t)sp[q].j;
+    dr[q] = _mm256_sub_pd(_mm256_maskload_pd(x + j3, m3), _mm256_maskload_pd(x + i3, m3));
+    dvr[q] = _mm256_sub_pd(_mm256_maskload_pd(v + j3, m3), _mm256_maskload_pd(v + i3, m3));
+  }
+  __m256d dv0, dv1, dv2;
+  transpose3(dr, d0, d1, d2);
+  transpose3(dvr, &dv0, &dv1, &dv2);
+  const __m256d len = _mm256_sqrt_pd(
+      _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(*d0, *d0), _mm256_mul_pd(*d1, *d1)), _mm256_mul_pd(*d2, *d2)));
+  *live = _mm256_cmp_pd(len, tiny, _CMP_NLE_UQ);
+  const __m256d inv = _mm256_div_pd(one, len);
+  const __m256d dvd =
+      _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(dv0, *d0), _mm256_mul_pd(dv1, *d1)), _mm256_mul_pd(dv2, *d2));
+  const __m256d rest = _mm256_set_pd(sp[3].rest, sp[2].rest, sp[1].rest, sp[0].rest);
+  const __m256d k = kscale ? _mm256_mul_pd(stiff, _mm256_loadu_pd(kscale)) : stiff;
+  return _mm256_and_pd(*live, _mm256_mul_pd(_mm256_add_pd(_mm256_mul_pd(k, _mm256_sub_pd(len, rest)),
+                                                          _mm256_mul_pd(_mm256_mul_pd(damp, dvd), inv)),
+                                            inv));
+}
+
 __attribute__((target("avx2"))) static void ms_spring_forces_avx2(const mass_spring_t *ms, const double *restrict x,
                                                                   const double *restrict v, double *restrict f,
                                                                   double damping) {
@@ -325,36 +363,12 @@ __attribute__((target("avx2"))) static void ms_spring_forces_avx2(const mass_spr
   const double *restrict kscale = ms->k_scale;
   const size_t ns = ms->nsprings;
   const __m256d stiff = _mm256_set1_pd(ms->p.stiffness), damp = _mm256_set1_pd(damping);
-  const __m256d one = _mm256_set1_pd(1.0), tiny = _mm256_set1_pd(MS_TINY);
-  const __m256i m3 = _mm256_set_epi64x(0, -1, -1, -1);
   uint32_t cur = UINT32_MAX;
   double fi0 = 0, fi1 = 0, fi2 = 0;
   size_t s = 0;
   for (; s + 4 <= ns; s += 4) {
-    /* Each end's (x, y, z) as one masked 4-wide load (the fourth lane is
-     * not read: no access past the array), the differences row by row,
-     * then a 4x4 transpose into one vector per component. */
-    __m256d dr[4], dvr[4];
-    for (int q = 0; q < 4; q++) {
-      const size_t i3 = 3 * (size_t)sp[s + q].i, j3 = 3 * (size_t)sp[s + q].j;
-      dr[q] = _mm256_sub_pd(_mm256_maskload_pd(x + j3, m3), _mm256_maskload_pd(x + i3, m3));
-      dvr[q] = _mm256_sub_pd(_mm256_maskload_pd(v + j3, m3), _mm256_maskload_pd(v + i3, m3));
-    }
-    __m256d d0, d1, d2, dv0, dv1, dv2;
-    transpose3(dr, &d0, &d1, &d2);
-    transpose3(dvr, &dv0, &dv1, &dv2);
-    const __m256d len = _mm256_sqrt_pd(
-        _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(d0, d0), _mm256_mul_pd(d1, d1)), _mm256_mul_pd(d2, d2)));
-    /* A zero-length spring pushes nothing; NaN stays live, as in the scalar test. */
-    const __m256d live = _mm256_cmp_pd(len, tiny, _CMP_NLE_UQ);
-    const __m256d inv = _mm256_div_pd(one, len);
-    const __m256d dvd =
-        _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(dv0, d0), _mm256_mul_pd(dv1, d1)), _mm256_mul_pd(dv2, d2));
-    const __m256d rest = _mm256_set_pd(sp[s + 3].rest, sp[s + 2].rest, sp[s + 1].rest, sp[s].rest);
-    const __m256d k = kscale ? _mm256_mul_pd(stiff, _mm256_loadu_pd(kscale + s)) : stiff;
-    const __m256d mag = _mm256_and_pd(live, _mm256_mul_pd(_mm256_add_pd(_mm256_mul_pd(k, _mm256_sub_pd(len, rest)),
-                                                                        _mm256_mul_pd(_mm256_mul_pd(damp, dvd), inv)),
-                                                          inv));
+    __m256d d0, d1, d2, live;
+    const __m256d mag = spring4(sp + s, x, v, kscale ? kscale + s : NULL, stiff, damp, &d0, &d1, &d2, &live);
     double g[3][4];
     _mm256_storeu_pd(g[0], _mm256_mul_pd(mag, d0));
     _mm256_storeu_pd(g[1], _mm256_mul_pd(mag, d1));
@@ -486,30 +500,11 @@ __attribute__((target("avx2"))) static size_t ms_gather_rows(const mass_spring_t
   const double *restrict kscale = ms->k_scale;
   const size_t ns = ms->nsprings;
   const __m256d stiff = _mm256_set1_pd(ms->p.stiffness), damp = _mm256_set1_pd(damping);
-  const __m256d one = _mm256_set1_pd(1.0), tiny = _mm256_set1_pd(MS_TINY), nzero = _mm256_set1_pd(-0.0);
-  const __m256i m3 = _mm256_set_epi64x(0, -1, -1, -1);
+  const __m256d nzero = _mm256_set1_pd(-0.0);
   size_t s = 0, dead = 0;
   for (; s + 4 <= ns; s += 4) {
-    __m256d dr[4], dvr[4];
-    for (int q = 0; q < 4; q++) {
-      const size_t i3 = 3 * (size_t)sp[s + q].i, j3 = 3 * (size_t)sp[s + q].j;
-      dr[q] = _mm256_sub_pd(_mm256_maskload_pd(x + j3, m3), _mm256_maskload_pd(x + i3, m3));
-      dvr[q] = _mm256_sub_pd(_mm256_maskload_pd(v + j3, m3), _mm256_maskload_pd(v + i3, m3));
-    }
-    __m256d d0, d1, d2, dv0, dv1, dv2;
-    transpose3(dr, &d0, &d1, &d2);
-    transpose3(dvr, &dv0, &dv1, &dv2);
-    const __m256d len = _mm256_sqrt_pd(
-        _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(d0, d0), _mm256_mul_pd(d1, d1)), _mm256_mul_pd(d2, d2)));
-    const __m256d live = _mm256_cmp_pd(len, tiny, _CMP_NLE_UQ);
-    const __m256d inv = _mm256_div_pd(one, len);
-    const __m256d dvd =
-        _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(dv0, d0), _mm256_mul_pd(dv1, d1)), _mm256_mul_pd(dv2, d2));
-    const __m256d rest = _mm256_set_pd(sp[s + 3].rest, sp[s + 2].rest, sp[s + 1].rest, sp[s].rest);
-    const __m256d k = kscale ? _mm256_mul_pd(stiff, _mm256_loadu_pd(kscale + s)) : stiff;
-    const __m256d mag = _mm256_and_pd(live, _mm256_mul_pd(_mm256_add_pd(_mm256_mul_pd(k, _mm256_sub_pd(len, rest)),
-                                                                        _mm256_mul_pd(_mm256_mul_pd(damp, dvd), inv)),
-                                                          inv));
+    __m256d d0, d1, d2, live;
+    const __m256d mag = spring4(sp + s, x, v, kscale ? kscale + s : NULL, stiff, damp, &d0, &d1, &d2, &live);
     const __m256d c0 = _mm256_mul_pd(mag, d0), c1 = _mm256_mul_pd(mag, d1), c2 = _mm256_mul_pd(mag, d2);
     const __m256d c3 = _mm256_and_pd(live, nzero);
     dead += 4 - (size_t)__builtin_popcount((unsigned)_mm256_movemask_pd(live));
