@@ -71,6 +71,7 @@ double contact_render_target(contact_render_t *r, const contact_model_t *m, cons
     return contact_model_force(m, x, v, r->max_force, f);
   }
   r->reanchored_ticks++;
+  if (!placed) r->unplaced_ticks++;
   double d_onset[3];
   v3_sub(d_onset, r->onset, x_cmd);
   double depth = v3_dot(d_onset, n); /* x_cmd below where the press began */

@@ -99,10 +99,11 @@ typedef struct contact_render {
   double step_tick;    /* N, this tick's change */
   uint64_t cuts;       /* forces zeroed at once (server lost) */
   uint64_t reanchored_ticks, plain_ticks;
-  double v_prev[3]; /* m/s, the hand's velocity last tick */
-  double accel[3];  /* m/s^2, its filtered acceleration */
-  double tick_s;    /* s, the tick length the controller budgets (recent longest) */
-  int have_v;       /* v_prev holds a velocity */
+  uint64_t unplaced_ticks; /* of reanchored_ticks: an answer we could not place, at the last placed lag */
+  double v_prev[3];        /* m/s, the hand's velocity last tick */
+  double accel[3];         /* m/s^2, its filtered acceleration */
+  double tick_s;           /* s, the tick length the controller budgets (recent longest) */
+  int have_v;              /* v_prev holds a velocity */
   /* The work done over ticks longer than CONTACT_RENDER_STALL_S (the
    * client's loop stalled: no controller can act within them), J, and the
    * observer's largest value without it: what the controller answers for. */
