@@ -19,6 +19,7 @@ void contact_render_sent(contact_render_t *r, uint64_t seq, const double x[3]) {
   size_t i = seq % CONTACT_RENDER_RING;
   r->ring_seq[i] = seq;
   v3_copy(r->ring_x[i], x);
+  if (seq > r->sent_seq) r->sent_seq = seq;
 }
 
 /* Where our command `seq` put the hand; 0 when it is no longer known. */
@@ -37,14 +38,21 @@ double contact_render_target(contact_render_t *r, const contact_model_t *m, cons
      * let go for a few steps while the tissue moved away faster than the
      * hand): re-anchoring mid-press at a deep proxy would take the tool's
      * stiffness for the organ's and overshoot. */
-    if (r->anchored && ++r->off_ticks * r->period_s > CONTACT_RENDER_HOLD_S) r->anchored = 0;
+    if (r->anchored && ++r->off_ticks * r->period_s > CONTACT_RENDER_HOLD_S) {
+      r->anchored = 0;
+      r->lag = 0;
+    }
     return 0;
   }
   r->off_ticks = 0;
   const double *n = m->normal;
   double k = m->stiffness;
   double x_cmd[3];
-  int known = sent_position(r, m->cmd_seq, x_cmd);
+  int placed = sent_position(r, m->cmd_seq, x_cmd), known = placed;
+  if (placed)
+    r->lag = r->sent_seq >= m->cmd_seq ? r->sent_seq - m->cmd_seq + 1 : 0;
+  else if (r->lag && r->anchored && r->sent_seq >= r->lag)
+    known = sent_position(r, r->sent_seq - r->lag + 1, x_cmd); /* as old as the last placed answer */
   double d_cmd[3];
   v3_sub(d_cmd, m->proxy, known ? x_cmd : x);
   double spring = k * v3_dot(d_cmd, n); /* the server's proxy spring at x_cmd */
@@ -63,13 +71,15 @@ double contact_render_target(contact_render_t *r, const contact_model_t *m, cons
     return contact_model_force(m, x, v, r->max_force, f);
   }
   r->reanchored_ticks++;
+  if (!placed) r->unplaced_ticks++;
   double d_onset[3];
   v3_sub(d_onset, r->onset, x_cmd);
   double depth = v3_dot(d_onset, n); /* x_cmd below where the press began */
-  if (depth > CONTACT_RENDER_MIN_DEPTH && spring > 0 && r->onset_spring < CONTACT_RENDER_ONSET_SPRING) {
+  if (placed && depth > CONTACT_RENDER_MIN_DEPTH && spring > 0 && r->onset_spring < CONTACT_RENDER_ONSET_SPRING) {
     double k_sec = fmin(k, spring / depth);
     r->k_eff += (k_sec - r->k_eff) * fmin(1.0, r->period_s / CONTACT_RENDER_K_TAU);
   }
+  if (r->k_eff > k) r->k_eff = k; /* the stiffness may drop mid-press */
   double moved[3];
   v3_sub(moved, x_cmd, x);
   double mag = spring + r->k_eff * v3_dot(moved, n);

@@ -17,8 +17,17 @@
  *    depth of x_cmd below the surface point where contact began, low-pass
  *    filtered, within [0, k]). With no delay x_cmd is the hand and F is the
  *    server's force; our positions are kept by command seq (a ring of
- *    CONTACT_RENDER_RING, 1 s at 1 kHz), a feedback answering a command we
- *    no longer know (or another station's) is rendered as the plain plane.
+ *    CONTACT_RENDER_RING, 1 s at 1 kHz). A feedback answering a command we
+ *    cannot place (no echo we sent, or a seq the ring no longer holds)
+ *    within a press whose answers we could place is re-anchored at the
+ *    command as old as the last placed one (the same lag behind our newest):
+ *    rendered as the plain plane instead, the way moved since takes the
+ *    tool's stiffness k (400 N/m) for the organ's (~120 N/m), and a hand
+ *    that stopped one round trip after pressing got a spike (issue 14:
+ *    1.166 N against 0.97 N at 50 ms, k x 0.5 mm for 3 ticks). A press
+ *    with no placed answer at all (another station's) stays the plain
+ *    plane. k_eff never exceeds the current sample's k (a stiffness that
+ *    drops mid-press, e.g. the device's clamp).
  * 2. Ramping. Every change of model (contact begins or ends, a new sample
  *    after a gap, the server back) reaches the hand through a bound on the
  *    force's change per tick, max_step: no step is felt.
@@ -78,6 +87,8 @@ typedef struct contact_render {
   double period_s, max_step, max_force;
   uint64_t ring_seq[CONTACT_RENDER_RING];
   double ring_x[CONTACT_RENDER_RING][3];
+  uint64_t sent_seq;   /* our newest command */
+  uint64_t lag;        /* commands between our newest and the one the last placed answer named (0: none this press) */
   int anchored;        /* the surface point where contact began is known */
   double onset[3];     /* that point */
   double onset_spring; /* N, the server's spring in the press's first sample */
@@ -88,10 +99,11 @@ typedef struct contact_render {
   double step_tick;    /* N, this tick's change */
   uint64_t cuts;       /* forces zeroed at once (server lost) */
   uint64_t reanchored_ticks, plain_ticks;
-  double v_prev[3]; /* m/s, the hand's velocity last tick */
-  double accel[3];  /* m/s^2, its filtered acceleration */
-  double tick_s;    /* s, the tick length the controller budgets (recent longest) */
-  int have_v;       /* v_prev holds a velocity */
+  uint64_t unplaced_ticks; /* of reanchored_ticks: an answer we could not place, at the last placed lag */
+  double v_prev[3];        /* m/s, the hand's velocity last tick */
+  double accel[3];         /* m/s^2, its filtered acceleration */
+  double tick_s;           /* s, the tick length the controller budgets (recent longest) */
+  int have_v;              /* v_prev holds a velocity */
   /* The work done over ticks longer than CONTACT_RENDER_STALL_S (the
    * client's loop stalled: no controller can act within them), J, and the
    * observer's largest value without it: what the controller answers for. */

@@ -239,6 +239,7 @@ void haptic_loop_run(const haptic_loop_t *l) {
   st->pc_ticks = s.render.pc.active_ticks;
   st->reanchored_ticks = s.render.reanchored_ticks;
   st->plain_ticks = s.render.plain_ticks;
+  st->unplaced_ticks = s.render.unplaced_ticks;
   st->cuts = s.render.cuts;
   st->elapsed_s = (double)(vtime_mono_ns() - start) * 1e-9;
 }

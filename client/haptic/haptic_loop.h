@@ -34,6 +34,7 @@ typedef struct haptic_stats {
   uint64_t pc_ticks, cuts, server_lost, feedback_stale;
   uint64_t liveliness_blips;              /* liveliness lapses heard with feedback still arriving: kept */
   uint64_t reanchored_ticks, plain_ticks; /* in contact: model re-anchored at the answered command, or not */
+  uint64_t unplaced_ticks; /* of reanchored_ticks: an answer naming no command we could place (contact_render.h) */
 } haptic_stats_t;
 
 typedef struct haptic_loop {
