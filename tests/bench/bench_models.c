@@ -195,7 +195,9 @@ int main(int argc, char **argv) {
   int quick = 0;
   const char *png = NULL, *only = NULL;
   static char xpbd_keys[160];
-  model_case_t *xpbd_case = &MODELS[4];
+  model_case_t *xpbd_case = NULL;
+  for (size_t mi = 0; mi < NMODELS; mi++)
+    if (!strcmp(MODELS[mi].label, "xpbd")) xpbd_case = &MODELS[mi];
   for (int i = 1; i < argc; i++) {
     if (!strcmp(argv[i], "--quick"))
       quick = 1;
@@ -203,11 +205,10 @@ int main(int argc, char **argv) {
       only = argv[++i];
     else if (!strcmp(argv[i], "--xpbd-iterations") && i + 1 < argc) {
       /* XPBD rows at this iteration count instead of the scene default. */
-      snprintf(xpbd_keys, sizeof xpbd_keys, "    model: xpbd\n    material: {mass: 0.15}\n    solver: {iterations: %d}\n",
-               atoi(argv[++i]));
-      xpbd_case->keys = xpbd_keys;
-    }
-    else
+      snprintf(xpbd_keys, sizeof xpbd_keys,
+               "    model: xpbd\n    material: {mass: 0.15}\n    solver: {iterations: %d}\n", atoi(argv[++i]));
+      if (xpbd_case) xpbd_case->keys = xpbd_keys;
+    } else
       png = argv[i];
   }
   int norgans = quick ? 3 : NORGANS, steps = quick ? 50 : 500;
