@@ -759,6 +759,10 @@ static int parse_organ(const ctx_t *c, const node_t *n, size_t idx, const char *
   /* implicit_pcg is built for a small fixed CG budget per step (integrator.h);
    * solver.cg_max_iterations, when given, overrides it. */
   if (!strcmp(o->integrator, "implicit_pcg")) o->solver.cg_max_iterations = SCENE_PCG_ITERATIONS;
+  /* XPBD's default iteration count keeps every shipped organ real time at one
+   * 1 ms sub-step (docs/numerics.md §9.1); solver.iterations, when given,
+   * overrides it. PBD keeps 10: its stiffness depends on the count. */
+  if (!strcmp(o->model, "xpbd")) o->solver.iterations = SCENE_XPBD_ITERATIONS;
   if (v[O_SOLVER]) {
     join(fp, sizeof fp, path, "solver");
     if (parse_solver(c, v[O_SOLVER], fp, &o->solver)) return -1;

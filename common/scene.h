@@ -49,12 +49,17 @@ typedef struct scene_material {
 
 /* Default CG iteration cap of the integrator implicit_pcg (one step per ms). */
 #define SCENE_PCG_ITERATIONS 10
+/* Default constraint iterations per sub-step of the model xpbd (pbd: 10). Six
+ * keep the S8-style probe force error within 2 % of XPBD at 10 iterations and
+ * 1/4 ms x 4 on every shipped organ, at 0.6 of the sweep cost (docs/numerics.md
+ * §9.1). */
+#define SCENE_XPBD_ITERATIONS 6
 
 /* Model-specific settings (key `solver:` and extra `material:` keys in the
  * scene file). Each model reads only its own fields; defaults in brackets. */
 typedef struct scene_solver {
   int substeps;          /* sub-steps per scene step; 0 = automatic from the stability bound [0] */
-  int iterations;        /* PBD/XPBD constraint iterations per sub-step [10] */
+  int iterations;        /* PBD/XPBD constraint iterations per sub-step [10; xpbd SCENE_XPBD_ITERATIONS] */
   double cg_tolerance;   /* implicit Euler: relative CG residual [1e-3] */
   int cg_max_iterations; /* implicit Euler [200]; implicit_pcg [SCENE_PCG_ITERATIONS] */
   double tet_size;       /* m, target tetrahedron edge when a volume mesh is built [0: auto] */

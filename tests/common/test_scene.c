@@ -349,6 +349,10 @@ static void test_model_fields(void) {
     snprintf(yaml, sizeof yaml, HEAD "    integrator: %s\n", integrators[i]);
     CHECK(loads(yaml, NULL) && !strcmp(s.organs[0].integrator, integrators[i]));
   }
+  /* xpbd has its own default iteration count; pbd keeps 10; a given count wins. */
+  CHECK(loads(HEAD "    model: xpbd\n", NULL) && s.organs[0].solver.iterations == SCENE_XPBD_ITERATIONS);
+  CHECK(loads(HEAD "    model: pbd\n", NULL) && s.organs[0].solver.iterations == 10);
+  CHECK(loads(HEAD "    model: xpbd\n    solver: {iterations: 10}\n", NULL) && s.organs[0].solver.iterations == 10);
   CHECK(loads(HEAD, NULL));
   o = &s.organs[0];
   m = &o->material;
