@@ -45,6 +45,7 @@
 #include "physics/integrator.h"
 #include "physics/model.h"
 #include "physics/model_guard.h"
+#include "physics/mol_linear.h"
 #include "physics/molecular.h"
 
 model_t *model_molecular_create(const model_params_t *p, verr_t *err);
@@ -55,7 +56,19 @@ typedef struct mol_model {
   integrator_t it;
   model_guard_t guard; /* the last finite state */
   coupling_set_t cpl;  /* symplectic Euler, implicit_pcg: the sub-step's tool springs (implicit) */
+  mol_linear_t lin;    /* implicit_pcg: the step's cached Gauss-Newton Jacobian (mol_linear.h) */
 } mol_model_t;
+
+/* implicit_pcg: the cached linearisation (physics/mol_linear.h). */
+static void mm_linearize(force_system_t *s, double h, double *rhs, double *diag) {
+  molecular_t *mol = s->ctx;
+  mol_linear_linearize(&((mol_model_t *)mol->user)->lin, mol, h, rhs, diag);
+}
+
+static void mm_linear_mul(force_system_t *s, const double *y, double *out) {
+  molecular_t *mol = s->ctx;
+  mol_linear_mul(&((mol_model_t *)mol->user)->lin, mol, y, out);
+}
 
 /* Between kick and drift: the declared tool springs implicitly
  * (physics/coupling.h), as in the mass-spring models. */
@@ -99,6 +112,7 @@ static void mm_destroy(model_t *m) {
   molecular_destroy(&mm->mol);
   model_guard_free(&mm->guard);
   coupling_set_free(&mm->cpl);
+  mol_linear_free(&mm->lin);
   free(mm);
 }
 
@@ -194,6 +208,14 @@ model_t *model_molecular_create(const model_params_t *p, verr_t *err) {
       mm_destroy(&mm->m);
       return NULL;
     }
+  }
+  if (kind == INT_IMPLICIT_PCG) {
+    if (mol_linear_reserve(&mm->lin, mol->ntris, err)) {
+      mm_destroy(&mm->m);
+      return NULL;
+    }
+    mol->fs.linearize = mm_linearize;
+    mol->fs.linear_mul = mm_linear_mul;
   }
   if (cfg->fixed_below_set) molecular_fix_below(mol, cfg->fixed_below);
   size_t n = mol->n;

@@ -23,7 +23,8 @@
  * tetrahedral mesh's nodes of volume models; plot_loglog_slope), writes the plot as
  * PNG when OUT.png is given. Figures are never asserted; the machine's load
  * average is printed with them.
- * usage: bench_models [--quick] [--model NAME] [OUT.png]   (--model: that model only) */
+ * usage: bench_models [--quick] [--model NAME] [--organ NAME] [OUT.png]
+ *   (--model, --organ: that model, that organ only) */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -49,6 +50,12 @@ static const model_case_t MODELS[] = {
     {"mass_spring_tet", "    model: mass_spring_tet\n    integrator: symplectic_euler\n    material: {mass: 0.15}\n"},
     {"molecular",
      "    model: molecular\n    integrator: verlet\n    material: {mass: 0.15, bond_k: 30, angle_k: 3.0e-5, "
+     "stretch_bend_k: 0, home_stiffness: 30, home_damping: 0.005}\n"},
+    {"molecular_symplectic",
+     "    model: molecular\n    integrator: symplectic_euler\n    material: {mass: 0.15, bond_k: 30, angle_k: 3.0e-5, "
+     "stretch_bend_k: 0, home_stiffness: 30, home_damping: 0.005}\n"},
+    {"molecular_pcg",
+     "    model: molecular\n    integrator: implicit_pcg\n    material: {mass: 0.15, bond_k: 30, angle_k: 3.0e-5, "
      "stretch_bend_k: 0, home_stiffness: 30, home_damping: 0.005}\n"},
     {"pbd", "    model: pbd\n    material: {mass: 0.15}\n"},
     {"xpbd", "    model: xpbd\n    material: {mass: 0.15}\n"},
@@ -188,12 +195,14 @@ static result_t run_case(const char *organ, const model_case_t *mc, int steps, i
 
 int main(int argc, char **argv) {
   int quick = 0;
-  const char *png = NULL, *only = NULL;
+  const char *png = NULL, *only = NULL, *organ = NULL;
   for (int i = 1; i < argc; i++) {
     if (!strcmp(argv[i], "--quick"))
       quick = 1;
     else if (!strcmp(argv[i], "--model") && i + 1 < argc)
       only = argv[++i];
+    else if (!strcmp(argv[i], "--organ") && i + 1 < argc)
+      organ = argv[++i];
     else
       png = argv[i];
   }
@@ -210,6 +219,7 @@ int main(int argc, char **argv) {
     double xs[NORGANS], ys[NORGANS], ysub[NORGANS];
     size_t n = 0;
     for (int oi = 0; oi < norgans; oi++) {
+      if (organ && strcmp(organ, ORGANS[oi])) continue;
       result_t r = run_case(ORGANS[oi], &MODELS[mi], steps, quick);
       if (!r.ok) {
         printf("%-20s %-13s refused or failed\n", MODELS[mi].label, ORGANS[oi]);
