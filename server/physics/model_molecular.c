@@ -45,7 +45,6 @@
 #include "physics/integrator.h"
 #include "physics/model.h"
 #include "physics/model_guard.h"
-#include "physics/mol_linear.h"
 #include "physics/molecular.h"
 
 model_t *model_molecular_create(const model_params_t *p, verr_t *err);
@@ -56,18 +55,17 @@ typedef struct mol_model {
   integrator_t it;
   model_guard_t guard; /* the last finite state */
   coupling_set_t cpl;  /* symplectic Euler, implicit_pcg: the sub-step's tool springs (implicit) */
-  mol_linear_t lin;    /* implicit_pcg: the step's cached Gauss-Newton Jacobian (mol_linear.h) */
 } mol_model_t;
 
-/* implicit_pcg: the cached linearisation (physics/mol_linear.h). */
+/* implicit_pcg: the right-hand side in one fused pass (molecular_linear_rhs).
+ * diag stays 0 (a mass-only Jacobi preconditioner, as without linearize:
+ * the stiffness diagonal cost a pass of its own and saved under 10 % of
+ * the iterations on the gallbladder) and products go through
+ * stiffness_mul (linear_mul NULL: a cached Jacobian was slower, its 1.3 MB
+ * per gallbladder outgrew the cache that the recomputing kernel fits in). */
 static void mm_linearize(force_system_t *s, double h, double *rhs, double *diag) {
-  molecular_t *mol = s->ctx;
-  mol_linear_linearize(&((mol_model_t *)mol->user)->lin, mol, h, rhs, diag);
-}
-
-static void mm_linear_mul(force_system_t *s, const double *y, double *out) {
-  molecular_t *mol = s->ctx;
-  mol_linear_mul(&((mol_model_t *)mol->user)->lin, mol, y, out);
+  molecular_linear_rhs(s->ctx, h, rhs);
+  memset(diag, 0, 3 * s->n * sizeof(double));
 }
 
 /* Between kick and drift: the declared tool springs implicitly
@@ -112,7 +110,6 @@ static void mm_destroy(model_t *m) {
   molecular_destroy(&mm->mol);
   model_guard_free(&mm->guard);
   coupling_set_free(&mm->cpl);
-  mol_linear_free(&mm->lin);
   free(mm);
 }
 
@@ -209,14 +206,7 @@ model_t *model_molecular_create(const model_params_t *p, verr_t *err) {
       return NULL;
     }
   }
-  if (kind == INT_IMPLICIT_PCG) {
-    if (mol_linear_reserve(&mm->lin, mol->ntris, err)) {
-      mm_destroy(&mm->m);
-      return NULL;
-    }
-    mol->fs.linearize = mm_linearize;
-    mol->fs.linear_mul = mm_linear_mul;
-  }
+  if (kind == INT_IMPLICIT_PCG) mol->fs.linearize = mm_linearize;
   if (cfg->fixed_below_set) molecular_fix_below(mol, cfg->fixed_below);
   size_t n = mol->n;
   if (model_guard_reserve(&mm->guard, n)) {
