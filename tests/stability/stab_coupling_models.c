@@ -12,6 +12,8 @@
  * (declarations ignored, 20 sub-steps); both settle.
  *
  *   molecular     symplectic Euler (coupling.h after the kick)
+ *   molecular     implicit_pcg, its shipped scene's integrator (coupling.h
+ *                 after the solve, one step per ms)
  *   vertex_based  the touched node's backward-Euler update takes the tool
  *                 stiffness in its denominator (vertex_based.h) */
 #include <math.h>
@@ -30,6 +32,9 @@ static const model_case_t CASES[] = {
     {"molecular", "    model: molecular\n    integrator: symplectic_euler\n"
                   "    material: {mass: 0.15, bond_k: 30, angle_k: 3.0e-5, stretch_bend_k: 0, home_stiffness: 30, "
                   "home_damping: 0.005}\n"},
+    {"molecular implicit_pcg", "    model: molecular\n    integrator: implicit_pcg\n"
+                               "    material: {mass: 0.15, bond_k: 30, angle_k: 3.0e-5, stretch_bend_k: 0, "
+                               "home_stiffness: 30, home_damping: 0.005}\n"},
     {"vertex_based",
      "    model: vertex_based\n"
      "    material: {mass: 0.15, home_stiffness: 30, home_damping: 0.005, slope_m1: 1.0, slope_m2: 0.6, "
