@@ -455,12 +455,12 @@ void molecular_linear_rhs(const molecular_t *m, double h, double *rhs) {
       corner(ab0, il0, il2, dr0, dr2, tr->c0[0], kt, ksb, &c00, &c22, &c02);
       corner(ab1, il1, il0, dr1, dr0, tr->c0[1], kt, ksb, &c11, &c00, &c01);
       corner(ab2, il2, il1, dr2, dr1, tr->c0[2], kt, ksb, &c22, &c11, &c12);
-      corner_d(ab0, -d3_dot(f0, e2) - d3_dot(e0, f2), il0, il2, ld0, ld2, dr0, dr2, tr->c0[0], akt, aksb, 0, &z00,
-               &z22, &z02, &d00, &d22, &d02);
-      corner_d(ab1, -d3_dot(f1, e0) - d3_dot(e1, f0), il1, il0, ld1, ld0, dr1, dr0, tr->c0[1], akt, aksb, 0, &z11,
-               &z00, &z01, &d11, &d00, &d01);
-      corner_d(ab2, -d3_dot(f2, e1) - d3_dot(e2, f1), il2, il1, ld2, ld1, dr2, dr1, tr->c0[2], akt, aksb, 0, &z22,
-               &z11, &z12, &d22, &d11, &d12);
+      corner_d(ab0, -d3_dot(f0, e2) - d3_dot(e0, f2), il0, il2, ld0, ld2, dr0, dr2, tr->c0[0], akt, aksb, 0, &z00, &z22,
+               &z02, &d00, &d22, &d02);
+      corner_d(ab1, -d3_dot(f1, e0) - d3_dot(e1, f0), il1, il0, ld1, ld0, dr1, dr0, tr->c0[1], akt, aksb, 0, &z11, &z00,
+               &z01, &d11, &d00, &d01);
+      corner_d(ab2, -d3_dot(f2, e1) - d3_dot(e2, f1), il2, il1, ld2, ld1, dr2, dr1, tr->c0[2], akt, aksb, 0, &z22, &z11,
+               &z12, &d22, &d11, &d12);
     }
     /* Force at vertex k: G_k - G_{k+2} with G = C e; K v at k: D_{k+2} - D_k
      * with D = d e. rhs gets h (force) - (K v): h (c e)_k - h (c e)_{k+2} +

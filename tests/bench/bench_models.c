@@ -48,16 +48,19 @@ typedef struct model_case {
 } model_case_t;
 
 #define MOL_MATERIAL                                                                                                   \
-  "    material: {mass: 0.15, bond_k: 30, angle_k: 3.0e-5, stretch_bend_k: 0, home_stiffness: 30, home_damping: "     \
+  "    material: {mass: 0.15, bond_k: 30, angle_k: 3.0e-5, stretch_bend_k: 0, home_stiffness: 30, home_damping: "      \
   "0.005}\n"
-/* Molecular reference: Verlet at 1/4 ms with 4 sub-steps (1/16 ms, about
- * 5x inside its stability bound on every organ). */
+/* Molecular reference: Verlet at 1/4 ms with 4 sub-steps (1/16 ms, 2.5-5x
+ * inside its stability bound on the shipped organs). */
 #define MOL_REF "    model: molecular\n    integrator: verlet\n    solver: {substeps: 4}\n" MOL_MATERIAL
 
 static const model_case_t MODELS[] = {
-    {"mass_spring_surface", "    model: mass_spring_surface\n    integrator: symplectic_euler\n"
-                            "    material: {mass: 0.15}\n", NULL},
-    {"mass_spring_tet", "    model: mass_spring_tet\n    integrator: symplectic_euler\n    material: {mass: 0.15}\n", NULL},
+    {"mass_spring_surface",
+     "    model: mass_spring_surface\n    integrator: symplectic_euler\n"
+     "    material: {mass: 0.15}\n",
+     NULL},
+    {"mass_spring_tet", "    model: mass_spring_tet\n    integrator: symplectic_euler\n    material: {mass: 0.15}\n",
+     NULL},
     {"molecular", "    model: molecular\n    integrator: implicit_pcg\n" MOL_MATERIAL, MOL_REF},
     {"molecular_verlet", "    model: molecular\n    integrator: verlet\n" MOL_MATERIAL, MOL_REF},
     {"molecular_symplectic", "    model: molecular\n    integrator: symplectic_euler\n" MOL_MATERIAL, MOL_REF},
