@@ -403,6 +403,79 @@ void molecular_stiffness_mul(const molecular_t *m, const double *x, double a_k, 
   }
 }
 
+/* rhs = h F(x, v) - h^2 K_GN v in one pass over the triangles: the force
+ * kernel's coefficients (corner) and the Gauss-Newton product's derivative
+ * coefficients (corner_d with geo = 0) share the edge vectors, lengths,
+ * inverse lengths and cosines, which the two separate passes computed
+ * twice (a square root per edge and a divide per triangle each). */
+void molecular_linear_rhs(const molecular_t *m, double h, double *rhs) {
+  const mol_params_t *p = &m->p;
+  const double *x = m->x, *v = m->v;
+  const double kh = p->home_stiffness, ch = p->home_damping, a_k = h * h;
+  for (size_t i = 0; i < m->n; i++) {
+    const double *xi = x + 3 * i, *vi = v + 3 * i, *xr = m->x_rest + 3 * i, *fe = m->f_ext + 3 * i;
+    double mi = m->mass[i];
+    for (int k = 0; k < 3; k++)
+      rhs[3 * i + k] = h * (fe[k] + mi * p->gravity[k] - kh * (xi[k] - xr[k]) - ch * vi[k]) - a_k * kh * vi[k];
+  }
+  const double kr = p->bond_k, cb = p->bond_damping, eps2 = m->eps2;
+  const double kt = p->angle_k, ksb = p->stretch_bend_k, akt = a_k * kt, aksb = a_k * ksb;
+  const int angles = kt != 0 || ksb != 0;
+  for (size_t t = 0; t < m->ntris; t++) {
+    const mol_tri_t *tr = &m->tris[t];
+    const uint32_t i0 = tr->v[0], i1 = tr->v[1], i2 = tr->v[2];
+    const d3 x0 = d3_at(x, i0), x1 = d3_at(x, i1), x2 = d3_at(x, i2);
+    const d3 v0 = d3_at(v, i0), v1 = d3_at(v, i1), v2 = d3_at(v, i2);
+    const d3 e0 = d3_minus(x1, x0), e1 = d3_minus(x2, x1), e2 = d3_minus(x0, x2);
+    const d3 f0 = d3_minus(v1, v0), f1 = d3_minus(v2, v1), f2 = d3_minus(v0, v2);
+    const double l0 = sqrt(d3_dot(e0, e0) + eps2), l1 = sqrt(d3_dot(e1, e1) + eps2), l2 = sqrt(d3_dot(e2, e2) + eps2);
+    const double inv = 1.0 / (l0 * l1 * l2);
+    const double il0 = l1 * l2 * inv, il1 = l0 * l2 * inv, il2 = l0 * l1 * inv;
+    const double dr0 = l0 - tr->r0[0], dr1 = l1 - tr->r0[1], dr2 = l2 - tr->r0[2];
+    const double ld0 = d3_dot(e0, f0) * il0, ld1 = d3_dot(e1, f1) * il1, ld2 = d3_dot(e2, f2) * il2;
+    /* c: the force's coefficients (molecular_forces); d: h^2 K_GN v's. */
+    double c00 = 0, c11 = 0, c22 = 0, c01 = 0, c12 = 0, c02 = 0;
+    double d00 = 0, d11 = 0, d22 = 0, d01 = 0, d12 = 0, d02 = 0;
+    double z00 = 0, z11 = 0, z22 = 0, z01 = 0, z12 = 0, z02 = 0; /* Gauss-Newton: the product's c part is 0 */
+    const uint32_t owns = tr->owns;
+    if (owns & 1u) {
+      c00 += (kr * dr0 + cb * ld0) * il0;
+      d00 += a_k * kr * ld0 * il0;
+    }
+    if (owns & 2u) {
+      c11 += (kr * dr1 + cb * ld1) * il1;
+      d11 += a_k * kr * ld1 * il1;
+    }
+    if (owns & 4u) {
+      c22 += (kr * dr2 + cb * ld2) * il2;
+      d22 += a_k * kr * ld2 * il2;
+    }
+    if (angles) {
+      const double ab0 = -d3_dot(e0, e2), ab1 = -d3_dot(e1, e0), ab2 = -d3_dot(e2, e1);
+      corner(ab0, il0, il2, dr0, dr2, tr->c0[0], kt, ksb, &c00, &c22, &c02);
+      corner(ab1, il1, il0, dr1, dr0, tr->c0[1], kt, ksb, &c11, &c00, &c01);
+      corner(ab2, il2, il1, dr2, dr1, tr->c0[2], kt, ksb, &c22, &c11, &c12);
+      corner_d(ab0, -d3_dot(f0, e2) - d3_dot(e0, f2), il0, il2, ld0, ld2, dr0, dr2, tr->c0[0], akt, aksb, 0, &z00, &z22,
+               &z02, &d00, &d22, &d02);
+      corner_d(ab1, -d3_dot(f1, e0) - d3_dot(e1, f0), il1, il0, ld1, ld0, dr1, dr0, tr->c0[1], akt, aksb, 0, &z11, &z00,
+               &z01, &d11, &d00, &d01);
+      corner_d(ab2, -d3_dot(f2, e1) - d3_dot(e2, f1), il2, il1, ld2, ld1, dr2, dr1, tr->c0[2], akt, aksb, 0, &z22, &z11,
+               &z12, &d22, &d11, &d12);
+    }
+    /* Force at vertex k: G_k - G_{k+2} with G = C e; K v at k: D_{k+2} - D_k
+     * with D = d e. rhs gets h (force) - (K v): h (c e)_k - h (c e)_{k+2} +
+     * (d e)_k - (d e)_{k+2}, so one combined coefficient set h c + d. */
+    const double q00 = h * c00 + d00, q11 = h * c11 + d11, q22 = h * c22 + d22;
+    const double q01 = h * c01 + d01, q12 = h * c12 + d12, q02 = h * c02 + d02;
+    const d3 G0 = d3_comb(q00, e0, q01, e1, q02, e2);
+    const d3 G1 = d3_comb(q01, e0, q11, e1, q12, e2);
+    const d3 G2 = d3_comb(q02, e0, q12, e1, q22, e2);
+    d3_acc(rhs, i0, d3_minus(G0, G2));
+    d3_acc(rhs, i1, d3_minus(G1, G0));
+    d3_acc(rhs, i2, d3_minus(G2, G1));
+  }
+}
+
 double molecular_potential(const molecular_t *m, const double *x) {
   const mol_params_t *p = &m->p;
   double e = 0;

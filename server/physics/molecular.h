@@ -130,6 +130,12 @@ void molecular_forces(const molecular_t *m, const double *x, const double *v, do
  * default) always does. */
 void molecular_stiffness_mul(const molecular_t *m, const double *x, double a, double b, const double *y, double *out);
 
+/* implicit_pcg's right-hand side (force_system_t.linearize): rhs = h F(x,
+ * v) - h^2 K v at the current state, K the Gauss-Newton part (as with
+ * definite_jacobian), in one pass over the triangles instead of a force
+ * pass and a product pass. */
+void molecular_linear_rhs(const molecular_t *m, double h, double *rhs);
+
 /* Potential energy (bond, angle, stretch-bend, home, gravity) at x, J. */
 double molecular_potential(const molecular_t *m, const double *x);
 /* Kinetic + potential at the current state, J. */

@@ -5,7 +5,8 @@
  *
  * For each model (mass_spring_surface under symplectic Euler, the live
  * default; mass_spring_tet; molecular with the kidney_molecular.yaml
- * material under Verlet; pbd; xpbd; vertex_based), each at the scene
+ * material under implicit_pcg, its scene's integrator, and under Verlet and
+ * symplectic Euler; pbd; xpbd; vertex_based), each at the scene
  * defaults (every key the scene leaves out: sub-steps chosen by the model,
  * solver iterations, automatic tetrahedron size) with the default material
  * (0.15 kg), and each organ of assets/meshes (tissue_block, spleen, kidney,
@@ -14,18 +15,19 @@
  * highest vertex at 5 cm/s until it holds 1 N (or 8 mm down), is held
  * 0.2 s, then `steps` steps are timed one by one, by the thread's CPU time
  * (a loaded machine inflates it less than wall time) and by wall time.
- * XPBD rows also carry its S8-style accuracy on that organ: the RMS force
- * error of the same press (0.3 s: down, then held) against XPBD at 1/4 ms
- * with 4 sub-steps (its reference setting in S8), relative to the peak
- * reference force (--quick leaves it out).
+ * XPBD and molecular rows also carry their S8-style accuracy on that organ:
+ * the RMS force error of the same press (0.3 s: down, then held) against
+ * the model's reference at 1/4 ms (XPBD: 4 sub-steps, its reference setting
+ * in S8; molecular: Verlet with 4 sub-steps), relative to the peak reference
+ * force (--quick leaves it out).
  * Prints one row per case, then per model the fitted log-log slope of CPU
  * time against simulated nodes (the surface vertices of surface models, the
  * tetrahedral mesh's nodes of volume models; plot_loglog_slope), writes the plot as
  * PNG when OUT.png is given. Figures are never asserted; the machine's load
  * average is printed with them.
- * usage: bench_models [--quick] [--model NAME] [--xpbd-iterations N] [OUT.png]
- *   (--model: that model only; --xpbd-iterations: XPBD at N iterations, the
- *   reference still at 10) */
+ * usage: bench_models [--quick] [--model NAME] [--organ NAME] [--xpbd-iterations N] [OUT.png]
+ *   (--model, --organ: that model, that organ only; --xpbd-iterations: XPBD
+ *   at N iterations, the reference still at 10) */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -43,18 +45,30 @@ static const char *ORGANS[] = {"tissue_block", "spleen", "kidney", "gallbladder"
 
 typedef struct model_case {
   const char *label, *keys;
+  const char *ref; /* S8-style reference setting (run at 1/4 ms), NULL: no accuracy column */
 } model_case_t;
 
+#define MOL_MATERIAL                                                                                                   \
+  "    material: {mass: 0.15, bond_k: 30, angle_k: 3.0e-5, stretch_bend_k: 0, home_stiffness: 30, home_damping: "      \
+  "0.005}\n"
+/* Molecular reference: Verlet at 1/4 ms with 4 sub-steps (1/16 ms, 2.5-5x
+ * inside its stability bound on the shipped organs). */
+#define MOL_REF "    model: molecular\n    integrator: verlet\n    solver: {substeps: 4}\n" MOL_MATERIAL
+
 static model_case_t MODELS[] = {
-    {"mass_spring_surface", "    model: mass_spring_surface\n    integrator: symplectic_euler\n"
-                            "    material: {mass: 0.15}\n"},
-    {"mass_spring_tet", "    model: mass_spring_tet\n    integrator: symplectic_euler\n    material: {mass: 0.15}\n"},
-    {"molecular",
-     "    model: molecular\n    integrator: verlet\n    material: {mass: 0.15, bond_k: 30, angle_k: 3.0e-5, "
-     "stretch_bend_k: 0, home_stiffness: 30, home_damping: 0.005}\n"},
-    {"pbd", "    model: pbd\n    material: {mass: 0.15}\n"},
-    {"xpbd", "    model: xpbd\n    material: {mass: 0.15}\n"},
-    {"vertex_based", "    model: vertex_based\n    material: {mass: 0.15}\n"},
+    {"mass_spring_surface",
+     "    model: mass_spring_surface\n    integrator: symplectic_euler\n"
+     "    material: {mass: 0.15}\n",
+     NULL},
+    {"mass_spring_tet", "    model: mass_spring_tet\n    integrator: symplectic_euler\n    material: {mass: 0.15}\n",
+     NULL},
+    {"molecular", "    model: molecular\n    integrator: implicit_pcg\n" MOL_MATERIAL, MOL_REF},
+    {"molecular_verlet", "    model: molecular\n    integrator: verlet\n" MOL_MATERIAL, MOL_REF},
+    {"molecular_symplectic", "    model: molecular\n    integrator: symplectic_euler\n" MOL_MATERIAL, MOL_REF},
+    {"pbd", "    model: pbd\n    material: {mass: 0.15}\n", NULL},
+    {"xpbd", "    model: xpbd\n    material: {mass: 0.15}\n",
+     "    model: xpbd\n    material: {mass: 0.15}\n    solver: {substeps: 4, iterations: 10}\n"},
+    {"vertex_based", "    model: vertex_based\n    material: {mass: 0.15}\n", NULL},
 };
 #define NMODELS (sizeof MODELS / sizeof MODELS[0])
 
@@ -111,8 +125,8 @@ static int load(runtime_t *rt, scene_t *sc, const char *organ, const char *keys,
   return 0;
 }
 
-/* XPBD's S8-style error on this organ (see the file comment). */
-static double xpbd_accuracy(const char *organ, const char *keys, const char *ref_keys) {
+/* The S8-style error on this organ (see the file comment). */
+static double s8_accuracy(const char *organ, const char *keys, const char *ref_keys) {
   static scene_t sc;
   static runtime_t rt;
   enum { N = 300, R = 4 }; /* 0.3 s of 1 ms steps; the reference steps 1/4 ms */
@@ -183,17 +197,15 @@ static result_t run_case(const char *organ, const model_case_t *mc, int steps, i
   r.tets = m->ntets;
   free(c);
   runtime_destroy(&rt);
-  /* The reference is pinned at 10 iterations (the S8 setting), so runs at
-   * other iteration counts are judged against the same curve. */
-  if (!quick && !strncmp(mc->label, "xpbd", 4))
-    r.s8 = xpbd_accuracy(organ, mc->keys,
-                         "    model: xpbd\n    material: {mass: 0.15}\n    solver: {substeps: 4, iterations: 10}\n");
+  /* The XPBD reference is pinned at 10 iterations (the S8 setting), so runs
+   * at other iteration counts are judged against the same curve. */
+  if (!quick && mc->ref) r.s8 = s8_accuracy(organ, mc->keys, mc->ref);
   return r;
 }
 
 int main(int argc, char **argv) {
   int quick = 0;
-  const char *png = NULL, *only = NULL;
+  const char *png = NULL, *only = NULL, *organ = NULL;
   static char xpbd_keys[160];
   model_case_t *xpbd_case = NULL;
   for (size_t mi = 0; mi < NMODELS; mi++)
@@ -208,7 +220,9 @@ int main(int argc, char **argv) {
       snprintf(xpbd_keys, sizeof xpbd_keys,
                "    model: xpbd\n    material: {mass: 0.15}\n    solver: {iterations: %d}\n", atoi(argv[++i]));
       if (xpbd_case) xpbd_case->keys = xpbd_keys;
-    } else
+    } else if (!strcmp(argv[i], "--organ") && i + 1 < argc)
+      organ = argv[++i];
+    else
       png = argv[i];
   }
   int norgans = quick ? 3 : NORGANS, steps = quick ? 50 : 500;
@@ -224,6 +238,7 @@ int main(int argc, char **argv) {
     double xs[NORGANS], ys[NORGANS], ysub[NORGANS];
     size_t n = 0;
     for (int oi = 0; oi < norgans; oi++) {
+      if (organ && strcmp(organ, ORGANS[oi])) continue;
       result_t r = run_case(ORGANS[oi], &MODELS[mi], steps, quick);
       if (!r.ok) {
         printf("%-20s %-13s refused or failed\n", MODELS[mi].label, ORGANS[oi]);
