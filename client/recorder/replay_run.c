@@ -264,9 +264,17 @@ static int open_recording(replay_t *r) {
 static int publish_all(replay_t *r) {
   verr_t err;
   int status = 0;
+  rp_type_verdict_t *verdicts = NULL;
+  size_t nverdicts = 0;
   /* The loopback configuration by default; off loopback, DDS Security or
    * an explicit --insecure (vdds_config.h). */
   if (vdds_config_prepare(stderr, "replay", &err)) {
+    fprintf(stderr, "replay: %s\n", err.msg);
+    status = 1;
+    goto out;
+  }
+  /* Before the participant: the check forks (replay_topic.h). */
+  if (rp_types_precheck(r->db, r->o.path, &verdicts, &nverdicts, &err) < 0) {
     fprintf(stderr, "replay: %s\n", err.msg);
     status = 1;
     goto out;
@@ -289,8 +297,14 @@ static int publish_all(replay_t *r) {
     goto out;
   }
   size_t refused = 0;
-  rp_setup_t su = {
-      .db = r->db, .path = r->o.path, .pp = r->pp, .pub = r->pub, .speed = r->o.speed, .refused = &refused};
+  rp_setup_t su = {.db = r->db,
+                   .path = r->o.path,
+                   .pp = r->pp,
+                   .pub = r->pub,
+                   .speed = r->o.speed,
+                   .refused = &refused,
+                   .verdicts = verdicts,
+                   .nverdicts = nverdicts};
   if (rp_topics_setup(&su, &r->topics, &r->ntopics, &err) < 0) {
     fprintf(stderr, "replay: %s\n", err.msg);
     status = 1;
@@ -348,6 +362,7 @@ static int publish_all(replay_t *r) {
     status = 1;
   }
 out:
+  free(verdicts);
   if (r->pp > 0) dds_delete(r->pp);
   for (size_t i = 0; i < r->ntopics; i++) rp_topic_free(&r->topics[i]);
   free(r->topics);

@@ -226,8 +226,11 @@ static int setup_topic(const rp_setup_t *r, sqlite3_stmt *st, rp_topic_t *t, ver
   char why[200];
   if (rp_ops_check(t->ops, (uint32_t)nops, (uint32_t)size, t->nkeys, t->keys, why, sizeof why))
     return verr_set(err, "topic %s: stored type program is damaged: %s", t->name, why);
-  if (rp_types_check(t->typeinfo, tilen, t->typemap, tmlen, why, sizeof why))
-    return verr_set(err, "topic %s: stored type information is damaged: %s", t->name, why);
+  const rp_type_verdict_t *v = NULL;
+  for (size_t i = 0; r->verdicts && i < r->nverdicts; i++)
+    if (r->verdicts[i].id == t->id) v = &r->verdicts[i];
+  if (v ? !v->ok : rp_types_check(t->typeinfo, tilen, t->typemap, tmlen, why, sizeof why) != 0)
+    return verr_set(err, "topic %s: stored type information is damaged: %s", t->name, v ? v->why : why);
   /* A wrong ops length makes dds_create_topic hang (docs/dds.md, "Topic descriptors"): the stored
    * count must be what Cyclone counts in the stored program. */
   uint32_t counted = dds_stream_countops(t->ops, t->nkeys, t->keys);
@@ -282,5 +285,28 @@ int rp_topics_setup(const rp_setup_t *r, rp_topic_t **topics, size_t *ntopics, v
     fprintf(stderr, "replay: %s: topic table partly unreadable: %s\n", r->path, sqlite3_errmsg(r->db));
   sqlite3_finalize(st);
   if (*ntopics == 0) return verr_set(err, "%s: no topic could be set up for replay", r->path);
+  return 0;
+}
+
+int rp_types_precheck(sqlite3 *db, const char *path, rp_type_verdict_t **out, size_t *n, verr_t *err) {
+  *out = NULL;
+  *n = 0;
+  sqlite3_stmt *st = NULL;
+  if (sqlite3_prepare_v2(db, "SELECT id, typeinfo, typemap FROM topics ORDER BY id", -1, &st, NULL) != SQLITE_OK)
+    return verr_set(err, "%s: topic table unreadable: %s", path, sqlite3_errmsg(db));
+  while (sqlite3_step(st) == SQLITE_ROW) {
+    rp_type_verdict_t *grown = realloc(*out, (*n + 1) * sizeof *grown);
+    if (!grown) break;
+    *out = grown;
+    rp_type_verdict_t *v = &grown[(*n)++];
+    memset(v, 0, sizeof *v);
+    v->id = sqlite3_column_int64(st, 0);
+    const unsigned char *ti = sqlite3_column_blob(st, 1);
+    uint32_t tilen = (uint32_t)sqlite3_column_bytes(st, 1);
+    const unsigned char *tm = sqlite3_column_blob(st, 2);
+    uint32_t tmlen = (uint32_t)sqlite3_column_bytes(st, 2);
+    v->ok = rp_types_check(ti, tilen, tm, tmlen, v->why, sizeof v->why) == 0;
+  }
+  sqlite3_finalize(st);
   return 0;
 }

@@ -39,6 +39,13 @@ typedef struct rp_topic {
   uint64_t written, bad;
 } rp_topic_t;
 
+/* The outcome of one topic's stored type check (replay_typecheck.h). */
+typedef struct rp_type_verdict {
+  int64_t id; /* topics.id */
+  int ok;     /* 1: the stored type information reads */
+  char why[200];
+} rp_type_verdict_t;
+
 /* Where the topics come from and where they go. */
 typedef struct rp_setup {
   sqlite3 *db;      /* the recording, read-only: the descriptor columns recfile does not expose */
@@ -46,7 +53,19 @@ typedef struct rp_setup {
   dds_entity_t pp, pub;
   double speed;    /* --speed */
   size_t *refused; /* if not NULL: incremented per topic NOT replayed */
+  /* From rp_types_precheck, made before the participant existed: the
+   * check forks, and a child forked while Cyclone's threads run can
+   * deadlock on a lock one of them held (seen: a 60 s hang under the
+   * sanitizers on a loaded machine). NULL: checked here, forking now. */
+  const rp_type_verdict_t *verdicts;
+  size_t nverdicts;
 } rp_setup_t;
+
+/* Checks every topic's stored type information and mapping
+ * (rp_types_check), each in a child process: call it before any DDS entity
+ * (any thread) exists. *out: one verdict per topic row (caller frees).
+ * -1 with err when the topic table is unreadable. */
+int rp_types_precheck(sqlite3 *db, const char *path, rp_type_verdict_t **out, size_t *n, verr_t *err);
 
 /* Sets up every topic of the recording that can be (the others are named
  * on stderr as NOT replayed) into *topics (*ntopics of them, the caller
