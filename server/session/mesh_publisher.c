@@ -46,6 +46,7 @@ int mesh_publisher_init(mesh_publisher_t *mp, uint32_t organ_id, size_t nverts, 
 
 void mesh_publisher_destroy(mesh_publisher_t *mp) {
   free(mp->key);
+  free(mp->chunk_blob);
   free(mp->idx);
   free(mp->dq);
   free(mp->written_idx);
@@ -56,16 +57,17 @@ void mesh_publisher_destroy(mesh_publisher_t *mp) {
 /* The current keyframe as chunks. A failure (a keyframe too large for the
  * chunks, out of memory) is counted and leaves MeshState alone to carry it. */
 static int write_chunks(mesh_publisher_t *mp, uint64_t sim_time_ns) {
-  uint8_t *blob;
-  size_t len;
   verr_t err;
-  if (key_encode(mp->key, mp->nverts, mp->tris, mp->ntris, MESH_PUBLISHER_CHUNK_LEVEL, &blob, &len, &err)) {
+  if (!mp->chunk_blob && key_encode(mp->key, mp->nverts, mp->tris, mp->ntris, MESH_PUBLISHER_CHUNK_LEVEL,
+                                    &mp->chunk_blob, &mp->chunk_len, &err)) {
+    mp->chunk_blob = NULL;
     mp->chunk_failures++;
     return 0;
   }
-  int n = key_chunks_write(mp->w_chunk, mp->organ_id, mp->topology_version, mp->keyframe_seq, sim_time_ns, blob, len,
-                           mp->chunk_copies ? mp->chunk_copies : KEY_CHUNK_COPIES, &mp->chunks_written, &err);
-  free(blob);
+  size_t len = mp->chunk_len;
+  int n =
+      key_chunks_write(mp->w_chunk, mp->organ_id, mp->topology_version, mp->keyframe_seq, sim_time_ns, mp->chunk_blob,
+                       len, mp->chunk_copies ? mp->chunk_copies : KEY_CHUNK_COPIES, &mp->chunks_written, &err);
   if (n < 0) {
     mp->chunk_failures++;
     return 0;
@@ -90,6 +92,8 @@ int mesh_publisher_rechunk(mesh_publisher_t *mp) {
 int mesh_publisher_keyframe(mesh_publisher_t *mp, const double *x, uint64_t sim_time_ns) {
   if (mp->broken) return -1;
   for (size_t i = 0; i < 3 * mp->nverts; i++) mp->key[i] = (float)x[i];
+  free(mp->chunk_blob); /* a new keyframe: its chunks are encoded anew */
+  mp->chunk_blob = NULL;
   mp->keyframe_seq++;
   mp->keyframes++;
   mp->keyframe_payload_bytes += mesh_publisher_keyframe_bytes(mp);

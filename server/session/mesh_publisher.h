@@ -59,6 +59,11 @@ typedef struct mesh_publisher {
   uint64_t chunk_sets, chunk_samples, chunk_payload_bytes, chunk_failures;
   uint64_t key_sim_time_ns; /* of the current keyframe */
   uint64_t chunk_rewrites;  /* sets written again for new readers (mesh_publisher_rechunk) */
+  /* The current keyframe's chunk encoding (owned; NULL until first written,
+   * dropped by the next keyframe): a new reader's copy is sent again
+   * without deflating the same keyframe again in the step thread. */
+  uint8_t *chunk_blob;
+  size_t chunk_len;
   /* Counters. */
   uint64_t frames, keyframes, delta_payload_bytes, keyframe_payload_bytes, retopos;
   long last_count; /* vertices in the last delta */
