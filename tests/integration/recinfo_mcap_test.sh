@@ -35,6 +35,10 @@ REC="$OUT/demo/session.db"
 "$RECINFO" "$REC" --export mcap --foxglove-scene "$OUT/demo.mcap" 2> "$OUT/export.err" \
   || { cat "$OUT/export.err"; fail "export failed"; }
 cat "$OUT/export.err"
+# The recording holds XCDR2 (@appendable types); the export re-encodes every
+# message as XCDR1, which Foxglove's reader decodes (docs/dds.md "Schema evolution").
+grep -q ' XCDR2 messages re-encoded as XCDR1, 0 exported as recorded$' "$OUT/export.err" \
+  || fail "not every recorded XCDR2 message was re-encoded as XCDR1"
 # recinfo's own table: topic and data samples (notes under a topic are indented)
 "$RECINFO" "$REC" | awk '/^topic /{ t = 1; next } /^total:/{ t = 0 } t && NF > 3 && $0 !~ /^ / { print $1, $3 }' > "$OUT/counts.txt"
 [ "$(wc -l < "$OUT/counts.txt")" -ge 8 ] || fail "recinfo listed too few topics: $(cat "$OUT/counts.txt")"
