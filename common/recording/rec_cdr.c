@@ -590,6 +590,7 @@ static int x1_value(cur_t *c, const rt_type_t *t, x1_t *x, int depth) {
       if (rd(c, &v, 1) < 0) return -1;
       e = v;
     }
+    if (!rt_enum_name(t, e)) return fail(c, "enum value the type does not have");
     return x1_put(c, x, &e, 4);
   }
   case RT_BOOL: {

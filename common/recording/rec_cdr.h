@@ -50,8 +50,8 @@ int rt_cdr_fields(const rt_type_t *top, const void *cdr, size_t len, rt_field_cb
  * struct encodes there as a final one: members an older writer's sample
  * lacks get their default (0, "", empty, an enum's first literal), members
  * a newer writer appended are dropped. An XCDR1 sample is copied as it is.
- * The sample is checked as for the text forms (lengths, bounds, booleans,
- * enum literals); on error `out` is left as it was. */
+ * The sample is checked as Cyclone's own reader checks it (lengths, bounds,
+ * booleans, enum values the type has); on error `out` is left as it was. */
 int rt_cdr_to_xcdr1(const rt_type_t *top, const void *cdr, size_t len, rt_str_t *out, verr_t *err);
 
 #endif
