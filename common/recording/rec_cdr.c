@@ -56,7 +56,10 @@ static int begin(cur_t *c, const void *cdr, size_t len, verr_t *err) {
 }
 
 static bool is_scalar(const rt_type_t *t) { return t->kind <= RT_ENUM; }
-static bool is_primitive(const rt_type_t *t) { return t->kind < RT_STRING || t->kind == RT_ENUM; }
+/* XTypes' primitive types: not strings, not enums. XCDR2 puts a DHEADER
+ * before a sequence or array of anything else, enums included (Cyclone
+ * 0.10.2 does: docs/dds.md "Schema evolution"). */
+static bool is_primitive(const rt_type_t *t) { return t->kind < RT_STRING; }
 
 static void json_string(rt_str_t *o, const char *s, size_t len) {
   rt_str_append(o, "\"", 1);

@@ -12,6 +12,7 @@
 
 #include <dds/ddsi/ddsi_cdrstream.h>
 
+#include "cdr_cases.h"
 #include "check.h"
 #include "recording/rec_cdr.h"
 #include "recording/rec_idl.h"
@@ -28,6 +29,7 @@ static const dds_topic_descriptor_t *final_twin(const dds_topic_descriptor_t *de
   if (desc == &viscera_MeshDelta_desc) return &viscera_format2_MeshDelta_desc;
   if (desc == &viscera_SceneInfo_desc) return &viscera_format2_SceneInfo_desc;
   if (desc == &viscera_AppliedInput_desc) return &viscera_format2_AppliedInput_desc;
+  if (desc == &cdr_cases_Colors_desc) return &cdr_cases_ColorsFinal_desc;
   return NULL;
 }
 
@@ -367,7 +369,37 @@ static void test_xcdr1(void) {
   free(b2);
 }
 
+/* Collections of enums and of strings carry a DHEADER in XCDR2, of octets
+ * none: JSON from both encodings, and the XCDR1 re-encoding. */
+static void test_collections(void) {
+  cdr_cases_Color seq[3] = {cdr_cases_GREEN, cdr_cases_BLUE, cdr_cases_RED};
+  char names[2][9] = {"ab", "cdef"};
+  uint8_t raw[3] = {1, 2, 255};
+  cdr_cases_Colors v = {.seq = {3, 3, seq, false},
+                        .names = {2, 2, names, false},
+                        .arr = {cdr_cases_BLUE, cdr_cases_GREEN},
+                        .raw = {3, 3, raw, false},
+                        .last = -0.5};
+  rt_model_t m;
+  CHECK(load(&m, &cdr_cases_Colors_desc, "cdr_cases::Colors") == 0);
+  const char *want = "{\"seq\":[\"GREEN\",\"BLUE\",\"RED\"],\"names\":[\"ab\",\"cdef\"],\"arr\":[\"BLUE\",\"GREEN\"],"
+                     "\"raw\":[1,2,255],\"last\":-0.5}";
+  for (int x = 1; x <= 2; x++) {
+    size_t len;
+    unsigned char *b = serialize(&v, &cdr_cases_Colors_desc, x, &len);
+    rt_str_t o = {0};
+    verr_t err = {{0}};
+    CHECK(rt_cdr_json(m.top, b, len, &o, &err) == 0 && o.s && strcmp(o.s, want) == 0);
+    if (!o.s || strcmp(o.s, want)) fprintf(stderr, "XCDR%d: %s %s\n", x, o.s ? o.s : "", err.msg);
+    rt_str_free(&o);
+    free(b);
+  }
+  rt_model_free(&m);
+  check_x1(&v, &cdr_cases_Colors_desc, "cdr_cases::Colors");
+}
+
 int main(void) {
+  test_collections();
   test_xcdr1();
   test_fields();
   test_idl();
