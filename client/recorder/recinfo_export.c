@@ -38,7 +38,9 @@ typedef struct mcap_ctx {
   size_t nwriters;
   chan_t *chans;
   size_t nchans;
-  uint64_t messages, other_rows;
+  rt_model_t *models; /* per topic (recfile_topic order): its recorded type; top NULL when unreadable */
+  rt_str_t x1;        /* the message re-encoded as XCDR1 */
+  uint64_t messages, other_rows, reencoded, not_reencoded;
   verr_t err;
   bool failed;
 } mcap_ctx_t;
@@ -66,15 +68,32 @@ static int on_mcap_row(void *arg, const recfile_row_t *row) {
     }
   }
   uint64_t t = row->source_ts_ns > 0 ? (uint64_t)row->source_ts_ns : 0;
-  if (mcap_message(c->w, (uint16_t)(k + 1), c->chans[k].seq++, t, t, row->cdr, row->cdr_len, &c->err) < 0) {
+  size_t ti = 0;
+  while (ti < recfile_topic_count(c->rf) && recfile_topic(c->rf, ti)->id != row->topic_id) ti++;
+  /* XCDR2 samples go out as XCDR1 (docs/dds.md "Schema evolution": Foxglove's
+   * reader misreads XCDR2 collections of structs); one that does not fit its
+   * type goes out as recorded, counted. */
+  const void *msg = row->cdr;
+  size_t len = row->cdr_len;
+  if (ti < recfile_topic_count(c->rf) && c->models[ti].top && row->cdr_len >= 4 &&
+      ((const unsigned char *)row->cdr)[1] >= 6) {
+    verr_t e = {{0}};
+    c->x1.len = 0;
+    if (rt_cdr_to_xcdr1(c->models[ti].top, row->cdr, row->cdr_len, &c->x1, &e) == 0) {
+      msg = c->x1.s, len = c->x1.len;
+      c->reencoded++;
+    } else if (c->not_reencoded++ == 0) {
+      fprintf(stderr, "recinfo: warning: row %lld (%s): not re-encoded as XCDR1 (%s); exported as recorded\n",
+              (long long)row->id, recfile_topic(c->rf, ti)->name, e.msg);
+    }
+  }
+  if (mcap_message(c->w, (uint16_t)(k + 1), c->chans[k].seq++, t, t, msg, len, &c->err) < 0) {
     c->failed = true;
     return 1;
   }
   c->messages++;
   if (c->scene) {
-    const char *topic = "";
-    for (size_t i = 0; i < recfile_topic_count(c->rf); i++)
-      if (recfile_topic(c->rf, i)->id == row->topic_id) topic = recfile_topic(c->rf, i)->name;
+    const char *topic = ti < recfile_topic_count(c->rf) ? recfile_topic(c->rf, ti)->name : "";
     if (export_scene_row(c->scene, topic, row, &c->err) < 0) {
       c->failed = true;
       return 1;
@@ -127,20 +146,23 @@ static int export_mcap(recfile_t *rf, const char *out, bool scene, bool quiet) {
   }
   size_t ntopics = recfile_topic_count(rf), nschemas = 0;
   uint16_t *schema_of = calloc(ntopics ? ntopics : 1, sizeof *schema_of);
+  c.models = calloc(ntopics ? ntopics : 1, sizeof *c.models);
+  if (!c.models) free(schema_of), schema_of = NULL;
   for (size_t i = 0; schema_of && i < ntopics && status == 0; i++) {
     const recfile_topic_t *t = recfile_topic(rf, i);
-    rt_model_t m;
+    rt_model_t *m = &c.models[i];
     rt_str_t idl = {0};
     verr_t e = {{0}};
-    if (rt_model_load_topic(&m, rf, t, &e) < 0 || rt_idl_text(&m, &idl, &e) < 0) {
+    if (rt_model_load_topic(m, rf, t, &e) < 0 || rt_idl_text(m, &idl, &e) < 0) {
       fprintf(stderr, "recinfo: warning: %s: topic %s: no schema (%s); its messages are exported without one\n", path,
               t->name, e.msg);
+      rt_model_free(m);
+      memset(m, 0, sizeof *m);
     } else {
       schema_of[i] = (uint16_t)++nschemas;
       if (mcap_schema(c.w, schema_of[i], t->type_name, "omgidl", idl.s, idl.len, &err) < 0) status = 1;
     }
     rt_str_free(&idl);
-    rt_model_free(&m);
   }
   for (size_t k = 0; schema_of && k < c.nchans && status == 0; k++) {
     const recfile_topic_t *t = NULL;
@@ -185,6 +207,13 @@ static int export_mcap(recfile_t *rf, const char *out, bool scene, bool quiet) {
             "not exported\n",
             out, (unsigned long long)c.messages, c.nchans, nschemas, c.other_rows ? "; " : "; ",
             (unsigned long long)c.other_rows);
+  if (!quiet && (c.reencoded || c.not_reencoded))
+    fprintf(stderr, "recinfo: %s: %llu XCDR2 messages re-encoded as XCDR1, %llu exported as recorded\n", out,
+            (unsigned long long)c.reencoded, (unsigned long long)c.not_reencoded);
+  for (size_t i = 0; c.models && i < ntopics; i++)
+    if (c.models[i].top) rt_model_free(&c.models[i]);
+  free(c.models);
+  rt_str_free(&c.x1);
   free(schema_of);
   free(c.chans);
   free(writers);

@@ -97,9 +97,12 @@ static int adr(walk_t *w, uint32_t p, unsigned depth, uint32_t size, uint32_t *l
   return bad(w, p, "member kind replay does not verify");
 }
 
-/* A struct's program from p to its RTS; members lie inside `size` bytes. */
+/* A struct's program from p to its RTS; members lie inside `size` bytes.
+ * An @appendable struct's program starts with DLC (its samples carry a
+ * delimiter in XCDR2); DLC anywhere else, and PLC (mutable), are refused. */
 static int walk_from(walk_t *w, uint32_t p, unsigned depth, uint32_t size) {
   if (depth > OPS_MAX_DEPTH) return bad(w, p, "nesting deeper than 16 levels");
+  if (p < w->nops && w->ops[p] == DDS_OP_DLC) p++;
   while (p < w->nops) {
     if (++w->steps > OPS_MAX_STEPS) return bad(w, p, "program too long to verify");
     uint32_t insn = w->ops[p];

@@ -56,7 +56,10 @@ static int begin(cur_t *c, const void *cdr, size_t len, verr_t *err) {
 }
 
 static bool is_scalar(const rt_type_t *t) { return t->kind <= RT_ENUM; }
-static bool is_primitive(const rt_type_t *t) { return t->kind < RT_STRING || t->kind == RT_ENUM; }
+/* XTypes' primitive types: not strings, not enums. XCDR2 puts a DHEADER
+ * before a sequence or array of anything else, enums included (Cyclone
+ * 0.10.2 does: docs/dds.md "Schema evolution"). */
+static bool is_primitive(const rt_type_t *t) { return t->kind < RT_STRING; }
 
 static void json_string(rt_str_t *o, const char *s, size_t len) {
   rt_str_append(o, "\"", 1);
@@ -435,4 +438,197 @@ int rt_cdr_fields(const rt_type_t *top, const void *cdr, size_t len, rt_field_cb
   int r = visit_struct(&c, top, "", &v, 0);
   rt_str_free(&v.tmp);
   return r;
+}
+
+/* XCDR1 re-encoding (rt_cdr_to_xcdr1). XCDR1 aligns every primitive to its
+ * size (at most 8) from the start of the payload, has no DHEADER, and
+ * encodes an enum in 4 bytes; values keep the sample's byte order. */
+typedef struct x1 {
+  rt_str_t *o;
+  size_t base; /* where the payload starts in o */
+  size_t cap;  /* most payload bytes written: defaults of absent members must not blow up */
+} x1_t;
+
+static int x1_put(cur_t *c, x1_t *x, const void *host, size_t size) {
+  static const char zero[8] = {0};
+  size_t rel = x->o->len - x->base, pad = (size - rel % size) % size;
+  if (rel + pad + size > x->cap) return fail(c, "re-encoded sample too large");
+  uint8_t tmp[8];
+  memcpy(tmp, host, size);
+  if (c->swap)
+    for (size_t i = 0; i < size / 2; i++) {
+      uint8_t t = tmp[i];
+      tmp[i] = tmp[size - 1 - i], tmp[size - 1 - i] = t;
+    }
+  rt_str_append(x->o, zero, pad);
+  rt_str_append(x->o, (const char *)tmp, size);
+  return x->o->oom ? verr_set(c->err, "out of memory") : 0;
+}
+
+static size_t prim_size(const rt_type_t *t) {
+  switch (t->kind) {
+  case RT_INT16:
+  case RT_UINT16:
+    return 2;
+  case RT_INT32:
+  case RT_UINT32:
+  case RT_FLOAT32:
+  case RT_ENUM:
+    return 4;
+  case RT_INT64:
+  case RT_UINT64:
+  case RT_FLOAT64:
+    return 8;
+  default:
+    return 1;
+  }
+}
+
+/* The default value (XTypes: zero, "", empty, an enum's first literal) of
+ * a member an older writer's sample lacks. */
+static int x1_default(cur_t *c, const rt_type_t *t, x1_t *x, int depth) {
+  if (depth > RT_MAX_DEPTH * 2) return fail(c, "nested too deep");
+  uint8_t zero[8] = {0};
+  switch (t->kind) {
+  case RT_ENUM: {
+    int32_t v = t->nliterals ? t->literals[0].value : 0;
+    return x1_put(c, x, &v, 4);
+  }
+  case RT_STRING: {
+    uint32_t one = 1;
+    if (x1_put(c, x, &one, 4) < 0) return -1;
+    return x1_put(c, x, zero, 1);
+  }
+  case RT_STRUCT:
+    if (t->base && x1_default(c, t->base, x, depth + 1) < 0) return -1;
+    for (uint32_t i = 0; i < t->nmembers; i++)
+      if (x1_default(c, t->members[i].type, x, depth + 1) < 0) return -1;
+    return 0;
+  case RT_SEQUENCE:
+    return x1_put(c, x, zero, 4);
+  case RT_ARRAY: {
+    uint64_t n = 1;
+    for (int i = 0; i < t->ndims; i++) n *= t->dims[i];
+    for (uint64_t i = 0; i < n; i++)
+      if (x1_default(c, t->elem, x, depth + 1) < 0) return -1;
+    return 0;
+  }
+  default:
+    return x1_put(c, x, zero, prim_size(t));
+  }
+}
+
+static int x1_value(cur_t *c, const rt_type_t *t, x1_t *x, int depth);
+
+static int x1_elements(cur_t *c, const rt_type_t *elem, uint64_t n, x1_t *x, int depth) {
+  if (n > c->n - c->pos) return fail(c, "element count beyond the sample");
+  for (uint64_t i = 0; i < n; i++)
+    if (x1_value(c, elem, x, depth + 1) < 0) return -1;
+  return 0;
+}
+
+static int x1_value(cur_t *c, const rt_type_t *t, x1_t *x, int depth) {
+  if (depth > RT_MAX_DEPTH * 2) return fail(c, "nested too deep");
+  size_t end;
+  switch (t->kind) {
+  case RT_STRUCT: {
+    if (t->ext == RT_MUTABLE) return fail(c, "mutable struct");
+    if (dheader(c, t->ext == RT_APPENDABLE, &end) < 0) return -1;
+    if (t->base && x1_value(c, t->base, x, depth + 1) < 0) return -1;
+    for (uint32_t i = 0; i < t->nmembers; i++) {
+      const rt_member_t *m = &t->members[i];
+      c->where = m->name;
+      if (m->optional) return fail(c, "optional members are not decoded");
+      int r = end != SIZE_MAX && c->pos >= end ? x1_default(c, m->type, x, depth + 1) /* an older writer's */
+                                               : x1_value(c, m->type, x, depth + 1);
+      if (r < 0) return -1;
+    }
+    if (end != SIZE_MAX) {
+      if (c->pos > end) return fail(c, "members run past their struct's DHEADER");
+      c->pos = end; /* members a newer type appended are dropped */
+    }
+    return 0;
+  }
+  case RT_SEQUENCE: {
+    if (dheader(c, !is_primitive(t->elem), &end) < 0) return -1;
+    uint32_t n;
+    if (rd_u32(c, &n) < 0 || x1_put(c, x, &n, 4) < 0) return -1;
+    if (t->bound && n > t->bound) return fail(c, "sequence longer than its bound");
+    if (x1_elements(c, t->elem, n, x, depth) < 0) return -1;
+    if (end != SIZE_MAX) c->pos = end;
+    return 0;
+  }
+  case RT_ARRAY: {
+    if (dheader(c, !is_primitive(t->elem), &end) < 0) return -1;
+    uint64_t n = 1;
+    for (int i = 0; i < t->ndims; i++) n *= t->dims[i];
+    if (x1_elements(c, t->elem, n, x, depth) < 0) return -1;
+    if (end != SIZE_MAX) c->pos = end;
+    return 0;
+  }
+  case RT_STRING: {
+    uint32_t len;
+    if (rd_u32(c, &len) < 0) return -1;
+    if (len == 0 || len > c->n - c->pos) return fail(c, "string length out of range");
+    if (t->bound && len - 1 > t->bound) return fail(c, "string longer than its bound");
+    const char *s = (const char *)c->b + c->pos;
+    if (s[len - 1] != 0 || memchr(s, 0, len - 1)) return fail(c, "string not NUL-terminated");
+    if (x1_put(c, x, &len, 4) < 0) return -1;
+    if (x->o->len - x->base + len > x->cap) return fail(c, "re-encoded sample too large");
+    rt_str_append(x->o, s, len);
+    c->pos += len;
+    return 0;
+  }
+  case RT_ENUM: {
+    int32_t e = 0;
+    int bits = t->bit_bound ? t->bit_bound : 32;
+    if (!c->v2 || bits > 16) {
+      if (rd(c, &e, 4) < 0) return -1;
+    } else if (bits > 8) {
+      int16_t v;
+      if (rd(c, &v, 2) < 0) return -1;
+      e = v;
+    } else {
+      int8_t v;
+      if (rd(c, &v, 1) < 0) return -1;
+      e = v;
+    }
+    if (!rt_enum_name(t, e)) return fail(c, "enum value the type does not have");
+    return x1_put(c, x, &e, 4);
+  }
+  case RT_BOOL: {
+    uint8_t v;
+    if (rd(c, &v, 1) < 0) return -1;
+    if (v > 1) return fail(c, "boolean neither 0 nor 1");
+    return x1_put(c, x, &v, 1);
+  }
+  default: {
+    if (!is_scalar(t)) return fail(c, "unknown type kind");
+    uint8_t v[8];
+    size_t size = prim_size(t);
+    if (rd(c, v, size) < 0) return -1;
+    return x1_put(c, x, v, size);
+  }
+  }
+}
+
+int rt_cdr_to_xcdr1(const rt_type_t *top, const void *cdr, size_t len, rt_str_t *out, verr_t *err) {
+  cur_t c;
+  if (begin(&c, cdr, len, err) < 0) return -1;
+  size_t mark = out->len;
+  const uint8_t *b = cdr;
+  if (!c.v2) { /* already XCDR1 */
+    rt_str_append(out, cdr, len);
+    return out->oom ? verr_set(err, "out of memory") : 0;
+  }
+  const char head[4] = {0, (char)(b[1] & 1u), 0, 0}; /* CDR_BE 0 / CDR_LE 1: the sample's byte order */
+  rt_str_append(out, head, 4);
+  x1_t x = {out, out->len, len * 64 + 65536};
+  if (x1_value(&c, top, &x, 0) < 0 || out->oom) {
+    if (out->oom) verr_set(err, "out of memory");
+    out->len = mark;
+    if (out->s) out->s[mark] = 0;
+    return -1;
+  }
+  return 0;
 }

@@ -43,4 +43,15 @@ typedef struct rt_field {
 typedef void (*rt_field_cb)(void *arg, const rt_field_t *f);
 int rt_cdr_fields(const rt_type_t *top, const void *cdr, size_t len, rt_field_cb cb, void *arg, verr_t *err);
 
+/* The sample re-encoded as XCDR1 (plain CDR, encoding header CDR_LE or
+ * CDR_BE in the sample's byte order) into `out` (binary: 4-byte header +
+ * payload, appended), for readers that cannot take XCDR2 (the MCAP export:
+ * docs/dds.md "Schema evolution"). XCDR1 has no DHEADER, so an appendable
+ * struct encodes there as a final one: members an older writer's sample
+ * lacks get their default (0, "", empty, an enum's first literal), members
+ * a newer writer appended are dropped. An XCDR1 sample is copied as it is.
+ * The sample is checked as Cyclone's own reader checks it (lengths, bounds,
+ * booleans, enum values the type has); on error `out` is left as it was. */
+int rt_cdr_to_xcdr1(const rt_type_t *top, const void *cdr, size_t len, rt_str_t *out, verr_t *err);
+
 #endif

@@ -94,11 +94,11 @@ damaged ts_min_nosession "DELETE FROM session; UPDATE samples SET source_ts_ns =
 run ts_min_nosession 1 "outside the recording's span" "$REPLAY" "$WORK/ts_min_nosession.db" "${RP[@]}"
 
 echo "== 4. one flipped bit in a MeshDelta header"
-# MeshDelta CDR: 4-byte header, organ_id, topology_version, keyframe_seq,
-# frame_seq, then sim_time_ns (little-endian) at bytes 20..27: byte 25 bit 4
-# is bit 44 of the time, +17,592 s.
+# MeshDelta CDR (XCDR2, @appendable): 4-byte header, DHEADER, organ_id,
+# topology_version, keyframe_seq, frame_seq, then sim_time_ns (little-endian,
+# aligned to 4) at bytes 24..31: byte 29 bit 4 is bit 44 of the time, +17,592 s.
 cp "$DB" "$WORK/flip.db"
-"$FLIP" "$WORK/flip.db" viscera_MeshDelta 10 25 16 || fail=1
+"$FLIP" "$WORK/flip.db" viscera_MeshDelta 10 29 16 || fail=1
 run resim_flip_reported "0|1" "beyond the recording" "$RESIM" --scene "$SRC/assets/scenes/default.yaml" \
   "$WORK/flip.db" --quiet
 steps=$(sed -n 's/^RESIM [A-Z]* steps=\([0-9]*\).*/\1/p' "$WORK/resim_flip_reported.out")

@@ -35,6 +35,10 @@ REC="$OUT/demo/session.db"
 "$RECINFO" "$REC" --export mcap --foxglove-scene "$OUT/demo.mcap" 2> "$OUT/export.err" \
   || { cat "$OUT/export.err"; fail "export failed"; }
 cat "$OUT/export.err"
+# The recording holds XCDR2 (@appendable types); the export re-encodes every
+# message as XCDR1, which Foxglove's reader decodes (docs/dds.md "Schema evolution").
+grep -q ' XCDR2 messages re-encoded as XCDR1, 0 exported as recorded$' "$OUT/export.err" \
+  || fail "not every recorded XCDR2 message was re-encoded as XCDR1"
 # recinfo's own table: topic and data samples (notes under a topic are indented)
 "$RECINFO" "$REC" | awk '/^topic /{ t = 1; next } /^total:/{ t = 0 } t && NF > 3 && $0 !~ /^ / { print $1, $3 }' > "$OUT/counts.txt"
 [ "$(wc -l < "$OUT/counts.txt")" -ge 8 ] || fail "recinfo listed too few topics: $(cat "$OUT/counts.txt")"
@@ -53,6 +57,17 @@ awk -v g="$(got tool0_contact_time)" -v w="$(srv contact_time)" \
   || fail "decoded contact time $(got tool0_contact_time), server $(srv contact_time)"
 grep -q '^scene_updates=[1-9]' "$OUT/read.out" || fail "no Foxglove scene update in the export"
 echo "ok: decoded peak $(got tool0_peak_force) N, contact $(got tool0_contact_time) s = the server's PALPATION line"
+# The recordings every build must read (tests/data: formats 1 and 2 final
+# types in XCDR1, format 3 @appendable in XCDR2) export and decode as well.
+for db in "$SRC"/tests/data/*.db; do
+  n=$(basename "$db" .db)
+  "$RECINFO" "$db" --export mcap "$OUT/$n.mcap" 2> "$OUT/$n.err" || { cat "$OUT/$n.err"; fail "$n: export failed"; }
+  "$RECINFO" "$db" | awk '/^topic /{ t = 1; next } /^total:/{ t = 0 } t && NF > 3 && $0 !~ /^ / { print $1, $3 }' \
+    > "$OUT/$n.counts"
+  NODE_PATH="$NPM/node_modules" node "$SRC/tests/integration/mcap_read.js" "$OUT/$n.mcap" "$OUT/$n.counts" \
+    > "$OUT/$n.read" || { cat "$OUT/$n.read"; fail "$n: the MCAP reader rejected the export"; }
+  echo "ok: tests/data/$n.db: $(tail -1 "$OUT/$n.read")"
+done
 # A damaged export is caught: the reader must fail on a flipped byte in a chunk.
 cp "$OUT/demo.mcap" "$OUT/bad.mcap"
 # (the middle of the file lies inside a chunk: its CRC must catch the change)

@@ -97,8 +97,13 @@ int main(void) {
     ops[3] = (4u << 16) | 0xfff0u; /* 16 ops before the start */
     CHECK(!ops_ok(d, ops, n, why) && strstr(why, "outside the stored program"));
     memcpy(ops, d->m_ops, n * sizeof *ops);
-    ops[1] = d->m_size; /* the first member just outside the sample */
+    uint32_t first = ops[0] == DDS_OP_DLC; /* @appendable: the program starts with DLC */
+    CHECK(first == 1);                     /* every product type is @appendable (idl/viscera.idl) */
+    ops[first + 1] = d->m_size;            /* the first member just outside the sample */
     CHECK(!ops_ok(d, ops, n, why) && strstr(why, "offset outside the sample"));
+    memcpy(ops, d->m_ops, n * sizeof *ops);
+    ops[first] = DDS_OP_DLC; /* a DLC where the first member was: refused */
+    CHECK(!ops_ok(d, ops, n, why) && strstr(why, "op 1"));
     memcpy(ops, d->m_ops, n * sizeof *ops);
     for (uint32_t k = 0; k < n; k++) ops[k] = ops[k] == DDS_OP_RTS ? 0xffffffffu : ops[k]; /* no end */
     CHECK(!ops_ok(d, ops, n, why));

@@ -1,27 +1,46 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* rec_types, rec_idl, rec_cdr: a topic's type rebuilt from its XTypes
  * type information (here the compiled one, as the recorder stores it), its
- * OMG IDL text, and samples serialized as a writer does (XCDR1 and XCDR2,
+ * OMG IDL text, and samples serialized as a writer does (XCDR2 of today's
+ * @appendable types; XCDR1 as recordings of the final types hold it,
  * little-endian) decoded into JSON and CSV; every truncation and garbled
- * length is refused with a message, never read out of bounds. */
+ * length is refused with a message, never read out of bounds. XCDR2
+ * re-encoded as XCDR1 (the MCAP export) equals Cyclone's own XCDR1 of the
+ * final type, byte for byte. */
 #include <stdlib.h>
 #include <string.h>
 
 #include <dds/ddsi/ddsi_cdrstream.h>
 
+#include "cdr_cases.h"
 #include "check.h"
 #include "recording/rec_cdr.h"
 #include "recording/rec_idl.h"
 #include "recording/rec_types.h"
 #include "viscera.h"
+#include "viscera_format2.h"
 
-/* Encoding header + payload as stored; xcdr 1 or 2. Caller frees. */
+/* The final type of the same layout (format 2 froze these types unchanged
+ * but final): Cyclone 0.10.2 writes XCDR1 only for final types, which is
+ * what recordings made before the types became @appendable hold. */
+static const dds_topic_descriptor_t *final_twin(const dds_topic_descriptor_t *desc) {
+  if (desc == &viscera_SessionEvent_desc) return &viscera_format2_SessionEvent_desc;
+  if (desc == &viscera_ContactFeedback_desc) return &viscera_format2_ContactFeedback_desc;
+  if (desc == &viscera_MeshDelta_desc) return &viscera_format2_MeshDelta_desc;
+  if (desc == &viscera_SceneInfo_desc) return &viscera_format2_SceneInfo_desc;
+  if (desc == &viscera_AppliedInput_desc) return &viscera_format2_AppliedInput_desc;
+  if (desc == &cdr_cases_Colors_desc) return &cdr_cases_ColorsFinal_desc;
+  return NULL;
+}
+
+/* Encoding header + payload as stored; xcdr 1 (CDR_LE, with the final twin)
+ * or 2 (D_CDR2_LE). Caller frees. */
 static unsigned char *serialize(const void *sample, const dds_topic_descriptor_t *desc, int xcdr, size_t *len) {
   dds_ostream_t os;
   dds_ostream_init(&os, 0, (uint32_t)xcdr);
-  dds_stream_write(&os, sample, desc->m_ops);
+  dds_stream_write(&os, sample, (xcdr == 1 ? final_twin(desc) : desc)->m_ops);
   unsigned char *b = malloc(os.m_index + 4);
-  b[0] = 0, b[1] = xcdr == 1 ? 1 : 7, b[2] = 0, b[3] = 0;
+  b[0] = 0, b[1] = xcdr == 1 ? 1 : 9, b[2] = 0, b[3] = 0;
   memcpy(b + 4, os.m_buffer, os.m_index);
   *len = os.m_index + 4;
   dds_ostream_fini(&os);
@@ -43,7 +62,7 @@ static void test_idl(void) {
   CHECK(rt_idl_text(&m, &idl, &err) == 0);
   const char *organ = strstr(idl.s, "struct OrganInfo {"), *scene = strstr(idl.s, "struct SceneInfo {");
   CHECK(organ && scene && organ < scene); /* used before it is used */
-  CHECK(strstr(idl.s, "module viscera {\n@final\nstruct SceneInfo {\n  string<64> scene;\n"));
+  CHECK(strstr(idl.s, "module viscera {\n@appendable\nstruct SceneInfo {\n  string<64> scene;\n"));
   CHECK(strstr(idl.s, "  sequence<viscera::OrganInfo> organs;\n"));
   CHECK(strstr(idl.s, "  float color[3];\n"));
   rt_str_free(&idl);
@@ -134,7 +153,7 @@ static void test_csv(void) {
     CHECK(rt_cdr_csv(m.top, b, len, &o, &err) == 0);
     CHECK(o.s && strcmp(o.s, "2,99,0,5000000,true,0,0,0,0,0,0,0,400,0.5,-0.25,1,7") == 0);
     /* a boolean that is neither 0 nor 1 */
-    size_t at = x == 1 ? 4 + 32 : 4 + 28; /* XCDR2 aligns 8-byte fields to 4 */
+    size_t at = 4 + 32; /* XCDR1: 3 x 8 aligned to 8 after 4 + pad; XCDR2: DHEADER, then 8-byte fields aligned to 4 */
     CHECK(b[at] == 1);
     b[at] = 5;
     CHECK(rt_cdr_csv(m.top, b, len, &o, &err) < 0 && strstr(err.msg, "boolean"));
@@ -217,7 +236,171 @@ static void test_fields(void) {
   rt_model_free(&m);
 }
 
+/* XCDR2 -> XCDR1 (rt_cdr_to_xcdr1) equals Cyclone's XCDR1 of the final
+ * type, with nested appendable structs in a sequence (SceneInfo.tools,
+ * AppliedInput.tools) and 8-byte members that XCDR1 aligns to 8; a member
+ * an older writer lacks gets its default. */
+static void check_x1(const void *sample, const dds_topic_descriptor_t *desc, const char *name) {
+  rt_model_t m;
+  CHECK(load(&m, desc, name) == 0);
+  size_t l1, l2;
+  unsigned char *b1 = serialize(sample, desc, 1, &l1), *b2 = serialize(sample, desc, 2, &l2);
+  rt_str_t o = {0};
+  verr_t err = {{0}};
+  CHECK(rt_cdr_to_xcdr1(m.top, b2, l2, &o, &err) == 0);
+  CHECK(o.len == l1 && memcmp(o.s, b1, l1) == 0);
+  if (o.len != l1 || memcmp(o.s, b1, l1))
+    fprintf(stderr, "%s: XCDR1 re-encoding differs (%zu vs %zu bytes)\n", name, o.len, l1);
+  o.len = 0; /* XCDR1 in: copied */
+  CHECK(rt_cdr_to_xcdr1(m.top, b1, l1, &o, &err) == 0 && o.len == l1 && memcmp(o.s, b1, l1) == 0);
+  int ok = 0; /* every truncation refused, the output left as it was */
+  for (size_t n = 0; n < l2; n++) {
+    o.len = 0;
+    ok += rt_cdr_to_xcdr1(m.top, b2, n, &o, &err) == 0;
+    CHECK(o.len == 0);
+  }
+  CHECK(ok == 0);
+  rt_str_free(&o);
+  free(b1);
+  free(b2);
+  rt_model_free(&m);
+}
+
+/* Damaged XCDR2 samples (1-3 random bytes changed): never a crash or a
+ * read out of bounds (this test runs under the sanitizers too), and every
+ * re-encoding accepted is well-formed XCDR1 of the final type: Cyclone's
+ * own reader (dds_stream_normalize) takes it. */
+static void mutate_x1(const void *sample, const dds_topic_descriptor_t *desc, const char *name) {
+  rt_model_t m;
+  CHECK(load(&m, desc, name) == 0);
+  size_t len;
+  unsigned char *b = serialize(sample, desc, 2, &len), *g = malloc(len);
+  rt_str_t o = {0};
+  verr_t err = {{0}};
+  int accepted = 0, refused = 0, wellformed = 0;
+  srand(11);
+  for (int k = 0; k < 4000; k++) {
+    memcpy(g, b, len);
+    for (int e = 1 + rand() % 3; e > 0; e--) g[4 + (size_t)rand() % (len - 4)] = (unsigned char)rand();
+    o.len = 0;
+    if (rt_cdr_to_xcdr1(m.top, g, len, &o, &err) < 0) {
+      refused++;
+      continue;
+    }
+    accepted++;
+    uint32_t off = 0, size = (uint32_t)(o.len - 4);
+    char *p = malloc(size ? size : 1);
+    memcpy(p, o.s + 4, size);
+    wellformed += dds_stream_normalize_data(p, &off, size, false, 1, final_twin(desc)->m_ops) != NULL;
+    free(p);
+  }
+  printf("%s: 4000 damaged XCDR2 samples: %d re-encoded (%d taken by Cyclone's XCDR1 reader), %d refused\n", name,
+         accepted, wellformed, refused);
+  CHECK(wellformed == accepted && refused > 0 && accepted > 0);
+  rt_str_free(&o);
+  free(g);
+  free(b);
+  rt_model_free(&m);
+}
+
+static void test_xcdr1(void) {
+  viscera_SceneInfo si;
+  memset(&si, 0, sizeof si);
+  snprintf(si.scene, sizeof si.scene, "kidney");
+  si.physics_dt = 0.001, si.publish_hz = 60, si.quant_step = 1e-5f;
+  viscera_ToolInfo tools[2];
+  memset(tools, 0, sizeof tools);
+  tools[0].tool_id = 0, tools[0].mpf = 0.8f;
+  snprintf(tools[0].name, sizeof tools[0].name, "probe");
+  tools[1].tool_id = 1, tools[1].radius = 0.002f;
+  snprintf(tools[1].kind, sizeof tools[1].kind, "grasper");
+  si.tools._buffer = tools;
+  si.tools._length = si.tools._maximum = 2;
+  check_x1(&si, &viscera_SceneInfo_desc, "viscera::SceneInfo");
+  mutate_x1(&si, &viscera_SceneInfo_desc, "viscera::SceneInfo");
+  viscera_AppliedInput in;
+  memset(&in, 0, sizeof in);
+  in.tick = 5, in.step = 4, in.sim_time_ns = 4000000, in.seq = 3;
+  viscera_AppliedTool at = {.tool_id = 0,
+                            .position = {0.01, -0.02, 0.03},
+                            .orientation = {1, 0, 0, 0},
+                            .buttons = 1,
+                            .max_force = 3,
+                            .cmd_seq = 9};
+  viscera_AppliedControl ac = {.source_id = 7,
+                               .seq = 1,
+                               .kind = viscera_CONTROL_GUIDE,
+                               .tool_id = 0,
+                               .organ_id = -1,
+                               .values = {0.5, 200, 0, 0},
+                               .result = 0,
+                               .task = -1};
+  snprintf(ac.text, sizeof ac.text, "instructor1");
+  in.tools._buffer = &at, in.tools._length = in.tools._maximum = 1;
+  in.controls._buffer = &ac, in.controls._length = in.controls._maximum = 1;
+  check_x1(&in, &viscera_AppliedInput_desc, "viscera::AppliedInput");
+  mutate_x1(&in, &viscera_AppliedInput_desc, "viscera::AppliedInput");
+  /* An older writer's SessionEvent (no task_id, task_name: its DHEADER ends
+   * before them): they get their defaults, -> the XCDR1 of the event with
+   * task_id 0 and task_name "". */
+  viscera_SessionEvent e;
+  memset(&e, 0, sizeof e);
+  e.seq = 3, e.kind = viscera_EVENT_CUT_END, e.value = 1.5;
+  snprintf(e.text, sizeof e.text, "cut");
+  size_t l1, l2;
+  unsigned char *b1 = serialize(&e, &viscera_SessionEvent_desc, 1, &l1);
+  unsigned char *b2 = serialize(&e, &viscera_SessionEvent_desc, 2, &l2);
+  /* the old sample: DHEADER shortened by task_id (4) and task_name ("" = 4 + 1 bytes, after padding) */
+  size_t old_len = l2 - 9;
+  while ((old_len - 4) % 4) old_len--; /* the text's end, aligned as the DHEADER counts it */
+  uint32_t dh = (uint32_t)(old_len - 8);
+  memcpy(b2 + 4, &dh, 4);
+  rt_model_t m;
+  CHECK(load(&m, &viscera_SessionEvent_desc, "viscera::SessionEvent") == 0);
+  rt_str_t o = {0};
+  verr_t err = {{0}};
+  CHECK(rt_cdr_to_xcdr1(m.top, b2, old_len, &o, &err) == 0);
+  CHECK(o.len == l1 && memcmp(o.s, b1, l1) == 0);
+  b2[1] = 11; /* PL_CDR2_LE: mutable, refused */
+  CHECK(rt_cdr_to_xcdr1(m.top, b2, l2, &o, &err) < 0);
+  rt_str_free(&o);
+  rt_model_free(&m);
+  free(b1);
+  free(b2);
+}
+
+/* Collections of enums and of strings carry a DHEADER in XCDR2, of octets
+ * none: JSON from both encodings, and the XCDR1 re-encoding. */
+static void test_collections(void) {
+  cdr_cases_Color seq[3] = {cdr_cases_GREEN, cdr_cases_BLUE, cdr_cases_RED};
+  char names[2][9] = {"ab", "cdef"};
+  uint8_t raw[3] = {1, 2, 255};
+  cdr_cases_Colors v = {.seq = {3, 3, seq, false},
+                        .names = {2, 2, names, false},
+                        .arr = {cdr_cases_BLUE, cdr_cases_GREEN},
+                        .raw = {3, 3, raw, false},
+                        .last = -0.5};
+  rt_model_t m;
+  CHECK(load(&m, &cdr_cases_Colors_desc, "cdr_cases::Colors") == 0);
+  const char *want = "{\"seq\":[\"GREEN\",\"BLUE\",\"RED\"],\"names\":[\"ab\",\"cdef\"],\"arr\":[\"BLUE\",\"GREEN\"],"
+                     "\"raw\":[1,2,255],\"last\":-0.5}";
+  for (int x = 1; x <= 2; x++) {
+    size_t len;
+    unsigned char *b = serialize(&v, &cdr_cases_Colors_desc, x, &len);
+    rt_str_t o = {0};
+    verr_t err = {{0}};
+    CHECK(rt_cdr_json(m.top, b, len, &o, &err) == 0 && o.s && strcmp(o.s, want) == 0);
+    if (!o.s || strcmp(o.s, want)) fprintf(stderr, "XCDR%d: %s %s\n", x, o.s ? o.s : "", err.msg);
+    rt_str_free(&o);
+    free(b);
+  }
+  rt_model_free(&m);
+  check_x1(&v, &cdr_cases_Colors_desc, "cdr_cases::Colors");
+}
+
 int main(void) {
+  test_collections();
+  test_xcdr1();
   test_fields();
   test_idl();
   test_json();

@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* rec_decode: stored CDR back into the compiled-in types. Serializes
- * samples as a writer does (XCDR1, little-endian header), decodes them,
+ * samples as a writer does (XCDR2 with delimiters, D_CDR2_LE header: every
+ * product type is @appendable), decodes them,
  * and feeds the decoder every kind of bad blob: truncated, garbled, an
  * enum value the type does not have, all zeros, an unknown encoding. Also
  * finds enum values by literal name in the type information, which is how
@@ -14,13 +15,13 @@
 #include "recording/rec_decode.h"
 #include "viscera.h"
 
-/* The 4-byte CDR_LE header + payload, as stored; *len set. Caller frees. */
+/* The 4-byte D_CDR2_LE header + payload, as stored; *len set. Caller frees. */
 static unsigned char *serialize(const void *sample, const dds_topic_descriptor_t *desc, size_t *len) {
   dds_ostream_t os;
-  dds_ostream_init(&os, 0, 1);
+  dds_ostream_init(&os, 0, 2);
   dds_stream_write(&os, sample, desc->m_ops);
   unsigned char *b = malloc(os.m_index + 4);
-  b[0] = 0, b[1] = 1, b[2] = 0, b[3] = 0;
+  b[0] = 0, b[1] = 9, b[2] = 0, b[3] = 0;
   memcpy(b + 4, os.m_buffer, os.m_index);
   *len = os.m_index + 4;
   dds_ostream_fini(&os);
@@ -51,18 +52,30 @@ static void test_event(void) {
   int truncated_ok = 0;
   for (size_t n = 0; n < len; n++) truncated_ok += rec_decode_cdr(b, n, &viscera_SessionEvent_desc, &got);
   CHECK(truncated_ok == 0);
-  /* an enum value past the type's last literal (a newer writer's kind) */
-  viscera_SessionEvent later = e;
-  later.kind = (viscera_EventKind)200;
-  size_t llen = 0;
-  unsigned char *lb = serialize(&later, &viscera_SessionEvent_desc, &llen);
+  /* an enum value past the type's last literal (a newer writer's kind):
+   * Cyclone's writer refuses to write one, so the kind's byte is found by
+   * writing another valid kind and changed in place */
+  viscera_SessionEvent other = e;
+  other.kind = viscera_EVENT_KEYFRAME;
+  size_t llen = 0, at = 0;
+  unsigned char *lb = serialize(&other, &viscera_SessionEvent_desc, &llen);
+  CHECK(llen == len);
+  while (at < len && lb[at] == b[at]) at++;
+  CHECK(at < len && at + 1 < len && lb[at + 1] == b[at + 1]); /* one byte differs: the kind's low byte */
+  memcpy(lb, b, len);
+  lb[at] = 200;
   CHECK(!rec_decode_cdr(lb, llen, &viscera_SessionEvent_desc, &got));
+  lb[at] = (unsigned char)viscera_EVENT_KEYFRAME; /* the same bytes with a known kind decode */
+  CHECK(rec_decode_cdr(lb, llen, &viscera_SessionEvent_desc, &got) && got.kind == viscera_EVENT_KEYFRAME);
+  rec_decode_free(&got, &viscera_SessionEvent_desc);
   free(lb);
   /* a string length beyond the sample */
   unsigned char *g = malloc(len);
   memcpy(g, b, len);
-  /* text length word: after source_id 4, pad 4, seq 8, sim 8, kind 4, organ 4, tool 4, pad 4, value 8 = 48 */
-  g[4 + 48] = 0xff, g[4 + 49] = 0xff;
+  /* text length word (XCDR2 aligns 8-byte members to 4): after DHEADER 4, source_id 4, seq 8, sim 8,
+   * kind 4, organ 4, tool 4, value 8 = 44 */
+  CHECK(b[4 + 44] == strlen(e.text) + 1);
+  g[4 + 44] = 0xff, g[4 + 45] = 0xff;
   CHECK(!rec_decode_cdr(g, len, &viscera_SessionEvent_desc, &got));
   /* unknown encoding identifier, and a zero-filled blob */
   memcpy(g, b, len);

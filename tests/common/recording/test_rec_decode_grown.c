@@ -9,7 +9,10 @@
  * format-2 recording (a resumed session) decodes through
  * idl/viscera_format2.idl with its resume state whole: read with the
  * format-1 twin it would decode too, without it (trailing bytes are
- * ignored), so the newest twin must come first. Needs VISCERA_SOURCE_DIR. */
+ * ignored), so the newest twin must come first. The format-3 recording
+ * (@appendable types, XCDR2) needs no twin: its samples decode with the
+ * grown types themselves, the appended fields at their default (0), which is
+ * what @appendable promises a later build. Needs VISCERA_SOURCE_DIR. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -97,7 +100,21 @@ int main(void) {
   CHECK(t.grown == 0);
   recfile_close(rf);
 
-  source_tally_t s1, s2;
+  /* format 3: XCDR2 samples of the @appendable types, read by the grown ones directly */
+  snprintf(path, sizeof path, "%s/tests/data/session_appendable_format3.db", src ? src : ".");
+  CHECK(recfile_open(&rf, path, &err) == 0);
+  if (rf) {
+    tally_t t3 = {0};
+    CHECK(rec_decode_topic(rf, "viscera_SessionEvent", &viscera_SessionEvent_desc, on_event, &t3, &rep) == 0);
+    CHECK(rep.undecodable == 0 && rep.decoded == 7);
+    CHECK(rec_decode_topic(rf, "viscera_ToolCommand", &viscera_ToolCommand_desc, on_command, &t3, &rep) == 0);
+    CHECK(rep.undecodable == 0 && rep.decoded == 251);
+    CHECK(t3.events == 7 && t3.texts == 7 && t3.commands == 251 && t3.seqs == 251 && t3.grown == 0);
+    recfile_close(rf);
+  }
+  source_tally_t s1, s2, s3;
+  source_of(src, "session_appendable_format3.db", &s3);
+  CHECK(s3.n == 1 && s3.have_text && s3.resume_len == 0 && s3.grown == 0);
   source_of(src, "session_applied_xcdr1.db", &s1); /* format 1: no resume fields */
   CHECK(s1.n == 1 && s1.have_text && s1.resume_len == 0 && s1.resume_sha256[0] == 0 && s1.grown == 0);
   source_of(src, "session_resumed_format2.db", &s2); /* format 2: resumed, its state whole */

@@ -41,5 +41,6 @@ while read -r rec commands frames metrics resumed; do
 done <<'LIST'
 session_applied_xcdr1.db 251 75 3
 session_resumed_format2.db 968 52 1 3000
+session_appendable_format3.db 250 92 4
 LIST
 echo PASS

@@ -1,0 +1,2 @@
+-- issue 15 (as recording/meshdelta_time.sql, at the XCDR2 offsets: header, DHEADER, four 4-byte members, then the time at bytes 24..31): a MeshDelta header whose sim time has bit 44 set (+17,592 s)
+UPDATE samples SET cdr = substr(cdr, 1, 24) || x'00c09a2f00100000' || substr(cdr, 33) WHERE id = (SELECT s.id FROM samples s JOIN topics t ON t.id = s.topic_id WHERE t.name = 'viscera_MeshDelta' ORDER BY s.id LIMIT 1 OFFSET 5)

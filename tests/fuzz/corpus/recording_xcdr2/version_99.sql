@@ -1,0 +1,3 @@
+-- issue 15: an unknown format version
+UPDATE session SET format_version = 99;
+PRAGMA user_version = 99
