@@ -61,7 +61,7 @@ async function main() {
     }
   }
   const perTopic = new Map(), indexedCount = new Map();
-  let decoded = 0, total = 0, peak = 0, inContact = 0, sceneUpdates = 0, lastT;
+  let decoded = 0, total = 0, peak = 0, metricsPeak = -1, inContact = 0, sceneUpdates = 0, lastT;
   for await (const m of indexed.readMessages({ validateCrcs: true })) {
     const ch = indexed.channelsById.get(m.channelId);
     if (ch.topic === "/viscera/scene") { // Foxglove scene primitives: one organ surface per message
@@ -85,6 +85,10 @@ async function main() {
       fail(`${ch.topic} message ${m.sequence} does not decode: ${e.message}`);
     }
     if (typeof msg !== "object" || msg === null) fail(`${ch.topic}: decoded to nothing`);
+    // the server's own running peak (ToolMetrics is reliable: a loaded
+    // recorder may lose ContactFeedback samples near the peak, not these)
+    if (ch.metadata.get("dds_topic") === "viscera_ToolMetrics" && msg.tool_id === 0 && msg.peak_force > metricsPeak)
+      metricsPeak = msg.peak_force;
     if (ch.metadata.get("dds_topic") === "viscera_ContactFeedback" && msg.tool_id === 0) {
       const f = Math.hypot(msg.force[0], msg.force[1], msg.force[2]);
       if (f > peak) peak = f;
@@ -122,7 +126,7 @@ async function main() {
   if (hasScene) console.log(`scene_updates=${sceneUpdates}`);
   if (bad) fail(`${bad} topic(s) differ`);
   // decoded values, for the caller to compare with the server's figures
-  console.log(`tool0_peak_force=${peak.toFixed(4)} tool0_contact_time=${inContact.toFixed(3)}`);
+  console.log(`tool0_peak_force=${peak.toFixed(4)} tool0_metrics_peak=${metricsPeak.toFixed(4)} tool0_contact_time=${inContact.toFixed(3)}`);
   console.log(`ok: ${total} messages in ${indexed.channelsById.size} channels, ${indexed.chunkIndexes.length} chunks, ` +
               `all ${decoded} DDS samples decoded with their OMG IDL schema`);
 }

@@ -50,8 +50,14 @@ cat "$OUT/read.out"
 # against the server's PALPATION line.
 srv() { grep '^PALPATION tool=probe ' "$OUT/demo/server.out" | tr ' ' '\n' | sed -n "s/^$1=//p"; }
 got() { tr ' ' '\n' < "$OUT/read.out" | sed -n "s/^$1=//p"; }
-awk -v g="$(got tool0_peak_force)" -v w="$(srv peak_force)" 'BEGIN { d = g - w; exit !(g != "" && d < 0.02 && d > -0.02) }' \
-  || fail "decoded peak force $(got tool0_peak_force), server $(srv peak_force)"
+# ToolMetrics carries the server's running peak (reliable, printed to 4
+# decimals like the PALPATION line); the peak of the ContactFeedback samples
+# may miss the top when a loaded recorder lost samples near it (seen: 0.7395
+# against 0.7736 N at load 12), never exceed it.
+awk -v g="$(got tool0_metrics_peak)" -v w="$(srv peak_force)" 'BEGIN { d = g - w; exit !(g != "" && d < 0.0002 && d > -0.0002) }' \
+  || fail "decoded ToolMetrics peak force $(got tool0_metrics_peak), server $(srv peak_force)"
+awk -v g="$(got tool0_peak_force)" -v w="$(srv peak_force)" 'BEGIN { exit !(g != "" && g <= w + 0.02 && g >= 0.9 * w) }' \
+  || fail "decoded ContactFeedback peak force $(got tool0_peak_force), server $(srv peak_force)"
 awk -v g="$(got tool0_contact_time)" -v w="$(srv contact_time)" \
   'BEGIN { d = g - w; t = 0.03 * w; if (t < 0.05) t = 0.05; exit !(g != "" && d <= t && -d <= t) }' \
   || fail "decoded contact time $(got tool0_contact_time), server $(srv contact_time)"
