@@ -119,8 +119,39 @@ static void ramp(const double f_prev[3], const double g[3], double step, double 
   v3_add(f, f_prev, d);
 }
 
-double contact_render_output(contact_render_t *r, const double target[3], int cut, int control, const double v[3],
-                             const double dx[3], double f[3]) {
+/* The late-model credit's episode (contact_render.h, passivity.h): g the
+ * model's force at the hand x this tick, k its stiffness. */
+static void late_credit(contact_render_t *r, const double g[3], double k, const double x[3]) {
+  double mag = v3_norm(g);
+  int pushing = mag > 0 && k > 0 && isfinite(mag) && v3_isfinite(x);
+  if (r->pc.episode && !r->credit_left && v3_isfinite(x)) {
+    double out[3];
+    v3_sub(out, x, r->credit_x);
+    r->credit_left = r->pc.ep_credit <= 0 || v3_dot(out, r->credit_n) >= r->credit_len;
+  }
+  if (!pushing) {
+    /* The press is over and the hand has left the credited spring since
+     * it was credited: the next press is a new episode. */
+    if (r->pc.episode && !r->anchored && r->credit_left) passivity_episode_close(&r->pc);
+    return;
+  }
+  if (!r->pc.episode) {
+    passivity_episode_open(&r->pc);
+    r->credit_left = 1;
+  }
+  if (passivity_credit(&r->pc, passivity_spring_energy(mag, k)) > 0) {
+    v3_copy(r->credit_x, x);
+    v3_scale(r->credit_n, g, 1.0 / mag);
+    r->credit_len = mag / k;
+    r->credit_left = 0;
+    r->credit_raises++;
+  }
+}
+
+/* contact_render_output's work; k > 0 (with x): the controlled contact's
+ * model stiffness, for the late-model credit. */
+static double render(contact_render_t *r, const double target[3], int cut, int control, double k, const double x[3],
+                     const double v[3], const double dx[3], double f[3]) {
   double before[3];
   v3_copy(before, r->f_prev);
   passivity_observe(&r->pc, r->f_prev, dx); /* last tick's force over the way the hand went since */
@@ -129,8 +160,8 @@ double contact_render_output(contact_render_t *r, const double target[3], int cu
     if (isfinite(de)) r->stall_energy += de;
     r->stall_ticks++;
   }
-  if (r->pc.energy - r->stall_energy > r->energy_max_unstalled)
-    r->energy_max_unstalled = r->pc.energy - r->stall_energy;
+  if (r->pc.energy - r->pc.credit - r->stall_energy > r->energy_max_unstalled)
+    r->energy_max_unstalled = r->pc.energy - r->pc.credit - r->stall_energy;
   if (cut) {
     /* The server is gone: nothing to ramp towards, and a wall it no longer
      * computes must not stay under the hand. */
@@ -146,6 +177,7 @@ double contact_render_output(contact_render_t *r, const double target[3], int cu
      * actually get (and the release it commits to), then the ramp's bound
      * again, widened to CONTACT_RENDER_PASSIVE_STEP where the controller
      * asked for less. */
+    if (control && x) late_credit(r, g, k, x);
     ramp(r->f_prev, g, r->max_step, f);
     if (control && passivity_control(&r->pc, v, r->accel, r->tick_s, CONTACT_RENDER_STALL_S, r->max_step, f) < 1.0) {
       double h[3];
@@ -163,9 +195,15 @@ double contact_render_output(contact_render_t *r, const double target[3], int cu
   return v3_norm(f);
 }
 
+double contact_render_output(contact_render_t *r, const double target[3], int cut, int control, const double v[3],
+                             const double dx[3], double f[3]) {
+  return render(r, target, cut, control, 0, NULL, v, dx, f);
+}
+
 double contact_render_tick(contact_render_t *r, const contact_model_t *m, int cut, const double x[3], const double v[3],
                            const double dx[3], double f[3]) {
   double target[3];
-  contact_render_target(r, cut ? NULL : m, x, v, target);
-  return contact_render_output(r, target, cut, 1, v, dx, f);
+  const contact_model_t *used = cut ? NULL : m;
+  contact_render_target(r, used, x, v, target);
+  return render(r, target, cut, 1, used && used->in_contact ? used->stiffness : 0, x, v, dx, f);
 }

@@ -39,6 +39,19 @@
  *    machine's late tick holds the force longer), so E stays <= 0; when it
  *    asks for less force the ramp yields, up to CONTACT_RENDER_PASSIVE_STEP
  *    per tick.
+ *    The late-model credit (passivity.h): a press whose model arrived
+ *    after the hand had gone in (at worst after it stopped inside: the
+ *    hand's work was done on the server's tissue while nothing was
+ *    rendered) is credited the stored energy of the model's spring at the
+ *    force it renders, less what the hand put in through this port in the
+ *    press, |F|^2 / (2 k) - B, a running maximum per press. An episode
+ *    opens at the press's first pushing model and closes only when the
+ *    press is over (its anchor forgotten: no contact for
+ *    CONTACT_RENDER_HOLD_S) and the hand has been back out of the credited
+ *    spring (|F| / k along its normal from where it was credited) since
+ *    the credit was last raised: the
+ *    model flapping, re-anchoring or the server back after a blip cannot
+ *    grant it again while the hand stays in.
  * 4. A stale model (no feedback for hold_s: the link is slow, lossy or the
  *    server stalls) is held, re-anchored at our own position, and then
  *    ramped to zero; only a cut (the server's liveliness lost: it is gone)
@@ -109,6 +122,11 @@ typedef struct contact_render {
    * observer's largest value without it: what the controller answers for. */
   double stall_energy, energy_max_unstalled;
   uint64_t stall_ticks;
+  /* The spring of the open episode's credit (its latest raise): where the
+   * hand was, the force's unit normal, its length |F| / k (m). */
+  double credit_x[3], credit_n[3], credit_len;
+  int credit_left; /* the hand has been out of that spring since */
+  uint64_t credit_raises; /* ticks that raised the credit */
   passivity_t pc;
 } contact_render_t;
 
