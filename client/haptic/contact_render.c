@@ -13,6 +13,7 @@ void contact_render_init(contact_render_t *r, double period_s, double max_force)
   r->max_force = max_force;
   r->tick_s = period_s;
   passivity_init(&r->pc, period_s);
+  r->pc.release_floor = CONTACT_RENDER_RELEASE_FLOOR;
 }
 
 void contact_render_sent(contact_render_t *r, uint64_t seq, const double x[3]) {
@@ -33,6 +34,10 @@ static int sent_position(const contact_render_t *r, uint64_t seq, double x[3]) {
 double contact_render_target(contact_render_t *r, const contact_model_t *m, const double x[3], const double v[3],
                              double f[3]) {
   v3_set(f, 0, 0, 0);
+  /* For the late-model credit of the next contact_render_output. */
+  r->target_set = 1;
+  r->target_k = m && m->in_contact ? m->stiffness : 0;
+  v3_copy(r->target_x, x);
   if (!m || !m->in_contact) {
     /* A press's anchor outlives a short gap in contact (the server's proxy
      * let go for a few steps while the tissue moved away faster than the
@@ -148,10 +153,10 @@ static void late_credit(contact_render_t *r, const double g[3], double k, const 
   }
 }
 
-/* contact_render_output's work; k > 0 (with x): the controlled contact's
- * model stiffness, for the late-model credit. */
-static double render(contact_render_t *r, const double target[3], int cut, int control, double k, const double x[3],
-                     const double v[3], const double dx[3], double f[3]) {
+double contact_render_output(contact_render_t *r, const double target[3], int cut, int control, const double v[3],
+                             const double dx[3], double f[3]) {
+  int credit = control && r->target_set;
+  r->target_set = 0;
   double before[3];
   v3_copy(before, r->f_prev);
   passivity_observe(&r->pc, r->f_prev, dx); /* last tick's force over the way the hand went since */
@@ -177,7 +182,7 @@ static double render(contact_render_t *r, const double target[3], int cut, int c
      * actually get (and the release it commits to), then the ramp's bound
      * again, widened to CONTACT_RENDER_PASSIVE_STEP where the controller
      * asked for less. */
-    if (control && x) late_credit(r, g, k, x);
+    if (credit) late_credit(r, g, r->target_k, r->target_x);
     ramp(r->f_prev, g, r->max_step, f);
     if (control && passivity_control(&r->pc, v, r->accel, r->tick_s, CONTACT_RENDER_STALL_S, r->max_step, f) < 1.0) {
       double h[3];
@@ -195,15 +200,9 @@ static double render(contact_render_t *r, const double target[3], int cut, int c
   return v3_norm(f);
 }
 
-double contact_render_output(contact_render_t *r, const double target[3], int cut, int control, const double v[3],
-                             const double dx[3], double f[3]) {
-  return render(r, target, cut, control, 0, NULL, v, dx, f);
-}
-
 double contact_render_tick(contact_render_t *r, const contact_model_t *m, int cut, const double x[3], const double v[3],
                            const double dx[3], double f[3]) {
   double target[3];
-  const contact_model_t *used = cut ? NULL : m;
-  contact_render_target(r, used, x, v, target);
-  return render(r, target, cut, 1, used && used->in_contact ? used->stiffness : 0, x, v, dx, f);
+  contact_render_target(r, cut ? NULL : m, x, v, target);
+  return contact_render_output(r, target, cut, 1, v, dx, f);
 }

@@ -86,6 +86,11 @@
  * machine's loop, seen 1-65 ms at load 8): the force rendered now is budgeted as held
  * this long. A longer stall of the client's loop can leave a few uJ. */
 #define CONTACT_RENDER_STALL_S 0.02
+/* m/s: the controller budgets every release for a hand leaving at least
+ * this fast (passivity.h release_floor): a hand that rests with the budget
+ * spent, then starts out, left 17 uJ over it (test_contact_render's
+ * flapping model). */
+#define CONTACT_RENDER_RELEASE_FLOOR 0.002
 /* s: how long a model is rendered without a new sample before it ramps out. */
 #define CONTACT_RENDER_HOLD_S 0.25
 /* m: the depth below which the press's secant stiffness is not estimated. */
@@ -126,6 +131,10 @@ typedef struct contact_render {
    * hand was, the force's unit normal, its length |F| / k (m). */
   double credit_x[3], credit_n[3], credit_len;
   int credit_left; /* the hand has been out of that spring since */
+  /* Set by contact_render_target for the next contact_render_output: the
+   * model's stiffness (0: no contact) and the hand's position. */
+  int target_set;
+  double target_k, target_x[3];
   uint64_t credit_raises; /* ticks that raised the credit */
   passivity_t pc;
 } contact_render_t;
@@ -150,7 +159,11 @@ double contact_render_tick(contact_render_t *r, const contact_model_t *m, int cu
                            const double dx[3], double f[3]);
 
 /* Ramp and passivity for a target force: the same bounds and observer as
- * contact_render_tick; control 0 observes without the controller (the
+ * contact_render_tick. The late-model credit needs the model: only a
+ * target from contact_render_target just before is credited (a controlled
+ * target from elsewhere gets none: with nothing banked it is withheld).
+ * control 0 observes without
+ * the controller (the
  * guiding hand: a led hand must receive the energy its guide puts in, so
  * one port alone may not be held passive; guide_force.h damps the coupling
  * for the delay instead). */

@@ -19,14 +19,18 @@ void passivity_init(passivity_t *p, double period_s) {
 /* N: the controller renders nothing rather than less than this. */
 #define PASSIVITY_MIN_FORCE 1e-4
 
-double passivity_owed(double m, double u, double a, double tick_s, double hold_s, double release_step) {
+double passivity_owed(double m, double u, double a, double tick_s, double hold_s, double release_step,
+                      double u_floor) {
   if (!(m > 0) || !(release_step > 0) || !isfinite(u) || !isfinite(a)) return 0;
+  if (!(u_floor > 0)) u_floor = 0;
   if (hold_s < tick_s) hold_s = tick_s;
   double ap = a > 0 ? a : 0, u0 = u + ap * hold_s, w = u0 > 0 ? m * u0 * hold_s : 0;
+  if (w < m * u_floor * tick_s) w = m * u_floor * tick_s; /* this tick, at least at the floor */
   for (int k = 1; k < PASSIVITY_MAX_RELEASE_TICKS; k++) {
     double mk = m - k * release_step;
     if (mk <= 0) break;
     double uk = u + ap * (hold_s + k * tick_s);
+    if (uk < u_floor) uk = u_floor;
     if (uk > 0) w += mk * uk * tick_s;
   }
   return w;
@@ -42,7 +46,7 @@ double passivity_control(passivity_t *p, const double v[3], const double a[3], d
   if (tick_s < p->period_s) tick_s = p->period_s;
   /* Within the budget with a relative margin for the rounding of the sums
    * (W is a sum of up to m / r products; E of every tick's). */
-  double owed = passivity_owed(m, u, acc, tick_s, hold_s, release_step) * PASSIVITY_ROUNDING;
+  double owed = passivity_owed(m, u, acc, tick_s, hold_s, release_step, p->release_floor) * PASSIVITY_ROUNDING;
   double e = p->energy - p->credit; /* <= 0: within the credited budget */
   if (e + owed <= 0) return 1;
   /* W grows with m: the largest m' in [0, m] within the budget, by
@@ -51,7 +55,7 @@ double passivity_control(passivity_t *p, const double v[3], const double a[3], d
   if (e < 0)
     for (int i = 0; i < 60; i++) {
       double mid = 0.5 * (lo + hi);
-      if (e + passivity_owed(mid, u, acc, tick_s, hold_s, release_step) * PASSIVITY_ROUNDING <= 0)
+      if (e + passivity_owed(mid, u, acc, tick_s, hold_s, release_step, p->release_floor) * PASSIVITY_ROUNDING <= 0)
         lo = mid;
       else
         hi = mid;
@@ -61,7 +65,7 @@ double passivity_control(passivity_t *p, const double v[3], const double a[3], d
   if (lo < PASSIVITY_MIN_FORCE) lo = 0;
   double s = lo / m;
   p->dissipated +=
-      (owed - passivity_owed(lo, u, acc, tick_s, hold_s, release_step) * PASSIVITY_ROUNDING) / PASSIVITY_ROUNDING;
+      (owed - passivity_owed(lo, u, acc, tick_s, hold_s, release_step, p->release_floor) * PASSIVITY_ROUNDING) / PASSIVITY_ROUNDING;
   p->active_ticks++;
   v3_scale(f, f, s);
   return s;

@@ -76,6 +76,11 @@ typedef struct passivity {
   double ep_start;   /* E when it opened, J */
   double ep_banked;  /* B_e, J */
   double ep_credit;  /* c_e, J (included in credit) */
+  /* m/s: the release is budgeted for a hand leaving at least this fast (0:
+   * as predicted). A hand at rest predicts no work, so without it a force
+   * could be rendered on a resting hand with no budget left, and the hand's
+   * first move out would then do the release's work unpaid. */
+  double release_floor;
   double dissipated; /* J of predicted work the controller withheld */
   uint64_t active_ticks;
 } passivity_t;
@@ -87,8 +92,10 @@ void passivity_init(passivity_t *p, double period_s);
  * (m/s, along the force; > 0 away from the wall) with acceleration a
  * (m/s^2, along the force; only a growth of u counts): the force is held
  * now for hold_s (>= tick_s: the reserve for this tick being late), then
- * released in ticks of tick_s. */
-double passivity_owed(double m, double u, double a, double tick_s, double hold_s, double release_step);
+ * released in ticks of tick_s, during which (and over this tick) the hand
+ * is taken to leave at u_floor (m/s) at least (0: as predicted). */
+double passivity_owed(double m, double u, double a, double tick_s, double hold_s, double release_step,
+                      double u_floor);
 
 /* The controller: f (in place) scaled down along its line, the least, so
  * that E + passivity_owed(|f|, ...) <= C (zero when even that cannot hold

@@ -362,25 +362,37 @@ int main(void) {
    * leaving at 1 cm/s is owed (0.24 + 0.16 + 0.08) N x 10 um; a hand that
    * presses (u < 0) and does not turn owes nothing; held 20 ms, the first
    * term is 20 times longer. */
-  CHECK_NEAR(passivity_owed(0.24, 0.01, 0, 1e-3, 1e-3, 0.08), 0.48 * 1e-5, 1e-15);
-  CHECK(passivity_owed(0.24, -0.01, 0, 1e-3, 1e-3, 0.08) == 0);
-  CHECK_NEAR(passivity_owed(0.24, 0.01, 0, 1e-3, 0.02, 0.08), (0.24 * 20 + 0.16 + 0.08) * 1e-5, 1e-15);
-  CHECK(passivity_owed(0.24, -0.01, 2.0, 1e-3, 1e-3, 0.08) == 0 &&
-        passivity_owed(0.24, -0.01, 10.0, 1e-3, 1e-3, 0.08) > 0); /* turns within the release, or not */
+  CHECK_NEAR(passivity_owed(0.24, 0.01, 0, 1e-3, 1e-3, 0.08, 0), 0.48 * 1e-5, 1e-15);
+  CHECK(passivity_owed(0.24, -0.01, 0, 1e-3, 1e-3, 0.08, 0) == 0);
+  CHECK_NEAR(passivity_owed(0.24, 0.01, 0, 1e-3, 0.02, 0.08, 0), (0.24 * 20 + 0.16 + 0.08) * 1e-5, 1e-15);
+  CHECK(passivity_owed(0.24, -0.01, 2.0, 1e-3, 1e-3, 0.08, 0) == 0 &&
+        passivity_owed(0.24, -0.01, 10.0, 1e-3, 1e-3, 0.08, 0) > 0); /* turns within the release, or not */
+  /* The release floor: a pressing hand is budgeted as leaving at 2 mm/s
+   * over this tick and while the force is released (0.24 + 0.16 + 0.08 N
+   * over 3 ticks). */
+  CHECK_NEAR(passivity_owed(0.24, -0.01, 0, 1e-3, 0.02, 0.08, 0.002), 0.48 * 2e-6, 1e-15);
   {
-    /* A stalled loop: the hand presses a 1 N wall for 0.1 s (the observer
-     * banks 1 mJ), then one tick lasts 60 ms while it leaves at 5 cm/s with
-     * the force held: 3 mJ no controller could stop, counted apart so the
-     * rest is still judged <= 0. */
+    /* A stalled loop: the hand presses 1 mm further into a plane it is
+     * already 2.5 mm inside (1 -> 1.4 N) in 0.1 s, then one tick lasts
+     * 60 ms while it leaves at 5 cm/s with the force held: 4 mJ no
+     * controller could stop, counted apart so the rest is still judged
+     * against the credit (the plane arrived late: credited). */
     static contact_render_t r;
     contact_render_init(&r, T_S, MAX_FORCE);
-    double g[3] = {0, 0, 1}, f[3], v[3] = {0, 0, -0.01}, dx[3] = {0, 0, -1e-5};
-    for (int i = 0; i < 100; i++) contact_render_output(&r, g, 0, 1, v, dx, f);
+    contact_model_t wall;
+    lp_plane(&wall, 0.0025);
+    double x[3] = {0, 0, 0}, f[3], v[3] = {0, 0, -0.01}, dx[3] = {0, 0, -1e-5};
+    for (int i = 0; i < 100; i++) {
+      x[2] -= 1e-5;
+      contact_render_tick(&r, &wall, 0, x, v, dx, f);
+    }
     double v2[3] = {0, 0, 0.05}, dx2[3] = {0, 0, 0.05 * 0.06};
     double f_held = f[2];
-    contact_render_output(&r, g, 0, 1, v2, dx2, f);
-    printf("stalled tick: force %.3f N held 60 ms, observer %.3g J, of which %.3g J in the stall; without it %.3g J\n",
-           f_held, r.pc.energy, r.stall_energy, r.energy_max_unstalled);
+    v3_add(x, x, dx2);
+    contact_render_tick(&r, &wall, 0, x, v2, dx2, f);
+    printf("stalled tick: force %.3f N held 60 ms, observer %.3g J, of which %.3g J in the stall; without it %.3g J "
+           "over the credit (%.3g J)\n",
+           f_held, r.pc.energy, r.stall_energy, r.energy_max_unstalled, r.pc.credit);
     CHECK(f_held > 0.9 && r.stall_ticks == 1 && r.pc.energy_max > 0);
     CHECK_NEAR(r.stall_energy, f_held * 0.003, 1e-12);
     CHECK(r.energy_max_unstalled <= 0);
@@ -419,7 +431,7 @@ int main(void) {
     printf("model flapping 8 times with the hand in: credit %.3g J (one spring at most %.3g J; credited per model "
            "%.3g J), energy returned %.3g J, max over credit %.3g J, step %.4f N\n",
            r.pc.credit, one, regranted, r.pc.energy, r.pc.excess_max, r.step_max);
-    CHECK(r.pc.credit <= one && regranted > 4 * one);
+    CHECK(r.pc.credit <= one && regranted > 3 * one);
     CHECK(r.pc.excess_max <= 0 && r.pc.energy <= r.pc.credit);
     CHECK(r.step_max <= CONTACT_RENDER_PASSIVE_STEP + 1e-12);
     /* The hand leaves and presses again, late again: a new press, a new credit. */
