@@ -75,8 +75,14 @@ static void hand_eval(const trajectory_t *tr, double t, double x[3]) {
 /* The hand as viscera-haptic's scripted device moves it along a file of
  * samples every sample_s of that path (tests/network/haptic_palpation_test.sh
  * writes 10 ms): linear between them, so its velocity jumps a little at
- * each sample; sample_s 0: the path itself. */
+ * each sample; sample_s 0: the path itself; < 0: the script's linear
+ * segments themselves. */
 static void hand_at(const trajectory_t *tr, double t, double sample_s, double x[3]) {
+  if (sample_s < 0) { /* the script's own linear segments (tests/bench/link_bench.sh drives these) */
+    uint32_t b;
+    trajectory_eval(tr, t, x, &b);
+    return;
+  }
   if (!(sample_s > 0)) {
     hand_eval(tr, t, x);
     return;
@@ -497,6 +503,32 @@ int main(void) {
       CHECK(res.step_max <= 0.1 + 1e-12);
       CHECK(res.excess_max <= 0 && res.stall_ticks == 0);
     }
+  /* The script's linear segments (link_bench's press): the hand stops
+   * 0.18 s after the surface, so from about 100 ms one way the first
+   * contact sample arrives after it stopped. Before the late-model credit
+   * the force was withheld there (0 N); now it ramps in. */
+  {
+    static trace_t tl;
+    CHECK(make_trace(&tl, -1, 0));
+    result_t lref;
+    run(&tl, &lk0, NULL, &lref);
+    const int ldl[] = {50, 100, 150};
+    for (size_t di = 0; di < 3; di++)
+      for (size_t li = 0; li < 2; li++) {
+        link_t lk = {.delay_ms = ldl[di], .loss = losses[li], .stall_from = -1, .seed = 41 + di * 2 + li};
+        result_t res;
+        run(&tl, &lk, NULL, &res);
+        double err = (res.peak - lref.peak) / lref.peak;
+        printf("linear segments %3d ms %2.0f%%: peak %.3f N (loopback %.3f N, %+.1f %%), step %.4f N, energy %.3g J, "
+               "credit %.3g J\n",
+               ldl[di], 100 * losses[li], res.peak, lref.peak, 100 * err, res.step_max, res.energy_max, res.credit);
+        CHECK(fabs(err) <= 0.10);
+        CHECK(res.step_max <= 0.1 + 1e-12);
+        CHECK(res.excess_max <= 0);
+      }
+    free(tl.x);
+    free(tl.fb);
+  }
   /* The proxy lets go for 8 steps in the middle of the press (the tissue
    * moved away faster than the hand): no overshoot when contact resumes
    * (re-anchored at the deep proxy, the press overshot 18 % at 50 ms). */
