@@ -188,6 +188,8 @@ static void record_force(const haptic_loop_t *l, const tick_state_t *s, double t
   if (mag > st->peak_force) st->peak_force = mag;
   st->energy_max_j = s->render.pc.energy_max;
   st->energy_j = s->render.pc.energy;
+  st->credit_j = s->render.pc.credit;
+  st->excess_max_j = s->render.pc.excess_max;
   st->stall_energy_j = s->render.stall_energy;
   st->energy_max_unstalled_j = s->render.energy_max_unstalled;
   st->stall_ticks = s->render.stall_ticks;

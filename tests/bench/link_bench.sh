@@ -10,8 +10,8 @@
 # Per setting (CSV and a table):
 #   peak force and its error against loopback, largest one-tick force change
 #   (from the client's force log), passivity energy (the largest energy of the
-#   haptic client's passivity observer, its energy_max_j=, when it reports
-#   one), commands applied (server's counter / client's ticks), keyframe
+#   haptic client's passivity observer over its late-model credit,
+#   excess_max_j=, else energy_max_j=, when it reports one), commands applied (server's counter / client's ticks), keyframe
 #   wait (from the writer's match), bytes per second per seat (trainee's
 #   traffic both ways) and per viewer (what the link carried to the late
 #   subscriber's ports: link_emu --port-stats).
@@ -116,8 +116,10 @@ run() {
   local ticks rate peak app energy step kf dur seat_b view_b kfs kfc m
   ticks=$(field "$OUT/run/$n-haptic.out" ticks); rate=$(field "$OUT/run/$n-haptic.out" rate_hz)
   peak=$(field "$OUT/run/$n-haptic.out" peak_force)
-  # The passivity observer's largest energy over the run (<= 0: passive), when the client reports one.
-  energy=$(field "$OUT/run/$n-haptic.out" energy_max_j)
+  # The passivity observer's largest energy over the run, over the late-model
+  # credit (<= 0: passive; client/haptic/passivity.h), when the client reports one.
+  energy=$(field "$OUT/run/$n-haptic.out" excess_max_j)
+  [ -n "$energy" ] || energy=$(field "$OUT/run/$n-haptic.out" energy_max_j)
   [ -n "$energy" ] || energy=$(field "$OUT/run/$n-haptic.out" energy_j)
   app=$(sed -n 's/^server: \([0-9]*\) tool commands applied.*/\1/p' "$OUT/run/$n-server.log")
   step=$(force_step "$OUT/run/$n-force.csv")
