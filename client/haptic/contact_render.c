@@ -125,7 +125,8 @@ static void ramp(const double f_prev[3], const double g[3], double step, double 
 }
 
 /* The late-model credit's episode (contact_render.h, passivity.h): g the
- * model's force at the hand x this tick, k its stiffness. */
+ * force the ramp passes this tick towards the model's at the hand x, k the
+ * model's stiffness. */
 static void late_credit(contact_render_t *r, const double g[3], double k, const double x[3]) {
   double mag = v3_norm(g);
   int pushing = mag > 0 && k > 0 && isfinite(mag) && v3_isfinite(x);
@@ -182,8 +183,11 @@ double contact_render_output(contact_render_t *r, const double target[3], int cu
      * actually get (and the release it commits to), then the ramp's bound
      * again, widened to CONTACT_RENDER_PASSIVE_STEP where the controller
      * asked for less. */
-    if (credit) late_credit(r, g, r->target_k, r->target_x);
     ramp(r->f_prev, g, r->max_step, f);
+    /* Credited for the force the ramp passes, not the target: a model that
+     * jumps for a tick (a plain plane before the press is re-anchored)
+     * holds no more than the ramp lets it render. */
+    if (credit) late_credit(r, f, r->target_k, r->target_x);
     if (control && passivity_control(&r->pc, v, r->accel, r->tick_s, CONTACT_RENDER_STALL_S, r->max_step, f) < 1.0) {
       double h[3];
       v3_copy(h, f);

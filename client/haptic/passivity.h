@@ -47,8 +47,10 @@
  *   c_e = max over the episode's ticks t of [ U(t) - B_e(t) ]^+,
  *   U(t) = |F(t)|^2 / (2 k(t)),
  *   B_e(t) = max over its ticks s <= t of (E(start of e) - E(s)),
- * F the model's force at the hand that tick (its target, before the ramp
- * and the controller), k the model's (device-clamped) stiffness: U is the
+ * F the force the renderer asks the controller for that tick (the model's
+ * force at the hand, after the ramp: a model that jumps for a tick holds
+ * no more than the ramp lets through), k the model's (device-clamped)
+ * stiffness: U is the
  * energy held by the server's own proxy spring while it pushes with |F|,
  * the least any spring of stiffness <= k holds at that force, and so at
  * most f_max^2 / (2 k). B_e is the most energy the hand has put in through
