@@ -33,6 +33,7 @@
 #include "check.h"
 #include "contact_model.h"
 #include "contact_render.h"
+#include "guide_force.h"
 #include "runtime/scene_runtime.h"
 #include "test_assets.h"
 #include "test_rng.h"
@@ -363,6 +364,64 @@ static double flapping(contact_render_t *r, double d, double *z) {
   return regranted;
 }
 
+/* The guiding hand's contact part (guide_force.h, issue 14 item 4): the
+ * trainee (owner, w = 0.5) and the instructor move the tool along the same
+ * press; the instructor's commands reach the trainee peer_ms later. Both
+ * are delay_ms from the server, which therefore mixes the same path: its
+ * answers are the trace's, delay_ms late each way. The trainee's client
+ * renders the coupled law with its contact part re-anchored (its ring
+ * holding the tool it predicted at each command) or the plain plane. The
+ * instructor's own commands echo nothing to the trainee, so no coupling
+ * force acts when peer_ms is 0 (the hands coincide): the rendered force is
+ * w times the contact. Returns the peak rendered force (N). */
+static double guided(const trace_t *tr, int delay_ms, int peer_ms, int reanchor) {
+  static contact_render_t r;
+  contact_render_init(&r, T_S, MAX_FORCE);
+  guide_role_t role;
+  memset(&role, 0, sizeof role);
+  role.known = 1;
+  strcpy(role.owner, "trainee");
+  strcpy(role.guide, "instructor");
+  role.authority = 0.5;
+  role.coupling_stiffness = 200;
+  static const contact_model_t none = {0};
+  const contact_model_t *newest = &none;
+  double prev[3], peak = 0;
+  v3_copy(prev, tr->x);
+  size_t next = 0, uncoupled = 0;
+  for (size_t j = 0; j < tr->n; j++) {
+    const double *x = tr->x + 3 * j;
+    double dx[3], v[3], f[3];
+    v3_sub(dx, x, prev);
+    v3_scale(v, dx, 1.0 / T_S);
+    v3_copy(prev, x);
+    contact_render_sent(&r, j + 1, x);
+    for (; next < tr->n && (long)next + 1 + 2 * delay_ms <= (long)j; next++) newest = &tr->fb[next];
+    guide_input_t in;
+    memset(&in, 0, sizeof in);
+    in.role = &role;
+    in.own_station = "trainee";
+    v3_copy(in.x, x);
+    v3_copy(in.v, v);
+    in.have_peer = 1;
+    v3_copy(in.peer, tr->x + 3 * (j >= (size_t)peer_ms ? j - (size_t)peer_ms : 0));
+    in.peer_age_s = T_S;
+    in.server_silent_s = T_S;
+    in.contact = newest;
+    in.max_force = MAX_FORCE;
+    in.period_s = T_S;
+    in.render = reanchor ? &r : NULL;
+    guide_output_t out;
+    guide_force(&in, &out);
+    uncoupled += !out.coupled;
+    if (reanchor) contact_render_sent(&r, j + 1, out.x_tool);
+    double mag = contact_render_output(&r, out.f, 0, 0, v, dx, f);
+    if (mag > peak) peak = mag;
+  }
+  CHECK(uncoupled == 0);
+  return peak;
+}
+
 int main(void) {
   /* The controller's budget: 0.24 N released at 0.08 N per tick into a hand
    * leaving at 1 cm/s is owed (0.24 + 0.16 + 0.08) N x 10 um; a hand that
@@ -528,6 +587,24 @@ int main(void) {
       }
     free(tl.x);
     free(tl.fb);
+  }
+  {
+    /* The guiding hand's contact part, re-anchored at the tool as the
+     * trainee's client predicted it (issue 14 item 4), against the plain
+     * plane (the law before): peer beside the trainee (exact prediction)
+     * and 25 ms from it (the prediction lags the peer by 25 ms while it
+     * moves; the peak, at rest, is the same). */
+    double g0 = guided(&tr, 0, 0, 1), g0p = guided(&tr, 0, 0, 0);
+    printf("guided press (w 0.5), loopback %.3f N (plain %.3f N)\n", g0, g0p);
+    CHECK(g0 > 0.4 && fabs(g0 - g0p) <= 0.01 * g0);
+    for (int d = 50; d <= 100; d += 50) {
+      double re = guided(&tr, d, 0, 1), plain = guided(&tr, d, 0, 0), lag = guided(&tr, d, 25, 1);
+      printf("guided press at %d ms one way: re-anchored %.3f N (%+.1f %%), plain plane %.3f N (%+.1f %%); peer 25 ms "
+             "from the trainee: %.3f N (%+.1f %%)\n",
+             d, re, 100 * (re - g0) / g0, plain, 100 * (plain - g0) / g0, lag, 100 * (lag - g0) / g0);
+      CHECK(fabs(re - g0) <= 0.10 * g0);
+      CHECK(plain > 1.10 * g0); /* what the test catches: the plain plane overshoots */
+    }
   }
   /* The proxy lets go for 8 steps in the middle of the press (the tissue
    * moved away faster than the hand): no overshoot when contact resumes
