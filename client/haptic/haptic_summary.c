@@ -53,15 +53,15 @@ void haptic_summary_print(const haptic_options_t *o, haptic_stats_t *st, haptic_
           h->guide.roles_received, h->guide.roles_rejected, h->guide.roles_ignored, h->guide.peer_samples,
           h->guide.bad_samples, h->guide.own_samples_skipped);
   pthread_mutex_unlock(&h->guide.lock);
-  fprintf(stderr,
-          "haptic: contact under delay: passivity observer max %.3g J over the late-model credit %.3g J (<= 0 passive), "
-          "controller active %" PRIu64
-          " ticks; largest one-tick force change %.4f N; %" PRIu64 " force cut(s) at a lost server, %" PRIu64
-          " server loss(es), %" PRIu64 " stale-feedback episode(s); in contact %" PRIu64
-          " ticks re-anchored at the answered command (%" PRIu64 " of them at the last placed lag), %" PRIu64
-          " plain plane\n",
-          st->excess_max_j, st->credit_j, st->pc_ticks, st->step_max_n, st->cuts, st->server_lost, st->feedback_stale,
-          st->reanchored_ticks, st->unplaced_ticks, st->plain_ticks);
+  fprintf(
+      stderr,
+      "haptic: contact under delay: passivity observer max %.3g J over the late-model credit %.3g J (<= 0 passive), "
+      "controller active %" PRIu64 " ticks; largest one-tick force change %.4f N; %" PRIu64
+      " force cut(s) at a lost server, %" PRIu64 " server loss(es), %" PRIu64
+      " stale-feedback episode(s); in contact %" PRIu64 " ticks re-anchored at the answered command (%" PRIu64
+      " of them at the last placed lag), %" PRIu64 " plain plane\n",
+      st->excess_max_j, st->credit_j, st->pc_ticks, st->step_max_n, st->cuts, st->server_lost, st->feedback_stale,
+      st->reanchored_ticks, st->unplaced_ticks, st->plain_ticks);
   /* Contact under delay (issue 14): scripts and the link benchmark read these. */
   printf("CONTACT step_max_n=%.4f server_lost=%" PRIu64 " liveliness_blips=%" PRIu64 " feedback_stale=%" PRIu64
          " cuts=%" PRIu64 " controller_ticks=%" PRIu64 " guide_rtt_ms=%.1f energy_j=%.4g energy_max_j=%.4g"

@@ -19,8 +19,7 @@ void passivity_init(passivity_t *p, double period_s) {
 /* N: the controller renders nothing rather than less than this. */
 #define PASSIVITY_MIN_FORCE 1e-4
 
-double passivity_owed(double m, double u, double a, double tick_s, double hold_s, double release_step,
-                      double u_floor) {
+double passivity_owed(double m, double u, double a, double tick_s, double hold_s, double release_step, double u_floor) {
   if (!(m > 0) || !(release_step > 0) || !isfinite(u) || !isfinite(a)) return 0;
   if (!(u_floor > 0)) u_floor = 0;
   if (hold_s < tick_s) hold_s = tick_s;
@@ -65,7 +64,8 @@ double passivity_control(passivity_t *p, const double v[3], const double a[3], d
   if (lo < PASSIVITY_MIN_FORCE) lo = 0;
   double s = lo / m;
   p->dissipated +=
-      (owed - passivity_owed(lo, u, acc, tick_s, hold_s, release_step, p->release_floor) * PASSIVITY_ROUNDING) / PASSIVITY_ROUNDING;
+      (owed - passivity_owed(lo, u, acc, tick_s, hold_s, release_step, p->release_floor) * PASSIVITY_ROUNDING) /
+      PASSIVITY_ROUNDING;
   p->active_ticks++;
   v3_scale(f, f, s);
   return s;

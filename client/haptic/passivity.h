@@ -96,8 +96,7 @@ void passivity_init(passivity_t *p, double period_s);
  * now for hold_s (>= tick_s: the reserve for this tick being late), then
  * released in ticks of tick_s, during which (and over this tick) the hand
  * is taken to leave at u_floor (m/s) at least (0: as predicted). */
-double passivity_owed(double m, double u, double a, double tick_s, double hold_s, double release_step,
-                      double u_floor);
+double passivity_owed(double m, double u, double a, double tick_s, double hold_s, double release_step, double u_floor);
 
 /* The controller: f (in place) scaled down along its line, the least, so
  * that E + passivity_owed(|f|, ...) <= C (zero when even that cannot hold

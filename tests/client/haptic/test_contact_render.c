@@ -484,8 +484,7 @@ int main(void) {
         CHECK(lr.step_max <= CONTACT_RENDER_PASSIVE_STEP + 1e-12);
         CHECK(lr.excess_max <= 0 && lr.energy_end <= lr.credit);
         /* The credit is the plane's spring at the hand, |F|^2 / (2 k), no more. */
-        CHECK(lr.credit > 0 &&
-              lr.credit <= 1.02 * passivity_spring_energy(LP_K * (0.0025 + tremors[ti]), LP_K) + 1e-9);
+        CHECK(lr.credit > 0 && lr.credit <= 1.02 * passivity_spring_energy(LP_K * (0.0025 + tremors[ti]), LP_K) + 1e-9);
       }
     /* Flapping and re-anchored models while the hand stays in: one credit. */
     static contact_render_t r;
@@ -505,8 +504,7 @@ int main(void) {
     lp_move(&r, NULL, &z, 0.005, 300);
     late_run_t lr;
     late_press(&r, 0.0025, 0.2, 0, &lr);
-    printf("a second press after the hand left: credit %.3g J -> %.3g J, held %.3f N\n", c1, r.pc.credit,
-           lr.hold_mean);
+    printf("a second press after the hand left: credit %.3g J -> %.3g J, held %.3f N\n", c1, r.pc.credit, lr.hold_mean);
     CHECK(r.pc.credit > c1 && fabs(lr.hold_mean - lr.model_f) <= 0.03 * lr.model_f && r.pc.excess_max <= 0);
   }
   static trace_t tr, tr10;
@@ -529,8 +527,8 @@ int main(void) {
       result_t res;
       run(&tr, &lk, NULL, &res);
       double err = (res.peak - ref.peak) / ref.peak;
-      printf("%6d ms %5.0f%% %10.3f %8.1f %10.4f %12.3g %10.3g %12.3f %11.3f\n", delays[di], 100 * losses[li],
-             res.peak, 100 * err, res.step_max, res.energy_max, res.credit, res.plain_peak, res.plain_step);
+      printf("%6d ms %5.0f%% %10.3f %8.1f %10.4f %12.3g %10.3g %12.3f %11.3f\n", delays[di], 100 * losses[li], res.peak,
+             100 * err, res.step_max, res.energy_max, res.credit, res.plain_peak, res.plain_step);
       CHECK(fabs(err) <= 0.10);
       CHECK(res.step_max <= 0.1 + 1e-12);
       CHECK(res.excess_max <= 0);
