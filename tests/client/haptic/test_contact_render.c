@@ -437,6 +437,27 @@ int main(void) {
    * over 3 ticks). */
   CHECK_NEAR(passivity_owed(0.24, -0.01, 0, 1e-3, 0.02, 0.08, 0.002), 0.48 * 2e-6, 1e-15);
   {
+    /* The credit's arithmetic: 1 N on 400 N/m holds 1.25 mJ; none outside
+     * an episode; a running maximum of U - B_e, never a sum; kept after the
+     * episode closes; a new episode is credited afresh. */
+    passivity_t p;
+    passivity_init(&p, T_S);
+    CHECK_NEAR(passivity_spring_energy(1.0, 400), 1.25e-3, 1e-15);
+    CHECK(passivity_spring_energy(1.0, 0) == 0 && passivity_credit(&p, 1e-3) == 0 && p.credit == 0);
+    passivity_episode_open(&p);
+    double f[3] = {0, 0, 1}, in[3] = {0, 0, -2e-4}, out[3] = {0, 0, 1e-4};
+    passivity_observe(&p, f, in); /* the hand puts 0.2 mJ in: B_e = 0.2 mJ */
+    CHECK_NEAR(passivity_credit(&p, 1.25e-3), 1.05e-3, 1e-15);
+    CHECK(passivity_credit(&p, 1.25e-3) == 0 && passivity_credit(&p, 0.5e-3) == 0);
+    passivity_observe(&p, f, out); /* 0.1 mJ back: B_e stays the most put in */
+    CHECK_NEAR(passivity_credit(&p, 1.45e-3), 0.2e-3, 1e-15);
+    CHECK_NEAR(p.credit, 1.25e-3, 1e-15);
+    passivity_episode_close(&p);
+    CHECK(passivity_credit(&p, 1e-3) == 0 && fabs(p.credit - 1.25e-3) < 1e-15);
+    passivity_episode_open(&p);
+    CHECK_NEAR(passivity_credit(&p, 1e-3), 1e-3, 1e-15);
+  }
+  {
     /* A stalled loop: the hand presses 1 mm further into a plane it is
      * already 2.5 mm inside (1 -> 1.4 N) in 0.1 s, then one tick lasts
      * 60 ms while it leaves at 5 cm/s with the force held: 4 mJ no
