@@ -151,7 +151,7 @@ for d in $DELAYS; do
   done
 done
 load=$(uptime | sed 's/.*load average: //')
-awk -F, -v load="$load" -v traj="$(basename "$TRAJ")" -v cfg="$(basename "$CONFIG")" -v kp="$KW_PATH" 'NR == 1 { print "| one way (ms) | jitter | loss % | reorder | peak force (N) | vs loopback | largest step (N) | observer energy max (J) | commands applied | keyframe (ms) | MeshState / chunks (ms) | seat kbit/s | viewer kbit/s | load (1 min) |";
+awk -F, -v load="$load" -v traj="$(basename "$TRAJ")" -v cfg="$(basename "$CONFIG")" -v kp="$KW_PATH" 'NR == 1 { print "| one way (ms) | jitter | loss % | reorder | peak force (N) | vs loopback | largest step (N) | observer max over the credit (J) | commands applied | keyframe (ms) | MeshState / chunks (ms) | seat kbit/s | viewer kbit/s | load (1 min) |";
     print "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"; next }
   { printf "| %s | %s | %s | %s | %s | %+.0f %% | %s | %s | %s %% | %s | %s / %s | %s | %s | %s |\n", $1, $2, $3, $4, $5, $6, $7, ($8 == "nan" ? "-" : $8), $9, $10, ($13 < 0 ? "-" : $13), ($14 < 0 ? "-" : $14), ($11 == "nan" ? "-" : sprintf("%.0f", $11)), ($12 == "nan" ? "-" : sprintf("%.0f", $12)), $15 }
   END { printf "\nconfiguration %s; trajectory %s; late subscriber takes keyframes: %s; load average at the end: %s\n", cfg, traj, kp, load }' "$OUT/link.csv" > "$OUT/link_table.md"
