@@ -13,6 +13,7 @@ void contact_render_init(contact_render_t *r, double period_s, double max_force)
   r->max_force = max_force;
   r->tick_s = period_s;
   passivity_init(&r->pc, period_s);
+  r->pc.release_floor = CONTACT_RENDER_RELEASE_FLOOR;
 }
 
 void contact_render_sent(contact_render_t *r, uint64_t seq, const double x[3]) {
@@ -33,6 +34,10 @@ static int sent_position(const contact_render_t *r, uint64_t seq, double x[3]) {
 double contact_render_target(contact_render_t *r, const contact_model_t *m, const double x[3], const double v[3],
                              double f[3]) {
   v3_set(f, 0, 0, 0);
+  /* For the late-model credit of the next contact_render_output. */
+  r->target_set = 1;
+  r->target_k = m && m->in_contact ? m->stiffness : 0;
+  v3_copy(r->target_x, x);
   if (!m || !m->in_contact) {
     /* A press's anchor outlives a short gap in contact (the server's proxy
      * let go for a few steps while the tissue moved away faster than the
@@ -119,8 +124,40 @@ static void ramp(const double f_prev[3], const double g[3], double step, double 
   v3_add(f, f_prev, d);
 }
 
+/* The late-model credit's episode (contact_render.h, passivity.h): g the
+ * force the ramp passes this tick towards the model's at the hand x, k the
+ * model's stiffness. */
+static void late_credit(contact_render_t *r, const double g[3], double k, const double x[3]) {
+  double mag = v3_norm(g);
+  int pushing = mag > 0 && k > 0 && isfinite(mag) && v3_isfinite(x);
+  if (r->pc.episode && !r->credit_left && v3_isfinite(x)) {
+    double out[3];
+    v3_sub(out, x, r->credit_x);
+    r->credit_left = r->pc.ep_credit <= 0 || v3_dot(out, r->credit_n) >= r->credit_len;
+  }
+  if (!pushing) {
+    /* The press is over and the hand has left the credited spring since
+     * it was credited: the next press is a new episode. */
+    if (r->pc.episode && !r->anchored && r->credit_left) passivity_episode_close(&r->pc);
+    return;
+  }
+  if (!r->pc.episode) {
+    passivity_episode_open(&r->pc);
+    r->credit_left = 1;
+  }
+  if (passivity_credit(&r->pc, passivity_spring_energy(mag, k)) > 0) {
+    v3_copy(r->credit_x, x);
+    v3_scale(r->credit_n, g, 1.0 / mag);
+    r->credit_len = mag / k;
+    r->credit_left = 0;
+    r->credit_raises++;
+  }
+}
+
 double contact_render_output(contact_render_t *r, const double target[3], int cut, int control, const double v[3],
                              const double dx[3], double f[3]) {
+  int credit = control && r->target_set;
+  r->target_set = 0;
   double before[3];
   v3_copy(before, r->f_prev);
   passivity_observe(&r->pc, r->f_prev, dx); /* last tick's force over the way the hand went since */
@@ -129,8 +166,8 @@ double contact_render_output(contact_render_t *r, const double target[3], int cu
     if (isfinite(de)) r->stall_energy += de;
     r->stall_ticks++;
   }
-  if (r->pc.energy - r->stall_energy > r->energy_max_unstalled)
-    r->energy_max_unstalled = r->pc.energy - r->stall_energy;
+  if (r->pc.energy - r->pc.credit - r->stall_energy > r->energy_max_unstalled)
+    r->energy_max_unstalled = r->pc.energy - r->pc.credit - r->stall_energy;
   if (cut) {
     /* The server is gone: nothing to ramp towards, and a wall it no longer
      * computes must not stay under the hand. */
@@ -147,6 +184,10 @@ double contact_render_output(contact_render_t *r, const double target[3], int cu
      * again, widened to CONTACT_RENDER_PASSIVE_STEP where the controller
      * asked for less. */
     ramp(r->f_prev, g, r->max_step, f);
+    /* Credited for the force the ramp passes, not the target: a model that
+     * jumps for a tick (a plain plane before the press is re-anchored)
+     * holds no more than the ramp lets it render. */
+    if (credit) late_credit(r, f, r->target_k, r->target_x);
     if (control && passivity_control(&r->pc, v, r->accel, r->tick_s, CONTACT_RENDER_STALL_S, r->max_step, f) < 1.0) {
       double h[3];
       v3_copy(h, f);

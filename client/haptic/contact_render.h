@@ -39,6 +39,19 @@
  *    machine's late tick holds the force longer), so E stays <= 0; when it
  *    asks for less force the ramp yields, up to CONTACT_RENDER_PASSIVE_STEP
  *    per tick.
+ *    The late-model credit (passivity.h): a press whose model arrived
+ *    after the hand had gone in (at worst after it stopped inside: the
+ *    hand's work was done on the server's tissue while nothing was
+ *    rendered) is credited the stored energy of the model's spring at the
+ *    force it renders, less what the hand put in through this port in the
+ *    press, |F|^2 / (2 k) - B, a running maximum per press. An episode
+ *    opens at the press's first pushing model and closes only when the
+ *    press is over (its anchor forgotten: no contact for
+ *    CONTACT_RENDER_HOLD_S) and the hand has been back out of the credited
+ *    spring (|F| / k along its normal from where it was credited) since
+ *    the credit was last raised: the
+ *    model flapping, re-anchoring or the server back after a blip cannot
+ *    grant it again while the hand stays in.
  * 4. A stale model (no feedback for hold_s: the link is slow, lossy or the
  *    server stalls) is held, re-anchored at our own position, and then
  *    ramped to zero; only a cut (the server's liveliness lost: it is gone)
@@ -73,6 +86,11 @@
  * machine's loop, seen 1-65 ms at load 8): the force rendered now is budgeted as held
  * this long. A longer stall of the client's loop can leave a few uJ. */
 #define CONTACT_RENDER_STALL_S 0.02
+/* m/s: the controller budgets every release for a hand leaving at least
+ * this fast (passivity.h release_floor): a hand that rests with the budget
+ * spent, then starts out, left 17 uJ over it (test_contact_render's
+ * flapping model). */
+#define CONTACT_RENDER_RELEASE_FLOOR 0.002
 /* s: how long a model is rendered without a new sample before it ramps out. */
 #define CONTACT_RENDER_HOLD_S 0.25
 /* m: the depth below which the press's secant stiffness is not estimated. */
@@ -109,6 +127,15 @@ typedef struct contact_render {
    * observer's largest value without it: what the controller answers for. */
   double stall_energy, energy_max_unstalled;
   uint64_t stall_ticks;
+  /* The spring of the open episode's credit (its latest raise): where the
+   * hand was, the force's unit normal, its length |F| / k (m). */
+  double credit_x[3], credit_n[3], credit_len;
+  int credit_left; /* the hand has been out of that spring since */
+  /* Set by contact_render_target for the next contact_render_output: the
+   * model's stiffness (0: no contact) and the hand's position. */
+  int target_set;
+  double target_k, target_x[3];
+  uint64_t credit_raises; /* ticks that raised the credit */
   passivity_t pc;
 } contact_render_t;
 
@@ -132,7 +159,11 @@ double contact_render_tick(contact_render_t *r, const contact_model_t *m, int cu
                            const double dx[3], double f[3]);
 
 /* Ramp and passivity for a target force: the same bounds and observer as
- * contact_render_tick; control 0 observes without the controller (the
+ * contact_render_tick. The late-model credit needs the model: only a
+ * target from contact_render_target just before is credited (a controlled
+ * target from elsewhere gets none: with nothing banked it is withheld).
+ * control 0 observes without
+ * the controller (the
  * guiding hand: a led hand must receive the energy its guide puts in, so
  * one port alone may not be held passive; guide_force.h damps the coupling
  * for the delay instead). */

@@ -95,7 +95,10 @@ void guide_force(const guide_input_t *in, guide_output_t *out) {
   for (int i = 0; i < 3; i++) x_tool[i] = w * in->x[i] + (1.0 - w) * in->peer[i];
   v3_scale(v_tool, in->v, w);
   double fc[3];
-  contact_model_force(in->contact, x_tool, v_tool, in->max_force, fc);
+  if (in->render)
+    contact_render_target(in->render, in->contact, x_tool, v_tool, fc);
+  else
+    contact_model_force(in->contact, x_tool, v_tool, in->max_force, fc);
   double f[3], b = guide_coupling_damping(w, k, in->period_s, in->rtt_s);
   for (int i = 0; i < 3; i++) f[i] = w * fc[i] + (1.0 - w) * k * (in->peer[i] - in->x[i]) - b * in->v[i];
   v3_copy(out->f, f);

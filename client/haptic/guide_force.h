@@ -17,7 +17,13 @@
  *   F = w F_contact(x_tool, w v) + (1 - w) (k (p - x) - k (T + tau / 2) v)
  * - F_contact is the ContactFeedback plane model (contact_model.h), with the
  *   stiffness and damping the caller already set (device-clamped, passive at
- *   period T). Its velocity is w v: the peer is taken as still within a tick,
+ *   period T), re-anchored at the tool position of the command it answered
+ *   when the caller gives its renderer (`render`, contact_render.h: the plain
+ *   plane one round trip old overshoots, as for an unguided hand). The tool
+ *   position is our prediction of the server's mix, with the peer's position
+ *   as it reached us: off by (1 - w) times the way the peer moved in the
+ *   difference between its path to us and to the server (none when both
+ *   are equally far, or the peer is still). Its velocity is w v: the peer is taken as still within a tick,
  *   so the tool moves at w v. The hand then feels stiffness w^2 k_c and
  *   damping w^2 b_c, the same ratio that keeps the plain wall passive.
  * - The coupling spring (1 - w) k pulls the hand towards the peer. Its
@@ -47,6 +53,7 @@
 #include <stdint.h>
 
 #include "contact_model.h"
+#include "contact_render.h"
 
 #define GUIDE_STATION_MAX 32 /* = VDDS_STATION_MAX, with the terminating NUL */
 #define GUIDE_PEER_TIMEOUT_S 0.1
@@ -96,6 +103,12 @@ typedef struct guide_input {
   double max_stiffness; /* N/m device rating, 0 = none stated */
   double period_s;      /* loop period T */
   double rtt_s;         /* tau: round trip to the peer, s (0: same machine or LAN) */
+  /* Coupled, the contact part re-anchored at the answered command
+   * (contact_render_target at the tool) when set: the renderer's ring must
+   * then hold, for each of our commands sent while coupled, the tool
+   * position the server mixes for it, as we predict it (w x + (1 - w) p at
+   * that tick: x_tool below). NULL: the plain plane at the tool. */
+  contact_render_t *render;
 } guide_input_t;
 
 typedef struct guide_output {

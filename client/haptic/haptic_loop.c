@@ -157,13 +157,18 @@ static void render_force(const haptic_loop_t *l, tick_state_t *s, double t, uint
                        .max_force = l->dev->max_force,
                        .max_stiffness = l->dev->max_stiffness,
                        .period_s = 1.0 / o->rate,
-                       .rtt_s = guide_rtt(l, s, gv.peer_transit_s)};
+                       .rtt_s = guide_rtt(l, s, gv.peer_transit_s),
+                       .render = &s->render};
   memcpy(gin.x, pos, sizeof gin.x);
   memcpy(gin.v, vel, sizeof gin.v);
   memcpy(gin.peer, gv.peer, sizeof gin.peer);
   guide_force(&gin, gout);
+  /* Coupled, the server answers this tick's command at the tool it mixes
+   * from both hands: the ring keeps our prediction of it (guide_force.h). */
+  if (gout->coupled) contact_render_sent(&s->render, s->seq, gout->x_tool);
   /* Uncoupled, the contact model re-anchored at our own position; coupled,
-   * the guiding law's force. Either way ramped and observed. */
+   * the guiding law's force (its contact part re-anchored at the tool).
+   * Either way ramped and observed. */
   double target[3];
   if (gout->coupled)
     memcpy(target, gout->f, sizeof target);
@@ -188,6 +193,8 @@ static void record_force(const haptic_loop_t *l, const tick_state_t *s, double t
   if (mag > st->peak_force) st->peak_force = mag;
   st->energy_max_j = s->render.pc.energy_max;
   st->energy_j = s->render.pc.energy;
+  st->credit_j = s->render.pc.credit;
+  st->excess_max_j = s->render.pc.excess_max;
   st->stall_energy_j = s->render.stall_energy;
   st->energy_max_unstalled_j = s->render.energy_max_unstalled;
   st->stall_ticks = s->render.stall_ticks;

@@ -26,6 +26,8 @@ typedef struct haptic_stats {
    * (N, cuts excluded), controller ticks, forces cut at a lost server,
    * liveliness losses and stale-feedback episodes. */
   double energy_max_j, energy_j, step_max_n;
+  /* The late-model credit C (passivity.h), J, and the largest E - C (J, <= 0 passive). */
+  double credit_j, excess_max_j;
   /* Work done over ticks that stalled past the controller's reserve
    * (contact_render.h), J, and the observer's largest value without it. */
   double stall_energy_j, energy_max_unstalled_j;

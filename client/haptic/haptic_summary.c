@@ -53,21 +53,22 @@ void haptic_summary_print(const haptic_options_t *o, haptic_stats_t *st, haptic_
           h->guide.roles_received, h->guide.roles_rejected, h->guide.roles_ignored, h->guide.peer_samples,
           h->guide.bad_samples, h->guide.own_samples_skipped);
   pthread_mutex_unlock(&h->guide.lock);
-  fprintf(stderr,
-          "haptic: contact under delay: passivity observer max %.3g J (<= 0 passive), controller active %" PRIu64
-          " ticks; largest one-tick force change %.4f N; %" PRIu64 " force cut(s) at a lost server, %" PRIu64
-          " server loss(es), %" PRIu64 " stale-feedback episode(s); in contact %" PRIu64
-          " ticks re-anchored at the answered command (%" PRIu64 " of them at the last placed lag), %" PRIu64
-          " plain plane\n",
-          st->energy_max_j, st->pc_ticks, st->step_max_n, st->cuts, st->server_lost, st->feedback_stale,
-          st->reanchored_ticks, st->unplaced_ticks, st->plain_ticks);
+  fprintf(
+      stderr,
+      "haptic: contact under delay: passivity observer max %.3g J over the late-model credit %.3g J (<= 0 passive), "
+      "controller active %" PRIu64 " ticks; largest one-tick force change %.4f N; %" PRIu64
+      " force cut(s) at a lost server, %" PRIu64 " server loss(es), %" PRIu64
+      " stale-feedback episode(s); in contact %" PRIu64 " ticks re-anchored at the answered command (%" PRIu64
+      " of them at the last placed lag), %" PRIu64 " plain plane\n",
+      st->excess_max_j, st->credit_j, st->pc_ticks, st->step_max_n, st->cuts, st->server_lost, st->feedback_stale,
+      st->reanchored_ticks, st->unplaced_ticks, st->plain_ticks);
   /* Contact under delay (issue 14): scripts and the link benchmark read these. */
   printf("CONTACT step_max_n=%.4f server_lost=%" PRIu64 " liveliness_blips=%" PRIu64 " feedback_stale=%" PRIu64
          " cuts=%" PRIu64 " controller_ticks=%" PRIu64 " guide_rtt_ms=%.1f energy_j=%.4g energy_max_j=%.4g"
-         " stall_ticks=%" PRIu64 " stall_energy_j=%.4g energy_max_unstalled_j=%.4g\n",
+         " stall_ticks=%" PRIu64 " stall_energy_j=%.4g energy_max_unstalled_j=%.4g credit_j=%.4g excess_max_j=%.4g\n",
          st->step_max_n, st->server_lost, st->liveliness_blips, st->feedback_stale, st->cuts, st->pc_ticks,
          st->guide_rtt_s * 1e3, st->energy_j, st->energy_max_j, st->stall_ticks, st->stall_energy_j,
-         st->energy_max_unstalled_j);
+         st->energy_max_unstalled_j, st->credit_j, st->excess_max_j);
   printf("SUMMARY ticks=%" PRIu64 " rate_hz=%.1f peak_force=%.4f contact_ticks=%" PRIu64 " latency_us_median=%.1f "
          "latency_us_p99=%.1f period_us_p99=%.1f jitter_us_p99=%.1f late_ticks=%" PRIu64 " guide_coupled_s=%.2f "
          "latency_us_mean=%.1f latency_samples=%zu\n",

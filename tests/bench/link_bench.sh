@@ -10,8 +10,8 @@
 # Per setting (CSV and a table):
 #   peak force and its error against loopback, largest one-tick force change
 #   (from the client's force log), passivity energy (the largest energy of the
-#   haptic client's passivity observer, its energy_max_j=, when it reports
-#   one), commands applied (server's counter / client's ticks), keyframe
+#   haptic client's passivity observer over its late-model credit,
+#   excess_max_j=, else energy_max_j=, when it reports one), commands applied (server's counter / client's ticks), keyframe
 #   wait (from the writer's match), bytes per second per seat (trainee's
 #   traffic both ways) and per viewer (what the link carried to the late
 #   subscriber's ports: link_emu --port-stats).
@@ -116,8 +116,10 @@ run() {
   local ticks rate peak app energy step kf dur seat_b view_b kfs kfc m
   ticks=$(field "$OUT/run/$n-haptic.out" ticks); rate=$(field "$OUT/run/$n-haptic.out" rate_hz)
   peak=$(field "$OUT/run/$n-haptic.out" peak_force)
-  # The passivity observer's largest energy over the run (<= 0: passive), when the client reports one.
-  energy=$(field "$OUT/run/$n-haptic.out" energy_max_j)
+  # The passivity observer's largest energy over the run, over the late-model
+  # credit (<= 0: passive; client/haptic/passivity.h), when the client reports one.
+  energy=$(field "$OUT/run/$n-haptic.out" excess_max_j)
+  [ -n "$energy" ] || energy=$(field "$OUT/run/$n-haptic.out" energy_max_j)
   [ -n "$energy" ] || energy=$(field "$OUT/run/$n-haptic.out" energy_j)
   app=$(sed -n 's/^server: \([0-9]*\) tool commands applied.*/\1/p' "$OUT/run/$n-server.log")
   step=$(force_step "$OUT/run/$n-force.csv")
@@ -149,7 +151,7 @@ for d in $DELAYS; do
   done
 done
 load=$(uptime | sed 's/.*load average: //')
-awk -F, -v load="$load" -v traj="$(basename "$TRAJ")" -v cfg="$(basename "$CONFIG")" -v kp="$KW_PATH" 'NR == 1 { print "| one way (ms) | jitter | loss % | reorder | peak force (N) | vs loopback | largest step (N) | observer energy max (J) | commands applied | keyframe (ms) | MeshState / chunks (ms) | seat kbit/s | viewer kbit/s | load (1 min) |";
+awk -F, -v load="$load" -v traj="$(basename "$TRAJ")" -v cfg="$(basename "$CONFIG")" -v kp="$KW_PATH" 'NR == 1 { print "| one way (ms) | jitter | loss % | reorder | peak force (N) | vs loopback | largest step (N) | observer max over the credit (J) | commands applied | keyframe (ms) | MeshState / chunks (ms) | seat kbit/s | viewer kbit/s | load (1 min) |";
     print "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"; next }
   { printf "| %s | %s | %s | %s | %s | %+.0f %% | %s | %s | %s %% | %s | %s / %s | %s | %s | %s |\n", $1, $2, $3, $4, $5, $6, $7, ($8 == "nan" ? "-" : $8), $9, $10, ($13 < 0 ? "-" : $13), ($14 < 0 ? "-" : $14), ($11 == "nan" ? "-" : sprintf("%.0f", $11)), ($12 == "nan" ? "-" : sprintf("%.0f", $12)), $15 }
   END { printf "\nconfiguration %s; trajectory %s; late subscriber takes keyframes: %s; load average at the end: %s\n", cfg, traj, kp, load }' "$OUT/link.csv" > "$OUT/link_table.md"

@@ -8,10 +8,11 @@
 # continuous). Judged from the client's own SUMMARY and force log:
 #   - peak force within 10 % of the 0 ms run's (the same trajectory),
 #   - no one-tick change above 0.1 N (step_n column, step_max_n),
-#   - the passivity observer's energy never above zero (energy_max_j <= 0;
-#     when the client's own loop stalled past the controller's 20 ms
-#     reserve, the work over those ticks is counted apart and the rest must
-#     be <= 0: energy_max_unstalled_j),
+#   - the passivity observer's energy never above the late-model credit
+#     (excess_max_j <= 0, client/haptic/passivity.h; when the client's own
+#     loop stalled past the controller's 20 ms reserve, the work over those
+#     ticks is counted apart and the rest must be <= 0:
+#     energy_max_unstalled_j),
 #   - no "server lost" (server_lost=0): the leases hold under the link.
 # Needs tests/network/sites.sh and prelude.sh (the two-site harness).
 # usage: haptic_palpation_test.sh BUILD SRC OUT
@@ -56,21 +57,20 @@ for setting in "d0:--delay 0" "d25:--delay 25 --jitter 5 --no-reorder --loss 2" 
   # shellcheck disable=SC2086
   [ "$name" = d0 ] || palpate "$name" $opts
   o="$OUT/$name-haptic.out"
-  peak=$(field "$o" peak_force) step=$(field "$o" step_max_n) en=$(field "$o" energy_max_j)
+  peak=$(field "$o" peak_force) step=$(field "$o" step_max_n) en=$(field "$o" excess_max_j)
   lost=$(field "$o" server_lost) lat=$(field "$o" latency_us_median)
   err=$(awk -v p="$peak" -v r="$ref" 'BEGIN { printf "%.1f", 100 * (p - r) / r }')
   printf "%-28s %8.3f %7s %8.4f %11.3g %6s %7.0f ms\n" "$opts" "$peak" "$err" "$step" "$en" "$lost" \
     "$(awk -v l="$lat" 'BEGIN { print l / 1000 }')"
   # When the first contact sample reached the client only after the hand
-  # had stopped (2.0 s; a loaded machine stalled the feedback), the hand put
-  # no energy into the wall and the controller must withhold the force.
+  # had stopped (2.0 s; a loaded machine stalled the feedback), the force
+  # still ramps in on the resting hand: the late-model credit (before it,
+  # the controller withheld it: 0 N).
   first=$(awk -F, 'NR > 1 && $8 == 1 { print $1; exit }' "$OUT/$name-force.csv")
   if awk -v t="${first:-0}" 'BEGIN { exit !(t >= 2.0) }'; then
-    echo "note: the first contact sample arrived at $first s, after the hand stopped (2.0 s): force withheld"
-    awk -v p="$peak" 'BEGIN { exit !(p == 0) }' || fail "$opts: $peak N rendered on a hand that put no energy in"
-  else
-    awk -v p="$peak" -v r="$ref" 'BEGIN { exit !(p >= 0.9 * r && p <= 1.1 * r) }' || fail "$opts: peak $peak N vs $ref N"
+    echo "note: the first contact sample arrived at $first s, after the hand stopped (2.0 s): credited $(field "$o" credit_j) J"
   fi
+  awk -v p="$peak" -v r="$ref" 'BEGIN { exit !(p >= 0.9 * r && p <= 1.1 * r) }' || fail "$opts: peak $peak N vs $ref N"
   awk -v s="$step" 'BEGIN { exit !(s <= 0.1) }' || fail "$opts: one-tick change $step N"
   # The controller budgets the whole rate-limited release of the force
   # before it renders it (client/haptic/passivity.h); before it did, a hand
