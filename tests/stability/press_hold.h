@@ -17,14 +17,17 @@
 #include "vmath.h"
 
 typedef struct press_result {
-  int ok, finite, contact, substeps;
+  int ok, finite, contact, substeps, max_substeps; /* substeps: at the start; max_substeps: the most of any step */
   double speed, force, spread, release_speed0, release_speed_end;
   uint64_t rollbacks;
 } press_result_t;
 
-static inline double surface_speed(const model_t *m, const double *prev, double dt) {
+/* Over the first n vertices: a refining model (adaptive_mass_spring)
+ * keeps its coarse vertices' indices and appends the new ones. */
+static inline double surface_speed(const model_t *m, const double *prev, size_t n, double dt) {
   double vmax = 0;
-  for (size_t i = 0; i < m->nsurf; i++) vmax = fmax(vmax, v3_dist(m->surf_x + 3 * i, prev + 3 * i) / dt);
+  if (n > m->nsurf) n = m->nsurf;
+  for (size_t i = 0; i < n; i++) vmax = fmax(vmax, v3_dist(m->surf_x + 3 * i, prev + 3 * i) / dt);
   return vmax;
 }
 
@@ -47,18 +50,27 @@ static inline press_result_t press(runtime_t *rt) {
   long ramp = lround(0.1 / dt), hold = lround(1.0 / dt), window = lround(0.1 / dt), after = lround(0.5 / dt);
   if (ramp < 1) ramp = 1;
   if (window < 2) window = 2;
-  double *prev = malloc(3 * m->nsurf * sizeof(double));
+  size_t cap = m->nsurf, nprev;
+  double *prev = malloc(3 * cap * sizeof(double));
   if (!prev) return r;
   double fsum = 0, flo = INFINITY, fhi = 0;
   for (long s = 0; s < ramp + hold + window + after; s++) {
     double a = fmin(1.0, (double)s / (double)ramp);
     p[2] = s < ramp + hold + window ? z0 + a * (z1 - z0) : z1 + 0.03;
-    memcpy(prev, m->surf_x, 3 * m->nsurf * sizeof(double));
+    if (m->nsurf > cap) { /* the surface grew (refinement) */
+      double *grown = realloc(prev, 3 * m->nsurf * sizeof(double));
+      if (!grown) break;
+      prev = grown;
+      cap = m->nsurf;
+    }
+    nprev = m->nsurf;
+    memcpy(prev, m->surf_x, 3 * nprev * sizeof(double));
     runtime_set_tool(rt, 0, p, 4);
     runtime_step(rt);
     m = rt->organs[0].model;
+    if (m->substeps > r.max_substeps) r.max_substeps = m->substeps;
     if (!state_finite(m)) r.finite = 0;
-    double speed = surface_speed(m, prev, dt);
+    double speed = surface_speed(m, prev, nprev, dt);
     if (s >= ramp + hold && s < ramp + hold + window) {
       double f = v3_norm(rt->tools[0].force);
       fsum += f;
