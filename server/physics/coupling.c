@@ -105,3 +105,17 @@ void coupling_set_apply(const coupling_set_t *cs, const double *inv_mass, double
     }
   }
 }
+
+void coupling_set_drift(const coupling_set_t *cs, const double *inv_mass, double h, const double *x_old,
+                        const double *v, double *x) {
+  for (size_t c = 0; c < cs->n; c++) {
+    const coupling_spring_t *sp = &cs->s[c];
+    for (uint32_t j = 0; j < sp->nw; j++) {
+      size_t o = 3 * (size_t)cs->node[sp->w0 + j];
+      if (inv_mass[o / 3] == 0) continue;
+      x[o] = x_old[o] + h * v[o];
+      x[o + 1] = x_old[o + 1] + h * v[o + 1];
+      x[o + 2] = x_old[o + 2] + h * v[o + 2];
+    }
+  }
+}

@@ -70,4 +70,10 @@ void coupling_end(coupling_set_t *cs);
  * node) holds a on entry and v' on return; inv_mass per node (0: fixed). */
 void coupling_set_apply(const coupling_set_t *cs, const double *inv_mass, double h, double *v);
 
+/* For a position-based solver (pbd.h), after coupling_set_apply on the
+ * sub-step's velocity: x = x_old + h v on the nodes of every spring's force
+ * set (the nodes the solve moved; fixed ones left). */
+void coupling_set_drift(const coupling_set_t *cs, const double *inv_mass, double h, const double *x_old,
+                        const double *v, double *x);
+
 #endif

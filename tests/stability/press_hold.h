@@ -1,8 +1,8 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* press_hold.h: press a probe into an organ, hold it, release it, through
  * the real runtime (the fixture of stab_implicit_pcg and
- * stab_coupling_models). The probe comes from 2 mm above the highest rest
- * vertex to 5 mm below it over 0.1 s, holds 1 s, is judged over 0.1 s
+ * stab_coupling_*). The probe comes from 2 mm above the highest rest
+ * vertex to 5 mm (press_to: depth) below it over 0.1 s, holds 1 s, is judged over 0.1 s
  * (surface speed from step-to-step displacement, force spread), then is
  * pulled 30 mm up in one step and the run goes on 0.5 s. Header-only. */
 #ifndef VISCERA_PRESS_HOLD_H
@@ -37,7 +37,9 @@ static inline int state_finite(const model_t *m) {
   return 1;
 }
 
-static inline press_result_t press(runtime_t *rt) {
+/* The press to `depth` (m) below the highest rest vertex, with the device's
+ * force limit `max_force` (N). */
+static inline press_result_t press_to(runtime_t *rt, double depth, double max_force) {
   press_result_t r = {.finite = 1, .contact = 1};
   const model_t *m = rt->organs[0].model;
   r.substeps = m->substeps;
@@ -46,7 +48,7 @@ static inline press_result_t press(runtime_t *rt) {
     if (m->surf_rest[3 * i + 2] > m->surf_rest[3 * top + 2]) top = i;
   double p[3], dt = rt->scene.dt;
   v3_copy(p, m->surf_rest + 3 * top);
-  double z0 = p[2] + 0.002, z1 = p[2] - 0.005;
+  double z0 = p[2] + 0.002, z1 = p[2] - depth;
   long ramp = lround(0.1 / dt), hold = lround(1.0 / dt), window = lround(0.1 / dt), after = lround(0.5 / dt);
   if (ramp < 1) ramp = 1;
   if (window < 2) window = 2;
@@ -65,7 +67,7 @@ static inline press_result_t press(runtime_t *rt) {
     }
     nprev = m->nsurf;
     memcpy(prev, m->surf_x, 3 * nprev * sizeof(double));
-    runtime_set_tool(rt, 0, p, 4);
+    runtime_set_tool(rt, 0, p, max_force);
     runtime_step(rt);
     m = rt->organs[0].model;
     if (m->substeps > r.max_substeps) r.max_substeps = m->substeps;
@@ -89,5 +91,8 @@ static inline press_result_t press(runtime_t *rt) {
   r.ok = r.finite && r.contact && r.rollbacks == 0 && r.speed < 1e-6 && r.spread <= 0.01 && r.force > 0;
   return r;
 }
+
+/* 5 mm down, 4 N device. */
+static inline press_result_t press(runtime_t *rt) { return press_to(rt, 0.005, 4); }
 
 #endif
