@@ -74,6 +74,16 @@ void coupling_end(coupling_set_t *cs) {
     cs->ne = sp->w0; /* nothing to couple */
 }
 
+void coupling_add(coupling_set_t *cs, double k, size_t n, size_t nw, const uint32_t *wi, const double *w, size_t nb,
+                  const uint32_t *bi, const double *b) {
+  coupling_begin(cs, k);
+  for (size_t j = 0; j < nw; j++)
+    if (wi[j] < n) coupling_push_w(cs, wi[j], w[j]);
+  for (size_t l = 0; l < nb; l++)
+    if (bi[l] < n) coupling_push_b(cs, bi[l], b[l]);
+  coupling_end(cs);
+}
+
 void coupling_set_apply(const coupling_set_t *cs, const double *inv_mass, double h, double *v) {
   for (size_t c = 0; c < cs->n; c++) {
     const coupling_spring_t *sp = &cs->s[c];

@@ -66,12 +66,7 @@ static void am_add_coupling(model_t *m, double k, size_t nw, const uint32_t *wi,
                             const uint32_t *bi, const double *b) {
   adaptive_model_t *am = (adaptive_model_t *)m;
   if (!m->implicit_tools) return;
-  coupling_begin(&am->cpl, k);
-  for (size_t j = 0; j < nw; j++)
-    if (wi[j] < am->ad.n) coupling_push_w(&am->cpl, wi[j], w[j]);
-  for (size_t l = 0; l < nb; l++)
-    if (bi[l] < am->ad.n) coupling_push_b(&am->cpl, bi[l], b[l]);
-  coupling_end(&am->cpl);
+  coupling_add(&am->cpl, k, am->ad.n, nw, wi, w, nb, bi, b);
 }
 
 /* Checkpoints (model.h save/restore_topology). The refined mesh is a
