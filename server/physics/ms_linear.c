@@ -6,6 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "physics/avx_rows.h"
+
 /* As mass_spring.c: below this length a spring has no direction. */
 #define MSL_TINY 1e-300
 
@@ -43,19 +45,8 @@ static inline void msl_flush(msl_run_t *run, double *restrict rhs, double *restr
   run->cur = UINT32_MAX;
 }
 
-#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+#ifdef VISCERA_HAVE_AVX_ROWS
 #define MSL_HAVE_AVX2_PATH 1
-#include <immintrin.h>
-
-/* Rows r[q] = (x, y, z, -) of four springs into c0 = (r0.x .. r3.x), c1, c2. */
-__attribute__((target("avx2"))) static inline void msl_transpose3(const __m256d r[4], __m256d *c0, __m256d *c1,
-                                                                  __m256d *c2) {
-  const __m256d t0 = _mm256_unpacklo_pd(r[0], r[1]), t1 = _mm256_unpackhi_pd(r[0], r[1]);
-  const __m256d t2 = _mm256_unpacklo_pd(r[2], r[3]), t3 = _mm256_unpackhi_pd(r[2], r[3]);
-  *c0 = _mm256_permute2f128_pd(t0, t2, 0x20);
-  *c1 = _mm256_permute2f128_pd(t1, t3, 0x20);
-  *c2 = _mm256_permute2f128_pd(t0, t2, 0x31);
-}
 
 /* The spring part of ms_linear_rhs four springs at a time (AVX2, chosen at
  * run time, as mass_spring.c's spring loop): each end's x and v as masked
@@ -90,8 +81,8 @@ __attribute__((target("avx2"))) static size_t msl_springs_avx2(ms_linear_t *L, c
       wr[q] = _mm256_sub_pd(_mm256_maskload_pd(v + i3, m3), _mm256_maskload_pd(v + j3, m3));
     }
     __m256d d0, d1, d2, w0, w1, w2;
-    msl_transpose3(dr, &d0, &d1, &d2);
-    msl_transpose3(wr, &w0, &w1, &w2);
+    avx_rows_transpose3(dr, &d0, &d1, &d2);
+    avx_rows_transpose3(wr, &w0, &w1, &w2);
     const __m256d len = _mm256_sqrt_pd(
         _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(d0, d0), _mm256_mul_pd(d1, d1)), _mm256_mul_pd(d2, d2)));
     const int live = _mm256_movemask_pd(_mm256_cmp_pd(len, tiny, _CMP_NLE_UQ));
