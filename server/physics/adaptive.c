@@ -1209,8 +1209,23 @@ int adaptive_step(adaptive_t *ad, double h, adaptive_pre_fn pre, void *ctx) {
       }
       clear_forced(ad);
     }
+    if (!ad->cpl || ad->cpl->n == 0) {
+      for (size_t i = 0; i < ad->n; i++)
+        if (!ad->fine[i]) kick_drift(ad, i, ad->f, hc);
+      continue;
+    }
+    /* A tool spring on coarse nodes too (a patch reaching past the refined
+     * region, or the proxy on a coarse triangle before the region follows
+     * it): the last sub-cycle's springs implicitly over the coarse nodes,
+     * the fine ones held (their inverse mass 0 for the solve, then restored
+     * from im_fine). */
     for (size_t i = 0; i < ad->n; i++)
-      if (!ad->fine[i]) kick_drift(ad, i, ad->f, hc);
+      if (!ad->fine[i]) v3_axpy(ad->v + 3 * i, ad->f + 3 * i, ad->inv_mass[i] * hc);
+    for (size_t a = 0; a < ad->nfine; a++) ad->inv_mass[ad->fine_nodes[a]] = 0;
+    coupling_set_apply(ad->cpl, ad->inv_mass, hc, ad->v);
+    for (size_t a = 0; a < ad->nfine; a++) ad->inv_mass[ad->fine_nodes[a]] = ad->im_fine[ad->fine_nodes[a]];
+    for (size_t i = 0; i < ad->n; i++)
+      if (!ad->fine[i]) v3_axpy(ad->x + 3 * i, ad->v + 3 * i, hc);
   }
   if (r > 1)
     for (size_t a = 0; a < ad->nfine; a++) ad->im_fine[ad->fine_nodes[a]] = 0;

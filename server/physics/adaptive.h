@@ -215,6 +215,7 @@ typedef void (*adaptive_pre_fn)(void *ctx);
  * it puts on coarse nodes are averaged over their sub-step. Tool springs
  * pre() declares in ad->cpl are integrated implicitly between kick and
  * drift (coupling.h; in a sub-cycle over the fine nodes, the held coarse
+ * ones masked; in the coarse step after it over the coarse nodes, the fine
  * ones masked), so their stiffness is in no bound: with tool_stiffness 0
  * the coarse sub-steps and the fine ratio follow the tissue alone.
  * Afterwards refines around the touched node, re-centres, or simplifies
