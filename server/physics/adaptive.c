@@ -1177,6 +1177,17 @@ static void advance(adaptive_t *ad, const uint32_t *list, size_t count, const do
   }
 }
 
+/* Whether a declared spring is attached at a coarse node: only then does
+ * the coarse step's implicit solve (fine nodes held) change anything. */
+static int couples_coarse(const adaptive_t *ad) {
+  const coupling_set_t *cs = ad->cpl;
+  if (!cs) return 0;
+  for (size_t c = 0; c < cs->n; c++)
+    for (uint32_t l = 0; l < cs->s[c].nb; l++)
+      if (!ad->fine[cs->node[cs->s[c].b0 + l]]) return 1;
+  return 0;
+}
+
 int adaptive_step(adaptive_t *ad, double h, adaptive_pre_fn pre, void *ctx) {
   model_guard_save(&ad->guard, ad->x, ad->v, ad->n, NULL);
   int sc = ad->substeps0 < 1 ? 1 : ad->substeps0, r = ad->nfine ? ad->fine_ratio : 1;
@@ -1209,7 +1220,7 @@ int adaptive_step(adaptive_t *ad, double h, adaptive_pre_fn pre, void *ctx) {
       }
       clear_forced(ad);
     }
-    if (!ad->cpl || ad->cpl->n == 0) {
+    if (!couples_coarse(ad)) {
       for (size_t i = 0; i < ad->n; i++)
         if (!ad->fine[i]) kick_drift(ad, i, ad->f, hc);
       continue;
