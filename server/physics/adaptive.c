@@ -180,6 +180,7 @@ void adaptive_destroy(adaptive_t *ad) {
       ad->tris,       ad->tri_face,  ad->springs, ad->spring_off, ad->root_face,  ad->root_node,    ad->root_first,
       ad->root_count, ad->face_root, ad->nodes,   ad->disabled,   ad->modv,       ad->vflag,        ad->stamp,
       ad->ksum,       ad->csum,      ad->vmark,   ad->fine,       ad->fine_nodes, ad->fine_springs, ad->is_forced,
+      ad->im_fine,
   };
   for (size_t k = 0; k < sizeof ptrs / sizeof ptrs[0]; k++) free(ptrs[k]);
   model_guard_free(&ad->guard);
@@ -404,11 +405,12 @@ int adaptive_create(adaptive_t *ad, const mesh_t *s, const adaptive_params_t *p,
   ad->ffine = calloc(3 * cv, sizeof(double));
   ad->forced = calloc(cv, sizeof(uint32_t));
   ad->is_forced = calloc(cv, 1);
-  if (!ad->vmark || !ad->fine || !ad->fine_nodes || !ad->fine_springs || !ad->ffine || !ad->forced || !ad->is_forced ||
-      !xr || !sp || !ad->x || !ad->v || !ad->f || !ad->f_ext || guard_rc || !ad->mass || !ad->inv_mass || !ad->kh ||
-      !ad->ch || !ad->fixed || !ad->vlevel || !ad->anchor || !ad->tris || !ad->tri_face || !ad->spring_off ||
-      !ad->root_face || !ad->root_node || !ad->root_first || !ad->root_count || !ad->face_root || !ad->nodes ||
-      !ad->disabled || !ad->modv || !ad->vflag || !ad->stamp || !ad->ksum || !ad->csum ||
+  ad->im_fine = calloc(cv, sizeof(double));
+  if (!ad->im_fine || !ad->vmark || !ad->fine || !ad->fine_nodes || !ad->fine_springs || !ad->ffine || !ad->forced ||
+      !ad->is_forced || !xr || !sp || !ad->x || !ad->v || !ad->f || !ad->f_ext || guard_rc || !ad->mass ||
+      !ad->inv_mass || !ad->kh || !ad->ch || !ad->fixed || !ad->vlevel || !ad->anchor || !ad->tris || !ad->tri_face ||
+      !ad->spring_off || !ad->root_face || !ad->root_node || !ad->root_first || !ad->root_count || !ad->face_root ||
+      !ad->nodes || !ad->disabled || !ad->modv || !ad->vflag || !ad->stamp || !ad->ksum || !ad->csum ||
       hash_init(&ad->mid, cv - n0) || hash_init(&ad->edge, ad->cap_s - ad->s0)) {
     adaptive_destroy(ad);
     return verr_set(err, "adaptive: out of memory for the refinement capacity (%zu vertices)", cv);
@@ -432,7 +434,7 @@ int adaptive_create(adaptive_t *ad, const mesh_t *s, const adaptive_params_t *p,
   {
     double *dz[] = {ad->x, ad->v, ad->f, ad->f_ext, ad->guard.x, ad->guard.v, ad->ffine};
     for (size_t k = 0; k < sizeof dz / sizeof dz[0]; k++) prefault(dz[k], 3 * cv * sizeof(double));
-    double *dn[] = {ad->mass, ad->inv_mass, ad->kh, ad->ch, ad->ksum, ad->csum};
+    double *dn[] = {ad->mass, ad->inv_mass, ad->kh, ad->ch, ad->ksum, ad->csum, ad->im_fine};
     for (size_t k = 0; k < sizeof dn / sizeof dn[0]; k++) prefault(dn[k], cv * sizeof(double));
     prefault(ad->fixed, cv);
     prefault(ad->vlevel, cv);
@@ -1155,18 +1157,51 @@ static inline void kick_drift(adaptive_t *ad, size_t i, const double *f, double 
   }
 }
 
+/* The nodes list[0..count) (all n when list is NULL) take one sub-step of h:
+ * with declared tool springs, the kick of every node, then the springs'
+ * implicit correction (coupling.h, inverse masses im: 0 for a node held),
+ * then the drift; without, the fused kick-drift. */
+static void advance(adaptive_t *ad, const uint32_t *list, size_t count, const double *f, double h, const double *im) {
+  if (!ad->cpl || ad->cpl->n == 0) {
+    for (size_t a = 0; a < count; a++) kick_drift(ad, list ? list[a] : a, f, h);
+    return;
+  }
+  for (size_t a = 0; a < count; a++) {
+    size_t i = list ? list[a] : a;
+    v3_axpy(ad->v + 3 * i, f + 3 * i, ad->inv_mass[i] * h);
+  }
+  coupling_set_apply(ad->cpl, im, h, ad->v);
+  for (size_t a = 0; a < count; a++) {
+    size_t i = list ? list[a] : a;
+    v3_axpy(ad->x + 3 * i, ad->v + 3 * i, h);
+  }
+}
+
+/* Whether a declared spring is attached at a coarse node: only then does
+ * the coarse step's implicit solve (fine nodes held) change anything. */
+static int couples_coarse(const adaptive_t *ad) {
+  const coupling_set_t *cs = ad->cpl;
+  if (!cs) return 0;
+  for (size_t c = 0; c < cs->n; c++)
+    for (uint32_t l = 0; l < cs->s[c].nb; l++)
+      if (!ad->fine[cs->node[cs->s[c].b0 + l]]) return 1;
+  return 0;
+}
+
 int adaptive_step(adaptive_t *ad, double h, adaptive_pre_fn pre, void *ctx) {
   model_guard_save(&ad->guard, ad->x, ad->v, ad->n, NULL);
   int sc = ad->substeps0 < 1 ? 1 : ad->substeps0, r = ad->nfine ? ad->fine_ratio : 1;
   double hc = h / sc, hf = hc / r;
   ad->step_touched = ADAPT_NONE;
   ad->step_touched_mag = 0;
+  if (r > 1)
+    for (size_t a = 0; a < ad->nfine; a++) ad->im_fine[ad->fine_nodes[a]] = ad->inv_mass[ad->fine_nodes[a]];
   for (int s = 0; s < sc; s++) {
     if (r == 1) {
       if (pre) pre(ctx);
       adaptive_forces(ad, ad->x, ad->v, ad->f);
       clear_forced(ad);
-      for (size_t i = 0; i < ad->n; i++) kick_drift(ad, i, ad->f, hc);
+      advance(ad, NULL, ad->n, ad->f, hc, ad->inv_mass);
       continue;
     }
     /* Multi-rate (eq. 5.18 for the refined level only): the coarse nodes'
@@ -1178,16 +1213,33 @@ int adaptive_step(adaptive_t *ad, double h, adaptive_pre_fn pre, void *ctx) {
     for (int q = 0; q < r; q++) {
       if (pre) pre(ctx);
       fine_forces(ad);
-      for (size_t a = 0; a < ad->nfine; a++) kick_drift(ad, ad->fine_nodes[a], ad->ffine, hf);
+      advance(ad, ad->fine_nodes, ad->nfine, ad->ffine, hf, ad->im_fine);
       for (size_t a = 0; a < ad->nforced; a++) {
         uint32_t i = ad->forced[a];
         if (!ad->fine[i]) v3_axpy(ad->f + 3 * (size_t)i, ad->f_ext + 3 * (size_t)i, 1.0 / r);
       }
       clear_forced(ad);
     }
+    if (!couples_coarse(ad)) {
+      for (size_t i = 0; i < ad->n; i++)
+        if (!ad->fine[i]) kick_drift(ad, i, ad->f, hc);
+      continue;
+    }
+    /* A tool spring on coarse nodes too (a patch reaching past the refined
+     * region, or the proxy on a coarse triangle before the region follows
+     * it): the last sub-cycle's springs implicitly over the coarse nodes,
+     * the fine ones held (their inverse mass 0 for the solve, then restored
+     * from im_fine). */
     for (size_t i = 0; i < ad->n; i++)
-      if (!ad->fine[i]) kick_drift(ad, i, ad->f, hc);
+      if (!ad->fine[i]) v3_axpy(ad->v + 3 * i, ad->f + 3 * i, ad->inv_mass[i] * hc);
+    for (size_t a = 0; a < ad->nfine; a++) ad->inv_mass[ad->fine_nodes[a]] = 0;
+    coupling_set_apply(ad->cpl, ad->inv_mass, hc, ad->v);
+    for (size_t a = 0; a < ad->nfine; a++) ad->inv_mass[ad->fine_nodes[a]] = ad->im_fine[ad->fine_nodes[a]];
+    for (size_t i = 0; i < ad->n; i++)
+      if (!ad->fine[i]) v3_axpy(ad->x + 3 * i, ad->v + 3 * i, hc);
   }
+  if (r > 1)
+    for (size_t a = 0; a < ad->nfine; a++) ad->im_fine[ad->fine_nodes[a]] = 0;
   if (model_guard_check(&ad->guard, ad->x, ad->v, ad->n, NULL, NULL)) return -1;
   /* Topology after the step, so the forces of this step went to the mesh
    * they were computed for. */

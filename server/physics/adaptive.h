@@ -61,6 +61,7 @@
 #include <stdint.h>
 
 #include "mesh.h"
+#include "physics/coupling.h"
 #include "physics/model.h"
 #include "physics/model_guard.h"
 #include "verr.h"
@@ -83,7 +84,7 @@ typedef struct adaptive_params {
   int refine_levels;     /* 0..ADAPT_MAX_LEVELS */
   double refine_force;   /* N, contact force that triggers refinement (docs/methods.md B §5.3) */
   double release_time;   /* s without contact before simplification */
-  double tool_stiffness; /* N/m, in the stability bound */
+  double tool_stiffness; /* N/m, in the stability bound (0 when tool springs are coupled implicitly: cpl) */
   adapt_mass_rule_t mass_rule;
   adapt_k_rule_t k_rule;
   adapt_home_rule_t home_rule;
@@ -172,8 +173,13 @@ typedef struct adaptive {
   uint8_t *fine; /* cap_v flags */
   uint32_t *fine_nodes, *fine_springs;
   size_t nfine, nfine_springs;
-  int fine_ratio;   /* 1 when not refined */
-  double *ffine;    /* 3 cap_v, forces on the fine nodes */
+  int fine_ratio;  /* 1 when not refined */
+  double *ffine;   /* 3 cap_v, forces on the fine nodes */
+  double *im_fine; /* cap_v: inv_mass on the fine nodes, 0 elsewhere (the coarse ones are held in a sub-cycle) */
+  /* Tool springs of the current (fine) sub-step taken implicitly
+   * (physics/coupling.h), filled by pre(); NULL or empty: all explicit.
+   * Owned by the caller (model_adaptive.c). */
+  const coupling_set_t *cpl;
   uint32_t *forced; /* nodes with an external force this sub-step */
   size_t nforced;
   uint8_t *is_forced;
@@ -206,7 +212,12 @@ typedef void (*adaptive_pre_fn)(void *ctx);
 /* One scene step of h: substeps0 coarse sub-steps, each sub-cycling the
  * refined region fine_ratio times with its coarse neighbours held; pre(ctx)
  * runs before every fine sub-step (ad->substeps calls per step), and forces
- * it puts on coarse nodes are averaged over their sub-step.
+ * it puts on coarse nodes are averaged over their sub-step. Tool springs
+ * pre() declares in ad->cpl are integrated implicitly between kick and
+ * drift (coupling.h; in a sub-cycle over the fine nodes, the held coarse
+ * ones masked; in the coarse step after it over the coarse nodes, the fine
+ * ones masked), so their stiffness is in no bound: with tool_stiffness 0
+ * the coarse sub-steps and the fine ratio follow the tissue alone.
  * Afterwards refines around the touched node, re-centres, or simplifies
  * after release_time without contact. Returns 0, or -1 when the state
  * became non-finite: it is then restored and the topology is left alone. */
@@ -236,6 +247,7 @@ uint32_t adaptive_locate(const adaptive_t *ad, uint32_t face, const double p[3],
 typedef struct adaptive_model {
   model_t base; /* base.topology_version follows ad.topology_version (model.h) */
   adaptive_t ad;
+  coupling_set_t cpl; /* the sub-step's tool springs (ad.cpl points here) */
 } adaptive_model_t;
 
 model_t *model_adaptive_create(const model_params_t *p, verr_t *err);

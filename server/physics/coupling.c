@@ -74,6 +74,16 @@ void coupling_end(coupling_set_t *cs) {
     cs->ne = sp->w0; /* nothing to couple */
 }
 
+void coupling_add(coupling_set_t *cs, double k, size_t n, size_t nw, const uint32_t *wi, const double *w, size_t nb,
+                  const uint32_t *bi, const double *b) {
+  coupling_begin(cs, k);
+  for (size_t j = 0; j < nw; j++)
+    if (wi[j] < n) coupling_push_w(cs, wi[j], w[j]);
+  for (size_t l = 0; l < nb; l++)
+    if (bi[l] < n) coupling_push_b(cs, bi[l], b[l]);
+  coupling_end(cs);
+}
+
 void coupling_set_apply(const coupling_set_t *cs, const double *inv_mass, double h, double *v) {
   for (size_t c = 0; c < cs->n; c++) {
     const coupling_spring_t *sp = &cs->s[c];
@@ -102,6 +112,20 @@ void coupling_set_apply(const coupling_set_t *cs, const double *inv_mass, double
       vj[0] -= a * s[0];
       vj[1] -= a * s[1];
       vj[2] -= a * s[2];
+    }
+  }
+}
+
+void coupling_set_drift(const coupling_set_t *cs, const double *inv_mass, double h, const double *x_old,
+                        const double *v, double *x) {
+  for (size_t c = 0; c < cs->n; c++) {
+    const coupling_spring_t *sp = &cs->s[c];
+    for (uint32_t j = 0; j < sp->nw; j++) {
+      size_t o = 3 * (size_t)cs->node[sp->w0 + j];
+      if (inv_mass[o / 3] == 0) continue;
+      x[o] = x_old[o] + h * v[o];
+      x[o + 1] = x_old[o + 1] + h * v[o + 1];
+      x[o + 2] = x_old[o + 2] + h * v[o + 2];
     }
   }
 }

@@ -65,9 +65,20 @@ void coupling_begin(coupling_set_t *cs, double k);
 void coupling_push_w(coupling_set_t *cs, uint32_t node, double w);
 void coupling_push_b(coupling_set_t *cs, uint32_t node, double b);
 void coupling_end(coupling_set_t *cs);
+/* begin, push, end in one, for a model whose surface vertices are its n
+ * nodes (model.h add_surface_coupling's arguments): entries with an index
+ * >= n are left out. */
+void coupling_add(coupling_set_t *cs, double k, size_t n, size_t nw, const uint32_t *wi, const double *w, size_t nb,
+                  const uint32_t *bi, const double *b);
 
 /* The implicit correction after the explicit kick (file comment): v (3 per
  * node) holds a on entry and v' on return; inv_mass per node (0: fixed). */
 void coupling_set_apply(const coupling_set_t *cs, const double *inv_mass, double h, double *v);
+
+/* For a position-based solver (pbd.h), after coupling_set_apply on the
+ * sub-step's velocity: x = x_old + h v on the nodes of every spring's force
+ * set (the nodes the solve moved; fixed ones left). */
+void coupling_set_drift(const coupling_set_t *cs, const double *inv_mass, double h, const double *x_old,
+                        const double *v, double *x);
 
 #endif

@@ -15,8 +15,11 @@
 #include "physics/adaptive.h"
 #include "state_blob.h"
 
+/* Before every (fine) sub-step: the hook's tool springs of the last one
+ * are gone; the hook declares this one's (am_add_coupling). */
 static void am_pre(void *ctx) {
   model_t *m = ctx;
+  coupling_set_clear(&((adaptive_model_t *)m)->cpl);
   if (m->hook) m->hook(m, m->hook_ctx);
 }
 
@@ -44,6 +47,7 @@ static int am_step(model_t *m, double h) {
 static void am_destroy(model_t *m) {
   adaptive_model_t *am = (adaptive_model_t *)m;
   adaptive_destroy(&am->ad);
+  coupling_set_free(&am->cpl);
   free(am);
 }
 
@@ -53,6 +57,16 @@ static double am_error(const model_t *m) { return adaptive_max_strain(&((const a
 
 static void am_add_force(model_t *m, uint32_t i, const double f[3]) {
   adaptive_add_force(&((adaptive_model_t *)m)->ad, i, f);
+}
+
+/* Tool springs implicitly (physics/coupling.h, adaptive.h adaptive_step):
+ * the stiffest tool is in none of the multi-rate bounds (coarse sub-steps,
+ * fine ratio). Indices beyond the current mesh are left out. */
+static void am_add_coupling(model_t *m, double k, size_t nw, const uint32_t *wi, const double *w, size_t nb,
+                            const uint32_t *bi, const double *b) {
+  adaptive_model_t *am = (adaptive_model_t *)m;
+  if (!m->implicit_tools) return;
+  coupling_add(&am->cpl, k, am->ad.n, nw, wi, w, nb, bi, b);
 }
 
 /* Checkpoints (model.h save/restore_topology). The refined mesh is a
@@ -118,6 +132,7 @@ static const model_ops_t adaptive_ops = {
     .energy = am_energy,
     .error_estimate = am_error,
     .add_surface_force = am_add_force,
+    .add_surface_coupling = am_add_coupling,
     .save_topology = am_save_topology,
     .restore_topology = am_restore_topology,
     .surface_anchor = am_surface_anchor,
@@ -152,18 +167,26 @@ model_t *model_adaptive_create(const model_params_t *p, verr_t *err) {
                           .refine_levels = mat->refine_levels,
                           .refine_force = ADAPT_DEFAULT_REFINE_FORCE,
                           .release_time = ADAPT_DEFAULT_RELEASE_TIME,
-                          .tool_stiffness = p->tool_stiffness,
+                          /* Tool springs implicit (am_add_coupling): out of the bounds. */
+                          .tool_stiffness = 0,
                           .mass_rule = ADAPT_MASS_AREA,
                           .k_rule = ADAPT_K_MEMBRANE};
   verr_t e;
+  if (coupling_set_init(&am->cpl, 256, 8192, err)) {
+    free(am);
+    return NULL;
+  }
   if (adaptive_create(&am->ad, p->surface, &ap, p->dt, cfg->solver.substeps, &e)) {
+    coupling_set_free(&am->cpl);
     free(am);
     verr_set(err, "%s", e.msg);
     return NULL;
   }
+  am->ad.cpl = &am->cpl;
   if (cfg->fixed_below_set) adaptive_fix_below(&am->ad, cfg->fixed_below);
   model_t *m = &am->base;
   m->ops = &adaptive_ops;
+  m->implicit_tools = 1;
   m->error_kind = "max_edge_strain";
   m->x = m->surf_x = am->ad.x;
   m->v = am->ad.v;

@@ -128,12 +128,7 @@ static void mm_add_surface_coupling(model_t *m, double k, size_t nw, const uint3
                                     const uint32_t *bi, const double *b) {
   mol_model_t *mm = (mol_model_t *)m;
   if (!m->implicit_tools) return;
-  coupling_begin(&mm->cpl, k);
-  for (size_t j = 0; j < nw; j++)
-    if (wi[j] < mm->mol.n) coupling_push_w(&mm->cpl, wi[j], w[j]);
-  for (size_t l = 0; l < nb; l++)
-    if (bi[l] < mm->mol.n) coupling_push_b(&mm->cpl, bi[l], b[l]);
-  coupling_end(&mm->cpl);
+  coupling_add(&mm->cpl, k, mm->mol.n, nw, wi, w, nb, bi, b);
 }
 
 static const model_ops_t MOL_OPS = {

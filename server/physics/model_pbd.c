@@ -24,6 +24,7 @@ typedef struct model_pbd {
    * the embedding), surf_attr holds their attribute. NULL before. */
   uint32_t *surf_node;
   double *surf_attr;
+  coupling_set_t cpl; /* the sub-step's tool springs as constraints (s.cpl points here) */
 } model_pbd_t;
 
 /* Sub-steps chosen when the scene leaves solver.substeps at 0: PBD and XPBD
@@ -51,6 +52,7 @@ static void surface_from_nodes(model_pbd_t *mp, const double *x) {
 
 static void pbd_pre_hook(pbd_t *s, void *ctx) {
   model_t *m = ctx;
+  coupling_set_clear(&((model_pbd_t *)m)->cpl);
   if (!m->hook) return;
   surface_from_nodes((model_pbd_t *)m, s->x);
   m->hook(m, m->hook_ctx);
@@ -76,6 +78,7 @@ static void pbd_model_destroy(model_t *m) {
   free(mp->surf_tris);
   free(mp->surf_node);
   free(mp->surf_attr);
+  coupling_set_free(&mp->cpl);
   free(mp);
 }
 
@@ -108,6 +111,34 @@ static void pbd_model_add_surface_force(model_t *m, uint32_t i, const double f[3
   }
 }
 
+/* A surface vertex's weight in node terms: the embedding's (or, after a
+ * cut, its node's), as pbd_model_add_surface_force spreads a force. */
+typedef void (*push_fn)(coupling_set_t *cs, uint32_t node, double w);
+static void push_surface(model_pbd_t *mp, push_fn push, uint32_t i, double w) {
+  if (mp->surf_node) {
+    if (i < mp->base.nsurf) push(&mp->cpl, mp->surf_node[i], w);
+    return;
+  }
+  if (i >= mp->emb.nsurf) return;
+  const uint32_t *q = mp->tm.tets + 4 * (size_t)mp->emb.tet[i];
+  const double *b = mp->emb.bary + 4 * (size_t)i;
+  for (int k = 0; k < 4; k++)
+    if (b[k] != 0) push(&mp->cpl, q[k], w * b[k]);
+}
+
+/* Tool springs implicitly (pbd.h, coupling.h): force weights and
+ * attachment weights carried from surface vertices to nodes through the
+ * embedding. */
+static void pbd_model_add_coupling(model_t *m, double k, size_t nw, const uint32_t *wi, const double *w, size_t nb,
+                                   const uint32_t *bi, const double *b) {
+  model_pbd_t *mp = (model_pbd_t *)m;
+  if (!m->implicit_tools || !isfinite(k)) return;
+  coupling_begin(&mp->cpl, k);
+  for (size_t j = 0; j < nw; j++) push_surface(mp, coupling_push_w, wi[j], w[j]);
+  for (size_t l = 0; l < nb; l++) push_surface(mp, coupling_push_b, bi[l], b[l]);
+  coupling_end(&mp->cpl);
+}
+
 static const model_edit_ops_t PBD_EDIT;
 
 /* pbd and xpbd share every operation; only the name (and the mode the
@@ -117,7 +148,8 @@ static const model_edit_ops_t PBD_EDIT;
 #define PBD_FAMILY_OPS(model_name)                                                                                     \
   {                                                                                                                    \
     .name = model_name, .step = pbd_model_step, .destroy = pbd_model_destroy, .energy = pbd_model_energy,              \
-    .error_estimate = pbd_model_error, .add_surface_force = pbd_model_add_surface_force, .edit = &PBD_EDIT             \
+    .error_estimate = pbd_model_error, .add_surface_force = pbd_model_add_surface_force,                               \
+    .add_surface_coupling = pbd_model_add_coupling, .edit = &PBD_EDIT                                                  \
   }
 static const model_ops_t PBD_OPS = PBD_FAMILY_OPS("pbd");
 static const model_ops_t XPBD_OPS = PBD_FAMILY_OPS("xpbd");
@@ -188,6 +220,11 @@ model_t *model_pbd_create(const model_params_t *p, verr_t *err) {
     return NULL;
   }
   if (cfg->fixed_below_set) pbd_fix_below(&mp->s, cfg->fixed_below);
+  if (coupling_set_init(&mp->cpl, 256, 8192, err)) {
+    pbd_model_destroy(&mp->base);
+    return NULL;
+  }
+  mp->s.cpl = &mp->cpl;
   size_t ns = surf->nverts;
   mp->surf_x = malloc(3 * ns * sizeof(double));
   mp->surf_rest = malloc(3 * ns * sizeof(double));
@@ -218,6 +255,7 @@ model_t *model_pbd_create(const model_params_t *p, verr_t *err) {
   m->surf_tris = mp->surf_tris;
   m->substeps = pp.substeps;
   m->stable_dt = INFINITY;
+  m->implicit_tools = 1;
   return m;
 }
 
@@ -294,6 +332,7 @@ static int pbd_commit(model_t *m, const model_topology_t *t, verr_t *err) {
   }
   pbd_destroy(&mp->s);
   mp->s = ns;
+  mp->s.cpl = &mp->cpl;
   free(mp->surf_x);
   free(mp->surf_rest);
   free(mp->surf_tris);

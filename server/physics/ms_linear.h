@@ -36,8 +36,16 @@ typedef struct ms_linear {
 int ms_linear_reserve(ms_linear_t *L, size_t nsprings, verr_t *err);
 void ms_linear_free(ms_linear_t *L);
 
-/* Requires L->spring_cap >= ms->nsprings. rhs and diag: 3 ms->n each. */
+/* Requires L->spring_cap >= ms->nsprings. rhs and diag: 3 ms->n each.
+ * Takes the AVX2 spring loop when the processor has it (run time). */
 void ms_linear_rhs(ms_linear_t *L, const mass_spring_t *ms, double h, double *rhs, double *diag);
+/* The same through a chosen spring loop: simd 1 the AVX2 loop (four springs
+ * at a time, the scalar loop's operations in its order: rhs, diag and the
+ * cache bit for bit the scalar loop's), 0 the scalar loop; simd 1 falls
+ * back to scalar when the processor lacks AVX2. */
+void ms_linear_rhs_path(ms_linear_t *L, const mass_spring_t *ms, double h, double *rhs, double *diag, int simd);
+/* 1 when ms_linear_rhs takes the AVX2 loop on this processor. */
+int ms_linear_simd_available(void);
 /* out = (M + h^2 K + h C) y with the blocks cached by the last
  * ms_linear_rhs (the lumped mass folded in: one pass over the nodes). */
 void ms_linear_mul(const ms_linear_t *L, const mass_spring_t *ms, const double *y, double *out);

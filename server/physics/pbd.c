@@ -630,6 +630,12 @@ static void substep(pbd_t *s, double h, double kd, double kv, double atd, double
   }
   double ih = 1.0 / h;
   for (size_t c3 = 0; c3 < 3 * n; c3++) v[c3] = (x[c3] - xo[c3]) * ih;
+  /* Tool springs (pbd.h): the rank-one implicit solve on the sub-step's
+   * velocity, then the moved nodes' positions from it. */
+  if (s->cpl && s->cpl->n > 0) {
+    coupling_set_apply(s->cpl, w, h, v);
+    coupling_set_drift(s->cpl, w, h, xo, v, x);
+  }
 }
 
 int pbd_step(pbd_t *s, double h, pbd_substep_fn pre, void *ctx) {

@@ -6,7 +6,8 @@
  * For each model (mass_spring_surface under symplectic Euler, the live
  * default; mass_spring_tet; molecular with the kidney_molecular.yaml
  * material under implicit_pcg, its scene's integrator, and under Verlet and
- * symplectic Euler; pbd; xpbd; vertex_based), each at the scene
+ * symplectic Euler; pbd; xpbd; vertex_based; adaptive_mass_spring with the
+ * kidney_adaptive.yaml material, refined under the probe), each at the scene
  * defaults (every key the scene leaves out: sub-steps chosen by the model,
  * solver iterations, automatic tetrahedron size) with the default material
  * (0.15 kg), and each organ of assets/meshes (tissue_block, spleen, kidney,
@@ -69,6 +70,12 @@ static model_case_t MODELS[] = {
     {"xpbd", "    model: xpbd\n    material: {mass: 0.15}\n",
      "    model: xpbd\n    material: {mass: 0.15}\n    solver: {substeps: 4, iterations: 10}\n"},
     {"vertex_based", "    model: vertex_based\n    material: {mass: 0.15}\n", NULL},
+    /* assets/scenes/kidney_adaptive.yaml's material: refines under the probe. */
+    {"adaptive_mass_spring",
+     "    model: adaptive_mass_spring\n    integrator: symplectic_euler\n"
+     "    material: {mass: 0.15, stiffness: 30, damping: 0.02, home_stiffness: 30, home_damping: 0.005, "
+     "refine_area: 1.0e-6, refine_levels: 2}\n",
+     NULL},
 };
 #define NMODELS (sizeof MODELS / sizeof MODELS[0])
 
