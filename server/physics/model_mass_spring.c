@@ -73,12 +73,15 @@
 #include "physics/model_mass_spring.h"
 #include "physics/model_volume.h"
 #include "physics/ms_linear.h"
+#include "physics/ms_regions.h"
 #include "state_blob.h"
 #include "tet_mesh.h"
 #include "vmath.h"
 
 /* h lambda_c at most this in the stiffest modes (file comment). */
 #define MS_DAMPING_CAP 0.5
+/* Regional sleeping: still sub-steps before a node sleeps (ms_regions.h). */
+#define MS_REGION_NEED 8
 
 typedef struct ms_model {
   model_t m; /* first: the model_t the caller holds */
@@ -105,6 +108,18 @@ typedef struct ms_model {
   double refine_lambda;
   coupling_set_t cpl; /* symplectic Euler, implicit_pcg: the tool springs of the sub-step (implicit) */
   ms_linear_t lin;    /* implicit_pcg: the step's Jacobian blocks */
+  /* Regional sleeping (physics/ms_regions.h): surface model under
+   * symplectic Euler with solver.region_force > 0. The nodes given an
+   * external force since the last clear (f_ext is cleared there only, not
+   * over every node; ntouched > n: clear all), and the material the
+   * regions were decided under (a change wakes every node). */
+  int regions;
+  ms_regions_t reg;
+  uint32_t *touched;
+  size_t ntouched;
+  ms_params_t reg_p;
+  double reg_damping_scale;
+  const double *reg_k_scale;
 } ms_model_t;
 
 static void embed(ms_model_t *mm) {
@@ -134,9 +149,19 @@ static void linear_mul(force_system_t *s, const double *y, double *out) {
 /* Before every sub-step: external forces are valid for one sub-step only;
  * the surface is brought to the sub-step's positions so the contact hook
  * sees where the tissue is. */
+/* f_ext back to zero: the touched nodes only under regional sleeping. */
+static void clear_f_ext(ms_model_t *mm) {
+  if (mm->regions && mm->reg.springs && mm->ntouched <= mm->ms.n) {
+    for (size_t a = 0; a < mm->ntouched; a++) memset(mm->ms.f_ext + 3 * (size_t)mm->touched[a], 0, 3 * sizeof(double));
+  } else {
+    memset(mm->ms.f_ext, 0, 3 * mm->ms.n * sizeof(double));
+  }
+  mm->ntouched = 0;
+}
+
 static void pre_substep(force_system_t *s) {
   ms_model_t *mm = s->ctx;
-  memset(mm->ms.f_ext, 0, 3 * mm->ms.n * sizeof(double));
+  clear_f_ext(mm);
   coupling_set_clear(&mm->cpl);
   embed(mm);
   if (mm->m.hook) mm->m.hook(&mm->m, mm->m.hook_ctx);
@@ -186,20 +211,51 @@ static void guarded_implicit(ms_model_t *mm, double h) {
   }
 }
 
+/* Regional sleeping is ready for this step: built for the current springs
+ * and nodes, every node woken when the material changed. 0 when it cannot
+ * run (out of memory: the step then integrates every node). */
+static int regions_ready(ms_model_t *mm) {
+  if (!mm->regions) return 0;
+  mass_spring_t *ms = &mm->ms;
+  if (!ms_regions_current(&mm->reg, ms)) {
+    verr_t err;
+    uint32_t *t = realloc(mm->touched, (ms->n + 1) * sizeof *t);
+    if (t) mm->touched = t;
+    if (!t || ms_regions_build(&mm->reg, ms, &err)) {
+      mm->reg.springs = NULL;
+      return 0;
+    }
+    mm->ntouched = ms->n + 1; /* f_ext's state unknown: the next clear is a full one */
+  } else if (memcmp(&mm->reg_p, &ms->p, sizeof ms->p) || mm->reg_damping_scale != ms->damping_scale ||
+             mm->reg_k_scale != ms->k_scale) {
+    ms_regions_wake_all(&mm->reg, ms);
+  }
+  mm->reg_p = ms->p;
+  mm->reg_damping_scale = ms->damping_scale;
+  mm->reg_k_scale = ms->k_scale;
+  return 1;
+}
+
 static int ms_step(model_t *m, double h) {
   ms_model_t *mm = (ms_model_t *)m;
-  size_t bytes = 3 * mm->ms.n * sizeof(double);
   model_guard_save_finite(&mm->guard, mm->ms.x, mm->ms.v, mm->ms.n, NULL);
   int ss = m->substeps < 1 ? 1 : m->substeps;
   double hs = h / ss;
+  int regions = regions_ready(mm);
   for (int s = 0; s < ss; s++) {
-    if (mm->it.kind == INT_IMPLICIT_EULER)
+    if (regions) {
+      pre_substep(&mm->ms.fs);
+      ms_regions_substep(&mm->reg, &mm->ms, hs);
+    } else if (mm->it.kind == INT_IMPLICIT_EULER) {
       guarded_implicit(mm, hs);
-    else
+    } else {
       integrator_substep(&mm->it, &mm->ms.fs, hs);
+    }
   }
-  memset(mm->ms.f_ext, 0, bytes);
+  clear_f_ext(mm);
   int rc = model_guard_check(&mm->guard, mm->ms.x, mm->ms.v, mm->ms.n, NULL, &m->rollbacks);
+  /* The restored state is not what the sleeping nodes were decided on. */
+  if (rc < 0 && regions) ms_regions_wake_all(&mm->reg, &mm->ms);
   embed(mm);
   return rc;
 }
@@ -215,6 +271,8 @@ static void ms_destroy(model_t *m) {
   model_guard_free(&mm->guard);
   coupling_set_free(&mm->cpl);
   ms_linear_free(&mm->lin);
+  ms_regions_free(&mm->reg);
+  free(mm->touched);
   free(mm->surf_buf);
   free(mm->surf_rest_buf);
   free(mm->tris);
@@ -238,7 +296,13 @@ static double tet_error(const model_t *m) {
 
 static void surface_add_force(model_t *m, uint32_t i, const double f[3]) {
   ms_model_t *mm = (ms_model_t *)m;
-  if (i < mm->ms.n) mass_spring_add_force(&mm->ms, i, f);
+  if (i >= mm->ms.n) return;
+  mass_spring_add_force(&mm->ms, i, f);
+  if (mm->regions && mm->reg.springs) {
+    if (mm->ntouched < mm->ms.n) mm->touched[mm->ntouched] = i;
+    if (mm->ntouched <= mm->ms.n) mm->ntouched++; /* past n: the next clear is a full one */
+    ms_regions_touch(&mm->reg, &mm->ms, i);
+  }
 }
 
 /* The embedded vertex moves as sum_k w_k x_k, so by virtual work a force on
@@ -260,10 +324,17 @@ static void surface_add_coupling(model_t *m, double k, size_t nw, const uint32_t
   if (!m->implicit_tools) return;
   coupling_set_t *cs = &mm->cpl;
   coupling_begin(cs, k);
+  int reg = mm->regions && mm->reg.springs;
   for (size_t j = 0; j < nw; j++)
-    if (wi[j] < mm->ms.n) coupling_push_w(cs, wi[j], w[j]);
+    if (wi[j] < mm->ms.n) {
+      coupling_push_w(cs, wi[j], w[j]);
+      if (reg) ms_regions_touch(&mm->reg, &mm->ms, wi[j]);
+    }
   for (size_t l = 0; l < nb; l++)
-    if (bi[l] < mm->ms.n) coupling_push_b(cs, bi[l], b[l]);
+    if (bi[l] < mm->ms.n) {
+      coupling_push_b(cs, bi[l], b[l]);
+      if (reg) ms_regions_touch(&mm->reg, &mm->ms, bi[l]);
+    }
   coupling_end(cs);
 }
 
@@ -412,6 +483,9 @@ static model_t *ms_create(const model_params_t *p, int tet, verr_t *err) {
     mm->ms.fs.linearize = linearize;
     mm->ms.fs.linear_mul = linear_mul;
   }
+  /* Regional sleeping: the live default (surface, symplectic Euler). */
+  mm->regions = !tet && kind == INT_SYMPLECTIC_EULER && cfg->solver.region_force > 0;
+  ms_regions_init(&mm->reg, cfg->solver.region_force, cfg->solver.region_speed, MS_REGION_NEED);
   /* Conjugate gradients need a definite matrix (see mass_spring.h). */
   mm->ms.definite_jacobian = kind == INT_IMPLICIT_EULER || kind == INT_IMPLICIT_PCG;
   if (cfg->fixed_below_set) mass_spring_fix_below(&mm->ms, cfg->fixed_below);
@@ -514,7 +588,9 @@ static int ms_reserve(model_t *m, size_t cap, int with_f_res, verr_t *err) {
     mm->it = it;
   }
   /* The arrays may have moved: the model's view follows (the caller bumps
-   * topology_version through commit before anyone steps again). */
+   * topology_version through commit before anyone steps again); regional
+   * sleeping is rebuilt (every node awake) at the next step. */
+  mm->reg.springs = NULL;
   m->x = m->surf_x = mm->ms.x;
   m->v = mm->ms.v;
   m->x_rest = m->surf_rest = mm->ms.x_rest;
@@ -587,6 +663,7 @@ static int ms_commit_nodes(model_t *m, size_t n, const uint32_t *old_to_new, siz
    * unique edges, at most 3 per triangle) before the springs change. */
   if (mm->ms.fs.linearize && ms_linear_reserve(&mm->lin, 3 * ntris, err)) return -1;
   if (mass_spring_set_surface_topology(&mm->ms, n, tris, ntris, err)) return -1;
+  mm->reg.springs = NULL; /* rebuilt, every node awake, at the next step */
   memcpy(mm->tris, tris, 3 * ntris * sizeof(uint32_t));
   model_guard_save(&mm->guard, mm->ms.x, mm->ms.v, n, NULL);
   m->nnodes = m->nsurf = n;
