@@ -80,8 +80,6 @@
 
 /* h lambda_c at most this in the stiffest modes (file comment). */
 #define MS_DAMPING_CAP 0.5
-/* Regional sleeping: still sub-steps before a node sleeps (ms_regions.h). */
-#define MS_REGION_NEED 8
 
 typedef struct ms_model {
   model_t m; /* first: the model_t the caller holds */
@@ -211,24 +209,20 @@ static void guarded_implicit(ms_model_t *mm, double h) {
   }
 }
 
-/* Regional sleeping is ready for this step: built for the current springs
- * and nodes, every node woken when the material changed. 0 when it cannot
- * run (out of memory: the step then integrates every node). */
+/* Regional sleeping is ready for this step: built for the current springs,
+ * nodes and material, and no sleeping node written from outside (else it
+ * is derived again from the state, ms_regions.h). 0 when it cannot run
+ * (out of memory: the step then integrates every node). */
 static int regions_ready(ms_model_t *mm) {
   if (!mm->regions) return 0;
   mass_spring_t *ms = &mm->ms;
-  if (!ms_regions_current(&mm->reg, ms)) {
+  if (!ms_regions_current(&mm->reg, ms) || memcmp(&mm->reg_p, &ms->p, sizeof ms->p) ||
+      mm->reg_damping_scale != ms->damping_scale || mm->reg_k_scale != ms->k_scale) {
     verr_t err;
     uint32_t *t = realloc(mm->touched, (ms->n + 1) * sizeof *t);
     if (t) mm->touched = t;
-    if (!t || ms_regions_build(&mm->reg, ms, &err)) {
-      mm->reg.springs = NULL;
-      return 0;
-    }
+    if (!t || ms_regions_build(&mm->reg, ms, &err)) return 0;
     mm->ntouched = ms->n + 1; /* f_ext's state unknown: the next clear is a full one */
-  } else if (memcmp(&mm->reg_p, &ms->p, sizeof ms->p) || mm->reg_damping_scale != ms->damping_scale ||
-             mm->reg_k_scale != ms->k_scale) {
-    ms_regions_wake_all(&mm->reg, ms);
   }
   mm->reg_p = ms->p;
   mm->reg_damping_scale = ms->damping_scale;
@@ -254,8 +248,9 @@ static int ms_step(model_t *m, double h) {
   }
   clear_f_ext(mm);
   int rc = model_guard_check(&mm->guard, mm->ms.x, mm->ms.v, mm->ms.n, NULL, &m->rollbacks);
-  /* The restored state is not what the sleeping nodes were decided on. */
-  if (rc < 0 && regions) ms_regions_wake_all(&mm->reg, &mm->ms);
+  /* The restored state is not what the sleeping nodes were decided on:
+   * derived again at the next step (after whatever the runtime does). */
+  if (rc < 0) mm->reg.springs = NULL;
   embed(mm);
   return rc;
 }
@@ -485,7 +480,7 @@ static model_t *ms_create(const model_params_t *p, int tet, verr_t *err) {
   }
   /* Regional sleeping: the live default (surface, symplectic Euler). */
   mm->regions = !tet && kind == INT_SYMPLECTIC_EULER && cfg->solver.region_force > 0;
-  ms_regions_init(&mm->reg, cfg->solver.region_force, cfg->solver.region_speed, MS_REGION_NEED);
+  ms_regions_init(&mm->reg, cfg->solver.region_force, cfg->solver.region_speed);
   /* Conjugate gradients need a definite matrix (see mass_spring.h). */
   mm->ms.definite_jacobian = kind == INT_IMPLICIT_EULER || kind == INT_IMPLICIT_PCG;
   if (cfg->fixed_below_set) mass_spring_fix_below(&mm->ms, cfg->fixed_below);
@@ -559,6 +554,23 @@ int model_mass_spring_cg_counts(const model_t *m, uint64_t *iterations, uint64_t
   if (mm->it.kind != INT_IMPLICIT_PCG) return -1;
   *iterations = mm->it.cg_iterations_total;
   *steps = mm->it.implicit_steps;
+  return 0;
+}
+
+int model_mass_spring_region_counts(const model_t *m, ms_region_counts_t *out) {
+  if (!m || m->ops != &SURFACE_OPS) return -1;
+  const ms_model_t *mm = (const ms_model_t *)m;
+  if (!mm->regions) return -1;
+  const ms_regions_t *r = &mm->reg;
+  *out = (ms_region_counts_t){.substeps = r->substeps,
+                              .node_updates = r->node_updates,
+                              .block_evals = r->block_evals,
+                              .wakes = r->wakes,
+                              .sleeps = r->sleeps,
+                              .builds = r->builds,
+                              .awake = r->nawake,
+                              .nodes = mm->ms.n,
+                              .springs = mm->ms.nsprings};
   return 0;
 }
 
