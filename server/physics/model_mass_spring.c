@@ -574,6 +574,12 @@ int model_mass_spring_region_counts(const model_t *m, ms_region_counts_t *out) {
   return 0;
 }
 
+const ms_regions_t *model_mass_spring_regions(const model_t *m) {
+  if (!m || m->ops != &SURFACE_OPS) return NULL;
+  const ms_model_t *mm = (const ms_model_t *)m;
+  return mm->regions && mm->reg.springs ? &mm->reg : NULL;
+}
+
 /* realloc that keeps *p on failure; NULL stays NULL. */
 static int grow_buf(double **p, size_t count) {
   if (!*p) return 0;

@@ -58,5 +58,9 @@ typedef struct ms_region_counts {
   size_t awake, nodes, springs;
 } ms_region_counts_t;
 int model_mass_spring_region_counts(const model_t *m, ms_region_counts_t *out);
+/* The regional sleeping state itself (read-only, per node: awake, xs), for
+ * tests; NULL as above or before the first step. */
+struct ms_regions;
+const struct ms_regions *model_mass_spring_regions(const model_t *m);
 
 #endif
