@@ -45,15 +45,16 @@ void ms_regions_free(ms_regions_t *r) {
 
 int ms_regions_current(const ms_regions_t *r, const mass_spring_t *ms) {
   if (!r->springs || r->springs != ms->springs || r->nsprings != ms->nsprings || r->n != ms->n) return 0;
-  /* Bit for bit (a NaN written in is a change too). */
-  const uint64_t *x = (const uint64_t *)ms->x, *v = (const uint64_t *)ms->v, *xs = (const uint64_t *)r->xs;
-  uint64_t diff = 0;
+  /* A NaN written in compares unequal: a change too. */
+  const double *x = ms->x, *v = ms->v, *xs = r->xs;
+  int diff = 0;
   for (size_t k = 0; k < r->n; k++)
     if (!r->awake[k]) {
       const size_t c = 3 * k;
-      diff |= (x[c] ^ xs[c]) | (x[c + 1] ^ xs[c + 1]) | (x[c + 2] ^ xs[c + 2]) | v[c] | v[c + 1] | v[c + 2];
+      diff |= (x[c] != xs[c]) | (x[c + 1] != xs[c + 1]) | (x[c + 2] != xs[c + 2]) | (v[c] != 0) | (v[c + 1] != 0) |
+              (v[c + 2] != 0);
     }
-  return diff == 0;
+  return !diff;
 }
 
 /* Counts node k as held: its springs' blocks are evaluated, its

@@ -80,7 +80,7 @@ void ms_regions_free(ms_regions_t *r);
  * 0, or -1 with err (OOM: r is then not current). */
 int ms_regions_build(ms_regions_t *r, const mass_spring_t *ms, verr_t *err);
 /* 1 when r was built for ms's current springs and nodes and every node it
- * holds asleep is still where it fell asleep, at zero velocity, bit for bit
+ * holds asleep is still where it fell asleep, at zero velocity
  * (else something wrote the state from outside: a test, a reset). */
 int ms_regions_current(const ms_regions_t *r, const mass_spring_t *ms);
 /* Node i is touched from outside in this sub-step (external force, tool
