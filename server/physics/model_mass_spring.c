@@ -209,21 +209,24 @@ static void guarded_implicit(ms_model_t *mm, double h) {
   }
 }
 
-/* Regional sleeping is ready for this step: built for the current springs,
- * nodes and material, and no sleeping node written from outside (else it
- * is derived again from the state, ms_regions.h). 0 when it cannot run
- * (out of memory: the step then integrates every node). */
+/* Regional sleeping for this step: 2 when it runs and guards the step
+ * itself (ms_regions_begin_step: the step then costs what its awake nodes
+ * cost), 1 when it runs but was (re)built now (after a topology change, a
+ * change of material, a rollback or a write from outside: derived again
+ * from the state, and the step is guarded over every node), 0 when it does
+ * not run (off, or out of memory: every node integrated). */
 static int regions_ready(ms_model_t *mm) {
   if (!mm->regions) return 0;
   mass_spring_t *ms = &mm->ms;
-  if (!ms_regions_current(&mm->reg, ms) || memcmp(&mm->reg_p, &ms->p, sizeof ms->p) ||
-      mm->reg_damping_scale != ms->damping_scale || mm->reg_k_scale != ms->k_scale) {
-    verr_t err;
-    uint32_t *t = realloc(mm->touched, (ms->n + 1) * sizeof *t);
-    if (t) mm->touched = t;
-    if (!t || ms_regions_build(&mm->reg, ms, &err)) return 0;
-    mm->ntouched = ms->n + 1; /* f_ext's state unknown: the next clear is a full one */
-  }
+  if (ms_regions_current(&mm->reg, ms) && !memcmp(&mm->reg_p, &ms->p, sizeof ms->p) &&
+      mm->reg_damping_scale == ms->damping_scale && mm->reg_k_scale == ms->k_scale &&
+      ms_regions_begin_step(&mm->reg, ms) == 0)
+    return 2;
+  verr_t err;
+  uint32_t *t = realloc(mm->touched, (ms->n + 1) * sizeof *t);
+  if (t) mm->touched = t;
+  if (!t || ms_regions_build(&mm->reg, ms, &err)) return 0;
+  mm->ntouched = ms->n + 1; /* f_ext's state unknown: the next clear is a full one */
   mm->reg_p = ms->p;
   mm->reg_damping_scale = ms->damping_scale;
   mm->reg_k_scale = ms->k_scale;
@@ -232,10 +235,10 @@ static int regions_ready(ms_model_t *mm) {
 
 static int ms_step(model_t *m, double h) {
   ms_model_t *mm = (ms_model_t *)m;
-  model_guard_save_finite(&mm->guard, mm->ms.x, mm->ms.v, mm->ms.n, NULL);
   int ss = m->substeps < 1 ? 1 : m->substeps;
   double hs = h / ss;
   int regions = regions_ready(mm);
+  if (regions != 2) model_guard_save_finite(&mm->guard, mm->ms.x, mm->ms.v, mm->ms.n, NULL);
   for (int s = 0; s < ss; s++) {
     if (regions) {
       pre_substep(&mm->ms.fs);
@@ -247,10 +250,15 @@ static int ms_step(model_t *m, double h) {
     }
   }
   clear_f_ext(mm);
-  int rc = model_guard_check(&mm->guard, mm->ms.x, mm->ms.v, mm->ms.n, NULL, &m->rollbacks);
-  /* The restored state is not what the sleeping nodes were decided on:
-   * derived again at the next step (after whatever the runtime does). */
-  if (rc < 0) mm->reg.springs = NULL;
+  int rc;
+  if (regions == 2) {
+    rc = ms_regions_end_step(&mm->reg, &mm->ms, &m->rollbacks);
+  } else {
+    rc = model_guard_check(&mm->guard, mm->ms.x, mm->ms.v, mm->ms.n, NULL, &m->rollbacks);
+    /* The restored state is not what the sleeping nodes were decided on:
+     * derived again at the next step (after whatever the runtime does). */
+    if (rc < 0) mm->reg.springs = NULL;
+  }
   embed(mm);
   return rc;
 }

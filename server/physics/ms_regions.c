@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 #include "physics/ms_regions.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -29,7 +30,14 @@ static void free_arrays(ms_regions_t *r) {
   free(r->pend2);
   free(r->f);
   free(r->xs);
-  r->xs = NULL;
+  free(r->gx);
+  free(r->gidx);
+  free(r->saved);
+  r->xs = r->gx = r->gv = NULL;
+  r->gidx = NULL;
+  r->saved = NULL;
+  r->in_step = 0;
+  r->gn = 0;
   r->adj_off = r->adj = r->nbr_held = r->list = r->pend = r->pend2 = NULL;
   r->awake = r->held = r->touched = r->blk_cnt = NULL;
   r->blk_bits = r->act_bits = NULL;
@@ -44,17 +52,17 @@ void ms_regions_free(ms_regions_t *r) {
 }
 
 int ms_regions_current(const ms_regions_t *r, const mass_spring_t *ms) {
-  if (!r->springs || r->springs != ms->springs || r->nsprings != ms->nsprings || r->n != ms->n) return 0;
-  /* A NaN written in compares unequal: a change too. */
-  const double *x = ms->x, *v = ms->v, *xs = r->xs;
-  int diff = 0;
-  for (size_t k = 0; k < r->n; k++)
-    if (!r->awake[k]) {
-      const size_t c = 3 * k;
-      diff |= (x[c] != xs[c]) | (x[c + 1] != xs[c + 1]) | (x[c + 2] != xs[c + 2]) | (v[c] != 0) | (v[c + 1] != 0) |
-              (v[c + 2] != 0);
-    }
-  return !diff;
+  return r->springs && r->springs == ms->springs && r->nsprings == ms->nsprings && r->n == ms->n;
+}
+
+/* The step's guard keeps node k's state from before the step (once). */
+static void guard_save(ms_regions_t *r, size_t k) {
+  if (!r->in_step || r->saved[k]) return;
+  r->saved[k] = 1;
+  r->gidx[r->gn] = (uint32_t)k;
+  memcpy(r->gx + 3 * r->gn, r->sx + 3 * k, 3 * sizeof(double));
+  memcpy(r->gv + 3 * r->gn, r->sv + 3 * k, 3 * sizeof(double));
+  r->gn++;
 }
 
 /* Counts node k as held: its springs' blocks are evaluated, its
@@ -82,6 +90,7 @@ static void release(ms_regions_t *r, size_t k) {
 }
 
 static void wake(ms_regions_t *r, size_t k) {
+  guard_save(r, k); /* asleep until now: its state is the one from before the step */
   r->awake[k] = 1;
   r->nawake++;
   r->wakes++;
@@ -106,8 +115,12 @@ static int reserve(ms_regions_t *r, size_t n, size_t ns) {
   r->pend2 = malloc((n + 1) * sizeof *r->pend2);
   r->f = malloc((3 * n + 1) * sizeof *r->f);
   r->xs = malloc((3 * n + 1) * sizeof *r->xs);
+  r->gx = malloc((6 * n + 1) * sizeof *r->gx);
+  r->gv = r->gx ? r->gx + 3 * n : NULL;
+  r->gidx = malloc((n + 1) * sizeof *r->gidx);
+  r->saved = malloc(n + 1);
   if (!r->adj_off || !r->adj || !r->awake || !r->held || !r->touched || !r->nbr_held || !r->blk_cnt || !r->blk_bits ||
-      !r->act_bits || !r->list || !r->pend || !r->pend2 || !r->f || !r->xs) {
+      !r->act_bits || !r->list || !r->pend || !r->pend2 || !r->f || !r->xs || !r->gx || !r->gidx || !r->saved) {
     free_arrays(r);
     return -1;
   }
@@ -142,6 +155,9 @@ int ms_regions_build(ms_regions_t *r, const mass_spring_t *ms, verr_t *err) {
   memset(r->awake, 0, n);
   memset(r->held, 0, n);
   memset(r->touched, 0, n);
+  memset(r->saved, 0, n);
+  r->in_step = 0;
+  r->gn = 0;
   memset(r->nbr_held, 0, n * sizeof *r->nbr_held);
   memset(r->blk_cnt, 0, nb);
   /* Every row and every node's force once: the rows of springs that stay
@@ -235,4 +251,59 @@ void ms_regions_substep(ms_regions_t *r, mass_spring_t *ms, double h) {
   r->pend = r->pend2;
   r->pend2 = t;
   r->npend = np;
+}
+
+int ms_regions_begin_step(ms_regions_t *r, mass_spring_t *ms) {
+  const double *x = ms->x, *v = ms->v, *xs = r->xs;
+  double sum = 0;
+  int diff = 0;
+  r->sx = ms->x;
+  r->sv = ms->v;
+  r->gn = 0;
+  r->in_step = 1;
+  /* A sleeping node must be where it fell asleep, at rest, bit for bit:
+   * one branch-free pass over every node on the bit patterns (integer
+   * operations: the floating-point compares cost twice as much); then the
+   * awake ones (all among the act nodes) are kept for a rollback. */
+  const uint8_t *awake = r->awake;
+  uint64_t bits_diff = 0;
+  for (size_t k = 0; k < r->n; k++) {
+    uint64_t a[3], b[3], u[3];
+    memcpy(a, x + 3 * k, sizeof a);
+    memcpy(b, xs + 3 * k, sizeof b);
+    memcpy(u, v + 3 * k, sizeof u);
+    const uint64_t asleep = (uint64_t)0 - (uint64_t)(awake[k] == 0);
+    bits_diff |= asleep & ((a[0] ^ b[0]) | (a[1] ^ b[1]) | (a[2] ^ b[2]) | u[0] | u[1] | u[2]);
+  }
+  diff = bits_diff != 0;
+  for (size_t w = 0; w < words(r->n); w++)
+    for (uint64_t bits = r->act_bits[w]; bits; bits &= bits - 1) {
+      const size_t k = 64 * w + (size_t)__builtin_ctzll(bits), c = 3 * k;
+      if (!awake[k]) continue;
+      sum += x[c] + x[c + 1] + x[c + 2] + v[c] + v[c + 1] + v[c + 2];
+      guard_save(r, k);
+    }
+  if (!diff && isfinite(sum)) return 0;
+  for (size_t a = 0; a < r->gn; a++) r->saved[r->gidx[a]] = 0;
+  r->gn = 0;
+  r->in_step = 0;
+  return -1;
+}
+
+int ms_regions_end_step(ms_regions_t *r, mass_spring_t *ms, uint64_t *rollbacks) {
+  double sum = 0;
+  for (size_t a = 0; a < r->gn; a++) {
+    const size_t c = 3 * (size_t)r->gidx[a];
+    sum += ms->x[c] + ms->x[c + 1] + ms->x[c + 2] + ms->v[c] + ms->v[c + 1] + ms->v[c + 2];
+    r->saved[r->gidx[a]] = 0;
+  }
+  r->in_step = 0;
+  if (isfinite(sum)) return 0;
+  for (size_t a = 0; a < r->gn; a++) {
+    memcpy(ms->x + 3 * (size_t)r->gidx[a], r->gx + 3 * a, 3 * sizeof(double));
+    memcpy(ms->v + 3 * (size_t)r->gidx[a], r->gv + 3 * a, 3 * sizeof(double));
+  }
+  if (rollbacks) (*rollbacks)++;
+  r->springs = NULL; /* derived again from the restored state */
+  return -1;
 }

@@ -67,6 +67,15 @@ typedef struct ms_regions {
   size_t npend;
   double *f;  /* 3 n: the sub-step's forces (valid at the act nodes) */
   double *xs; /* 3 n: where each sleeping node sleeps (to see a write from outside) */
+  /* The step's guard (begin_step .. end_step): the nodes the step may
+   * change, with their state from before it (awake ones at the start,
+   * woken ones when they wake: asleep, they had not moved). */
+  double *gx, *gv;
+  uint32_t *gidx;
+  uint8_t *saved;
+  size_t gn;
+  int in_step;
+  double *sx, *sv; /* the state being stepped (ms->x, ms->v) */
   size_t nawake;
   /* Counters since init (for tests and benchmarks). */
   uint64_t substeps, node_updates, block_evals, wakes, sleeps, builds;
@@ -79,10 +88,19 @@ void ms_regions_free(ms_regions_t *r);
  * who sleeps from the state (above); evaluates every spring once.
  * 0, or -1 with err (OOM: r is then not current). */
 int ms_regions_build(ms_regions_t *r, const mass_spring_t *ms, verr_t *err);
-/* 1 when r was built for ms's current springs and nodes and every node it
- * holds asleep is still where it fell asleep, at zero velocity
- * (else something wrote the state from outside: a test, a reset). */
+/* 1 when r was built for ms's current springs and nodes. */
 int ms_regions_current(const ms_regions_t *r, const mass_spring_t *ms);
+/* The start of a step, in one pass over the nodes: checks that every node
+ * it holds asleep is still where it fell asleep, at zero velocity (else
+ * something wrote the state from outside: a test, a reset) and that the
+ * awake ones are finite, and keeps the awake ones' state for a rollback.
+ * 0, or -1 (nothing kept: the caller builds again and guards the step
+ * itself). The guard then costs what the awake nodes cost, not the organ. */
+int ms_regions_begin_step(ms_regions_t *r, mass_spring_t *ms);
+/* The end of that step: 0 when every node the step may have changed is
+ * finite; otherwise puts them back as before the step, counts the rollback
+ * in *rollbacks, leaves r to be built again, and returns -1. */
+int ms_regions_end_step(ms_regions_t *r, mass_spring_t *ms, uint64_t *rollbacks);
 /* Node i is touched from outside in this sub-step (external force, tool
  * spring): awake now. A fixed or out-of-range node is ignored. */
 void ms_regions_touch(ms_regions_t *r, const mass_spring_t *ms, uint32_t i);
