@@ -464,11 +464,13 @@ enum {
   V_REGION_SPEED,
   V_NKEYS
 };
-static const char *const solver_keys[V_NKEYS] = {
-    [V_SUBSTEPS] = "substeps",         [V_ITERATIONS] = "iterations",
-    [V_CG_TOLERANCE] = "cg_tolerance", [V_CG_MAX_ITERATIONS] = "cg_max_iterations",
-    [V_TET_SIZE] = "tet_size",         [V_REGION_FORCE] = "region_force",
-    [V_REGION_SPEED] = "region_speed"};
+static const char *const solver_keys[V_NKEYS] = {[V_SUBSTEPS] = "substeps",
+                                                 [V_ITERATIONS] = "iterations",
+                                                 [V_CG_TOLERANCE] = "cg_tolerance",
+                                                 [V_CG_MAX_ITERATIONS] = "cg_max_iterations",
+                                                 [V_TET_SIZE] = "tet_size",
+                                                 [V_REGION_FORCE] = "region_force",
+                                                 [V_REGION_SPEED] = "region_speed"};
 
 enum {
   O_NAME,

@@ -36,6 +36,15 @@
  * of more (they are not resolved at that h either way). Requested
  * sub-steps (solver.substeps) keep the full damping.
  *
+ * Regional sleeping (physics/ms_regions.h, issue 17): under symplectic Euler
+ * a surface organ integrates only its awake nodes (solver.region_force > 0,
+ * the default); the tool forces and springs the hook adds wake the nodes
+ * they act on, f_ext is cleared over the nodes it was set on, and the step
+ * is guarded over the nodes it may change (ms_regions_begin_step), unless
+ * the sleeping nodes were derived again for this step (built: after a
+ * topology change, a rollback, a change of material or a write from
+ * outside), when the whole state is guarded as before.
+ *
  * implicit_pcg (integrator.h, issue 17.3) is one step per scene step: the
  * tool springs implicit as under symplectic Euler (correct_v after the
  * solve), the spring pass fused with the Jacobian (physics/ms_linear.h),
