@@ -454,12 +454,23 @@ static const char *const material_keys[M_NKEYS] = {[M_MASS] = "mass",
                                                    [M_REFINE_AREA] = "refine_area",
                                                    [M_REFINE_LEVELS] = "refine_levels"};
 
-enum { V_SUBSTEPS, V_ITERATIONS, V_CG_TOLERANCE, V_CG_MAX_ITERATIONS, V_TET_SIZE, V_NKEYS };
+enum {
+  V_SUBSTEPS,
+  V_ITERATIONS,
+  V_CG_TOLERANCE,
+  V_CG_MAX_ITERATIONS,
+  V_TET_SIZE,
+  V_REGION_FORCE,
+  V_REGION_SPEED,
+  V_NKEYS
+};
 static const char *const solver_keys[V_NKEYS] = {[V_SUBSTEPS] = "substeps",
                                                  [V_ITERATIONS] = "iterations",
                                                  [V_CG_TOLERANCE] = "cg_tolerance",
                                                  [V_CG_MAX_ITERATIONS] = "cg_max_iterations",
-                                                 [V_TET_SIZE] = "tet_size"};
+                                                 [V_TET_SIZE] = "tet_size",
+                                                 [V_REGION_FORCE] = "region_force",
+                                                 [V_REGION_SPEED] = "region_speed"};
 
 enum {
   O_NAME,
@@ -571,6 +582,8 @@ static void organ_defaults(scene_organ_t *o) {
   o->solver.cg_tolerance = 1e-3;
   o->solver.cg_max_iterations = 200;
   o->solver.tet_size = 0;
+  o->solver.region_force = SCENE_REGION_FORCE;
+  o->solver.region_speed = SCENE_REGION_SPEED;
 }
 
 static void tool_defaults(scene_tool_t *t) {
@@ -653,6 +666,10 @@ static int parse_solver(const ctx_t *c, const node_t *n, const char *path, scene
               &sv->cg_max_iterations))
     return -1;
   if (opt_number(c, v[V_TET_SIZE], path, "tet_size", "organs.solver.tet_size", &sv->tet_size)) return -1;
+  if (opt_number(c, v[V_REGION_FORCE], path, "region_force", "organs.solver.region_force", &sv->region_force))
+    return -1;
+  if (opt_number(c, v[V_REGION_SPEED], path, "region_speed", "organs.solver.region_speed", &sv->region_speed))
+    return -1;
   /* 0 asks for the automatic size; anything else below 0.1 mm would build
    * millions of tetrahedra for an organ. */
   if (sv->tet_size != 0 && sv->tet_size < 1e-4) {

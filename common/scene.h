@@ -55,6 +55,12 @@ typedef struct scene_material {
  * §9.1). */
 #define SCENE_XPBD_ITERATIONS 6
 
+/* Regional sleeping's defaults (ms_regions.h, docs/numerics.md §11):
+ * 10 uN per sleeping node (a hundred of them by the probe hold at most 1 mN,
+ * 0.1 % of a 1 N press) and 10 um/s. */
+#define SCENE_REGION_FORCE 1e-5
+#define SCENE_REGION_SPEED 1e-5
+
 /* Model-specific settings (key `solver:` and extra `material:` keys in the
  * scene file). Each model reads only its own fields; defaults in brackets. */
 typedef struct scene_solver {
@@ -63,6 +69,12 @@ typedef struct scene_solver {
   double cg_tolerance;   /* implicit Euler: relative CG residual [1e-3] */
   int cg_max_iterations; /* implicit Euler [200]; implicit_pcg [SCENE_PCG_ITERATIONS] */
   double tet_size;       /* m, target tetrahedron edge when a volume mesh is built [0: auto] */
+  /* mass_spring_surface under symplectic Euler: regional sleeping
+   * (server/physics/ms_regions.h). region_force: N, a sleeping node's net
+   * force that wakes it, 0 = off [SCENE_REGION_FORCE]; region_speed: m/s, an
+   * awake node slower than this may sleep [SCENE_REGION_SPEED]. */
+  double region_force;
+  double region_speed;
 } scene_solver_t;
 
 typedef struct scene_organ {

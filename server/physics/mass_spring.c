@@ -491,32 +491,36 @@ void mass_spring_springs_changed(mass_spring_t *ms) {
 }
 
 #ifdef MS_HAVE_AVX2_PATH
-/* Pass 1: g rows of every spring; returns how many are dead (zero length:
- * live lane +0.0, else -0.0, whose sign bit pass 2 can blend on). */
-__attribute__((target("avx2"))) static size_t ms_gather_rows(const mass_spring_t *ms, const double *restrict x,
-                                                             const double *restrict v, double *restrict g,
-                                                             double damping) {
+/* Pass 1 for the springs 4b .. 4b + 3 (a whole block: s + 4 <= ns): g rows;
+ * returns how many are dead (zero length: live lane +0.0, else -0.0, whose
+ * sign bit pass 2 can blend on). */
+__attribute__((target("avx2"))) static inline size_t ms_row_block(const ms_spring_t *restrict sp,
+                                                                  const double *restrict x, const double *restrict v,
+                                                                  const double *restrict kscale, double *restrict g,
+                                                                  size_t s, __m256d stiff, __m256d damp) {
+  const __m256d nzero = _mm256_set1_pd(-0.0);
+  __m256d d0, d1, d2, live;
+  const __m256d mag = spring4(sp + s, x, v, kscale ? kscale + s : NULL, stiff, damp, &d0, &d1, &d2, &live);
+  const __m256d c0 = _mm256_mul_pd(mag, d0), c1 = _mm256_mul_pd(mag, d1), c2 = _mm256_mul_pd(mag, d2);
+  const __m256d c3 = _mm256_and_pd(live, nzero);
+  /* Columns back to one row per spring. */
+  const __m256d t0 = _mm256_unpacklo_pd(c0, c1), t1 = _mm256_unpackhi_pd(c0, c1);
+  const __m256d t2 = _mm256_unpacklo_pd(c2, c3), t3 = _mm256_unpackhi_pd(c2, c3);
+  _mm256_store_pd(g + 4 * s, _mm256_permute2f128_pd(t0, t2, 0x20));
+  _mm256_store_pd(g + 4 * s + 4, _mm256_permute2f128_pd(t1, t3, 0x20));
+  _mm256_store_pd(g + 4 * s + 8, _mm256_permute2f128_pd(t0, t2, 0x31));
+  _mm256_store_pd(g + 4 * s + 12, _mm256_permute2f128_pd(t1, t3, 0x31));
+  return 4 - (size_t)__builtin_popcount((unsigned)_mm256_movemask_pd(live));
+}
+
+/* Pass 1 for the springs s .. ns - 1 (fewer than four), scalar: the same
+ * operations. Returns how many are dead. */
+static size_t ms_row_tail(const mass_spring_t *ms, const double *restrict x, const double *restrict v,
+                          double *restrict g, size_t s, double damping) {
   const ms_spring_t *restrict sp = ms->springs;
   const double *restrict kscale = ms->k_scale;
-  const size_t ns = ms->nsprings;
-  const __m256d stiff = _mm256_set1_pd(ms->p.stiffness), damp = _mm256_set1_pd(damping);
-  const __m256d nzero = _mm256_set1_pd(-0.0);
-  size_t s = 0, dead = 0;
-  for (; s + 4 <= ns; s += 4) {
-    __m256d d0, d1, d2, live;
-    const __m256d mag = spring4(sp + s, x, v, kscale ? kscale + s : NULL, stiff, damp, &d0, &d1, &d2, &live);
-    const __m256d c0 = _mm256_mul_pd(mag, d0), c1 = _mm256_mul_pd(mag, d1), c2 = _mm256_mul_pd(mag, d2);
-    const __m256d c3 = _mm256_and_pd(live, nzero);
-    dead += 4 - (size_t)__builtin_popcount((unsigned)_mm256_movemask_pd(live));
-    /* Columns back to one row per spring. */
-    const __m256d t0 = _mm256_unpacklo_pd(c0, c1), t1 = _mm256_unpackhi_pd(c0, c1);
-    const __m256d t2 = _mm256_unpacklo_pd(c2, c3), t3 = _mm256_unpackhi_pd(c2, c3);
-    _mm256_store_pd(g + 4 * s, _mm256_permute2f128_pd(t0, t2, 0x20));
-    _mm256_store_pd(g + 4 * s + 4, _mm256_permute2f128_pd(t1, t3, 0x20));
-    _mm256_store_pd(g + 4 * s + 8, _mm256_permute2f128_pd(t0, t2, 0x31));
-    _mm256_store_pd(g + 4 * s + 12, _mm256_permute2f128_pd(t1, t3, 0x31));
-  }
-  for (; s < ns; s++) { /* the remainder, scalar: the same operations */
+  size_t dead = 0;
+  for (; s < ms->nsprings; s++) {
     const double *xi = x + 3 * (size_t)sp[s].i, *xj = x + 3 * (size_t)sp[s].j;
     const double *vi = v + 3 * (size_t)sp[s].i, *vj = v + 3 * (size_t)sp[s].j;
     const double d0 = xj[0] - xi[0], d1 = xj[1] - xi[1], d2 = xj[2] - xi[2];
@@ -539,48 +543,110 @@ __attribute__((target("avx2"))) static size_t ms_gather_rows(const mass_spring_t
   return dead;
 }
 
-/* Pass 2: node terms, then each node's events (see above). `blend`: some
- * spring is dead and must be skipped, as the scalar loop skips it. */
-__attribute__((target("avx2"))) static void ms_gather_nodes(const mass_spring_t *ms, const double *restrict x,
-                                                            const double *restrict v, double *restrict f,
-                                                            const double *restrict g, int blend) {
+/* Pass 1: g rows of every spring; returns how many are dead. */
+__attribute__((target("avx2"))) static size_t ms_gather_rows(const mass_spring_t *ms, const double *restrict x,
+                                                             const double *restrict v, double *restrict g,
+                                                             double damping) {
+  const ms_spring_t *restrict sp = ms->springs;
+  const double *restrict kscale = ms->k_scale;
+  const size_t ns = ms->nsprings;
+  const __m256d stiff = _mm256_set1_pd(ms->p.stiffness), damp = _mm256_set1_pd(damping);
+  size_t s = 0, dead = 0;
+  for (; s + 4 <= ns; s += 4) dead += ms_row_block(sp, x, v, kscale, g, s, stiff, damp);
+  return dead + ms_row_tail(ms, x, v, g, s, damping);
+}
+
+/* Pass 2 for node k: node terms, then its events (see above). `blend`:
+ * some spring may be dead and must be skipped, as the scalar loop skips it
+ * (blending is exact for live springs too, only slower). */
+typedef struct ms_node_consts {
+  __m256i m3;
+  __m256d grav, hk, hc;
+} ms_node_consts_t;
+
+__attribute__((target("avx2"))) static inline ms_node_consts_t ms_node_consts(const mass_spring_t *ms) {
+  return (ms_node_consts_t){.m3 = _mm256_set_epi64x(0, -1, -1, -1),
+                            .grav = _mm256_set_pd(0, ms->p.gravity[2], ms->p.gravity[1], ms->p.gravity[0]),
+                            .hk = _mm256_set1_pd(ms->p.home_stiffness),
+                            .hc = _mm256_set1_pd(ms->p.home_damping)};
+}
+
+__attribute__((target("avx2"))) static inline void ms_gather_node(const mass_spring_t *ms, const ms_node_consts_t *kc,
+                                                                  const double *restrict x, const double *restrict v,
+                                                                  double *restrict f, const double *restrict g,
+                                                                  int blend, size_t k) {
   const struct ms_gather *gi = &ms->gather;
   const uint32_t *restrict off = gi->off, *restrict ev = gi->ev;
   const double *restrict xr = ms->x_rest, *restrict fext = ms->f_ext, *restrict mass = ms->mass;
   const double *restrict fres = ms->f_res;
-  const __m256i m3 = _mm256_set_epi64x(0, -1, -1, -1);
-  const __m256d grav = _mm256_set_pd(0, ms->p.gravity[2], ms->p.gravity[1], ms->p.gravity[0]);
-  const __m256d hk = _mm256_set1_pd(ms->p.home_stiffness), hc = _mm256_set1_pd(ms->p.home_damping);
-  const size_t n = ms->n, nv = gi->nv;
-  for (size_t k = 0; k < n; k++) {
-    const size_t c = 3 * k;
-    __m256d acc = _mm256_add_pd(_mm256_maskload_pd(fext + c, m3), _mm256_mul_pd(_mm256_set1_pd(mass[k]), grav));
-    acc = _mm256_sub_pd(
-        acc, _mm256_mul_pd(hk, _mm256_sub_pd(_mm256_maskload_pd(x + c, m3), _mm256_maskload_pd(xr + c, m3))));
-    acc = _mm256_sub_pd(acc, _mm256_mul_pd(hc, _mm256_maskload_pd(v + c, m3)));
-    if (fres) acc = _mm256_add_pd(acc, _mm256_maskload_pd(fres + c, m3));
-    if (k < nv) {
-      const uint32_t *e = ev + off[k], *end = ev + off[k + 1];
-      while (e < end) {
-        const uint32_t q = *e++;
-        if (q & MS_RUN) {
-          const uint32_t re = *e++;
-          __m256d r = _mm256_setzero_pd();
-          for (uint32_t s = q & ~MS_RUN; s < re; s++) {
-            const __m256d gs = _mm256_load_pd(g + 4 * (size_t)s);
-            r = blend ? _mm256_blendv_pd(r, _mm256_add_pd(r, gs), _mm256_permute4x64_pd(gs, 0xff))
-                      : _mm256_add_pd(r, gs);
-          }
-          acc = _mm256_add_pd(acc, r);
-        } else {
-          const __m256d gs = _mm256_load_pd(g + 4 * (size_t)q);
-          acc = blend ? _mm256_blendv_pd(acc, _mm256_sub_pd(acc, gs), _mm256_permute4x64_pd(gs, 0xff))
-                      : _mm256_sub_pd(acc, gs);
+  const __m256i m3 = kc->m3;
+  const size_t c = 3 * k;
+  __m256d acc = _mm256_add_pd(_mm256_maskload_pd(fext + c, m3), _mm256_mul_pd(_mm256_set1_pd(mass[k]), kc->grav));
+  acc = _mm256_sub_pd(
+      acc, _mm256_mul_pd(kc->hk, _mm256_sub_pd(_mm256_maskload_pd(x + c, m3), _mm256_maskload_pd(xr + c, m3))));
+  acc = _mm256_sub_pd(acc, _mm256_mul_pd(kc->hc, _mm256_maskload_pd(v + c, m3)));
+  if (fres) acc = _mm256_add_pd(acc, _mm256_maskload_pd(fres + c, m3));
+  if (k < gi->nv) {
+    const uint32_t *e = ev + off[k], *end = ev + off[k + 1];
+    while (e < end) {
+      const uint32_t q = *e++;
+      if (q & MS_RUN) {
+        const uint32_t re = *e++;
+        __m256d r = _mm256_setzero_pd();
+        for (uint32_t s = q & ~MS_RUN; s < re; s++) {
+          const __m256d gs = _mm256_load_pd(g + 4 * (size_t)s);
+          r = blend ? _mm256_blendv_pd(r, _mm256_add_pd(r, gs), _mm256_permute4x64_pd(gs, 0xff)) : _mm256_add_pd(r, gs);
         }
+        acc = _mm256_add_pd(acc, r);
+      } else {
+        const __m256d gs = _mm256_load_pd(g + 4 * (size_t)q);
+        acc = blend ? _mm256_blendv_pd(acc, _mm256_sub_pd(acc, gs), _mm256_permute4x64_pd(gs, 0xff))
+                    : _mm256_sub_pd(acc, gs);
       }
     }
-    _mm256_maskstore_pd(f + c, m3, acc);
   }
+  _mm256_maskstore_pd(f + c, m3, acc);
+}
+
+/* Pass 2 over every node. */
+__attribute__((target("avx2"))) static void ms_gather_nodes(const mass_spring_t *ms, const double *restrict x,
+                                                            const double *restrict v, double *restrict f,
+                                                            const double *restrict g, int blend) {
+  const ms_node_consts_t kc = ms_node_consts(ms);
+  const size_t n = ms->n;
+  if (blend)
+    for (size_t k = 0; k < n; k++) ms_gather_node(ms, &kc, x, v, f, g, 1, k);
+  else
+    for (size_t k = 0; k < n; k++) ms_gather_node(ms, &kc, x, v, f, g, 0, k);
+}
+
+/* The active set (mass_spring_forces_subset): pass 1 over the marked
+ * blocks, pass 2 over the marked nodes. Blending always: rows of blocks not
+ * evaluated now may be dead ones from before. */
+__attribute__((target("avx2"))) static void ms_gather_subset(const mass_spring_t *ms, const double *restrict x,
+                                                             const double *restrict v, double *restrict f,
+                                                             const uint64_t *blk, const uint64_t *nodes,
+                                                             double damping) {
+  const ms_spring_t *restrict sp = ms->springs;
+  const double *restrict kscale = ms->k_scale;
+  double *restrict g = ms->gather.g;
+  const size_t ns = ms->nsprings, nb = (ns + 3) / 4;
+  const __m256d stiff = _mm256_set1_pd(ms->p.stiffness), damp = _mm256_set1_pd(damping);
+  for (size_t w = 0; w < (nb + 63) / 64; w++)
+    for (uint64_t bits = blk[w]; bits; bits &= bits - 1) {
+      const size_t s = 4 * (64 * w + (size_t)__builtin_ctzll(bits));
+      if (s + 4 <= ns)
+        ms_row_block(sp, x, v, kscale, g, s, stiff, damp);
+      else if (s < ns)
+        ms_row_tail(ms, x, v, g, s, damping);
+    }
+  const ms_node_consts_t kc = ms_node_consts(ms);
+  const size_t n = ms->n;
+  for (size_t w = 0; w < (n + 63) / 64; w++)
+    for (uint64_t bits = nodes[w]; bits; bits &= bits - 1) {
+      const size_t k = 64 * w + (size_t)__builtin_ctzll(bits);
+      if (k < n) ms_gather_node(ms, &kc, x, v, f, g, 1, k);
+    }
 }
 #endif
 #undef MS_RUN
@@ -597,6 +663,28 @@ int mass_spring_simd_available(void) {
 #else
   return 0;
 #endif
+}
+
+int mass_spring_subset_available(const mass_spring_t *ms) {
+#ifdef MS_HAVE_AVX2_PATH
+  return ms_gather_usable(ms) && mass_spring_simd_available();
+#else
+  (void)ms;
+  return 0;
+#endif
+}
+
+void mass_spring_forces_subset(const mass_spring_t *ms, const double *x, const double *v, double *f,
+                               const uint64_t *blk, const uint64_t *nodes) {
+#ifdef MS_HAVE_AVX2_PATH
+  if (mass_spring_subset_available(ms)) {
+    ms_gather_subset(ms, x, v, f, blk, nodes, ms->p.damping * ms->damping_scale);
+    return;
+  }
+#endif
+  (void)blk;
+  (void)nodes;
+  mass_spring_forces(ms, x, v, f);
 }
 
 void mass_spring_forces(const mass_spring_t *ms, const double *x, const double *v, double *f) {

@@ -136,6 +136,19 @@ void mass_spring_forces(const mass_spring_t *ms, const double *x, const double *
  * needs no -mavx2). For the tests and benchmarks that compare them. */
 void mass_spring_forces_path(const mass_spring_t *ms, const double *x, const double *v, double *f, int simd);
 int mass_spring_simd_available(void);
+/* The active set of physics/ms_regions.h: pass 1 of the gather loop (each
+ * spring's force row) only over the blocks of four springs (4b .. 4b + 3)
+ * whose bit b is set in blk, pass 2 (node terms and the sum of the rows)
+ * only over the nodes whose bit is set in nodes (64 per word, bit k % 64 of
+ * word k / 64); f is written at those nodes only. Rows of the other blocks
+ * are kept from when they were last evaluated: the caller marks every block
+ * whose springs' ends may have changed since. A node whose springs' blocks
+ * are all marked gets mass_spring_forces' value bit for bit. Without
+ * mass_spring_subset_available (no AVX2, no gather index) it is
+ * mass_spring_forces (every node written). */
+int mass_spring_subset_available(const mass_spring_t *ms);
+void mass_spring_forces_subset(const mass_spring_t *ms, const double *x, const double *v, double *f,
+                               const uint64_t *blk, const uint64_t *nodes);
 /* Code that rewrites springs[] in place (order, ends) calls this after, so
  * the AVX2 loop's gather index follows (it allocates; on OOM the AVX2 loop
  * falls back to scattering, same forces). Whatever replaces the array

@@ -36,6 +36,15 @@
  * of more (they are not resolved at that h either way). Requested
  * sub-steps (solver.substeps) keep the full damping.
  *
+ * Regional sleeping (physics/ms_regions.h, issue 17): under symplectic Euler
+ * a surface organ integrates only its awake nodes (solver.region_force > 0,
+ * the default); the tool forces and springs the hook adds wake the nodes
+ * they act on, f_ext is cleared over the nodes it was set on, and the step
+ * is guarded over the nodes it may change (ms_regions_begin_step), unless
+ * the sleeping nodes were derived again for this step (built: after a
+ * topology change, a rollback, a change of material or a write from
+ * outside), when the whole state is guarded as before.
+ *
  * implicit_pcg (integrator.h, issue 17.3) is one step per scene step: the
  * tool springs implicit as under symplectic Euler (correct_v after the
  * solve), the spring pass fused with the Jacobian (physics/ms_linear.h),
@@ -73,6 +82,7 @@
 #include "physics/model_mass_spring.h"
 #include "physics/model_volume.h"
 #include "physics/ms_linear.h"
+#include "physics/ms_regions.h"
 #include "state_blob.h"
 #include "tet_mesh.h"
 #include "vmath.h"
@@ -105,6 +115,18 @@ typedef struct ms_model {
   double refine_lambda;
   coupling_set_t cpl; /* symplectic Euler, implicit_pcg: the tool springs of the sub-step (implicit) */
   ms_linear_t lin;    /* implicit_pcg: the step's Jacobian blocks */
+  /* Regional sleeping (physics/ms_regions.h): surface model under
+   * symplectic Euler with solver.region_force > 0. The nodes given an
+   * external force since the last clear (f_ext is cleared there only, not
+   * over every node; ntouched > n: clear all), and the material the
+   * regions were decided under (a change wakes every node). */
+  int regions;
+  ms_regions_t reg;
+  uint32_t *touched;
+  size_t ntouched;
+  ms_params_t reg_p;
+  double reg_damping_scale;
+  const double *reg_k_scale;
 } ms_model_t;
 
 static void embed(ms_model_t *mm) {
@@ -134,9 +156,19 @@ static void linear_mul(force_system_t *s, const double *y, double *out) {
 /* Before every sub-step: external forces are valid for one sub-step only;
  * the surface is brought to the sub-step's positions so the contact hook
  * sees where the tissue is. */
+/* f_ext back to zero: the touched nodes only under regional sleeping. */
+static void clear_f_ext(ms_model_t *mm) {
+  if (mm->regions && mm->reg.springs && mm->ntouched <= mm->ms.n) {
+    for (size_t a = 0; a < mm->ntouched; a++) memset(mm->ms.f_ext + 3 * (size_t)mm->touched[a], 0, 3 * sizeof(double));
+  } else {
+    memset(mm->ms.f_ext, 0, 3 * mm->ms.n * sizeof(double));
+  }
+  mm->ntouched = 0;
+}
+
 static void pre_substep(force_system_t *s) {
   ms_model_t *mm = s->ctx;
-  memset(mm->ms.f_ext, 0, 3 * mm->ms.n * sizeof(double));
+  clear_f_ext(mm);
   coupling_set_clear(&mm->cpl);
   embed(mm);
   if (mm->m.hook) mm->m.hook(&mm->m, mm->m.hook_ctx);
@@ -186,20 +218,56 @@ static void guarded_implicit(ms_model_t *mm, double h) {
   }
 }
 
+/* Regional sleeping for this step: 2 when it runs and guards the step
+ * itself (ms_regions_begin_step: the step then costs what its awake nodes
+ * cost), 1 when it runs but was (re)built now (after a topology change, a
+ * change of material, a rollback or a write from outside: derived again
+ * from the state, and the step is guarded over every node), 0 when it does
+ * not run (off, or out of memory: every node integrated). */
+static int regions_ready(ms_model_t *mm) {
+  if (!mm->regions) return 0;
+  mass_spring_t *ms = &mm->ms;
+  if (ms_regions_current(&mm->reg, ms) && !memcmp(&mm->reg_p, &ms->p, sizeof ms->p) &&
+      mm->reg_damping_scale == ms->damping_scale && mm->reg_k_scale == ms->k_scale &&
+      ms_regions_begin_step(&mm->reg, ms) == 0)
+    return 2;
+  verr_t err;
+  uint32_t *t = realloc(mm->touched, (ms->n + 1) * sizeof *t);
+  if (t) mm->touched = t;
+  if (!t || ms_regions_build(&mm->reg, ms, &err)) return 0;
+  mm->ntouched = ms->n + 1; /* f_ext's state unknown: the next clear is a full one */
+  mm->reg_p = ms->p;
+  mm->reg_damping_scale = ms->damping_scale;
+  mm->reg_k_scale = ms->k_scale;
+  return 1;
+}
+
 static int ms_step(model_t *m, double h) {
   ms_model_t *mm = (ms_model_t *)m;
-  size_t bytes = 3 * mm->ms.n * sizeof(double);
-  model_guard_save_finite(&mm->guard, mm->ms.x, mm->ms.v, mm->ms.n, NULL);
   int ss = m->substeps < 1 ? 1 : m->substeps;
   double hs = h / ss;
+  int regions = regions_ready(mm);
+  if (regions != 2) model_guard_save_finite(&mm->guard, mm->ms.x, mm->ms.v, mm->ms.n, NULL);
   for (int s = 0; s < ss; s++) {
-    if (mm->it.kind == INT_IMPLICIT_EULER)
+    if (regions) {
+      pre_substep(&mm->ms.fs);
+      ms_regions_substep(&mm->reg, &mm->ms, hs);
+    } else if (mm->it.kind == INT_IMPLICIT_EULER) {
       guarded_implicit(mm, hs);
-    else
+    } else {
       integrator_substep(&mm->it, &mm->ms.fs, hs);
+    }
   }
-  memset(mm->ms.f_ext, 0, bytes);
-  int rc = model_guard_check(&mm->guard, mm->ms.x, mm->ms.v, mm->ms.n, NULL, &m->rollbacks);
+  clear_f_ext(mm);
+  int rc;
+  if (regions == 2) {
+    rc = ms_regions_end_step(&mm->reg, &mm->ms, &m->rollbacks);
+  } else {
+    rc = model_guard_check(&mm->guard, mm->ms.x, mm->ms.v, mm->ms.n, NULL, &m->rollbacks);
+    /* The restored state is not what the sleeping nodes were decided on:
+     * derived again at the next step (after whatever the runtime does). */
+    if (rc < 0) mm->reg.springs = NULL;
+  }
   embed(mm);
   return rc;
 }
@@ -215,6 +283,8 @@ static void ms_destroy(model_t *m) {
   model_guard_free(&mm->guard);
   coupling_set_free(&mm->cpl);
   ms_linear_free(&mm->lin);
+  ms_regions_free(&mm->reg);
+  free(mm->touched);
   free(mm->surf_buf);
   free(mm->surf_rest_buf);
   free(mm->tris);
@@ -238,7 +308,13 @@ static double tet_error(const model_t *m) {
 
 static void surface_add_force(model_t *m, uint32_t i, const double f[3]) {
   ms_model_t *mm = (ms_model_t *)m;
-  if (i < mm->ms.n) mass_spring_add_force(&mm->ms, i, f);
+  if (i >= mm->ms.n) return;
+  mass_spring_add_force(&mm->ms, i, f);
+  if (mm->regions && mm->reg.springs) {
+    if (mm->ntouched < mm->ms.n) mm->touched[mm->ntouched] = i;
+    if (mm->ntouched <= mm->ms.n) mm->ntouched++; /* past n: the next clear is a full one */
+    ms_regions_touch(&mm->reg, &mm->ms, i);
+  }
 }
 
 /* The embedded vertex moves as sum_k w_k x_k, so by virtual work a force on
@@ -260,10 +336,17 @@ static void surface_add_coupling(model_t *m, double k, size_t nw, const uint32_t
   if (!m->implicit_tools) return;
   coupling_set_t *cs = &mm->cpl;
   coupling_begin(cs, k);
+  int reg = mm->regions && mm->reg.springs;
   for (size_t j = 0; j < nw; j++)
-    if (wi[j] < mm->ms.n) coupling_push_w(cs, wi[j], w[j]);
+    if (wi[j] < mm->ms.n) {
+      coupling_push_w(cs, wi[j], w[j]);
+      if (reg) ms_regions_touch(&mm->reg, &mm->ms, wi[j]);
+    }
   for (size_t l = 0; l < nb; l++)
-    if (bi[l] < mm->ms.n) coupling_push_b(cs, bi[l], b[l]);
+    if (bi[l] < mm->ms.n) {
+      coupling_push_b(cs, bi[l], b[l]);
+      if (reg) ms_regions_touch(&mm->reg, &mm->ms, bi[l]);
+    }
   coupling_end(cs);
 }
 
@@ -412,6 +495,9 @@ static model_t *ms_create(const model_params_t *p, int tet, verr_t *err) {
     mm->ms.fs.linearize = linearize;
     mm->ms.fs.linear_mul = linear_mul;
   }
+  /* Regional sleeping: the live default (surface, symplectic Euler). */
+  mm->regions = !tet && kind == INT_SYMPLECTIC_EULER && cfg->solver.region_force > 0;
+  ms_regions_init(&mm->reg, cfg->solver.region_force, cfg->solver.region_speed);
   /* Conjugate gradients need a definite matrix (see mass_spring.h). */
   mm->ms.definite_jacobian = kind == INT_IMPLICIT_EULER || kind == INT_IMPLICIT_PCG;
   if (cfg->fixed_below_set) mass_spring_fix_below(&mm->ms, cfg->fixed_below);
@@ -488,6 +574,29 @@ int model_mass_spring_cg_counts(const model_t *m, uint64_t *iterations, uint64_t
   return 0;
 }
 
+int model_mass_spring_region_counts(const model_t *m, ms_region_counts_t *out) {
+  if (!m || m->ops != &SURFACE_OPS) return -1;
+  const ms_model_t *mm = (const ms_model_t *)m;
+  if (!mm->regions) return -1;
+  const ms_regions_t *r = &mm->reg;
+  *out = (ms_region_counts_t){.substeps = r->substeps,
+                              .node_updates = r->node_updates,
+                              .block_evals = r->block_evals,
+                              .wakes = r->wakes,
+                              .sleeps = r->sleeps,
+                              .builds = r->builds,
+                              .awake = r->nawake,
+                              .nodes = mm->ms.n,
+                              .springs = mm->ms.nsprings};
+  return 0;
+}
+
+const ms_regions_t *model_mass_spring_regions(const model_t *m) {
+  if (!m || m->ops != &SURFACE_OPS) return NULL;
+  const ms_model_t *mm = (const ms_model_t *)m;
+  return mm->regions && mm->reg.springs ? &mm->reg : NULL;
+}
+
 /* realloc that keeps *p on failure; NULL stays NULL. */
 static int grow_buf(double **p, size_t count) {
   if (!*p) return 0;
@@ -514,7 +623,9 @@ static int ms_reserve(model_t *m, size_t cap, int with_f_res, verr_t *err) {
     mm->it = it;
   }
   /* The arrays may have moved: the model's view follows (the caller bumps
-   * topology_version through commit before anyone steps again). */
+   * topology_version through commit before anyone steps again); regional
+   * sleeping is rebuilt (every node awake) at the next step. */
+  mm->reg.springs = NULL;
   m->x = m->surf_x = mm->ms.x;
   m->v = mm->ms.v;
   m->x_rest = m->surf_rest = mm->ms.x_rest;
@@ -587,6 +698,7 @@ static int ms_commit_nodes(model_t *m, size_t n, const uint32_t *old_to_new, siz
    * unique edges, at most 3 per triangle) before the springs change. */
   if (mm->ms.fs.linearize && ms_linear_reserve(&mm->lin, 3 * ntris, err)) return -1;
   if (mass_spring_set_surface_topology(&mm->ms, n, tris, ntris, err)) return -1;
+  mm->reg.springs = NULL; /* rebuilt, every node awake, at the next step */
   memcpy(mm->tris, tris, 3 * ntris * sizeof(uint32_t));
   model_guard_save(&mm->guard, mm->ms.x, mm->ms.v, n, NULL);
   m->nnodes = m->nsurf = n;

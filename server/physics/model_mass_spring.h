@@ -46,4 +46,21 @@ mass_spring_t *model_mass_spring_surface_system(model_t *m);
  * -1 for another model or integrator. */
 int model_mass_spring_cg_counts(const model_t *m, uint64_t *iterations, uint64_t *steps);
 
+/* Regional sleeping's counters (physics/ms_regions.h) of a
+ * mass_spring_surface model: since creation, the sub-steps run with it,
+ * the node updates (nodes integrated, summed over those sub-steps), the
+ * blocks of 4 springs evaluated, wakes and sleeps of single nodes, builds
+ * (creation, topology changes); and the nodes awake now. 0, or -1 when the
+ * model does not sleep by regions (another model or integrator, or
+ * solver.region_force 0). */
+typedef struct ms_region_counts {
+  uint64_t substeps, node_updates, block_evals, wakes, sleeps, builds;
+  size_t awake, nodes, springs;
+} ms_region_counts_t;
+int model_mass_spring_region_counts(const model_t *m, ms_region_counts_t *out);
+/* The regional sleeping state itself (read-only, per node: awake, xs), for
+ * tests; NULL as above or before the first step. */
+struct ms_regions;
+const struct ms_regions *model_mass_spring_regions(const model_t *m);
+
 #endif

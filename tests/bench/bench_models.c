@@ -20,7 +20,10 @@
  * the RMS force error of the same press (0.3 s: down, then held) against
  * the model's reference at 1/4 ms (XPBD: 4 sub-steps, its reference setting
  * in S8; molecular: Verlet with 4 sub-steps), relative to the peak reference
- * force (--quick leaves it out).
+ * force (--quick leaves it out). The mass_spring_surface row's figure is
+ * that of its regional sleeping (physics/ms_regions.h, on by default): the
+ * same press against the same model with it off (solver.region_force 0)
+ * at the same 1 ms step; mass_spring_awake is that model's cost.
  * Prints one row per case, then per model the fitted log-log slope of CPU
  * time against simulated nodes (the surface vertices of surface models, the
  * tetrahedral mesh's nodes of volume models; plot_loglog_slope), writes the plot as
@@ -34,6 +37,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "physics/model_mass_spring.h"
 #include "plot/plot.h"
 #include "runtime/scene_runtime.h"
 #include "test_runtime.h"
@@ -49,6 +53,10 @@ typedef struct model_case {
   const char *ref; /* S8-style reference setting (run at 1/4 ms), NULL: no accuracy column */
 } model_case_t;
 
+/* A reference that turns regional sleeping off (ms_regions.h) judges that
+ * mechanism alone: it runs at the same 1 ms step. */
+static int ref_same_dt(const model_case_t *mc) { return mc->ref && strstr(mc->ref, "region_force: 0") != NULL; }
+
 #define MOL_MATERIAL                                                                                                   \
   "    material: {mass: 0.15, bond_k: 30, angle_k: 3.0e-5, stretch_bend_k: 0, home_stiffness: 30, home_damping: "      \
   "0.005}\n"
@@ -60,6 +68,11 @@ static model_case_t MODELS[] = {
     {"mass_spring_surface",
      "    model: mass_spring_surface\n    integrator: symplectic_euler\n"
      "    material: {mass: 0.15}\n",
+     "    model: mass_spring_surface\n    integrator: symplectic_euler\n"
+     "    material: {mass: 0.15}\n    solver: {region_force: 0}\n"},
+    {"mass_spring_awake",
+     "    model: mass_spring_surface\n    integrator: symplectic_euler\n"
+     "    material: {mass: 0.15}\n    solver: {region_force: 0}\n",
      NULL},
     {"mass_spring_tet", "    model: mass_spring_tet\n    integrator: symplectic_euler\n    material: {mass: 0.15}\n",
      NULL},
@@ -93,6 +106,7 @@ typedef struct result {
   int ok, substeps;
   size_t verts, nodes, tets;
   double cpu_us, wall_us, force, s8; /* medians per step; force held (N); XPBD accuracy (relative RMS) */
+  double awake_frac;                 /* regional sleeping: node updates / (nodes x sub-steps) while timed, or -1 */
 } result_t;
 
 /* Press and hold in the loaded runtime; the device path is the same for
@@ -133,10 +147,11 @@ static int load(runtime_t *rt, scene_t *sc, const char *organ, const char *keys,
 }
 
 /* The S8-style error on this organ (see the file comment). */
-static double s8_accuracy(const char *organ, const char *keys, const char *ref_keys) {
+static double s8_accuracy(const char *organ, const char *keys, const char *ref_keys, int same_dt) {
   static scene_t sc;
   static runtime_t rt;
   enum { N = 300, R = 4 }; /* 0.3 s of 1 ms steps; the reference steps 1/4 ms */
+  const int r = same_dt ? 1 : R;
   double f[N], fr[R * N], top[3];
   for (int i = 0; i < N; i++) f[i] = NAN;
   for (int i = 0; i < R * N; i++) fr[i] = NAN;
@@ -146,14 +161,14 @@ static double s8_accuracy(const char *organ, const char *keys, const char *ref_k
   runtime_destroy(&rt);
   /* The reference takes 4 steps per 1 ms command (the device moves by the
    * same amount per 1 ms, so the press runs at the same speed). */
-  if (load(&rt, &sc, organ, ref_keys, "dt: 0.00025", top)) return NAN;
+  if (load(&rt, &sc, organ, ref_keys, same_dt ? "dt: 0.001" : "dt: 0.00025", top)) return NAN;
   double p[3];
   v3_copy(p, top);
   p[2] += 0.002;
   int s = 0, pressing = 1;
   for (; s < N; s++) {
     if (pressing && s < 200) p[2] -= 5e-5;
-    for (int k = 0; k < R; k++) {
+    for (int k = 0; k < r; k++) {
       runtime_set_tool(&rt, 0, p, 100);
       runtime_step(&rt);
     }
@@ -187,6 +202,8 @@ static result_t run_case(const char *organ, const model_case_t *mc, int steps, i
     runtime_destroy(&rt);
     return r;
   }
+  ms_region_counts_t rc0, rc1;
+  int regions = model_mass_spring_region_counts(m, &rc0) == 0;
   for (int s = 0; s < steps; s++) {
     uint64_t t0 = vtime_mono_ns(), c0 = vtime_thread_cpu_ns();
     runtime_set_tool(&rt, 0, p, 100);
@@ -195,6 +212,9 @@ static result_t run_case(const char *organ, const model_case_t *mc, int steps, i
     w[s] = (double)(vtime_mono_ns() - t0) * 1e-3;
   }
   r.ok = 1;
+  r.awake_frac = -1;
+  if (regions && model_mass_spring_region_counts(m, &rc1) == 0 && rc1.substeps > rc0.substeps)
+    r.awake_frac = (double)(rc1.node_updates - rc0.node_updates) / ((double)(rc1.substeps - rc0.substeps) * rc1.nodes);
   r.cpu_us = vstats_summarise(c, (size_t)steps).median;
   r.wall_us = vstats_summarise(w, (size_t)steps).median;
   r.force = v3_norm(rt.tools[0].force);
@@ -206,7 +226,7 @@ static result_t run_case(const char *organ, const model_case_t *mc, int steps, i
   runtime_destroy(&rt);
   /* The XPBD reference is pinned at 10 iterations (the S8 setting), so runs
    * at other iteration counts are judged against the same curve. */
-  if (!quick && mc->ref) r.s8 = s8_accuracy(organ, mc->keys, mc->ref);
+  if (!quick && mc->ref) r.s8 = s8_accuracy(organ, mc->keys, mc->ref, ref_same_dt(mc));
   return r;
 }
 
@@ -251,8 +271,12 @@ int main(int argc, char **argv) {
         printf("%-20s %-13s refused or failed\n", MODELS[mi].label, ORGANS[oi]);
         continue;
       }
-      printf("%-20s %-13s %6zu %6zu %6zu %4d %9.1f %9.1f %7.3f %8.4f %5.2f\n", MODELS[mi].label, ORGANS[oi], r.verts,
-             r.nodes, r.tets, r.substeps, r.cpu_us, r.wall_us, r.force, r.s8, load_average());
+      printf(r.s8 < 1e-3 ? "%-20s %-13s %6zu %6zu %6zu %4d %9.1f %9.1f %7.3f %8.1e %5.2f"
+                         : "%-20s %-13s %6zu %6zu %6zu %4d %9.1f %9.1f %7.3f %8.4f %5.2f",
+             MODELS[mi].label, ORGANS[oi], r.verts, r.nodes, r.tets, r.substeps, r.cpu_us, r.wall_us, r.force, r.s8,
+             load_average());
+      if (r.awake_frac >= 0) printf("  (timed steps: %.1f %% of the nodes integrated)", 100 * r.awake_frac);
+      printf("\n");
       fflush(stdout);
       /* In order of nodes (the volume models' automatic tetrahedron size
        * does not grow with the surface), so the plotted line is a curve. */
