@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* avx_rows: the 4x4 transpose the AVX2 spring loops share (ms_linear.c;
- * mass_spring.c has its own copy, transpose3, to be replaced by this one).
+/* avx_rows: the 4x4 transpose the AVX2 spring loops share (ms_linear.c,
+ * mass_spring.c).
  * Four rows r[q] = (x, y, z, -) of four springs, loaded as masked 4-wide
  * rows, become one vector per component: c0 = (r0.x .. r3.x), c1, c2.
  * Defines VISCERA_HAVE_AVX_ROWS where the compiler can build AVX2 code

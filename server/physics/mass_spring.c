@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "physics/avx_rows.h"
 #include "vmath.h"
 
 /* Below this length a spring has no usable direction (v3_normalize's guard). */
@@ -295,9 +296,8 @@ static inline void ms_spring_forces(const mass_spring_t *ms, const double *restr
   }
 }
 
-#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+#ifdef VISCERA_HAVE_AVX_ROWS
 #define MS_HAVE_AVX2_PATH 1
-#include <immintrin.h>
 
 /* The spring loop with the arithmetic four springs at a time (AVX2, chosen
  * at run time): both ends' x and v as masked row loads transposed into one
@@ -308,15 +308,6 @@ static inline void ms_spring_forces(const mass_spring_t *ms, const double *restr
  * multiply-add), then the scatter of the four g in spring order with the
  * same runs of equal i as the scalar loop: the forces are bit for bit the
  * scalar path's (test_ms_forces). */
-/* Rows r[q] = (x, y, z, -) of four springs into c0 = (r0.x .. r3.x), c1, c2. */
-__attribute__((target("avx2"))) static inline void transpose3(const __m256d r[4], __m256d *c0, __m256d *c1,
-                                                              __m256d *c2) {
-  const __m256d t0 = _mm256_unpacklo_pd(r[0], r[1]), t1 = _mm256_unpackhi_pd(r[0], r[1]);
-  const __m256d t2 = _mm256_unpacklo_pd(r[2], r[3]), t3 = _mm256_unpackhi_pd(r[2], r[3]);
-  *c0 = _mm256_permute2f128_pd(t0, t2, 0x20);
-  *c1 = _mm256_permute2f128_pd(t1, t3, 0x20);
-  *c2 = _mm256_permute2f128_pd(t0, t2, 0x31);
-}
 
 /* Springs sp[0..3]: their direction d (j - i, unnormalised, one vector per
  * component), which of them are live (longer than MS_TINY; a zero-length
@@ -341,8 +332,8 @@ __attribute__((target("avx2"))) static inline __m256d spring4(const ms_spring_t 
     dvr[q] = _mm256_sub_pd(_mm256_maskload_pd(v + j3, m3), _mm256_maskload_pd(v + i3, m3));
   }
   __m256d dv0, dv1, dv2;
-  transpose3(dr, d0, d1, d2);
-  transpose3(dvr, &dv0, &dv1, &dv2);
+  avx_rows_transpose3(dr, d0, d1, d2);
+  avx_rows_transpose3(dvr, &dv0, &dv1, &dv2);
   const __m256d len = _mm256_sqrt_pd(
       _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(*d0, *d0), _mm256_mul_pd(*d1, *d1)), _mm256_mul_pd(*d2, *d2)));
   *live = _mm256_cmp_pd(len, tiny, _CMP_NLE_UQ);
