@@ -5,7 +5,10 @@
  *
  * Cost: every organ's model is stepped SCENE_CHECK_STEPS times at the
  * scene's dt, awake (an organ the trainee touches is stepped whatever its
- * sleep settings) and without tools, timed with the thread's CPU clock: what
+ * sleep settings) and without tools, on a runtime built with regional
+ * sleeping off (the caller's: a cut, a reset or a sweeping tool can wake
+ * every node, and at rest a sleeping organ would time as nearly free),
+ * timed with the thread's CPU clock: what
  * a step costs when the server has a core, so a loaded machine does not
  * make a scene look slow (its wall time would). The organs' sum is compared
  * with dt: above it, the server runs slower than real time at this dt; the

@@ -320,6 +320,9 @@ static void drive_tool(server_t *s, size_t t, uint64_t now) {
     s->tool[t].lost = 0;
     if (!s->opts->quiet) fprintf(stderr, "server: tool %zu: haptic client back\n", t);
   }
+  const double *was = s->rt.tools[t].cmd.pos;
+  double d[3] = {eff.cmd.pos[0] - was[0], eff.cmd.pos[1] - was[1], eff.cmd.pos[2] - was[2]};
+  s->tool[t].jumped = s->rt.tools[t].active && v3_norm(d) > SESSION_EARLY_JUMP_M;
   runtime_command_tool(&s->rt, t, &eff.cmd);
   applied_input_command(&s->ai, t, &eff.cmd);
 }
@@ -598,11 +601,13 @@ static void write_feedback(server_t *s, size_t t, const tool_rt_t *tool) {
 /* Before the tissue step (issue 17): every driven tool with a fresh command
  * (bit t of `fresh`) is answered at once from the preview (its god-object
  * moved over the surfaces as they are; runtime_feedback_preview), stamped
- * with the step's start time. Returns the tools answered. */
+ * with the step's start time, unless its command jumped (session_tool.h:
+ * SESSION_EARLY_JUMP_M; it is answered after the step, publish_feedback).
+ * Returns the tools answered. */
 static uint32_t publish_feedback_early(server_t *s, uint32_t fresh) {
   uint32_t done = 0;
   for (size_t t = 0; t < s->rt.ntools; t++)
-    if ((fresh & (1u << t)) && s->rt.tools[t].active) done |= 1u << t;
+    if ((fresh & (1u << t)) && s->rt.tools[t].active && !s->tool[t].jumped) done |= 1u << t;
   if (!done) return 0;
   runtime_feedback_preview(&s->rt, s->preview);
   for (size_t t = 0; t < s->rt.ntools; t++)

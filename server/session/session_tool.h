@@ -30,6 +30,16 @@ typedef struct session_tool {
   uint64_t last_cmd_mono; /* monotonic ns when its last command was accepted (the command timeout) */
   int lost;               /* released for a lost client (to report its return) */
   int was_contact;        /* the contact last written in ContactFeedback (CONTACT_BEGIN/END) */
+  int jumped;             /* this step's command moved the tip more than SESSION_EARLY_JUMP_M */
 } session_tool_t;
+
+/* m: a command that moves the tool's tip further than this since the last
+ * one it took is answered after the tissue step, not before it. A hand at
+ * 1 kHz moves 0.05 mm per command pressing at 5 cm/s; a longer move is
+ * commands lost or bunched by a link (issue 14), and the early answer,
+ * computed on a surface that has not yet yielded to the jump, stretches the
+ * tool's spring by all of it for one step (seen: 1.061 N, then 0.963 N for
+ * the same command), which a resting hand feels as an overshoot. */
+#define SESSION_EARLY_JUMP_M 2.5e-4
 
 #endif

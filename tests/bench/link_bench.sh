@@ -25,9 +25,8 @@
 #     could make leaves the rendering something to be judged on: palpate_kidney.traj
 #     jumps from rest to 4.3 cm/s within a tick and stops 0.18 s after the surface, so
 #     from 100 ms one way its first contact sample reaches the client after the hand
-#     stopped, and a client held passive at every tick withholds that force (-100 %,
-#     docs/remote.md): a figure of the script, not of the link. Pass
-#     assets/trajectories/palpate_kidney.traj to see that case.
+#     stopped (the late-model credit of docs/remote.md lets the force ramp in on the
+#     resting hand). Pass assets/trajectories/palpate_kidney.traj to see that case.
 #   --config FILE: the Cyclone configuration of the sites (default
 #     deploy/cyclonedds-site.xml; e.g. deploy/cyclonedds-lan.xml to compare)
 #   --kw-path state|chunks|both: the keyframes the late subscriber takes

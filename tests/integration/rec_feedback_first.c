@@ -13,11 +13,21 @@
  * other: end / dt - 1), must fall on strictly increasing steps: never two
  * in one step.
  *
+ * A command that moved the tool's tip further than the server's jump
+ * (server/session/session_tool.h: SESSION_EARLY_JUMP_M, 0.25 mm, from the
+ * position AppliedInput gave the tool before) is answered after the step
+ * instead (issue 14: an answer before the tissue yields to a jump stretches
+ * the tool's spring by all of it): a jump above twice that must be answered
+ * late ("jump_late"; answered before the step it is "jump_early", a
+ * failure), a move below half of it on time, one in between either way
+ * (answered late it counts as "edge").
+ *
  * Prints `FEEDBACK_FIRST commands=N answered=A on_time=O late=L other=X
- * repeated=R dt_ns=D` and exits 0 when late = other = repeated = 0 and at
- * least `min` commands were answered (missing samples of a best-effort
- * topic are not a failure); 1 otherwise or when the recording cannot be
- * read. usage: rec_feedback_first FILE.db MIN */
+ * repeated=R jump_late=J jump_early=E edge=G dt_ns=D` and exits 0 when late =
+ * other = repeated = jump_early = 0, at least `min` commands were answered
+ * (missing samples of a best-effort topic are not a failure) and at least
+ * `min_jumps` jumps were answered late; 1 otherwise or when the recording
+ * cannot be read. usage: rec_feedback_first FILE.db MIN [MIN_JUMPS] */
 #include <inttypes.h>
 #include <math.h>
 #include <stdio.h>
@@ -27,9 +37,11 @@
 #include "viscera.h"
 
 #define MAXT 8
+#define JUMP_M 2.5e-4 /* = SESSION_EARLY_JUMP_M (server/session/session_tool.h) */
 
 typedef struct cmd {
   uint64_t seq, start_ns;
+  double move; /* m the tip moved since the tool's previous command (0: the first one) */
 } cmd_t;
 typedef struct fb {
   uint64_t seq, cmd_seq, sim_ns;
@@ -40,6 +52,8 @@ typedef struct data {
   size_t ncmd[MAXT], capc[MAXT];
   fb_t *fb[MAXT];
   size_t nfb[MAXT], capf[MAXT];
+  double prev[MAXT][3]; /* the tip's last applied position */
+  int has_prev[MAXT];
   uint64_t dt_ns;
   int oom;
 } data_t;
@@ -64,12 +78,22 @@ static int on_applied(void *arg, const void *sample, const recfile_row_t *row) {
   if (a->paused) return 0; /* a paused session takes no step */
   for (uint32_t i = 0; i < a->tools._length; i++) {
     const viscera_AppliedTool *t = &a->tools._buffer[i];
-    if (t->released || t->tool_id >= MAXT) continue;
+    if (t->tool_id >= MAXT) continue;
     size_t k = t->tool_id;
+    if (t->released) { /* the next command is a new start, not a move */
+      d->has_prev[k] = 0;
+      continue;
+    }
+    double move = 0;
+    if (d->has_prev[k])
+      move = sqrt(pow(t->position[0] - d->prev[k][0], 2) + pow(t->position[1] - d->prev[k][1], 2) +
+                  pow(t->position[2] - d->prev[k][2], 2));
+    for (int q = 0; q < 3; q++) d->prev[k][q] = t->position[q];
+    d->has_prev[k] = 1;
     cmd_t *c = grow(d->cmd[k], &d->capc[k], d->ncmd[k], sizeof *c, &d->oom);
     if (!c) return 0;
     d->cmd[k] = c;
-    c[d->ncmd[k]++] = (cmd_t){t->cmd_seq, a->sim_time_ns};
+    c[d->ncmd[k]++] = (cmd_t){t->cmd_seq, a->sim_time_ns, move};
   }
   return 0;
 }
@@ -93,8 +117,8 @@ static int by_seq(const void *a, const void *b) {
 }
 
 int main(int argc, char **argv) {
-  if (argc != 3) {
-    fprintf(stderr, "usage: rec_feedback_first FILE.db MIN\n");
+  if (argc != 3 && argc != 4) {
+    fprintf(stderr, "usage: rec_feedback_first FILE.db MIN [MIN_JUMPS]\n");
     return 2;
   }
   recfile_t *rf = NULL;
@@ -113,7 +137,8 @@ int main(int argc, char **argv) {
     fprintf(stderr, "rec_feedback_first: %s\n", d.oom ? "out of memory" : bad ? "unreadable samples" : "no step seen");
     return 1;
   }
-  size_t commands = 0, answered = 0, on_time = 0, late = 0, other = 0, repeated = 0;
+  size_t commands = 0, answered = 0, on_time = 0, late = 0, other = 0, repeated = 0, jump_late = 0, jump_early = 0,
+         edge = 0;
   for (size_t t = 0; t < MAXT; t++) {
     if (d.nfb[t]) qsort(d.fb[t], d.nfb[t], sizeof *d.fb[t], by_seq); /* (a tool without samples has no array) */
     /* The step each sample answers: before the step it took a command in,
@@ -131,11 +156,24 @@ int main(int argc, char **argv) {
       if (f == d.nfb[t]) continue; /* not recorded (best effort) */
       j = f + 1;
       answered++;
+      int jump = c->move > 2 * JUMP_M, either = !jump && c->move >= 0.5 * JUMP_M;
       if (d.fb[t][f].sim_ns == c->start_ns) {
-        on_time++;
+        if (jump) {
+          jump_early++;
+          if (jump_early <= 5)
+            fprintf(stderr, "tool %zu command %" PRIu64 " moved the tip %.3f mm and was answered before the step\n", t,
+                    c->seq, c->move * 1e3);
+        } else {
+          on_time++;
+        }
         early[f] = 1;
       } else if (llabs((int64_t)(d.fb[t][f].sim_ns - c->start_ns) - (int64_t)d.dt_ns) <= 1) { /* ns truncation */
-        late++;
+        if (jump)
+          jump_late++;
+        else if (either)
+          edge++; /* near the server's jump: either way is right */
+        else
+          late++;
       } else {
         other++;
         if (other <= 5)
@@ -153,8 +191,12 @@ int main(int argc, char **argv) {
     free(d.cmd[t]);
     free(d.fb[t]);
   }
-  long min = strtol(argv[2], NULL, 10);
-  printf("FEEDBACK_FIRST commands=%zu answered=%zu on_time=%zu late=%zu other=%zu repeated=%zu dt_ns=%" PRIu64 "\n",
-         commands, answered, on_time, late, other, repeated, d.dt_ns);
-  return late == 0 && other == 0 && repeated == 0 && (long)answered >= min ? 0 : 1;
+  long min = strtol(argv[2], NULL, 10), min_jumps = argc == 4 ? strtol(argv[3], NULL, 10) : 0;
+  printf("FEEDBACK_FIRST commands=%zu answered=%zu on_time=%zu late=%zu other=%zu repeated=%zu jump_late=%zu "
+         "jump_early=%zu edge=%zu dt_ns=%" PRIu64 "\n",
+         commands, answered, on_time, late, other, repeated, jump_late, jump_early, edge, d.dt_ns);
+  return late == 0 && other == 0 && repeated == 0 && jump_early == 0 && (long)answered >= min &&
+                 (long)jump_late >= min_jumps
+             ? 0
+             : 1;
 }
