@@ -32,8 +32,10 @@
 # share of steps in which it slept.
 #
 # Before the lab starts, one seat runs alone (same scene, same trainee, same
-# scheduling, no subscribers) for BASELINE s: its step times are the
-# reference that "step time unchanged" is judged against.
+# scheduling, its share of the subscribers: SUBSCRIBERS / SEATS rounded up) for
+# BASELINE s: its step times are the reference that "step time unchanged" is
+# judged against (with no subscriber the seat alone would skip the mesh
+# writes a lab seat makes for its readers).
 #
 # usage: deploy/load_bench.sh [--build DIR] [--out DIR] [--seats N] [--subscribers M] [--duration S]
 #                             [--baseline S] [--rt-priority S] [--haptic-rt-priority H]
@@ -115,9 +117,18 @@ echo "load_bench: baseline, one seat alone for $BASELINE s" >&2
   "${SRV_RT[@]}" > "$OUT/alone-server.out" 2> "$OUT/alone-server.log" &
 alone=$!
 sleep 1
+# Its share of the lab's subscribers (a seat's step writes the meshes they read).
+alone_subs=()
+for k in $(seq 1 $(( (SUBS + SEATS - 1) / SEATS ))); do
+  "$BUILD/tests/bench/delta_sub" --partition "load/alone" --duration "$BASELINE" --name "alone-sub$k" \
+    > "$OUT/alone-sub$k.out" 2>&1 &
+  alone_subs+=($!)
+done
 "$BUILD/client/haptic/viscera-haptic" --partition "load/alone" --trajectory "$TRAJ" --duration "$BASELINE" --quiet \
   "${HAP_RT[@]}" > "$OUT/alone-haptic.log" 2>&1 || true
 wait "$alone" || true
+for p in "${alone_subs[@]}"; do kill -TERM "$p" 2>/dev/null || true; done
+wait "${alone_subs[@]}" 2>/dev/null || true
 pids=()
 cleanup() { for p in "${pids[@]}"; do kill -TERM "$p" 2>/dev/null || true; done; wait 2>/dev/null || true; }
 trap cleanup EXIT
