@@ -157,9 +157,12 @@ int main(int argc, char **argv) {
   check_monotonic("viscera_MeshDelta");
 
   /* the dispose, as a dispose, of the right instance (organ_id is the
-   * first member, so it is the first 4 payload bytes of key and sample).
-   * Organ 0 is disposed too, by the writer's auto-dispose when rec_pub
-   * exits, so look for organ 1 among the dispose rows. */
+   * first member, so it is the first 4 payload bytes of a key-only sample
+   * and of an XCDR1 sample; an XCDR2 sample of the @appendable type, which
+   * a dispose inferred from instance state stores whole, has its DHEADER
+   * first: encapsulation D_CDR2, 8 or 9). Organ 0 is disposed too, by the
+   * writer's auto-dispose when rec_pub exits, so look for organ 1 among
+   * the dispose rows. */
   sqlite3_stmt *st = NULL;
   sqlite3_prepare_v2(db,
                      "SELECT s.cdr, s.inferred FROM samples s JOIN topics t ON t.id=s.topic_id"
@@ -171,8 +174,12 @@ int main(int argc, char **argv) {
     int n = sqlite3_column_bytes(st, 0);
     CHECK(n >= 8);
     if (n < 8) continue;
-    uint32_t organ = (b[1] & 1) ? (uint32_t)b[4] | (uint32_t)b[5] << 8 | (uint32_t)b[6] << 16 | (uint32_t)b[7] << 24
-                                : (uint32_t)b[7] | (uint32_t)b[6] << 8 | (uint32_t)b[5] << 16 | (uint32_t)b[4] << 24;
+    int at = sqlite3_column_int(st, 1) && (b[1] == 8 || b[1] == 9) ? 8 : 4;
+    CHECK(n >= at + 4);
+    if (n < at + 4) continue;
+    const unsigned char *k = b + at; /* organ_id */
+    uint32_t organ = (b[1] & 1) ? (uint32_t)k[0] | (uint32_t)k[1] << 8 | (uint32_t)k[2] << 16 | (uint32_t)k[3] << 24
+                                : (uint32_t)k[3] | (uint32_t)k[2] << 8 | (uint32_t)k[1] << 16 | (uint32_t)k[0] << 24;
     if (organ == REC_TEST_DISPOSED_ORGAN) {
       disposes_of_organ++;
       printf("rec_check: dispose of organ %u stored (%d bytes, %s)\n", organ, n,
