@@ -300,8 +300,8 @@ void scene_probe(nb_t *nb) {
   };
   for (size_t i = 0; i < sizeof MODELS / sizeof MODELS[0]; i++) probe_model(nb, &MODELS[i], csv, &wp, &ed, &color);
   if (csv) fclose(csv);
-  plot_note(&wp, "Product setting: sub-steps chosen by each model from its stability bound (tool spring included, "
-                 "except mass-spring under symplectic Euler: implicit, docs/numerics.md §9).");
+  plot_note(&wp, "Product setting: sub-steps chosen by each model from its stability bound (the tool spring left out "
+                 "where it is coupled implicitly, docs/numerics.md §9.3).");
   plot_note(&wp, "Reference: same model, RK4 at 1/3840 s with 8 sub-steps (PBD/XPBD: their own scheme at 1/1920 s with "
                  "4 sub-steps x 10 iterations). Device set once per scene step.");
   plot_note(&ed,
