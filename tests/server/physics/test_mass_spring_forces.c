@@ -22,6 +22,7 @@
 #include "check.h"
 #include "physics/mass_spring.h"
 #include "test_assets.h"
+#include "ms_shuffle.h"
 #include "test_rng.h"
 
 /* Reference: every spring on its own, both ends written per spring. */
@@ -184,20 +185,7 @@ int main(void) {
 
   /* Shuffled springs (Fisher-Yates, factors moved with them) and every third
    * spring's ends swapped: runs of equal i broken up. */
-  for (size_t s = ns - 1; s > 0; s--) {
-    size_t r = (size_t)(test_rng_uniform(&rng) * (double)(s + 1));
-    ms_spring_t t = ms.springs[s];
-    ms.springs[s] = ms.springs[r];
-    ms.springs[r] = t;
-    double k = ms.k_scale[s];
-    ms.k_scale[s] = ms.k_scale[r];
-    ms.k_scale[r] = k;
-  }
-  for (size_t s = 0; s < ns; s += 3) {
-    uint32_t t = ms.springs[s].i;
-    ms.springs[s].i = ms.springs[s].j;
-    ms.springs[s].j = t;
-  }
+  ms_shuffle_springs(&ms, &rng);
   mass_spring_springs_changed(&ms); /* the AVX2 loop's gather index follows the new order */
   size_t runs = 0;
   for (size_t s = 0; s < ns; s++) runs += s == 0 || ms.springs[s].i != ms.springs[s - 1].i;

@@ -19,6 +19,7 @@
 #include "check.h"
 #include "physics/ms_linear.h"
 #include "test_assets.h"
+#include "ms_shuffle.h"
 #include "test_rng.h"
 
 static double rel_diff(const double *got, const double *want, size_t count) {
@@ -98,20 +99,7 @@ int main(void) {
   uint32_t zi = ms.springs[11].i, zj = ms.springs[11].j; /* a zero-length spring */
   memcpy(ms.x + 3 * (size_t)zj, ms.x + 3 * (size_t)zi, 3 * sizeof(double));
   compare("k_scale + f_res + fixed + zero length", &ms, &L);
-  for (size_t s = ns - 1; s > 0; s--) {
-    size_t r = (size_t)(test_rng_uniform(&rng) * (double)(s + 1));
-    ms_spring_t t = ms.springs[s];
-    ms.springs[s] = ms.springs[r];
-    ms.springs[r] = t;
-    double k = ms.k_scale[s];
-    ms.k_scale[s] = ms.k_scale[r];
-    ms.k_scale[r] = k;
-  }
-  for (size_t s = 0; s < ns; s += 3) {
-    uint32_t t = ms.springs[s].i;
-    ms.springs[s].i = ms.springs[s].j;
-    ms.springs[s].j = t;
-  }
+  ms_shuffle_springs(&ms, &rng);
   mass_spring_springs_changed(&ms);
   compare("shuffled + k_scale + f_res + zero", &ms, &L);
   free(scale);
