@@ -7,3 +7,9 @@ add_test(NAME load_bench_smoke COMMAND bash ${PROJECT_SOURCE_DIR}/deploy/load_be
          --out ${CMAKE_CURRENT_BINARY_DIR}/load_smoke --seats 2 --subscribers 4 --duration 12 --baseline 3)
 set_tests_properties(load_bench_smoke PROPERTIES LABELS bench TIMEOUT 120
   ENVIRONMENT "CYCLONEDDS_URI=file://${VISCERA_DDS_CONFIG};VISCERA_DOMAIN=148")
+# What sharing a core costs a busy seat's step, without DDS (issue 17 item 6).
+add_executable(bench_seats ${CMAKE_CURRENT_LIST_DIR}/bench_seats.c)
+target_link_libraries(bench_seats PRIVATE viscera_sim viscera_test_support)
+add_test(NAME bench_seats_smoke COMMAND bench_seats --seats 1,2 --seconds 1.6)
+set_tests_properties(bench_seats_smoke PROPERTIES LABELS bench TIMEOUT 120
+  ENVIRONMENT "VISCERA_SOURCE_DIR=${PROJECT_SOURCE_DIR}")

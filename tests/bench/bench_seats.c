@@ -1,0 +1,151 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* bench_seats: what sharing a core costs a busy seat's physics step
+ * (issue 17 item 6), without DDS or the scheduler in the way.
+ *
+ * A classroom puts several seats' servers on each core; each server sleeps
+ * between its 1 ms ticks, so when its step starts the other seats' steps
+ * have just run on that core and pushed its data out of the core's own
+ * cache. This program loads SEATS copies of one scene (default
+ * assets/scenes/classroom_gallbladder.yaml) into one process and drives
+ * each with load_bench.sh --busy's trajectory (down 8 mm in 0.5 s at
+ * x 12 mm, y 4 mm, then sweeping 5 mm either side every 2 s: the organ never
+ * rests). Each simulated millisecond it steps every seat in turn on this one
+ * thread and times each step (thread CPU time), so every seat's step finds
+ * its data after the other seats' steps: the lab's cache, made repeatable.
+ * With --seats 1 the seat's data stays in the cache from one step to the
+ * next: the seat alone. Prints the median and p99 step time per seat count
+ * and the ratio to one seat, and the bytes of the seat's state that a step
+ * reads (the sizes of the arrays the model holds).
+ *
+ * usage: bench_seats [--scene FILE] [--seats LIST] [--seconds S]
+ *   defaults: classroom_gallbladder.yaml, seats 1,2,3, 4 s of simulated
+ *   time each (the first 1 s, the press, is not timed).
+ * Figures are not checked: the machine's load moves them; compare the
+ * ratios of one run. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "runtime/scene_runtime.h"
+#include "test_assets.h"
+#include "test_runtime.h"
+#include "vstats.h"
+#include "vtime.h"
+
+enum { MAX_SEATS = 8 };
+
+/* load_bench.sh --busy's probe target at simulated time t (m). */
+static void busy_target(double t, double p[3]) {
+  p[1] = 0.004;
+  if (t < 0.5) {
+    p[0] = 0.012;
+    p[2] = 0.07 + (0.027 - 0.07) * t / 0.5;
+    return;
+  }
+  p[2] = 0.027;
+  if (t < 1.0) {
+    p[0] = 0.012 + 0.005 * (t - 0.5) / 0.5;
+    return;
+  }
+  double ph = fmod(t - 1.0, 2.0); /* 1 s to x = 7 mm, 1 s back to 17 mm */
+  p[0] = ph < 1.0 ? 0.017 - 0.010 * ph : 0.007 + 0.010 * (ph - 1.0);
+}
+
+static int run(const char *scene_yaml, int nseats, double seconds, vstats_summary_t *out) {
+  static scene_t sc[MAX_SEATS];
+  static runtime_t rt[MAX_SEATS];
+  verr_t err;
+  for (int k = 0; k < nseats; k++)
+    if (!test_runtime_load(&rt[k], &sc[k], scene_yaml, &err)) {
+      for (int j = 0; j < k; j++) runtime_destroy(&rt[j]);
+      return -1;
+    }
+  const int steps = (int)lround(seconds / sc[0].dt), warm = (int)lround(1.0 / sc[0].dt);
+  double *c = malloc((size_t)(steps - warm) * (size_t)nseats * sizeof *c);
+  if (!c) return -1;
+  size_t nc = 0;
+  for (int s = 0; s < steps; s++) {
+    double p[3];
+    busy_target(s * sc[0].dt, p);
+    for (int k = 0; k < nseats; k++) {
+      uint64_t c0 = vtime_thread_cpu_ns();
+      runtime_set_tool(&rt[k], 0, p, 100);
+      runtime_step(&rt[k]);
+      uint64_t c1 = vtime_thread_cpu_ns();
+      if (s >= warm) c[nc++] = (double)(c1 - c0) * 1e-3;
+    }
+  }
+  *out = vstats_summarise(c, nc);
+  free(c);
+  for (int k = 0; k < nseats; k++) runtime_destroy(&rt[k]);
+  return 0;
+}
+
+static char *slurp(const char *path) {
+  FILE *f = fopen(path, "rb");
+  if (!f) return NULL;
+  fseek(f, 0, SEEK_END);
+  long n = ftell(f);
+  fseek(f, 0, SEEK_SET);
+  char *t = n >= 0 ? malloc((size_t)n + 1) : NULL;
+  if (t && fread(t, 1, (size_t)n, f) != (size_t)n) {
+    free(t);
+    t = NULL;
+  }
+  if (t) t[n] = 0;
+  fclose(f);
+  return t;
+}
+
+int main(int argc, char **argv) {
+  const char *scene = NULL, *list = "1,2,3";
+  double seconds = 4.0;
+  for (int i = 1; i < argc; i++) {
+    if (!strcmp(argv[i], "--scene") && i + 1 < argc)
+      scene = argv[++i];
+    else if (!strcmp(argv[i], "--seats") && i + 1 < argc)
+      list = argv[++i];
+    else if (!strcmp(argv[i], "--seconds") && i + 1 < argc)
+      seconds = atof(argv[++i]);
+    else {
+      fprintf(stderr, "usage: bench_seats [--scene FILE] [--seats LIST] [--seconds S]\n");
+      return 2;
+    }
+  }
+  if (!(seconds > 1.5 && seconds <= 600)) {
+    fprintf(stderr, "bench_seats: --seconds must be in (1.5, 600]\n");
+    return 2;
+  }
+  if (!scene) scene = test_asset("scenes/classroom_gallbladder.yaml");
+  char *yaml = slurp(scene);
+  if (!yaml) {
+    fprintf(stderr, "bench_seats: cannot read the scene '%s'\n", scene);
+    return 2;
+  }
+  /* The scene names its mesh relative to assets/scenes (test_runtime_load). */
+  printf("bench_seats: %s, busy trajectory, %.1f s simulated per run (first 1 s not timed)\n", scene, seconds);
+  printf("%-6s %14s %14s %12s\n", "seats", "CPU median us", "CPU p99 us", "vs 1 seat");
+  double base = NAN;
+  const char *q = list;
+  while (*q) {
+    char *end;
+    long n = strtol(q, &end, 10);
+    if (end == q || n < 1 || n > MAX_SEATS) {
+      fprintf(stderr, "bench_seats: --seats takes numbers 1..%d separated by commas\n", MAX_SEATS);
+      free(yaml);
+      return 2;
+    }
+    vstats_summary_t r;
+    if (run(yaml, (int)n, seconds, &r)) {
+      free(yaml);
+      return 1;
+    }
+    if (n == 1) base = r.median;
+    printf("%-6ld %14.1f %14.1f %11.2fx\n", n, r.median, r.p99, r.median / base);
+    fflush(stdout);
+    q = *end == ',' ? end + 1 : end;
+  }
+  free(yaml);
+  return 0;
+}
