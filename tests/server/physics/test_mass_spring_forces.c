@@ -22,6 +22,7 @@
 #include "check.h"
 #include "physics/mass_spring.h"
 #include "test_assets.h"
+#include "ms_kidney.h"
 #include "ms_shuffle.h"
 #include "test_rng.h"
 
@@ -138,14 +139,7 @@ int main(void) {
   if (test_mesh_load("kidney.obj", &mesh)) return 1;
   verr_t err;
   mass_spring_t ms;
-  ms_params_t p = {.mass = 0.15,
-                   .stiffness = 400,
-                   .damping = 0.8,
-                   .home_stiffness = 5,
-                   .home_damping = 0.05,
-                   .gravity = {0, 0, -9.81}};
-  CHECK(mass_spring_create_surface(&ms, &mesh, &p, &err) == 0);
-  printf("kidney: %zu nodes, %zu springs\n", ms.n, ms.nsprings);
+  CHECK(ms_kidney_create(&ms, &mesh, &err) == 0);
   CHECK(ms.nsprings > 1000);
   size_t n = ms.n, m = 3 * n, ns = ms.nsprings;
   double *x = malloc(m * sizeof *x), *v = malloc(m * sizeof *v), *y = malloc(m * sizeof *y);

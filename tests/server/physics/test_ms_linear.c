@@ -19,6 +19,7 @@
 #include "check.h"
 #include "physics/ms_linear.h"
 #include "test_assets.h"
+#include "ms_kidney.h"
 #include "ms_shuffle.h"
 #include "test_rng.h"
 
@@ -66,17 +67,10 @@ int main(void) {
   if (test_mesh_load("kidney.obj", &mesh)) return 1;
   verr_t err;
   mass_spring_t ms;
-  ms_params_t p = {.mass = 0.15,
-                   .stiffness = 400,
-                   .damping = 0.8,
-                   .home_stiffness = 5,
-                   .home_damping = 0.05,
-                   .gravity = {0, 0, -9.81}};
-  CHECK(mass_spring_create_surface(&ms, &mesh, &p, &err) == 0);
+  CHECK(ms_kidney_create(&ms, &mesh, &err) == 0);
   ms_linear_t L = {0};
   CHECK(ms_linear_reserve(&L, ms.nsprings, &err) == 0);
   const size_t n = ms.n, m = 3 * n, ns = ms.nsprings;
-  printf("kidney: %zu nodes, %zu springs\n", n, ns);
   double *scale = malloc(ns * sizeof *scale);
   CHECK(scale != NULL && ns > 1000);
   if (!scale) return check_report("test_ms_linear");
