@@ -33,19 +33,7 @@ SEAT=hp/palp
 TRAJ="$OUT/palpate_smooth.traj"
 smooth_press "$TRAJ"
 
-palpate() { # palpate NAME EMULATOR-OPTIONS...
-  local name="$1" srv
-  shift
-  link_start --duration 60 --seed 5 "$@" || fail "$name: emulator did not start"
-  run_in_site a "$BUILD/server/viscera-server" --scene "$SRC/assets/scenes/default.yaml" --partition $SEAT \
-    > "$OUT/$name-server.out" 2> "$OUT/$name-server.log" &
-  srv=$!; PIDS+=("$srv")
-  run_in_site b timeout 60 "$BUILD/client/haptic/viscera-haptic" --trajectory "$TRAJ" --partition $SEAT \
-    --wait-server 15 --force-csv "$OUT/$name-force.csv" > "$OUT/$name-haptic.out" 2> "$OUT/$name-haptic.log" \
-    || fail "$name: haptic client failed"
-  kill -INT "$srv"; wait "$srv" || fail "$name: server exited with an error"
-  link_stop > "$OUT/$name-link.txt"
-}
+palpate() { net_press "$1" 60 5 "$TRAJ" "${@:2}"; } # palpate NAME EMULATOR-OPTIONS... (prelude.sh)
 
 palpate d0 --delay 0
 ref=$(field "$OUT/d0-haptic.out" peak_force)
