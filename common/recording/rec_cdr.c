@@ -567,18 +567,16 @@ typedef struct x1 {
 } x1_t;
 
 static int x1_put(cur_t *c, x1_t *x, const void *host, size_t size) {
-  static const char zero[8] = {0};
   size_t rel = x->o->len - x->base, pad = (size - rel % size) % size;
   if (rel + pad + size > x->cap) return fail(c, "re-encoded sample too large");
-  uint8_t tmp[8];
-  memcpy(tmp, host, size);
+  uint8_t tmp[16] = {0}; /* the padding (zeros), then the value in the sample's byte order: one append */
+  memcpy(tmp + pad, host, size);
   if (c->swap)
     for (size_t i = 0; i < size / 2; i++) {
-      uint8_t t = tmp[i];
-      tmp[i] = tmp[size - 1 - i], tmp[size - 1 - i] = t;
+      uint8_t t = tmp[pad + i];
+      tmp[pad + i] = tmp[pad + size - 1 - i], tmp[pad + size - 1 - i] = t;
     }
-  rt_str_append(x->o, zero, pad);
-  rt_str_append(x->o, (const char *)tmp, size);
+  rt_str_append(x->o, (const char *)tmp, pad + size);
   return x->o->oom ? verr_set(c->err, "out of memory") : 0;
 }
 
