@@ -469,11 +469,14 @@ static int csv_struct(cur_t *c, const rt_type_t *t, rt_str_t *o, bool *first) {
     if (mt->kind == RT_STRUCT) {
       if (csv_struct(c, mt, o, first) < 0) return -1;
     } else if (split_array(mt)) {
+      size_t aend; /* XCDR2: an array of enums or strings starts with a DHEADER */
+      if (dheader(c, !is_primitive(mt->elem), &aend) < 0) return -1;
       for (uint32_t k = 0; k < mt->dims[0]; k++) {
         rt_str_printf(o, "%s", *first ? "" : ",");
         *first = false;
         if (scalar(c, mt->elem, o, AS_CSV) < 0) return -1;
       }
+      if (aend != SIZE_MAX) c->pos = aend;
     } else if (is_scalar(mt)) {
       rt_str_printf(o, "%s", *first ? "" : ",");
       *first = false;
