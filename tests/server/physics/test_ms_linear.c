@@ -23,16 +23,6 @@
 #include "ms_shuffle.h"
 #include "test_rng.h"
 
-static double rel_diff(const double *got, const double *want, size_t count) {
-  double diff = 0, scale = 0;
-  for (size_t c = 0; c < count; c++) {
-    if (!isfinite(got[c])) return INFINITY;
-    diff = fmax(diff, fabs(got[c] - want[c]));
-    scale = fmax(scale, fabs(want[c]));
-  }
-  return scale > 0 ? diff / scale : diff;
-}
-
 static void compare(const char *label, mass_spring_t *ms, ms_linear_t *L) {
   const size_t m = 3 * ms->n, full = ms->nsprings;
   double *r0 = malloc(m * sizeof *r0), *d0 = malloc(m * sizeof *d0), *r1 = malloc(m * sizeof *r1);
@@ -45,7 +35,7 @@ static void compare(const char *label, mass_spring_t *ms, ms_linear_t *L) {
     ms_linear_rhs_path(L, ms, h, r0, d0, 0);
     memcpy(b0, L->blk, 5 * ms->nsprings * sizeof *b0);
     ms_linear_rhs_path(L, ms, h, r1, d1, 1);
-    double e = fmax(rel_diff(r1, r0, m), rel_diff(d1, d0, m));
+    double e = fmax(ms_rel_diff(r1, r0, m), ms_rel_diff(d1, d0, m));
     printf("%-36s springs %zu: simd (%s) against scalar rel diff %.3g\n", label, ms->nsprings,
            ms_linear_simd_available() ? "AVX2" : "not available here: scalar twice", e);
     CHECK(e < 1e-12);
