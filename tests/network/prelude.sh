@@ -5,6 +5,7 @@
 #   PIDS              processes to kill -9 when the script exits
 #   fail MSG          prints MSG and the tail of every OUT/*.log, exits 1
 #   net_press         one scripted palpation session through the link
+#   server_stall_us, client_stall_us   a process's longest step / tick from its log
 #   the sites.sh functions; exits 77 (skip) where sites cannot be made.
 # At exit: PIDS killed, then the sites (namespaces, veths, emulator) removed.
 BUILD="$1"; SRC="$2"; OUT="$3"
@@ -51,6 +52,15 @@ net_press() {
   kill -INT "$srv"; wait "$srv" || fail "$name: server exited with an error"
   link_stop > "$OUT/$name-link.txt"
 }
+# server_stall_us LOG: the server's longest step (us) from its log: a step
+# longer than the feedback lease (150 ms) is a real stall (a loaded machine),
+# and a "server lost" then is not false; nor when the client's own loop
+# stalled 100 ms.
+server_stall_us() { sed -n 's/^server: .* step time median .* max \([0-9.]*\) us.*/\1/p' "$1" | tail -1; }
+# client_stall_us LOG: the haptic client's longest tick period (us): a loop
+# starved for 100 ms or more means its DDS threads may have been too, past
+# the lease.
+client_stall_us() { sed -n 's/^haptic: .* period median .* max \([0-9.]*\) us.*/\1/p' "$1" | tail -1; }
 # A key=value field from a SUMMARY-style line of FILE: field FILE KEY.
 field() { sed -n "s/.*[ :]$2=\([-0-9.e+]*\).*/\1/p" "$1" | tail -1; }
 # smooth_press FILE: the kidney palpation as a hand makes it (haptic client
