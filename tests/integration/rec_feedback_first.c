@@ -34,27 +34,20 @@
 #include <stdlib.h>
 
 #include "rec_read.h"
+#include "rec_taken.h"
 #include "viscera.h"
 
-#define MAXT 8
+#define MAXT REC_TAKEN_TOOLS
 #define JUMP_M 2.5e-4 /* = SESSION_EARLY_JUMP_M (server/session/session_tool.h) */
 
-typedef struct cmd {
-  uint64_t seq, start_ns;
-  double move; /* m the tip moved since the tool's previous command (0: the first one) */
-} cmd_t;
 typedef struct fb {
   uint64_t seq, cmd_seq, sim_ns;
 } fb_t;
 
 typedef struct data {
-  cmd_t *cmd[MAXT];
-  size_t ncmd[MAXT], capc[MAXT];
+  rec_taken_t taken; /* the commands each tool took, the step each was taken in (rec_taken.h) */
   fb_t *fb[MAXT];
   size_t nfb[MAXT], capf[MAXT];
-  double prev[MAXT][3]; /* the tip's last applied position */
-  int has_prev[MAXT];
-  uint64_t dt_ns;
   int oom;
 } data_t;
 
@@ -68,34 +61,6 @@ static void *grow(void *p, size_t *cap, size_t n, size_t size, int *oom) {
   }
   *cap = c;
   return q;
-}
-
-static int on_applied(void *arg, const void *sample, const recfile_row_t *row) {
-  (void)row;
-  data_t *d = arg;
-  const viscera_AppliedInput *a = sample;
-  if (a->step > 0 && !d->dt_ns) d->dt_ns = (uint64_t)llround((double)a->sim_time_ns / (double)a->step);
-  if (a->paused) return 0; /* a paused session takes no step */
-  for (uint32_t i = 0; i < a->tools._length; i++) {
-    const viscera_AppliedTool *t = &a->tools._buffer[i];
-    if (t->tool_id >= MAXT) continue;
-    size_t k = t->tool_id;
-    if (t->released) { /* the next command is a new start, not a move */
-      d->has_prev[k] = 0;
-      continue;
-    }
-    double move = 0;
-    if (d->has_prev[k])
-      move = sqrt(pow(t->position[0] - d->prev[k][0], 2) + pow(t->position[1] - d->prev[k][1], 2) +
-                  pow(t->position[2] - d->prev[k][2], 2));
-    for (int q = 0; q < 3; q++) d->prev[k][q] = t->position[q];
-    d->has_prev[k] = 1;
-    cmd_t *c = grow(d->cmd[k], &d->capc[k], d->ncmd[k], sizeof *c, &d->oom);
-    if (!c) return 0;
-    d->cmd[k] = c;
-    c[d->ncmd[k]++] = (cmd_t){t->cmd_seq, a->sim_time_ns, move};
-  }
-  return 0;
 }
 
 static int on_feedback(void *arg, const void *sample, const recfile_row_t *row) {
@@ -128,13 +93,16 @@ int main(int argc, char **argv) {
     return 1;
   }
   static data_t d;
-  int bad =
-      rec_read_topic("rec_feedback_first", rf, "viscera_AppliedInput", &viscera_AppliedInput_desc, on_applied, &d);
+  int bad = rec_taken_read("rec_feedback_first", rf, &d.taken);
   bad += rec_read_topic("rec_feedback_first", rf, "viscera_ContactFeedback", &viscera_ContactFeedback_desc, on_feedback,
                         &d);
   recfile_close(rf);
-  if (bad || d.oom || !d.dt_ns) {
-    fprintf(stderr, "rec_feedback_first: %s\n", d.oom ? "out of memory" : bad ? "unreadable samples" : "no step seen");
+  const uint64_t dt_ns = d.taken.dt_ns;
+  if (bad || d.oom || d.taken.oom || !dt_ns) {
+    fprintf(stderr, "rec_feedback_first: %s\n",
+            d.oom || d.taken.oom ? "out of memory"
+            : bad                ? "unreadable samples"
+                                 : "no step seen");
     return 1;
   }
   size_t commands = 0, answered = 0, on_time = 0, late = 0, other = 0, repeated = 0, jump_late = 0, jump_early = 0,
@@ -146,8 +114,8 @@ int main(int argc, char **argv) {
     char *early = calloc(d.nfb[t] + 1, 1);
     if (!early) return 1;
     size_t j = 0;
-    for (size_t i = 0; i < d.ncmd[t]; i++) {
-      const cmd_t *c = &d.cmd[t][i];
+    for (size_t i = 0; i < d.taken.n[t]; i++) {
+      const rec_taken_cmd_t *c = &d.taken.cmd[t][i];
       commands++;
       /* Commands and answers go in the same order: the first sample at or
        * after j echoing this seq. */
@@ -167,7 +135,7 @@ int main(int argc, char **argv) {
           on_time++;
         }
         early[f] = 1;
-      } else if (llabs((int64_t)(d.fb[t][f].sim_ns - c->start_ns) - (int64_t)d.dt_ns) <= 1) { /* ns truncation */
+      } else if (llabs((int64_t)(d.fb[t][f].sim_ns - c->start_ns) - (int64_t)dt_ns) <= 1) { /* ns truncation */
         if (jump)
           jump_late++;
         else if (either)
@@ -183,18 +151,18 @@ int main(int argc, char **argv) {
     }
     int64_t last = -1;
     for (size_t i = 0; i < d.nfb[t]; i++) {
-      int64_t step = (int64_t)llround((double)d.fb[t][i].sim_ns / (double)d.dt_ns) - (early[i] ? 0 : 1);
+      int64_t step = (int64_t)llround((double)d.fb[t][i].sim_ns / (double)dt_ns) - (early[i] ? 0 : 1);
       if (step <= last) repeated++;
       last = step;
     }
     free(early);
-    free(d.cmd[t]);
     free(d.fb[t]);
   }
+  rec_taken_free(&d.taken);
   long min = strtol(argv[2], NULL, 10), min_jumps = argc == 4 ? strtol(argv[3], NULL, 10) : 0;
   printf("FEEDBACK_FIRST commands=%zu answered=%zu on_time=%zu late=%zu other=%zu repeated=%zu jump_late=%zu "
          "jump_early=%zu edge=%zu dt_ns=%" PRIu64 "\n",
-         commands, answered, on_time, late, other, repeated, jump_late, jump_early, edge, d.dt_ns);
+         commands, answered, on_time, late, other, repeated, jump_late, jump_early, edge, dt_ns);
   return late == 0 && other == 0 && repeated == 0 && jump_early == 0 && (long)answered >= min &&
                  (long)jump_late >= min_jumps
              ? 0

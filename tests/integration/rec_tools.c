@@ -43,6 +43,7 @@
 #include <string.h>
 
 #include "rec_read.h"
+#include "rec_taken.h"
 #include "viscera.h"
 
 static recfile_t *rf;
@@ -134,60 +135,17 @@ static int on_object(void *ctx, const void *p, const recfile_row_t *row) {
   return 0;
 }
 
-/* The step each command of tools 0 and 1 was taken in (AppliedInput: the
- * sim time at that step's start), in recording order, so an answer can be
- * told as written before the step (its sim time is that start) or after
- * it: a command that jumped is answered after the step (server/session/
- * session_tool.h), though it is new. */
-typedef struct applied_seqs {
-  unsigned long long *seq, *start;
-  size_t n, cap, cursor;
-} applied_seqs_t;
-static applied_seqs_t applied[2];
-static int on_applied(void *ctx, const void *p, const recfile_row_t *row) {
-  (void)row;
-  (void)ctx;
-  const viscera_AppliedInput *a = p;
-  if (a->paused) return 0;
-  for (uint32_t k = 0; k < a->tools._length; k++) {
-    const viscera_AppliedTool *t = &a->tools._buffer[k];
-    if (t->released || t->tool_id > 1) continue;
-    applied_seqs_t *q = &applied[t->tool_id];
-    if (q->n == q->cap) {
-      size_t cap = q->cap ? 2 * q->cap : 4096;
-      unsigned long long *s1 = realloc(q->seq, cap * sizeof *s1), *s2 = s1 ? realloc(q->start, cap * sizeof *s2) : NULL;
-      if (s1) q->seq = s1;
-      if (!s1 || !s2) return 1; /* out of memory: stop reading */
-      q->start = s2;
-      q->cap = cap;
-    }
-    q->seq[q->n] = t->cmd_seq;
-    q->start[q->n++] = a->sim_time_ns;
-  }
-  return 0;
-}
-/* Whether command `seq` of tool i was taken in the step starting at `t`
- * (answers come in the order commands were taken: a cursor, not a search). */
-static int taken_at(int i, unsigned long long seq, unsigned long long t) {
-  applied_seqs_t *q = &applied[i];
-  for (size_t c = q->cursor; c < q->n; c++)
-    if (q->seq[c] == seq) {
-      q->cursor = c;
-      return q->start[c] == t;
-    }
-  return 0;
-}
-
 /* ContactFeedback of tools 0 and 1: the tip each is told, matched when
  * both come from one evaluation of the tools (the tool-tool contact keeps
  * the tips apart within one): the same sim time and the same kind. A
  * sample answering a new command (cmd_seq changed) was evaluated before
  * its step's tissue step (sim time = the step's start; issue 17 item 5)
- * unless the command jumped (taken_at), the others after a step (sim time =
- * its end), so an answer of step k and
+ * unless the command jumped (told by the step that took it: rec_taken.h),
+ * the others after a step (sim time = its end), so an answer of step k and
  * the other tool's after-step sample of step k - 1 share a sim time but
  * not an evaluation. */
 typedef struct fb_pairs {
+  rec_taken_t *taken; /* the step each command of the tools was taken in */
   unsigned long long t[2], cmd_seq[2];
   int early[2];
   float pos[2][3];
@@ -201,7 +159,8 @@ static int on_feedback(void *ctx, const void *p, const recfile_row_t *row) {
   const viscera_ContactFeedback *f = p;
   if (f->tool_id > 1) return 0;
   int i = (int)f->tool_id;
-  fp->early[i] = (!fp->have[i] || f->cmd_seq != fp->cmd_seq[i]) && taken_at(i, f->cmd_seq, f->sim_time_ns);
+  fp->early[i] = (!fp->have[i] || f->cmd_seq != fp->cmd_seq[i]) &&
+                 rec_taken_in(fp->taken, (unsigned)i, f->cmd_seq, f->sim_time_ns);
   fp->cmd_seq[i] = f->cmd_seq;
   fp->t[i] = f->sim_time_ns;
   memcpy(fp->pos[i], f->proxy_position, sizeof fp->pos[i]);
@@ -379,8 +338,9 @@ int main(int argc, char **argv) {
   each("viscera_SessionEvent", &viscera_SessionEvent_desc, on_event, NULL);
   each("viscera_ToolMetrics", &viscera_ToolMetrics_desc, on_tool_metrics, NULL);
   each("viscera_ObjectState", &viscera_ObjectState_desc, on_object, NULL);
-  each("viscera_AppliedInput", &viscera_AppliedInput_desc, on_applied, NULL);
-  fb_pairs_t fp = {.min_d = INFINITY};
+  rec_taken_t taken;
+  bad += rec_taken_read("rec_tools", rf, &taken);
+  fb_pairs_t fp = {.taken = &taken, .min_d = INFINITY};
   each("viscera_ContactFeedback", &viscera_ContactFeedback_desc, on_feedback, &fp);
   for (int i = 0; i < MAXN; i++)
     if (have_tm[i])
@@ -402,10 +362,7 @@ int main(int argc, char **argv) {
            v.deltas);
   }
   recfile_close(rf);
-  for (int i = 0; i < 2; i++) {
-    free(applied[i].seq);
-    free(applied[i].start);
-  }
+  rec_taken_free(&taken);
   if (bad) fprintf(stderr, "rec_tools: %d samples or rows unreadable\n", bad);
   if (expect && !strcmp(expect, "grasp_pull")) expect_grasp_pull(with_vertex ? &v : NULL, haptic_csv, server_out);
   if (expect && !strcmp(expect, "stone_removal")) expect_stone_removal(server_out);

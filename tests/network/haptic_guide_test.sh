@@ -22,13 +22,6 @@
 set -euo pipefail
 source "$2/tests/network/prelude.sh"
 net_sites hp2
-# The server's longest step (us) from its log: a step longer than the
-# feedback lease (150 ms) is a real stall (a loaded machine), and a "server
-# lost" then is not false; nor when the client's own loop stalled 100 ms.
-server_stall_us() { sed -n 's/^server: .* step time median .* max \([0-9.]*\) us.*/\1/p' "$1" | tail -1; }
-# The client's longest tick period (us): a loop starved for 100 ms or more
-# means its DDS threads may have been too, past the lease.
-client_stall_us() { sed -n 's/^haptic: .* period median .* max \([0-9.]*\) us.*/\1/p' "$1" | tail -1; }
 export CYCLONEDDS_URI="file://$SRC/deploy/cyclonedds-site.xml"
 # The site file without DDS Security: every program refuses it unless told (issue 14 item 5).
 export VISCERA_INSECURE=1

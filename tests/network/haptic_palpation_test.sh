@@ -19,13 +19,6 @@
 set -euo pipefail
 source "$2/tests/network/prelude.sh"
 net_sites hp1
-# The server's longest step (us) from its log: a step longer than the
-# feedback lease (150 ms) is a real stall (a loaded machine), and a "server
-# lost" then is not false; nor when the client's own loop stalled 100 ms.
-server_stall_us() { sed -n 's/^server: .* step time median .* max \([0-9.]*\) us.*/\1/p' "$1" | tail -1; }
-# The client's longest tick period (us): a loop starved for 100 ms or more
-# means its DDS threads may have been too, past the lease.
-client_stall_us() { sed -n 's/^haptic: .* period median .* max \([0-9.]*\) us.*/\1/p' "$1" | tail -1; }
 export CYCLONEDDS_URI="file://$SRC/deploy/cyclonedds-site.xml"
 # The site file without DDS Security: every program refuses it unless told (issue 14 item 5).
 export VISCERA_INSECURE=1
@@ -33,19 +26,7 @@ SEAT=hp/palp
 TRAJ="$OUT/palpate_smooth.traj"
 smooth_press "$TRAJ"
 
-palpate() { # palpate NAME EMULATOR-OPTIONS...
-  local name="$1" srv
-  shift
-  link_start --duration 60 --seed 5 "$@" || fail "$name: emulator did not start"
-  run_in_site a "$BUILD/server/viscera-server" --scene "$SRC/assets/scenes/default.yaml" --partition $SEAT \
-    > "$OUT/$name-server.out" 2> "$OUT/$name-server.log" &
-  srv=$!; PIDS+=("$srv")
-  run_in_site b timeout 60 "$BUILD/client/haptic/viscera-haptic" --trajectory "$TRAJ" --partition $SEAT \
-    --wait-server 15 --force-csv "$OUT/$name-force.csv" > "$OUT/$name-haptic.out" 2> "$OUT/$name-haptic.log" \
-    || fail "$name: haptic client failed"
-  kill -INT "$srv"; wait "$srv" || fail "$name: server exited with an error"
-  link_stop > "$OUT/$name-link.txt"
-}
+palpate() { net_press "$1" 60 5 "$TRAJ" "${@:2}"; } # palpate NAME EMULATOR-OPTIONS... (prelude.sh)
 
 palpate d0 --delay 0
 ref=$(field "$OUT/d0-haptic.out" peak_force)

@@ -28,19 +28,7 @@ export CYCLONEDDS_URI="file://$SRC/deploy/cyclonedds-site.xml"
 export VISCERA_INSECURE=1
 SEAT=lc/palp
 TRAJ="$SRC/assets/trajectories/palpate_kidney.traj"
-press() { # press NAME EMULATOR-OPTIONS...
-  local name="$1" srv
-  shift
-  link_start --duration 40 --seed 9 "$@" || fail "$name: emulator did not start"
-  run_in_site a "$BUILD/server/viscera-server" --scene "$SRC/assets/scenes/default.yaml" --partition $SEAT \
-    > "$OUT/$name-server.out" 2> "$OUT/$name-server.log" &
-  srv=$!; PIDS+=("$srv")
-  run_in_site b timeout 40 "$BUILD/client/haptic/viscera-haptic" --trajectory "$TRAJ" --partition $SEAT \
-    --wait-server 15 --force-csv "$OUT/$name-force.csv" > "$OUT/$name-haptic.out" 2> "$OUT/$name-haptic.log" \
-    || fail "$name: haptic client failed"
-  kill -INT "$srv"; wait "$srv" || fail "$name: server exited with an error"
-  link_stop > "$OUT/$name-link.txt"
-}
+press() { net_press "$1" 40 9 "$TRAJ" "${@:2}"; } # press NAME EMULATOR-OPTIONS... (prelude.sh)
 press d0 --delay 0
 press d100 --delay 100 --jitter 10 --no-reorder --loss 5
 ref=$(field "$OUT/d0-haptic.out" peak_force)

@@ -370,7 +370,8 @@ static void test_xcdr1(void) {
 }
 
 /* Collections of enums and of strings carry a DHEADER in XCDR2, of octets
- * none: JSON from both encodings, and the XCDR1 re-encoding. */
+ * none: JSON and CSV (the enum array split into columns) from both
+ * encodings, and the XCDR1 re-encoding. */
 static void test_collections(void) {
   cdr_cases_Color seq[3] = {cdr_cases_GREEN, cdr_cases_BLUE, cdr_cases_RED};
   char names[2][9] = {"ab", "cdef"};
@@ -384,6 +385,9 @@ static void test_collections(void) {
   CHECK(load(&m, &cdr_cases_Colors_desc, "cdr_cases::Colors") == 0);
   const char *want = "{\"seq\":[\"GREEN\",\"BLUE\",\"RED\"],\"names\":[\"ab\",\"cdef\"],\"arr\":[\"BLUE\",\"GREEN\"],"
                      "\"raw\":[1,2,255],\"last\":-0.5}";
+  const char *want_csv =
+      "\"[\"\"GREEN\"\",\"\"BLUE\"\",\"\"RED\"\"]\",\"[\"\"ab\"\",\"\"cdef\"\"]\",\"BLUE\",\"GREEN\","
+      "\"[1,2,255]\",-0.5";
   for (int x = 1; x <= 2; x++) {
     size_t len;
     unsigned char *b = serialize(&v, &cdr_cases_Colors_desc, x, &len);
@@ -391,6 +395,9 @@ static void test_collections(void) {
     verr_t err = {{0}};
     CHECK(rt_cdr_json(m.top, b, len, &o, &err) == 0 && o.s && strcmp(o.s, want) == 0);
     if (!o.s || strcmp(o.s, want)) fprintf(stderr, "XCDR%d: %s %s\n", x, o.s ? o.s : "", err.msg);
+    rt_str_free(&o);
+    CHECK(rt_cdr_csv(m.top, b, len, &o, &err) == 0 && o.s && strcmp(o.s, want_csv) == 0);
+    if (!o.s || strcmp(o.s, want_csv)) fprintf(stderr, "CSV XCDR%d: %s %s\n", x, o.s ? o.s : "", err.msg);
     rt_str_free(&o);
     free(b);
   }

@@ -22,6 +22,7 @@
 #include "check.h"
 #include "physics/mass_spring.h"
 #include "test_assets.h"
+#include "ms_kidney.h"
 #include "ms_shuffle.h"
 #include "test_rng.h"
 
@@ -87,23 +88,12 @@ static void ref_stiffness_mul(const mass_spring_t *ms, const double *x, double a
   }
 }
 
-/* max |got - want| / max |want|; also fails on any non-finite component. */
-static double rel_diff(const double *got, const double *want, size_t count) {
-  double diff = 0, scale = 0;
-  for (size_t c = 0; c < count; c++) {
-    if (!isfinite(got[c])) return INFINITY;
-    diff = fmax(diff, fabs(got[c] - want[c]));
-    scale = fmax(scale, fabs(want[c]));
-  }
-  return scale > 0 ? diff / scale : diff;
-}
-
 static void compare(const char *label, const mass_spring_t *ms, const double *x, const double *v, const double *y,
                     double *got, double *want) {
   size_t m = 3 * ms->n;
   mass_spring_forces(ms, x, v, got);
   ref_forces(ms, x, v, want);
-  double e = rel_diff(got, want, m);
+  double e = ms_rel_diff(got, want, m);
   printf("%-34s forces rel diff %.3g\n", label, e);
   CHECK(e < 1e-12);
   /* The two spring loops (mass_spring.h): scalar and AVX2 give the same
@@ -113,7 +103,7 @@ static void compare(const char *label, const mass_spring_t *ms, const double *x,
   if (alt) {
     mass_spring_forces_path(ms, x, v, alt, 0);
     mass_spring_forces_path(ms, x, v, got, 1);
-    e = rel_diff(got, alt, m);
+    e = ms_rel_diff(got, alt, m);
     CHECK(e < 1e-12);
     CHECK(memcmp(got, alt, m * sizeof *alt) == 0);
     printf("%-34s simd (%s) against scalar rel diff %.3g\n", label,
@@ -127,7 +117,7 @@ static void compare(const char *label, const mass_spring_t *ms, const double *x,
   for (int q = 0; q < 3; q++) {
     mass_spring_stiffness_mul(ms, x, ab[q][0], ab[q][1], y, got);
     ref_stiffness_mul(ms, x, ab[q][0], ab[q][1], y, want);
-    e = rel_diff(got, want, m);
+    e = ms_rel_diff(got, want, m);
     printf("%-34s stiffness_mul(a %g, b %g) rel diff %.3g\n", label, ab[q][0], ab[q][1], e);
     CHECK(e < 1e-12);
   }
@@ -138,14 +128,7 @@ int main(void) {
   if (test_mesh_load("kidney.obj", &mesh)) return 1;
   verr_t err;
   mass_spring_t ms;
-  ms_params_t p = {.mass = 0.15,
-                   .stiffness = 400,
-                   .damping = 0.8,
-                   .home_stiffness = 5,
-                   .home_damping = 0.05,
-                   .gravity = {0, 0, -9.81}};
-  CHECK(mass_spring_create_surface(&ms, &mesh, &p, &err) == 0);
-  printf("kidney: %zu nodes, %zu springs\n", ms.n, ms.nsprings);
+  CHECK(ms_kidney_create(&ms, &mesh, &err) == 0);
   CHECK(ms.nsprings > 1000);
   size_t n = ms.n, m = 3 * n, ns = ms.nsprings;
   double *x = malloc(m * sizeof *x), *v = malloc(m * sizeof *v), *y = malloc(m * sizeof *y);

@@ -19,18 +19,9 @@
 #include "check.h"
 #include "physics/ms_linear.h"
 #include "test_assets.h"
+#include "ms_kidney.h"
 #include "ms_shuffle.h"
 #include "test_rng.h"
-
-static double rel_diff(const double *got, const double *want, size_t count) {
-  double diff = 0, scale = 0;
-  for (size_t c = 0; c < count; c++) {
-    if (!isfinite(got[c])) return INFINITY;
-    diff = fmax(diff, fabs(got[c] - want[c]));
-    scale = fmax(scale, fabs(want[c]));
-  }
-  return scale > 0 ? diff / scale : diff;
-}
 
 static void compare(const char *label, mass_spring_t *ms, ms_linear_t *L) {
   const size_t m = 3 * ms->n, full = ms->nsprings;
@@ -44,7 +35,7 @@ static void compare(const char *label, mass_spring_t *ms, ms_linear_t *L) {
     ms_linear_rhs_path(L, ms, h, r0, d0, 0);
     memcpy(b0, L->blk, 5 * ms->nsprings * sizeof *b0);
     ms_linear_rhs_path(L, ms, h, r1, d1, 1);
-    double e = fmax(rel_diff(r1, r0, m), rel_diff(d1, d0, m));
+    double e = fmax(ms_rel_diff(r1, r0, m), ms_rel_diff(d1, d0, m));
     printf("%-36s springs %zu: simd (%s) against scalar rel diff %.3g\n", label, ms->nsprings,
            ms_linear_simd_available() ? "AVX2" : "not available here: scalar twice", e);
     CHECK(e < 1e-12);
@@ -66,17 +57,10 @@ int main(void) {
   if (test_mesh_load("kidney.obj", &mesh)) return 1;
   verr_t err;
   mass_spring_t ms;
-  ms_params_t p = {.mass = 0.15,
-                   .stiffness = 400,
-                   .damping = 0.8,
-                   .home_stiffness = 5,
-                   .home_damping = 0.05,
-                   .gravity = {0, 0, -9.81}};
-  CHECK(mass_spring_create_surface(&ms, &mesh, &p, &err) == 0);
+  CHECK(ms_kidney_create(&ms, &mesh, &err) == 0);
   ms_linear_t L = {0};
   CHECK(ms_linear_reserve(&L, ms.nsprings, &err) == 0);
   const size_t n = ms.n, m = 3 * n, ns = ms.nsprings;
-  printf("kidney: %zu nodes, %zu springs\n", n, ns);
   double *scale = malloc(ns * sizeof *scale);
   CHECK(scale != NULL && ns > 1000);
   if (!scale) return check_report("test_ms_linear");
