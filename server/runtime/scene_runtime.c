@@ -63,7 +63,7 @@ static int organ_init(organ_rt_t *o, runtime_t *rt, const scene_organ_t *cfg, ui
 int runtime_init(runtime_t *rt, const scene_t *scene, verr_t *err) {
   memset(rt, 0, sizeof *rt);
   rt->scene = *scene;
-  rt->cull.scale = 1;
+  rt->cull.patch_scale = rt->cull.shaft_scale = 1;
   double tool_k = 0;
   for (size_t t = 0; t < scene->ntools; t++)
     if (scene->tools[t].stiffness > tool_k) tool_k = scene->tools[t].stiffness;
@@ -268,7 +268,7 @@ static void build_patch(runtime_t *rt, tool_rt_t *tool) {
   if (!rt->cull.force_scan && m->topology_version == o->topology_version &&
       vertex_cull_usable(&o->cull, &o->tree, m->surf_x, m->nsurf, m->nsurf_tris)) {
     vertex_cull_begin(&o->cull);
-    double g = r * (1 + VERTEX_CULL_PAD) * rt->cull.scale, lo[3], hi[3];
+    double g = r * (1 + VERTEX_CULL_PAD) * rt->cull.patch_scale, lo[3], hi[3];
     for (int k = 0; k < 3; k++) {
       double pad = g + VERTEX_CULL_PAD * 1e-3 * fabs(tool->proxy.pos[k]);
       lo[k] = tool->proxy.pos[k] - pad;

@@ -46,12 +46,13 @@ typedef struct runtime {
   /* The vertex culls of the contact patch and the shafts' node test
    * (runtime/vertex_cull.h): how often each culled or scanned every vertex,
    * and two knobs for tests: force_scan (1: always scan, the reference)
-   * and scale (1 at init; a test shrinks the culls' radii with it to show
-   * that a cull short of the proven radius misses vertices). */
+   * and patch_scale, shaft_scale (1 at init; a test shrinks the culls'
+   * radii with them to show that a cull short of its proven radius misses
+   * vertices). */
   struct {
     uint64_t patch_culls, patch_scans, shaft_culls, shaft_scans;
     int force_scan;
-    double scale;
+    double patch_scale, shaft_scale;
   } cull;
 } runtime_t;
 
