@@ -274,7 +274,7 @@ static void build_patch(runtime_t *rt, tool_rt_t *tool) {
       lo[k] = tool->proxy.pos[k] - pad;
       hi[k] = tool->proxy.pos[k] + pad;
     }
-    vertex_cull_box(&o->cull, &o->tree, m->surf_tris, lo, hi);
+    vertex_cull_box(&o->cull, &o->tree, lo, hi);
     for (int k = 0; k < 3; k++) vertex_cull_add(&o->cull, tri[k]);
     nc = vertex_cull_take(&o->cull, &cand);
   }

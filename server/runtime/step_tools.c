@@ -218,8 +218,7 @@ static void shaft_candidates(runtime_t *rt, organ_rt_t *o, const double p0[3], c
     }
   }
   const uint32_t *cand;
-  size_t n =
-      vertex_cull_segment(&o->cull, &o->tree, m->surf_tris, p0, p1, radius * rt->cull.shaft_scale, moved, nmoved, &cand);
+  size_t n = vertex_cull_segment(&o->cull, &o->tree, p0, p1, radius * rt->cull.shaft_scale, moved, nmoved, &cand);
   if (n == SIZE_MAX) {
     rt->cull.shaft_scans++;
     return;

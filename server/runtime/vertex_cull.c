@@ -13,7 +13,6 @@
 
 void vertex_cull_free(vertex_cull_t *c) {
   free(c->bits);
-  free(c->tris);
   free(c->out);
   memset(c, 0, sizeof *c);
 }
@@ -22,9 +21,8 @@ int vertex_cull_setup(vertex_cull_t *c, size_t nverts, const uint32_t *tris, siz
   vertex_cull_free(c);
   size_t nw = (nverts + 63) / 64;
   c->bits = calloc(nw ? nw : 1, sizeof *c->bits);
-  c->tris = malloc(VERTEX_CULL_TRI_CAP * sizeof *c->tris);
   c->out = malloc((nverts ? nverts : 1) * sizeof *c->out);
-  if (!c->bits || !c->tris || !c->out) {
+  if (!c->bits || !c->out) {
     vertex_cull_free(c);
     return verr_set(err, "vertex_cull: out of memory for %zu vertices", nverts);
   }
@@ -59,19 +57,36 @@ void vertex_cull_add(vertex_cull_t *c, uint32_t i) {
   if (w + 1 > c->whi) c->whi = w + 1;
 }
 
-void vertex_cull_box(vertex_cull_t *c, const aabb_tree_t *tree, const uint32_t *tris, const double lo[3],
-                     const double hi[3]) {
+/* Node box (floats, rounded outward) against [lo, hi]. */
+static int node_overlaps(const aabb_node_t *n, int c, const double lo[3], const double hi[3]) {
+  return (double)n->lo[0][c] <= hi[0] && (double)n->hi[0][c] >= lo[0] && (double)n->lo[1][c] <= hi[1] &&
+         (double)n->hi[1][c] >= lo[1] && (double)n->lo[2][c] <= hi[2] && (double)n->hi[2][c] >= lo[2];
+}
+
+void vertex_cull_box(vertex_cull_t *c, const aabb_tree_t *tree, const double lo[3], const double hi[3]) {
   if (c->overflow) return;
-  size_t n = aabb_tree_box_query(tree, lo, hi, c->tris, VERTEX_CULL_TRI_CAP);
-  if (n > VERTEX_CULL_TRI_CAP) {
-    c->overflow = 1;
-    return;
-  }
-  for (size_t k = 0; k < n; k++) {
-    const uint32_t *v = tris + 3 * (size_t)c->tris[k];
-    vertex_cull_add(c, v[0]);
-    vertex_cull_add(c, v[1]);
-    vertex_cull_add(c, v[2]);
+  for (int k = 0; k < 3; k++)
+    if (!(tree->lo[k] <= hi[k] && tree->hi[k] >= lo[k])) return;
+  const double *x = tree->x;
+  uint32_t stack[AABB_TREE_STACK];
+  int sp = 0;
+  stack[sp++] = tree->root;
+  while (sp) {
+    uint32_t ref = stack[--sp];
+    if (ref & AABB_LEAF) {
+      /* The leaf's triangle corners (shared ones come again: the bits
+       * keep each once), tested where they are now. */
+      const uint32_t *tv = tree->tri_v + 3 * (size_t)AABB_LEAF_FIRST(ref);
+      for (uint32_t k = 0; k < 3 * AABB_LEAF_COUNT(ref); k++) {
+        const double *p = x + 3 * (size_t)tv[k];
+        if (p[0] >= lo[0] && p[0] <= hi[0] && p[1] >= lo[1] && p[1] <= hi[1] && p[2] >= lo[2] && p[2] <= hi[2])
+          vertex_cull_add(c, tv[k]);
+      }
+      continue;
+    }
+    const aabb_node_t *n = &tree->nodes[ref];
+    for (int ch = 1; ch >= 0; ch--)
+      if (node_overlaps(n, ch, lo, hi)) stack[sp++] = n->child[ch];
   }
 }
 
@@ -87,9 +102,8 @@ size_t vertex_cull_take(vertex_cull_t *c, const uint32_t **out) {
   return c->overflow ? SIZE_MAX : n;
 }
 
-size_t vertex_cull_segment(vertex_cull_t *c, const aabb_tree_t *tree, const uint32_t *tris, const double p0[3],
-                           const double p1[3], double radius, const uint32_t *moved, size_t nmoved,
-                           const uint32_t **out) {
+size_t vertex_cull_segment(vertex_cull_t *c, const aabb_tree_t *tree, const double p0[3], const double p1[3],
+                           double radius, const uint32_t *moved, size_t nmoved, const uint32_t **out) {
   vertex_cull_begin(c);
   double d[3], len = 0;
   for (int k = 0; k < 3; k++) {
@@ -111,7 +125,7 @@ size_t vertex_cull_segment(vertex_cull_t *c, const aabb_tree_t *tree, const uint
       lo[k] = fmin(a, b) - g;
       hi[k] = fmax(a, b) + g;
     }
-    vertex_cull_box(c, tree, tris, lo, hi);
+    vertex_cull_box(c, tree, lo, hi);
   }
   for (size_t j = 0; j < nmoved && !c->overflow; j++) vertex_cull_add(c, moved[j]);
   return vertex_cull_take(c, out);

@@ -8,8 +8,9 @@
  * positions, patches (indices and weights), hand forces and shaft
  * reactions must be equal to the bit. Scenes: the shipped gallbladder and
  * kidney seats, the mass-spring block after a scalpel cut (new topology),
- * each fallback forced (a model that cannot say what moved, queries that
- * overflow, an incomplete surface, a tree over other positions), and a
+ * a probe as wide as the organ (candidates = most of it), each fallback
+ * forced (a model that cannot say what moved, an incomplete surface, a
+ * tree over other positions or another surface, a NaN query), and a
  * cull whose radius is shrunk below the proven one, which must differ from
  * the scan (so the comparison can fail). */
 #include <math.h>
@@ -135,9 +136,9 @@ static void press(size_t t, size_t i, diffs_t *d) {
 static void report(const char *what, const diffs_t *d) {
   printf("  %-34s %5ld steps (shaft touching in %4ld): differ state %ld, patch %ld, force %ld, shaft %ld; "
          "culled patch %llu / scanned %llu, culled shaft %llu / scanned %llu\n",
-         what, d->steps, d->shaft_steps, d->state, d->patch, d->force, d->shaft, (unsigned long long)ra.cull.patch_culls,
-         (unsigned long long)ra.cull.patch_scans, (unsigned long long)ra.cull.shaft_culls,
-         (unsigned long long)ra.cull.shaft_scans);
+         what, d->steps, d->shaft_steps, d->state, d->patch, d->force, d->shaft,
+         (unsigned long long)ra.cull.patch_culls, (unsigned long long)ra.cull.patch_scans,
+         (unsigned long long)ra.cull.shaft_culls, (unsigned long long)ra.cull.shaft_scans);
 }
 
 static int equal(const diffs_t *d) { return d->state == 0 && d->patch == 0 && d->force == 0 && d->shaft == 0; }
@@ -186,8 +187,8 @@ static void test_after_cut(void) {
   double up[4] = {1, 0, 0, 0}, park[3] = {0.5, 0.5, 0.5};
   /* The probe waits far away; the knife goes in, across and out. */
   step_both(1, park, up, 0, &d);
-  double top = -0.1, y = 0.005, pts[4][3] = {{-0.03, y, top + 0.02}, {-0.03, y, top - 0.005}, {0.03, y, top - 0.005},
-                                              {0.03, y, top + 0.02}};
+  double top = -0.1, y = 0.005,
+         pts[4][3] = {{-0.03, y, top + 0.02}, {-0.03, y, top - 0.005}, {0.03, y, top - 0.005}, {0.03, y, top + 0.02}};
   int counts[3] = {200, 400, 200};
   for (int seg = 0; seg < 3; seg++)
     for (int s = 1; s <= counts[seg]; s++) {
@@ -204,14 +205,16 @@ static void test_after_cut(void) {
   destroy_both();
 }
 
-/* Fallbacks: a model that cannot tell what moved (regional sleeping off:
- * the sub-steps' shaft test scans, the after-step one culls), and queries
- * that overflow (a probe as wide as the organ): the scan, equal still. */
+/* A model that cannot tell what moved (regional sleeping off: the
+ * sub-steps' shaft test scans, the after-step one culls), and a probe as
+ * wide as the organ (most of it candidates): equal still. */
 static void test_fallbacks_runtime(void) {
   verr_t e;
-  CHECK(test_runtime_one_organ(&ra, &sa, "t", "kidney.obj", "    model: mass_spring_surface\n    solver: {region_force: 0}\n",
+  CHECK(test_runtime_one_organ(&ra, &sa, "t", "kidney.obj",
+                               "    model: mass_spring_surface\n    solver: {region_force: 0}\n",
                                "radius: 0.003, length: 0.1, stiffness: 400, max_force: 4", &e));
-  CHECK(test_runtime_one_organ(&rb, &sb, "t", "kidney.obj", "    model: mass_spring_surface\n    solver: {region_force: 0}\n",
+  CHECK(test_runtime_one_organ(&rb, &sb, "t", "kidney.obj",
+                               "    model: mass_spring_surface\n    solver: {region_force: 0}\n",
                                "radius: 0.003, length: 0.1, stiffness: 400, max_force: 4", &e));
   rb.cull.force_scan = 1;
   diffs_t d = {0};
@@ -220,21 +223,22 @@ static void test_fallbacks_runtime(void) {
   CHECK(equal(&d));
   CHECK(ra.cull.patch_culls > 0 && ra.cull.shaft_culls > 0 && ra.cull.shaft_scans > 0);
   destroy_both();
-  CHECK(test_runtime_one_organ(&ra, &sa, "t", "kidney.obj", "", "radius: 0.05, length: 0.3, stiffness: 400, max_force: 4",
-                               &e));
-  CHECK(test_runtime_one_organ(&rb, &sb, "t", "kidney.obj", "", "radius: 0.05, length: 0.3, stiffness: 400, max_force: 4",
-                               &e));
+  CHECK(test_runtime_one_organ(&ra, &sa, "t", "kidney.obj", "",
+                               "radius: 0.05, length: 0.3, stiffness: 400, max_force: 4", &e));
+  CHECK(test_runtime_one_organ(&rb, &sb, "t", "kidney.obj", "",
+                               "radius: 0.05, length: 0.3, stiffness: 400, max_force: 4", &e));
   rb.cull.force_scan = 1;
   memset(&d, 0, sizeof d);
   for (int k = 0; k < 4; k++) press(0, 0, &d);
   report("kidney, probe wider than the organ", &d);
   CHECK(equal(&d));
-  CHECK(ra.cull.patch_scans > 0 && ra.cull.shaft_scans > 0);
+  CHECK(ra.cull.patch_culls > 0);
   destroy_both();
 }
 
-/* Fallbacks of vertex_cull itself: a vertex no triangle uses, a tree over
- * another position array or surface, an overflowing query. */
+/* vertex_cull itself: a vertex no triangle uses, a tree over another
+ * position array or surface (no cull), a vertex moved since the refit (found
+ * only when added), ascending order, a NaN query (no cull). */
 static void test_fallbacks_unit(void) {
   double x[3 * 5] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 5, 5, 5};
   uint32_t tris[6] = {0, 1, 2, 1, 3, 2};
@@ -252,23 +256,40 @@ static void test_fallbacks_unit(void) {
   memcpy(other, x, sizeof other);
   CHECK(!vertex_cull_usable(&c, &tree, other, 4, 2)); /* the tree reads other positions */
   CHECK(!vertex_cull_usable(&c, &tree, x, 4, 1) && !vertex_cull_usable(&c, NULL, x, 4, 2));
-  /* A box around vertex 3 gives the corners of the triangle using it,
-   * ascending; one around everything all four. */
+  /* A box around vertex 3 gives vertex 3; single vertices come ascending,
+   * each once. */
   const uint32_t *out;
   double lo[3] = {0.9, 0.9, -0.1}, hi[3] = {1.1, 1.1, 0.1};
   vertex_cull_begin(&c);
-  vertex_cull_box(&c, &tree, tris, lo, hi);
+  vertex_cull_box(&c, &tree, lo, hi);
   size_t n = vertex_cull_take(&c, &out);
-  CHECK(n == 3 && out[0] == 1 && out[1] == 2 && out[2] == 3);
+  CHECK(n == 1 && out[0] == 3);
   vertex_cull_begin(&c);
   vertex_cull_add(&c, 3);
   vertex_cull_add(&c, 0);
+  vertex_cull_add(&c, 3);
   vertex_cull_add(&c, 99); /* out of range: ignored */
   n = vertex_cull_take(&c, &out);
   CHECK(n == 2 && out[0] == 0 && out[1] == 3);
+  /* A vertex moved since the refit, far beyond its leaf's box, is found
+   * only when the caller adds it (the model's moved list). */
+  x[9] = 3;
+  double lo2[3] = {2.9, 0.9, -0.1}, hi2[3] = {3.1, 1.1, 0.1};
+  vertex_cull_begin(&c);
+  vertex_cull_box(&c, &tree, lo2, hi2);
+  CHECK(vertex_cull_take(&c, &out) == 0);
+  vertex_cull_begin(&c);
+  vertex_cull_box(&c, &tree, lo2, hi2);
+  vertex_cull_add(&c, 3);
+  CHECK(vertex_cull_take(&c, &out) == 1 && out[0] == 3);
+  aabb_tree_refit(&tree, x);
+  vertex_cull_begin(&c);
+  vertex_cull_box(&c, &tree, lo2, hi2);
+  CHECK(vertex_cull_take(&c, &out) == 1 && out[0] == 3); /* after the refit the tree finds it */
   aabb_tree_destroy(&tree);
   vertex_cull_free(&c);
-  /* Overflow: more triangles in the box than one query holds. */
+  /* A grid: a segment over all of it gives every vertex, ascending; one
+   * down through a cell its four corners; a NaN segment SIZE_MAX. */
   size_t g = 40, nv = (g + 1) * (g + 1), nt = 2 * g * g;
   double *gx = malloc(3 * nv * sizeof *gx);
   uint32_t *gt = malloc(3 * nt * sizeof *gt);
@@ -284,13 +305,18 @@ static void test_fallbacks_unit(void) {
   CHECK(aabb_tree_build(&tree, gx, nv, gt, nt, &e) == 0);
   CHECK(vertex_cull_setup(&c, nv, gt, nt, &e) == 0 && vertex_cull_usable(&c, &tree, gx, nv, nt));
   double p0[3] = {-1, -1, 0}, p1[3] = {g + 1.0, g + 1.0, 0};
-  CHECK(nt > VERTEX_CULL_TRI_CAP);
-  CHECK(vertex_cull_segment(&c, &tree, gt, p0, p1, 100, NULL, 0, &out) == SIZE_MAX);
-  /* Clear again afterwards: a small query works. */
-  double s0[3] = {2.2, 2.2, 1}, s1[3] = {2.2, 2.2, -1};
-  n = vertex_cull_segment(&c, &tree, gt, s0, s1, 0.5, NULL, 0, &out);
-  CHECK(n != SIZE_MAX && n >= 4);
-  for (size_t k = 1; k < n && n != SIZE_MAX; k++) CHECK(out[k - 1] < out[k]);
+  n = vertex_cull_segment(&c, &tree, p0, p1, 100, NULL, 0, &out);
+  CHECK(n == nv);
+  int asc = 1;
+  for (size_t k = 0; k < n && n == nv; k++) asc &= out[k] == k;
+  CHECK(asc);
+  double s0[3] = {2.5, 2.5, 1}, s1[3] = {2.5, 2.5, -1};
+  n = vertex_cull_segment(&c, &tree, s0, s1, 0.75, NULL, 0, &out);
+  CHECK(n == 4 && out[0] == 2 * (g + 1) + 2 && out[3] == 3 * (g + 1) + 3);
+  s1[0] = NAN;
+  CHECK(vertex_cull_segment(&c, &tree, s0, s1, 0.75, NULL, 0, &out) == SIZE_MAX);
+  s1[0] = 2.5;
+  CHECK(vertex_cull_segment(&c, &tree, s0, s1, 0.75, NULL, 0, &out) == 4); /* clear again afterwards */
   aabb_tree_destroy(&tree);
   vertex_cull_free(&c);
   free(gx);
