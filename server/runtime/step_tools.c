@@ -196,8 +196,9 @@ static void add_spring_force(void *ctx, uint32_t i, const double f[3]) {
  * rebuilt it) or, inside the step (the model's hook), for every vertex
  * but those the model says may have moved since the step began
  * (model.h surface_moved), which join the candidates. Sets s->cand, or
- * leaves it NULL (scan every vertex) when the model cannot tell, the
- * tree is another surface's or a query overflows. */
+ * leaves it NULL (scan every vertex) when the model cannot tell, more
+ * than a quarter of the surface moved, the tree is another surface's or
+ * the shaft is not a number. */
 static void shaft_candidates(runtime_t *rt, organ_rt_t *o, const double p0[3], const double p1[3], double radius,
                              int in_step, shaft_surface_t *s) {
   const model_t *m = o->model;
