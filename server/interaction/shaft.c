@@ -24,30 +24,51 @@ void shaft_segment(const double tip[3], const double axis[3], double tip_radius,
   v3_axpy(p1, axis, length);
 }
 
-size_t shaft_push(const double p0[3], const double p1[3], double radius, double k, const double *x, size_t n,
-                  shaft_add_fn add, void *ctx, double f_tool[3]) {
-  cylinder_t c;
-  v3_copy(c.p0, p0);
-  v3_copy(c.p1, p1);
-  c.radius = radius;
-  /* Broad phase: the shaft's box, grown by the radius. */
-  double lo[3], hi[3];
+/* One vertex of the node test (the scan and the candidate list run this
+ * same code, so their forces agree to the bit): 1 when pushed. */
+static int push_node(const cylinder_t *c, const double lo[3], const double hi[3], double k, const double *x, uint32_t i,
+                     shaft_add_fn add, void *ctx, double f_tool[3]) {
+  const double *v = x + 3 * (size_t)i;
+  if (v[0] < lo[0] || v[0] > hi[0] || v[1] < lo[1] || v[1] > hi[1] || v[2] < lo[2] || v[2] > hi[2]) return 0;
+  cylinder_hit_t h;
+  if (!cylinder_test_node(c, v, &h) || v3_norm(h.dir) < 0.5) return 0; /* on the axis: no direction */
+  double mag = fmin(k * (c->radius - h.dist), SHAFT_MAX_VERTEX_FORCE), f[3];
+  v3_scale(f, h.dir, -mag); /* dir points to the axis: push the other way */
+  add(ctx, i, f);
+  v3_axpy(f_tool, f, -1);
+  return 1;
+}
+
+/* The cylinder and its broad-phase box: the shaft's box, grown by the
+ * radius. */
+static void node_test_setup(const double p0[3], const double p1[3], double radius, cylinder_t *c, double lo[3],
+                            double hi[3]) {
+  v3_copy(c->p0, p0);
+  v3_copy(c->p1, p1);
+  c->radius = radius;
   for (int j = 0; j < 3; j++) {
     lo[j] = fmin(p0[j], p1[j]) - radius;
     hi[j] = fmax(p0[j], p1[j]) + radius;
   }
+}
+
+size_t shaft_push(const double p0[3], const double p1[3], double radius, double k, const double *x, size_t n,
+                  shaft_add_fn add, void *ctx, double f_tool[3]) {
+  cylinder_t c;
+  double lo[3], hi[3];
+  node_test_setup(p0, p1, radius, &c, lo, hi);
   size_t hits = 0;
-  for (size_t i = 0; i < n; i++) {
-    const double *v = x + 3 * i;
-    if (v[0] < lo[0] || v[0] > hi[0] || v[1] < lo[1] || v[1] > hi[1] || v[2] < lo[2] || v[2] > hi[2]) continue;
-    cylinder_hit_t h;
-    if (!cylinder_test_node(&c, v, &h) || v3_norm(h.dir) < 0.5) continue; /* on the axis: no direction */
-    double mag = fmin(k * (radius - h.dist), SHAFT_MAX_VERTEX_FORCE), f[3];
-    v3_scale(f, h.dir, -mag); /* dir points to the axis: push the other way */
-    add(ctx, (uint32_t)i, f);
-    v3_axpy(f_tool, f, -1);
-    hits++;
-  }
+  for (size_t i = 0; i < n; i++) hits += (size_t)push_node(&c, lo, hi, k, x, (uint32_t)i, add, ctx, f_tool);
+  return hits;
+}
+
+size_t shaft_push_list(const double p0[3], const double p1[3], double radius, double k, const double *x,
+                       const uint32_t *idx, size_t nidx, shaft_add_fn add, void *ctx, double f_tool[3]) {
+  cylinder_t c;
+  double lo[3], hi[3];
+  node_test_setup(p0, p1, radius, &c, lo, hi);
+  size_t hits = 0;
+  for (size_t j = 0; j < nidx; j++) hits += (size_t)push_node(&c, lo, hi, k, x, idx[j], add, ctx, f_tool);
   return hits;
 }
 
@@ -184,7 +205,8 @@ size_t shaft_crossings(const double p0[3], const double p1[3], const shaft_surfa
 
 size_t shaft_contact(const double p0[3], const double p1[3], double radius, double k, const shaft_surface_t *s,
                      shaft_add_fn add, void *ctx, double f_tool[3], shaft_stats_t *st) {
-  size_t nodes = shaft_push(p0, p1, radius, k, s->x, s->n, add, ctx, f_tool);
+  size_t nodes = s->cand ? shaft_push_list(p0, p1, radius, k, s->x, s->cand, s->ncand, add, ctx, f_tool)
+                         : shaft_push(p0, p1, radius, k, s->x, s->n, add, ctx, f_tool);
   uint32_t tri[SHAFT_MAX_CROSSINGS];
   double tc[SHAFT_MAX_CROSSINGS], bary[SHAFT_MAX_CROSSINGS][3];
   size_t nc = shaft_crossings(p0, p1, s, tri, tc, bary, SHAFT_MAX_CROSSINGS);

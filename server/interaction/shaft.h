@@ -71,6 +71,12 @@ typedef void (*shaft_add_fn)(void *ctx, uint32_t i, const double f[3]);
  * f_tool (not reset) and returns the count. */
 size_t shaft_push(const double p0[3], const double p1[3], double radius, double k, const double *x, size_t n,
                   shaft_add_fn add, void *ctx, double f_tool[3]);
+/* The same test over the vertices idx (nidx of them, each < the count of
+ * x): with every vertex the test can push among them, in ascending order,
+ * the forces, their order and the reaction are shaft_push's to the bit
+ * (runtime/vertex_cull.h gathers such lists from the organ's tree). */
+size_t shaft_push_list(const double p0[3], const double p1[3], double radius, double k, const double *x,
+                       const uint32_t *idx, size_t nidx, shaft_add_fn add, void *ctx, double f_tool[3]);
 
 /* A contact surface: positions x (3 n), triangles tris (3 ntris, indices
  * < n) and optionally the AABB tree over them (NULL: scan every triangle),
@@ -82,6 +88,9 @@ typedef struct shaft_surface {
   size_t ntris;
   const aabb_tree_t *tree;
   double slack; /* m the surface may have moved since the tree's refit */
+  /* The node test's candidates (NULL: every vertex), see shaft_push_list. */
+  const uint32_t *cand;
+  size_t ncand;
 } shaft_surface_t;
 
 typedef struct shaft_stats {

@@ -157,6 +157,13 @@ typedef struct model_ops {
    * (runtime/topology_follow.c). */
   uint32_t (*surface_anchor)(const model_t *m, uint32_t tri);
   uint32_t (*surface_locate)(const model_t *m, uint32_t anchor, const double p[3], double bary[3]);
+  /* Optional (NULL: not known). From the hook, inside a step: the surface
+   * vertices that may have moved since the step began (each once, any
+   * order) in *idx (the model's memory, valid until it continues), and
+   * their count; SIZE_MAX when the model cannot tell in this step. Lets
+   * the runtime trust the collision tree refit before the step for every
+   * other vertex (runtime/vertex_cull.h). */
+  size_t (*surface_moved)(const model_t *m, const uint32_t **idx);
 } model_ops_t;
 
 struct model {

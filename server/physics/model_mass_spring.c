@@ -383,6 +383,16 @@ static int surface_restore_topology(model_t *m, state_blob_t *b, size_t nnodes, 
 
 static const model_edit_ops_t SURFACE_EDIT;
 
+/* Under regional sleeping with the step guarded by the regions, every node
+ * the step may change is in the guard's list before it moves (awake at
+ * the start, or woken: ms_regions.h); otherwise any node may move. */
+static size_t surface_moved(const model_t *m, const uint32_t **idx) {
+  const ms_model_t *mm = (const ms_model_t *)m;
+  if (!mm->regions || !mm->reg.springs || !mm->reg.in_step || m->surf_x != mm->ms.x) return SIZE_MAX;
+  *idx = mm->reg.gidx;
+  return mm->reg.gn;
+}
+
 static const model_ops_t SURFACE_OPS = {.name = "mass_spring_surface",
                                         .step = ms_step,
                                         .destroy = ms_destroy,
@@ -392,7 +402,8 @@ static const model_ops_t SURFACE_OPS = {.name = "mass_spring_surface",
                                         .add_surface_coupling = surface_add_coupling,
                                         .save_topology = surface_save_topology,
                                         .restore_topology = surface_restore_topology,
-                                        .edit = &SURFACE_EDIT};
+                                        .edit = &SURFACE_EDIT,
+                                        .surface_moved = surface_moved};
 static const model_ops_t TET_OPS = {.name = "mass_spring_tet",
                                     .step = ms_step,
                                     .destroy = ms_destroy,

@@ -212,6 +212,10 @@ int ckpt_state_get(state_blob_t *b, runtime_t *rt, const ckpt_session_io_t *io, 
     model_t *m = rt->organs[i].model;
     memcpy(m->x, b->p + at[i].x, 3 * m->nnodes * sizeof(double));
     memcpy(m->v, b->p + at[i].v, 3 * m->nnodes * sizeof(double));
+    /* Positions written from outside: the tree's boxes fit them again
+     * before anything queries it (proxies, the vertex culls). */
+    aabb_tree_t *tree = &rt->organs[i].tree;
+    if (tree->ntris && tree->x == m->surf_x && tree->nverts == m->nsurf) aabb_tree_refit(tree, m->surf_x);
   }
   memcpy(rt->tasks, tasks, rt->ntasks * sizeof tasks[0]);
   for (size_t k = 0; k < rt->nstones; k++) {

@@ -11,6 +11,7 @@
 #include "mesh.h"
 #include "physics/model.h"
 #include "runtime/organ_sleep.h"
+#include "runtime/vertex_cull.h"
 #include "scene.h"
 
 /* An organ: its model (model.h) owns the state. Everything that touches
@@ -27,6 +28,7 @@ typedef struct organ_rt {
   model_t *model;      /* sub-steps and stable dt live in the model */
   double patch_radius; /* m, contact patch radius: max(2 tool radius, 1.5 mean surface edge) */
   aabb_tree_t tree;    /* over the model's contact surface, refit after every step */
+  vertex_cull_t cull;  /* the surface vertices near a box, through tree (vertex_cull.h) */
   double *vn_rest;     /* unit vertex normals of the rest surface (force shading, proxy.h) */
   uint64_t rollbacks;
   uint32_t rollback_run; /* consecutive rolled-back steps (scene_runtime.h RUNTIME_ROLLBACK_RESET) */

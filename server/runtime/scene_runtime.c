@@ -63,6 +63,7 @@ static int organ_init(organ_rt_t *o, runtime_t *rt, const scene_organ_t *cfg, ui
 int runtime_init(runtime_t *rt, const scene_t *scene, verr_t *err) {
   memset(rt, 0, sizeof *rt);
   rt->scene = *scene;
+  rt->cull.patch_scale = rt->cull.shaft_scale = 1;
   double tool_k = 0;
   for (size_t t = 0; t < scene->ntools; t++)
     if (scene->tools[t].stiffness > tool_k) tool_k = scene->tools[t].stiffness;
@@ -99,6 +100,11 @@ int runtime_init(runtime_t *rt, const scene_t *scene, verr_t *err) {
       return -1;
     }
     rt->surfaces[i].tree = &o->tree;
+    if (vertex_cull_setup(&o->cull, m->nsurf, m->surf_tris, m->nsurf_tris, &te)) {
+      verr_set(err, "%s:%d: organ '%s': %s", rt->scene.path, o->cfg->line, o->cfg->name, te.msg);
+      runtime_destroy(rt);
+      return -1;
+    }
     o->topology_version = m->topology_version;
     o->vn_rest = malloc(3 * m->nsurf * sizeof *o->vn_rest);
     if (!o->vn_rest) {
@@ -141,6 +147,7 @@ void runtime_destroy(runtime_t *rt) {
     model_destroy(rt->organs[i].model);
     rt->organs[i].model = NULL;
     aabb_tree_destroy(&rt->organs[i].tree);
+    vertex_cull_free(&rt->organs[i].cull);
     free(rt->organs[i].vn_rest);
     rt->organs[i].vn_rest = NULL;
     mesh_free(&rt->organs[i].rest);
@@ -219,34 +226,64 @@ static void apply_contacts(model_t *m, void *vctx) {
   interact_apply(rt, o, m);
 }
 
+/* Vertex i's turn in the patch (see build_patch): the one test the scan
+ * and the culled candidates both run, in ascending vertex order. */
+static void patch_consider(tool_rt_t *tool, const double *x, const uint32_t *tri, double r, size_t i) {
+  double d = v3_dist(x + 3 * i, tool->proxy.pos);
+  int in_tri = i == tri[0] || i == tri[1] || i == tri[2];
+  if (d >= r && !in_tri) return;
+  double w = d < r ? (1 - d / r) * (1 - d / r) : 0;
+  if (in_tri) w = fmax(w, 1e-3);
+  size_t slot = tool->npatch;
+  if (slot == TOOL_PATCH_MAX) { /* full: replace the lightest if this is heavier */
+    size_t lightest = 0;
+    for (size_t j = 1; j < TOOL_PATCH_MAX; j++)
+      if (tool->patch_w[j] < tool->patch_w[lightest]) lightest = j;
+    if (tool->patch_w[lightest] >= w) return;
+    slot = lightest;
+  } else {
+    tool->npatch++;
+  }
+  tool->patch[slot] = (uint32_t)i;
+  tool->patch_w[slot] = w;
+}
+
 /* The vertices within the patch radius of the proxy, weighted by a smooth
  * kernel (1 - d/r)^2; the contact triangle's vertices always belong, so a
- * patch is never empty. Keeps the TOOL_PATCH_MAX heaviest if more qualify. */
+ * patch is never empty. Keeps the TOOL_PATCH_MAX heaviest if more qualify.
+ * The candidates come from the organ's tree (runtime/vertex_cull.h: the
+ * tree was refit at the end of the last step, or rebuilt by the topology
+ * follow-up just before), plus the contact triangle's corners; every other
+ * vertex fails the test, so the patch is the scan's bit for bit. The scan
+ * over every vertex stays for what the cull cannot vouch for. */
 static void build_patch(runtime_t *rt, tool_rt_t *tool) {
   tool->npatch = 0;
   if (!tool->proxy.in_contact) return;
-  const organ_rt_t *o = &rt->organs[tool->proxy.surface];
+  organ_rt_t *o = &rt->organs[tool->proxy.surface];
   const model_t *m = o->model;
   double r = fmax(o->patch_radius, 1e-6), sum = 0;
   const uint32_t *tri = m->surf_tris + 3 * tool->proxy.tri;
-  for (size_t i = 0; i < m->nsurf; i++) {
-    double d = v3_dist(m->surf_x + 3 * i, tool->proxy.pos);
-    int in_tri = i == tri[0] || i == tri[1] || i == tri[2];
-    if (d >= r && !in_tri) continue;
-    double w = d < r ? (1 - d / r) * (1 - d / r) : 0;
-    if (in_tri) w = fmax(w, 1e-3);
-    size_t slot = tool->npatch;
-    if (slot == TOOL_PATCH_MAX) { /* full: replace the lightest if this is heavier */
-      size_t lightest = 0;
-      for (size_t j = 1; j < TOOL_PATCH_MAX; j++)
-        if (tool->patch_w[j] < tool->patch_w[lightest]) lightest = j;
-      if (tool->patch_w[lightest] >= w) continue;
-      slot = lightest;
-    } else {
-      tool->npatch++;
+  size_t nc = SIZE_MAX;
+  const uint32_t *cand = NULL;
+  if (!rt->cull.force_scan && m->topology_version == o->topology_version &&
+      vertex_cull_usable(&o->cull, &o->tree, m->surf_x, m->nsurf, m->nsurf_tris)) {
+    vertex_cull_begin(&o->cull);
+    double g = r * (1 + VERTEX_CULL_PAD) * rt->cull.patch_scale, lo[3], hi[3];
+    for (int k = 0; k < 3; k++) {
+      double pad = g + VERTEX_CULL_PAD * 1e-3 * fabs(tool->proxy.pos[k]);
+      lo[k] = tool->proxy.pos[k] - pad;
+      hi[k] = tool->proxy.pos[k] + pad;
     }
-    tool->patch[slot] = (uint32_t)i;
-    tool->patch_w[slot] = w;
+    vertex_cull_box(&o->cull, &o->tree, lo, hi);
+    for (int k = 0; k < 3; k++) vertex_cull_add(&o->cull, tri[k]);
+    nc = vertex_cull_take(&o->cull, &cand);
+  }
+  if (nc == SIZE_MAX) {
+    rt->cull.patch_scans++;
+    for (size_t i = 0; i < m->nsurf; i++) patch_consider(tool, m->surf_x, tri, r, i);
+  } else {
+    rt->cull.patch_culls++;
+    for (size_t j = 0; j < nc; j++) patch_consider(tool, m->surf_x, tri, r, cand[j]);
   }
   for (size_t j = 0; j < tool->npatch; j++) sum += tool->patch_w[j];
   for (size_t j = 0; j < tool->npatch; j++) tool->patch_w[j] /= sum;
@@ -258,6 +295,9 @@ static void build_patch(runtime_t *rt, tool_rt_t *tool) {
 static void follow_organ(runtime_t *rt, size_t i, const topo_anchor_t anchors[SCENE_MAX_TOOLS]) {
   organ_rt_t *o = &rt->organs[i];
   topo_follow(rt, i, anchors, NULL);
+  /* The culls' scratch for the new surface (out of memory: they scan). */
+  verr_t e;
+  vertex_cull_setup(&o->cull, o->model->nsurf, o->model->surf_tris, o->model->nsurf_tris, &e);
   for (size_t t = 0; t < rt->ntools; t++) {
     if (anchors[t].in_contact) build_patch(rt, &rt->tools[t]);
     /* Held tissue is a list of vertex indices of the old surface: the

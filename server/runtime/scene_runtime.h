@@ -43,6 +43,17 @@ typedef struct runtime {
    * RUNTIME_ROLLBACK_RESET consecutive rolled-back steps (organ_rt.h
    * rollback_run); the server says so (event and log). */
   uint32_t organs_reset;
+  /* The vertex culls of the contact patch and the shafts' node test
+   * (runtime/vertex_cull.h): how often each culled or scanned every vertex,
+   * and two knobs for tests: force_scan (1: always scan, the reference)
+   * and patch_scale, shaft_scale (1 at init; a test shrinks the culls'
+   * radii with them to show that a cull short of its proven radius misses
+   * vertices). */
+  struct {
+    uint64_t patch_culls, patch_scans, shaft_culls, shaft_scans;
+    int force_scan;
+    double patch_scale, shaft_scale;
+  } cull;
 } runtime_t;
 
 /* Consecutive rolled-back steps after which an organ is put back to rest

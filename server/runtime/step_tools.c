@@ -189,6 +189,46 @@ static void add_spring_force(void *ctx, uint32_t i, const double f[3]) {
   declare_spring(sc->m, i, sc->k);
 }
 
+/* The shaft's node test over the candidates of organ o's tree
+ * (runtime/vertex_cull.h) instead of every vertex: the tree fits the
+ * positions it was refit to at the end of the last step, which the
+ * surface still has after the step (in_step 0: the runtime refit or
+ * rebuilt it) or, inside the step (the model's hook), for every vertex
+ * but those the model says may have moved since the step began
+ * (model.h surface_moved), which join the candidates. Sets s->cand, or
+ * leaves it NULL (scan every vertex) when the model cannot tell, more
+ * than a quarter of the surface moved, the tree is another surface's or
+ * the shaft is not a number. */
+static void shaft_candidates(runtime_t *rt, organ_rt_t *o, const double p0[3], const double p1[3], double radius,
+                             int in_step, shaft_surface_t *s) {
+  const model_t *m = o->model;
+  s->cand = NULL;
+  if (rt->cull.force_scan || m->topology_version != o->topology_version ||
+      !vertex_cull_usable(&o->cull, &o->tree, m->surf_x, m->nsurf, m->nsurf_tris)) {
+    rt->cull.shaft_scans++;
+    return;
+  }
+  const uint32_t *moved = NULL;
+  size_t nmoved = 0;
+  if (in_step) {
+    nmoved = m->ops->surface_moved ? m->ops->surface_moved(m, &moved) : SIZE_MAX;
+    /* Most of the organ moving: the scan is as cheap. */
+    if (nmoved > m->nsurf / 4) {
+      rt->cull.shaft_scans++;
+      return;
+    }
+  }
+  const uint32_t *cand;
+  size_t n = vertex_cull_segment(&o->cull, &o->tree, p0, p1, radius * rt->cull.shaft_scale, moved, nmoved, &cand);
+  if (n == SIZE_MAX) {
+    rt->cull.shaft_scans++;
+    return;
+  }
+  rt->cull.shaft_culls++;
+  s->cand = cand;
+  s->ncand = n;
+}
+
 void interact_apply(runtime_t *rt, organ_rt_t *o, model_t *m) {
   for (size_t t = 0; t < rt->ntools; t++) {
     tool_rt_t *tool = &rt->tools[t];
@@ -220,15 +260,20 @@ void interact_apply(runtime_t *rt, organ_rt_t *o, model_t *m) {
     if (!shaft_of(rt, tool, t, p0, p1)) continue;
     double radius = SHAFT_RADIUS_FRACTION * tool->cfg->radius;
     spring_ctx_t sc = {m, tool->cfg->stiffness};
+    shaft_surface_t surf = {m->surf_x, m->nsurf, m->surf_tris, m->nsurf_tris, tree, radius, NULL, 0};
+    shaft_candidates(rt, o, p0, p1, radius, 1, &surf);
     if (tip_on(tool, o->id)) {
       /* The tip presses this organ: the shaft rises out of the tip's own dent,
        * whose walls its axis can graze when the dent is deep; pushing those
        * triangles aside would open the dent under the god-object (stability
        * case 9 lost its contact that way). Only the node test here. */
-      shaft_push(p0, p1, radius, tool->cfg->stiffness, m->surf_x, m->nsurf, add_spring_force, &sc, ft);
+      if (surf.cand)
+        shaft_push_list(p0, p1, radius, tool->cfg->stiffness, m->surf_x, surf.cand, surf.ncand, add_spring_force, &sc,
+                        ft);
+      else
+        shaft_push(p0, p1, radius, tool->cfg->stiffness, m->surf_x, m->nsurf, add_spring_force, &sc, ft);
       continue;
     }
-    shaft_surface_t surf = {m->surf_x, m->nsurf, m->surf_tris, m->nsurf_tris, tree, radius};
     shaft_contact(p0, p1, radius, tool->cfg->stiffness, &surf, add_spring_force, &sc, ft, NULL);
   }
   for (size_t i = 0; i < rt->nstones; i++) {
@@ -273,8 +318,9 @@ static void shaft_contribution(const runtime_t *rt, tool_rt_t *tool, size_t t) {
   double p0[3], p1[3];
   v3_set(from->shaft, 0, 0, 0);
   if (!shaft_of(rt, tool, t, p0, p1)) return;
+  double radius = SHAFT_RADIUS_FRACTION * tool->cfg->radius;
   for (size_t i = 0; i < rt->norgans; i++) {
-    const organ_rt_t *o = &rt->organs[i];
+    organ_rt_t *o = (organ_rt_t *)&rt->organs[i];
     const model_t *m = o->model;
     /* After the step the runtime has refit (or rebuilt) the tree. */
     shaft_surface_t surf = {m->surf_x,
@@ -282,11 +328,18 @@ static void shaft_contribution(const runtime_t *rt, tool_rt_t *tool, size_t t) {
                             m->surf_tris,
                             m->nsurf_tris,
                             o->tree.ntris && m->topology_version == o->topology_version ? &o->tree : NULL,
+                            0,
+                            NULL,
                             0};
-    size_t h = tip_on(tool, i) ? shaft_push(p0, p1, SHAFT_RADIUS_FRACTION * tool->cfg->radius, tool->cfg->stiffness,
-                                            m->surf_x, m->nsurf, add_nothing, NULL, from->shaft)
-                               : shaft_contact(p0, p1, SHAFT_RADIUS_FRACTION * tool->cfg->radius, tool->cfg->stiffness,
-                                               &surf, add_nothing, NULL, from->shaft, NULL);
+    /* The culls' scratch and counters are the runtime's working memory,
+     * not its state: a preview's read-only pass may use them. */
+    shaft_candidates((runtime_t *)rt, o, p0, p1, radius, 0, &surf);
+    size_t h = tip_on(tool, i)
+                   ? (surf.cand ? shaft_push_list(p0, p1, radius, tool->cfg->stiffness, m->surf_x, surf.cand,
+                                                  surf.ncand, add_nothing, NULL, from->shaft)
+                                : shaft_push(p0, p1, radius, tool->cfg->stiffness, m->surf_x, m->nsurf, add_nothing,
+                                             NULL, from->shaft))
+                   : shaft_contact(p0, p1, radius, tool->cfg->stiffness, &surf, add_nothing, NULL, from->shaft, NULL);
     if (h && from->shaft_organ < 0) from->shaft_organ = (int)i;
     from->shaft_hits += h;
   }

@@ -96,7 +96,7 @@ static void test_coarse_triangle(void) {
          ti, nearest * 1e3, radius * 1e3, n_old);
   CHECK(n_old == 0 && old.n == 0 && v3_norm(f_old) == 0);
 
-  shaft_surface_t s = {m.pos, m.nverts, m.tris, m.ntris, &tree, 0};
+  shaft_surface_t s = {m.pos, m.nverts, m.tris, m.ntris, &tree, 0, NULL, 0};
   shaft_stats_t st;
   double ft[3] = {0, 0, 0}, fs[3] = {0, 0, 0};
   size_t nt = shaft_contact(p0, p1, radius, k, &s, record, &with_tree, ft, &st);
@@ -196,7 +196,7 @@ static void sweep(const char *name, double wobble, int refit) {
       p0[j] = mid + span * (test_rng_uniform(&rng) - 0.5) * 1.2;
       p1[j] = mid + span * (test_rng_uniform(&rng) - 0.5) * 1.2;
     }
-    shaft_surface_t s = {m.pos, m.nverts, m.tris, m.ntris, &tree, slack};
+    shaft_surface_t s = {m.pos, m.nverts, m.tris, m.ntris, &tree, slack, NULL, 0};
     uint32_t t1[SHAFT_MAX_CROSSINGS], t2[SHAFT_MAX_CROSSINGS];
     double u1[SHAFT_MAX_CROSSINGS], u2[SHAFT_MAX_CROSSINGS], b1[SHAFT_MAX_CROSSINGS][3], b2[SHAFT_MAX_CROSSINGS][3];
     size_t n1 = shaft_crossings(p0, p1, &s, t1, u1, b1, SHAFT_MAX_CROSSINGS);
