@@ -309,11 +309,12 @@ int main(int argc, char **argv) {
            "per sub-step %.2f\n",
            MODELS[mi].label, slope, used, slope_big, used_big, slope_sub);
     char lab[112];
-    snprintf(lab, sizeof lab, "%s (slope %.2f, per sub-step %.2f)", MODELS[mi].label, slope, slope_sub);
+    snprintf(lab, sizeof lab, "%s: %.2f (%.2f)", MODELS[mi].label, slope, slope_sub);
     plot_add(&pl, lab, n, xs, ys, (int)mi, (int)mi, PLOT_LINE_SOLID);
   }
   double ref[2] = {45, 23522}, refy[2] = {1000, 1000};
   plot_add(&pl, "real time (1 ms)", 2, ref, refy, PLOT_GREY, -1, PLOT_LINE_DASHED);
+  plot_note(&pl, "after each model: log-log slope of the step (of one sub-step)");
   plot_note(&pl, "load average %.1f when written (2 cores shared)", load_average());
   int rc = 0;
   if (png) {
