@@ -661,32 +661,74 @@ static inline int boxes_overlap(const double alo[3], const double ahi[3], const 
            ahi[2] < blo[2]);
 }
 
-size_t aabb_tree_box_query(const aabb_tree_t *t, const double lo[3], const double hi[3], uint32_t *out, size_t cap) {
-  if (!t->ntris || !boxes_overlap(t->lo, t->hi, lo, hi)) return 0;
+/* Every leaf whose box overlaps [lo, hi], child 0 first (so leaves come in
+ * leaf order): leaf(ctx, first slot, count). Nothing when the root's box
+ * misses it (a NaN bound misses). */
+typedef void (*leaf_fn)(const aabb_tree_t *t, uint32_t first, uint32_t count, void *ctx);
+static void walk_box(const aabb_tree_t *t, const double lo[3], const double hi[3], leaf_fn leaf, void *ctx) {
+  if (!t->ntris) return;
   for (int k = 0; k < 3; k++)
-    if (!(lo[k] <= hi[k]) || !isfinite(lo[k]) || !isfinite(hi[k])) return 0; /* as tri_box_overlap */
+    if (!(t->lo[k] <= hi[k] && t->hi[k] >= lo[k])) return;
   uint32_t stack[AABB_TREE_STACK];
   int sp = 0;
-  size_t count = 0;
   stack[sp++] = t->root;
   while (sp) {
     uint32_t ref = stack[--sp];
     if (ref & AABB_LEAF) {
-      uint32_t first = AABB_LEAF_FIRST(ref), end = first + AABB_LEAF_COUNT(ref);
-      for (uint32_t s = first; s < end; s++) {
-        const uint32_t *tv = t->tri_v + 3 * (size_t)s;
-        if (!tri_box_overlap(t->x + 3 * (size_t)tv[0], t->x + 3 * (size_t)tv[1], t->x + 3 * (size_t)tv[2], lo, hi))
-          continue;
-        if (count < cap) out[count] = t->tri_id[s];
-        count++;
-      }
+      leaf(t, AABB_LEAF_FIRST(ref), AABB_LEAF_COUNT(ref), ctx);
       continue;
     }
     const aabb_node_t *n = &t->nodes[ref];
-    for (int c = 1; c >= 0; c--) { /* child 0 on top: results come in leaf order */
+    for (int c = 1; c >= 0; c--) {
       double clo[3] = {n->lo[0][c], n->lo[1][c], n->lo[2][c]}, chi[3] = {n->hi[0][c], n->hi[1][c], n->hi[2][c]};
       if (boxes_overlap(clo, chi, lo, hi)) stack[sp++] = n->child[c];
     }
   }
-  return count;
+}
+
+typedef struct box_query_ctx {
+  const double *lo, *hi;
+  uint32_t *out;
+  size_t cap, count;
+} box_query_ctx_t;
+
+static void query_leaf(const aabb_tree_t *t, uint32_t first, uint32_t count, void *vctx) {
+  box_query_ctx_t *q = vctx;
+  for (uint32_t s = first; s < first + count; s++) {
+    const uint32_t *tv = t->tri_v + 3 * (size_t)s;
+    if (!tri_box_overlap(t->x + 3 * (size_t)tv[0], t->x + 3 * (size_t)tv[1], t->x + 3 * (size_t)tv[2], q->lo, q->hi))
+      continue;
+    if (q->count < q->cap) q->out[q->count] = t->tri_id[s];
+    q->count++;
+  }
+}
+
+size_t aabb_tree_box_query(const aabb_tree_t *t, const double lo[3], const double hi[3], uint32_t *out, size_t cap) {
+  for (int k = 0; k < 3; k++)
+    if (!(lo[k] <= hi[k]) || !isfinite(lo[k]) || !isfinite(hi[k])) return 0; /* as tri_box_overlap */
+  box_query_ctx_t q = {lo, hi, out, cap, 0};
+  walk_box(t, lo, hi, query_leaf, &q);
+  return q.count;
+}
+
+typedef struct corners_ctx {
+  const double *lo, *hi;
+  aabb_corner_fn fn;
+  void *ctx;
+} corners_ctx_t;
+
+static void corners_leaf(const aabb_tree_t *t, uint32_t first, uint32_t count, void *vctx) {
+  const corners_ctx_t *c = vctx;
+  const uint32_t *tv = t->tri_v + 3 * (size_t)first;
+  for (uint32_t k = 0; k < 3 * count; k++) {
+    const double *p = t->x + 3 * (size_t)tv[k];
+    if (p[0] >= c->lo[0] && p[0] <= c->hi[0] && p[1] >= c->lo[1] && p[1] <= c->hi[1] && p[2] >= c->lo[2] &&
+        p[2] <= c->hi[2])
+      c->fn(c->ctx, tv[k]);
+  }
+}
+
+void aabb_tree_box_corners(const aabb_tree_t *t, const double lo[3], const double hi[3], aabb_corner_fn fn, void *ctx) {
+  corners_ctx_t c = {lo, hi, fn, ctx};
+  walk_box(t, lo, hi, corners_leaf, &c);
 }

@@ -167,6 +167,15 @@ int aabb_tree_segment_first(const aabb_tree_t *t, const double p0[3], const doub
  * tree order) and returns how many there are in all, which may exceed cap. */
 size_t aabb_tree_box_query(const aabb_tree_t *t, const double lo[3], const double hi[3], uint32_t *out, size_t cap);
 
+/* Every corner of a triangle in a leaf whose box overlaps [lo, hi] and
+ * whose position (the array the tree reads, as it is now) lies in the
+ * closed box: fn(ctx, vertex index), a vertex shared by several such
+ * triangles once per triangle. A vertex that has not moved since the last
+ * refit lies in its leaves' boxes, so every such vertex in the box is
+ * reported (runtime/vertex_cull.h). A NaN bound reports nothing. */
+typedef void (*aabb_corner_fn)(void *ctx, uint32_t vertex);
+void aabb_tree_box_corners(const aabb_tree_t *t, const double lo[3], const double hi[3], aabb_corner_fn fn, void *ctx);
+
 /* Exact triangle vs axis-aligned box overlap by separating axes (box
  * faces, triangle normal, the nine edge cross products); touching counts.
  * 0 for a non-finite or inverted box and for a triangle with a NaN corner.

@@ -57,37 +57,10 @@ void vertex_cull_add(vertex_cull_t *c, uint32_t i) {
   if (w + 1 > c->whi) c->whi = w + 1;
 }
 
-/* Node box (floats, rounded outward) against [lo, hi]. */
-static int node_overlaps(const aabb_node_t *n, int c, const double lo[3], const double hi[3]) {
-  return (double)n->lo[0][c] <= hi[0] && (double)n->hi[0][c] >= lo[0] && (double)n->lo[1][c] <= hi[1] &&
-         (double)n->hi[1][c] >= lo[1] && (double)n->lo[2][c] <= hi[2] && (double)n->hi[2][c] >= lo[2];
-}
+static void add_corner(void *ctx, uint32_t i) { vertex_cull_add(ctx, i); }
 
 void vertex_cull_box(vertex_cull_t *c, const aabb_tree_t *tree, const double lo[3], const double hi[3]) {
-  if (c->overflow) return;
-  for (int k = 0; k < 3; k++)
-    if (!(tree->lo[k] <= hi[k] && tree->hi[k] >= lo[k])) return;
-  const double *x = tree->x;
-  uint32_t stack[AABB_TREE_STACK];
-  int sp = 0;
-  stack[sp++] = tree->root;
-  while (sp) {
-    uint32_t ref = stack[--sp];
-    if (ref & AABB_LEAF) {
-      /* The leaf's triangle corners (shared ones come again: the bits
-       * keep each once), tested where they are now. */
-      const uint32_t *tv = tree->tri_v + 3 * (size_t)AABB_LEAF_FIRST(ref);
-      for (uint32_t k = 0; k < 3 * AABB_LEAF_COUNT(ref); k++) {
-        const double *p = x + 3 * (size_t)tv[k];
-        if (p[0] >= lo[0] && p[0] <= hi[0] && p[1] >= lo[1] && p[1] <= hi[1] && p[2] >= lo[2] && p[2] <= hi[2])
-          vertex_cull_add(c, tv[k]);
-      }
-      continue;
-    }
-    const aabb_node_t *n = &tree->nodes[ref];
-    for (int ch = 1; ch >= 0; ch--)
-      if (node_overlaps(n, ch, lo, hi)) stack[sp++] = n->child[ch];
-  }
+  if (!c->overflow) aabb_tree_box_corners(tree, lo, hi, add_corner, c);
 }
 
 size_t vertex_cull_take(vertex_cull_t *c, const uint32_t **out) {
