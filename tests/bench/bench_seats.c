@@ -29,7 +29,7 @@
 
 #include "runtime/scene_runtime.h"
 #include "test_assets.h"
-#include "test_runtime.h"
+#include "scene.h"
 #include "vstats.h"
 #include "vtime.h"
 
@@ -52,22 +52,23 @@ static void busy_target(double t, double p[3]) {
   p[0] = ph < 1.0 ? 0.017 - 0.010 * ph : 0.007 + 0.010 * (ph - 1.0);
 }
 
-static int run(const char *scene_yaml, int nseats, double seconds, vstats_summary_t *out) {
-  static scene_t sc[MAX_SEATS];
+static int run(const scene_t *scene, int nseats, double seconds, vstats_summary_t *out) {
   static runtime_t rt[MAX_SEATS];
   verr_t err;
   for (int k = 0; k < nseats; k++)
-    if (!test_runtime_load(&rt[k], &sc[k], scene_yaml, &err)) {
+    if (runtime_init(&rt[k], scene, &err)) {
+      fprintf(stderr, "bench_seats: %s\n", err.msg);
       for (int j = 0; j < k; j++) runtime_destroy(&rt[j]);
       return -1;
     }
-  const int steps = (int)lround(seconds / sc[0].dt), warm = (int)lround(1.0 / sc[0].dt);
+  const scene_t *sc = scene;
+  const int steps = (int)lround(seconds / sc->dt), warm = (int)lround(1.0 / sc->dt);
   double *c = malloc((size_t)(steps - warm) * (size_t)nseats * sizeof *c);
   if (!c) return -1;
   size_t nc = 0;
   for (int s = 0; s < steps; s++) {
     double p[3];
-    busy_target(s * sc[0].dt, p);
+    busy_target(s * sc->dt, p);
     for (int k = 0; k < nseats; k++) {
       uint64_t c0 = vtime_thread_cpu_ns();
       runtime_set_tool(&rt[k], 0, p, 100);
@@ -80,22 +81,6 @@ static int run(const char *scene_yaml, int nseats, double seconds, vstats_summar
   free(c);
   for (int k = 0; k < nseats; k++) runtime_destroy(&rt[k]);
   return 0;
-}
-
-static char *slurp(const char *path) {
-  FILE *f = fopen(path, "rb");
-  if (!f) return NULL;
-  fseek(f, 0, SEEK_END);
-  long n = ftell(f);
-  fseek(f, 0, SEEK_SET);
-  char *t = n >= 0 ? malloc((size_t)n + 1) : NULL;
-  if (t && fread(t, 1, (size_t)n, f) != (size_t)n) {
-    free(t);
-    t = NULL;
-  }
-  if (t) t[n] = 0;
-  fclose(f);
-  return t;
 }
 
 int main(int argc, char **argv) {
@@ -118,12 +103,12 @@ int main(int argc, char **argv) {
     return 2;
   }
   if (!scene) scene = test_asset("scenes/classroom_gallbladder.yaml");
-  char *yaml = slurp(scene);
-  if (!yaml) {
-    fprintf(stderr, "bench_seats: cannot read the scene '%s'\n", scene);
+  static scene_t sc;
+  verr_t err;
+  if (scene_load(scene, &sc, &err)) { /* meshes relative to the scene file, as the server reads it */
+    fprintf(stderr, "bench_seats: %s\n", err.msg);
     return 2;
   }
-  /* The scene names its mesh relative to assets/scenes (test_runtime_load). */
   printf("bench_seats: %s, busy trajectory, %.1f s simulated per run (first 1 s not timed)\n", scene, seconds);
   printf("%-6s %14s %14s %12s\n", "seats", "CPU median us", "CPU p99 us", "vs 1 seat");
   double base = NAN;
@@ -133,19 +118,14 @@ int main(int argc, char **argv) {
     long n = strtol(q, &end, 10);
     if (end == q || n < 1 || n > MAX_SEATS) {
       fprintf(stderr, "bench_seats: --seats takes numbers 1..%d separated by commas\n", MAX_SEATS);
-      free(yaml);
       return 2;
     }
     vstats_summary_t r;
-    if (run(yaml, (int)n, seconds, &r)) {
-      free(yaml);
-      return 1;
-    }
+    if (run(&sc, (int)n, seconds, &r)) return 1;
     if (n == 1) base = r.median;
     printf("%-6ld %14.1f %14.1f %11.2fx\n", n, r.median, r.p99, r.median / base);
     fflush(stdout);
     q = *end == ',' ? end + 1 : end;
   }
-  free(yaml);
   return 0;
 }
