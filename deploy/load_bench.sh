@@ -226,13 +226,20 @@ pids=()
     echo "  $s: $(step_line "$OUT/$s-server.log")"
   done
   # The lab's seats against the seat alone (issue 17 item 6: "step time
-  # unchanged from one seat alone"), step CPU medians.
-  cpu_median() { sed -n 's/^server: step CPU time median \([0-9.]*\) us.*/\1/p' "$1"; }
-  base=$(cpu_median "$OUT/alone-server.log")
-  for i in $(seq 1 "$SEATS"); do cpu_median "$OUT/$(printf 'seat%02d' "$i")-server.log"; done | sort -g |
-    awk -v b="$base" 'NF { v[++n] = $1 } END { if (n && b > 0)
-      printf "  step CPU median, seats against the seat alone: %+.0f %% to %+.0f %% (%.1f-%.1f us against %.1f us)\n",
-        100 * (v[1] / b - 1), 100 * (v[n] / b - 1), v[1], v[n], b }'
+  # unchanged from one seat alone"), step CPU medians: the whole step, then
+  # its two parts (the server's "step CPU split" line: the runtime's tissue
+  # step, and the rest: commands, feedback, inputs, frames).
+  against_alone() { # label, sed expression printing one number from a server log
+    local base
+    base=$(sed -n "$2" "$OUT/alone-server.log")
+    for i in $(seq 1 "$SEATS"); do sed -n "$2" "$OUT/$(printf 'seat%02d' "$i")-server.log"; done | sort -g |
+      awk -v b="$base" -v what="$1" 'NF { v[++n] = $1 } END { if (n && b > 0)
+        printf "  %s, seats against the seat alone: %+.0f %% to %+.0f %% (%.1f-%.1f us against %.1f us)\n",
+          what, 100 * (v[1] / b - 1), 100 * (v[n] / b - 1), v[1], v[n], b }'
+  }
+  against_alone "step CPU median" 's/^server: step CPU time median \([0-9.]*\) us.*/\1/p'
+  against_alone "  of it the tissue step" 's/^server: step CPU split: tissue (contact and organs) median \([0-9.]*\) us.*/\1/p'
+  against_alone "  the rest (commands, feedback, inputs, frames)" 's/^server: step CPU split: .* the rest ([^)]*) median \([0-9.]*\) us.*/\1/p'
   if [ -n "$(awake_line "$OUT/alone-server.log")" ]; then
     echo "  organ sleeping: alone: $(awake_line "$OUT/alone-server.log")"
     for i in $(seq 1 "$SEATS"); do

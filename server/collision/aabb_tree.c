@@ -309,7 +309,9 @@ static size_t sweep_nodes(aabb_tree_t *t, int all) {
   return nodes;
 }
 
-void aabb_tree_refit(aabb_tree_t *t, const double *x) {
+/* The refit over the vertices in cand (n of them), or over every vertex
+ * when cand is NULL. */
+static void refit(aabb_tree_t *t, const double *x, const uint32_t *cand, size_t n) {
   t->x = x;
   t->refit_leaves = t->refit_nodes = 0;
   int full = t->full;
@@ -320,7 +322,9 @@ void aabb_tree_refit(aabb_tree_t *t, const double *x) {
      * rest the branch is always predicted: one compare per vertex. */
     const double m = t->margin, *xr = t->xr;
     uint32_t *moved = t->vmoved;
-    for (size_t v = 0; v < t->nverts; v++) {
+    for (size_t a = 0; a < n; a++) {
+      const size_t v = cand ? cand[a] : a;
+      if (v >= t->nverts) continue;
       const double *p = x + 3 * v, *r = xr + 3 * v;
       if (fabs(p[0] - r[0]) <= m && fabs(p[1] - r[1]) <= m && fabs(p[2] - r[2]) <= m) continue;
       moved[nmoved++] = (uint32_t)v;
@@ -356,6 +360,16 @@ void aabb_tree_refit(aabb_tree_t *t, const double *x) {
   }
   t->refit_leaves = ndirty;
   if (t->nnodes) t->refit_nodes = sweep_nodes(t, 0);
+}
+
+void aabb_tree_refit(aabb_tree_t *t, const double *x) { refit(t, x, NULL, t->nverts); }
+
+void aabb_tree_refit_listed(aabb_tree_t *t, const double *x, const uint32_t *idx, size_t n) {
+  if (x != t->x || t->full) {
+    refit(t, x, NULL, t->nverts);
+    return;
+  }
+  refit(t, x, idx, n);
 }
 
 /* ---- nearest point -------------------------------------------------------- */

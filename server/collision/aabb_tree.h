@@ -111,6 +111,13 @@ void aabb_tree_destroy(aabb_tree_t *t);
  * depth) boxes; when more than an eighth of the vertices moved, every box
  * (the plain bottom-up sweep, cheaper then). No allocation. */
 void aabb_tree_refit(aabb_tree_t *t, const double *x);
+/* The same refit, the same boxes, looking only at the n vertices in idx
+ * (each once; indices past the vertex count are ignored): for a caller
+ * that knows every other vertex is bit for bit where it was at the last
+ * refit or the build, in the same array x (a model's last_step_moved).
+ * O(n) compares instead of O(vertices); with another array than the last
+ * refit's it falls back to aabb_tree_refit. */
+void aabb_tree_refit_listed(aabb_tree_t *t, const double *x, const uint32_t *idx, size_t n);
 
 /* The build's margin: this fraction of the mean triangle edge length at the
  * build. A vertex resting or creeping below it costs one compare per refit;

@@ -164,6 +164,14 @@ typedef struct model_ops {
    * the runtime trust the collision tree refit before the step for every
    * other vertex (runtime/vertex_cull.h). */
   size_t (*surface_moved)(const model_t *m, const uint32_t **idx);
+  /* Optional (NULL: not known). After a step, until the next step or a
+   * write from outside (model_note_outside_write): the surface vertices
+   * that step may have moved (each once, any order; rolled back or not) in
+   * *idx (the model's memory), and their count; SIZE_MAX when the model
+   * cannot tell. Every other surface vertex is bit for bit where it was
+   * before the step, so the runtime refits the collision tree and watches
+   * for rest over these alone instead of the whole surface. */
+  size_t (*last_step_moved)(const model_t *m, const uint32_t **idx);
 } model_ops_t;
 
 struct model {
@@ -193,9 +201,18 @@ struct model {
    * rebuilds what depends on the surface (collision tree, proxies, grasps,
    * publisher). */
   uint32_t topology_version;
+  /* Writes from outside: whoever writes x, v or surf_x other than through
+   * ops->step (a reset to rest, a checkpoint restore, a test) calls
+   * model_note_outside_write afterwards. A model may trust between steps
+   * that a state it did not write is unchanged while this stays put
+   * (regional sleeping then need not look at its sleeping nodes). */
+  uint64_t outside_writes;
   void (*hook)(model_t *m, void *ctx);
   void *hook_ctx;
 };
+
+/* The state (x, v or surf_x) was written from outside the model's step. */
+static inline void model_note_outside_write(model_t *m) { m->outside_writes++; }
 
 /* Everything a model constructor gets. tool_stiffness (N/m) is the stiffest
  * tool spring that may act on the surface: explicit schemes include it in

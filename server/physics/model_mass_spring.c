@@ -127,6 +127,12 @@ typedef struct ms_model {
   ms_params_t reg_p;
   double reg_damping_scale;
   const double *reg_k_scale;
+  /* model.h outside_writes as of the end of the last step: another value
+   * at the next step means a write from outside since. */
+  uint64_t seen_writes;
+  /* The last step was guarded by the regions (its guard lists every node
+   * it may have moved: last_step_moved). */
+  int moved_listed;
 } ms_model_t;
 
 static void embed(ms_model_t *mm) {
@@ -227,9 +233,10 @@ static void guarded_implicit(ms_model_t *mm, double h) {
 static int regions_ready(ms_model_t *mm) {
   if (!mm->regions) return 0;
   mass_spring_t *ms = &mm->ms;
+  int written = mm->m.outside_writes != mm->seen_writes;
   if (ms_regions_current(&mm->reg, ms) && !memcmp(&mm->reg_p, &ms->p, sizeof ms->p) &&
       mm->reg_damping_scale == ms->damping_scale && mm->reg_k_scale == ms->k_scale &&
-      ms_regions_begin_step(&mm->reg, ms) == 0)
+      ms_regions_begin_step(&mm->reg, ms, written) == 0)
     return 2;
   verr_t err;
   uint32_t *t = realloc(mm->touched, (ms->n + 1) * sizeof *t);
@@ -247,6 +254,8 @@ static int ms_step(model_t *m, double h) {
   int ss = m->substeps < 1 ? 1 : m->substeps;
   double hs = h / ss;
   int regions = regions_ready(mm);
+  mm->seen_writes = m->outside_writes;
+  mm->moved_listed = 0;
   if (regions != 2) model_guard_save_finite(&mm->guard, mm->ms.x, mm->ms.v, mm->ms.n, NULL);
   for (int s = 0; s < ss; s++) {
     if (regions) {
@@ -262,6 +271,7 @@ static int ms_step(model_t *m, double h) {
   int rc;
   if (regions == 2) {
     rc = ms_regions_end_step(&mm->reg, &mm->ms, &m->rollbacks);
+    mm->moved_listed = 1; /* the guard's nodes, restored or not */
   } else {
     rc = model_guard_check(&mm->guard, mm->ms.x, mm->ms.v, mm->ms.n, NULL, &m->rollbacks);
     /* The restored state is not what the sleeping nodes were decided on:
@@ -393,6 +403,15 @@ static size_t surface_moved(const model_t *m, const uint32_t **idx) {
   return mm->reg.gn;
 }
 
+/* The same list after the step (model.h last_step_moved), while nothing
+ * wrote the state from outside since. */
+static size_t last_step_moved(const model_t *m, const uint32_t **idx) {
+  const ms_model_t *mm = (const ms_model_t *)m;
+  if (!mm->moved_listed || m->outside_writes != mm->seen_writes || m->surf_x != mm->ms.x) return SIZE_MAX;
+  *idx = mm->reg.gidx;
+  return mm->reg.gn;
+}
+
 static const model_ops_t SURFACE_OPS = {.name = "mass_spring_surface",
                                         .step = ms_step,
                                         .destroy = ms_destroy,
@@ -403,7 +422,8 @@ static const model_ops_t SURFACE_OPS = {.name = "mass_spring_surface",
                                         .save_topology = surface_save_topology,
                                         .restore_topology = surface_restore_topology,
                                         .edit = &SURFACE_EDIT,
-                                        .surface_moved = surface_moved};
+                                        .surface_moved = surface_moved,
+                                        .last_step_moved = last_step_moved};
 static const model_ops_t TET_OPS = {.name = "mass_spring_tet",
                                     .step = ms_step,
                                     .destroy = ms_destroy,
@@ -596,6 +616,7 @@ int model_mass_spring_region_counts(const model_t *m, ms_region_counts_t *out) {
                               .wakes = r->wakes,
                               .sleeps = r->sleeps,
                               .builds = r->builds,
+                              .sleeper_checks = r->sleeper_checks,
                               .awake = r->nawake,
                               .nodes = mm->ms.n,
                               .springs = mm->ms.nsprings};

@@ -54,7 +54,7 @@ int model_mass_spring_cg_counts(const model_t *m, uint64_t *iterations, uint64_t
  * model does not sleep by regions (another model or integrator, or
  * solver.region_force 0). */
 typedef struct ms_region_counts {
-  uint64_t substeps, node_updates, block_evals, wakes, sleeps, builds;
+  uint64_t substeps, node_updates, block_evals, wakes, sleeps, builds, sleeper_checks;
   size_t awake, nodes, springs;
 } ms_region_counts_t;
 int model_mass_spring_region_counts(const model_t *m, ms_region_counts_t *out);

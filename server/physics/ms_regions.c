@@ -2,6 +2,7 @@
 #include "physics/ms_regions.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -253,18 +254,11 @@ void ms_regions_substep(ms_regions_t *r, mass_spring_t *ms, double h) {
   r->npend = np;
 }
 
-int ms_regions_begin_step(ms_regions_t *r, mass_spring_t *ms) {
-  const double *x = ms->x, *v = ms->v, *xs = r->xs;
-  double sum = 0;
-  int diff = 0;
-  r->sx = ms->x;
-  r->sv = ms->v;
-  r->gn = 0;
-  r->in_step = 1;
-  /* A sleeping node must be where it fell asleep, at rest, bit for bit:
-   * one branch-free pass over every node on the bit patterns (integer
-   * operations: the floating-point compares cost twice as much); then the
-   * awake ones (all among the act nodes) are kept for a rollback. */
+/* 1 when some node held asleep is not where it fell asleep, at rest, bit
+ * for bit: one branch-free pass over every node on the bit patterns
+ * (integer operations: the floating-point compares cost twice as much). */
+static int sleepers_moved(const ms_regions_t *r, const double *x, const double *v) {
+  const double *xs = r->xs;
   const uint8_t *awake = r->awake;
   uint64_t bits_diff = 0;
   for (size_t k = 0; k < r->n; k++) {
@@ -275,7 +269,36 @@ int ms_regions_begin_step(ms_regions_t *r, mass_spring_t *ms) {
     const uint64_t asleep = (uint64_t)0 - (uint64_t)(awake[k] == 0);
     bits_diff |= asleep & ((a[0] ^ b[0]) | (a[1] ^ b[1]) | (a[2] ^ b[2]) | u[0] | u[1] | u[2]);
   }
-  diff = bits_diff != 0;
+  return bits_diff != 0;
+}
+
+int ms_regions_begin_step(ms_regions_t *r, mass_spring_t *ms, int written) {
+  const double *x = ms->x, *v = ms->v;
+  double sum = 0;
+  r->sx = ms->x;
+  r->sv = ms->v;
+  r->gn = 0;
+  r->in_step = 1;
+  /* The sleeping nodes are looked at only after a write from outside: the
+   * pass over every node cost as much as the awake nodes' forces, and
+   * streamed the whole organ through the cache at every step. */
+  int diff = 0;
+  if (written) {
+    r->sleeper_checks++;
+    diff = sleepers_moved(r, x, v);
+  }
+#ifdef VISCERA_CHECK_OUTSIDE_WRITES
+  /* Sanitizer builds check the writers' side of the contract (model.h
+   * outside_writes): a write nobody noted would desynchronise the sleeping
+   * nodes from the state without a trace. */
+  if (!written && sleepers_moved(r, x, v)) {
+    fprintf(stderr, "ms_regions: a sleeping node was written from outside the step without "
+                    "model_note_outside_write\n");
+    abort();
+  }
+#endif
+  /* The awake ones (all among the act nodes) are kept for a rollback. */
+  const uint8_t *awake = r->awake;
   for (size_t w = 0; w < words(r->n); w++)
     for (uint64_t bits = r->act_bits[w]; bits; bits &= bits - 1) {
       const size_t k = 64 * w + (size_t)__builtin_ctzll(bits), c = 3 * k;

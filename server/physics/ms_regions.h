@@ -35,7 +35,8 @@
  * checkpoint restore, a re-simulation) continues bit for bit as the running
  * one would (test_checkpoint, resim_*). The model rebuilds after a topology
  * change, a rollback, a change of material, and whenever a sleeping node's
- * position or velocity changed from outside between steps.
+ * position or velocity changed from outside between steps (seen after a
+ * write noted through model_note_outside_write: ms_regions_begin_step).
  *
  * Ownership: the model (model_mass_spring.c) owns one per mass-spring
  * system. Allocation in build only. Not thread-safe: one physics thread. */
@@ -79,6 +80,7 @@ typedef struct ms_regions {
   size_t nawake;
   /* Counters since init (for tests and benchmarks). */
   uint64_t substeps, node_updates, block_evals, wakes, sleeps, builds;
+  uint64_t sleeper_checks; /* passes over every node after a write from outside */
 } ms_regions_t;
 
 /* Thresholds: force_wake > 0 (N), speed_sleep >= 0 (m/s). */
@@ -90,13 +92,17 @@ void ms_regions_free(ms_regions_t *r);
 int ms_regions_build(ms_regions_t *r, const mass_spring_t *ms, verr_t *err);
 /* 1 when r was built for ms's current springs and nodes. */
 int ms_regions_current(const ms_regions_t *r, const mass_spring_t *ms);
-/* The start of a step, in one pass over the nodes: checks that every node
- * it holds asleep is still where it fell asleep, at zero velocity (else
- * something wrote the state from outside: a test, a reset) and that the
- * awake ones are finite, and keeps the awake ones' state for a rollback.
- * 0, or -1 (nothing kept: the caller builds again and guards the step
- * itself). The guard then costs what the awake nodes cost, not the organ. */
-int ms_regions_begin_step(ms_regions_t *r, mass_spring_t *ms);
+/* The start of a step: checks that the awake nodes are finite and keeps
+ * their state for a rollback; when `written` (the state was written from
+ * outside since the last step: model.h outside_writes), first checks in
+ * one pass over every node that each node it holds asleep is still where
+ * it fell asleep, at zero velocity. 0, or -1 (something changed from
+ * outside, or not finite; nothing kept: the caller builds again and
+ * guards the step itself). Without a write from outside the step's guard
+ * costs what the awake nodes cost, not the organ. Builds with
+ * VISCERA_CHECK_OUTSIDE_WRITES (the sanitizer configuration) always look
+ * and abort when a sleeping node changed without `written`. */
+int ms_regions_begin_step(ms_regions_t *r, mass_spring_t *ms, int written);
 /* The end of that step: 0 when every node the step may have changed is
  * finite; otherwise puts them back as before the step, counts the rollback
  * in *rollbacks, leaves r to be built again, and returns -1. */

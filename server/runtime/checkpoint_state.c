@@ -208,8 +208,9 @@ int ckpt_state_get(state_blob_t *b, runtime_t *rt, const ckpt_session_io_t *io, 
   int rc = restore_topologies(rt, b, at, err);
   if (rc) return rc == -2 ? -2 : -3;
   for (size_t i = 0; i < rt->norgans; i++) {
-    if (at[i].topo > 0) continue; /* restore_topology took its positions */
     model_t *m = rt->organs[i].model;
+    model_note_outside_write(m);
+    if (at[i].topo > 0) continue; /* restore_topology took its positions */
     memcpy(m->x, b->p + at[i].x, 3 * m->nnodes * sizeof(double));
     memcpy(m->v, b->p + at[i].v, 3 * m->nnodes * sizeof(double));
     /* Positions written from outside: the tree's boxes fit them again

@@ -34,7 +34,8 @@ void organ_sleep_wake(organ_sleep_t *s) {
    * first step after waking is measured against the right positions. */
 }
 
-int organ_sleep_observe(organ_sleep_t *s, const double *x, size_t n, double max_move, uint32_t need, int disturbed) {
+int organ_sleep_observe_listed(organ_sleep_t *s, const double *x, size_t n, const uint32_t *idx, size_t nidx,
+                               double max_move, uint32_t need, int disturbed) {
   if (n != s->n || !s->have_prev) {
     s->have_prev = 0;
     s->still = 0;
@@ -45,15 +46,24 @@ int organ_sleep_observe(organ_sleep_t *s, const double *x, size_t n, double max_
     return 0;
   }
   /* Compare squared distances: no sqrt per vertex. `!(d <= lim)` makes
-   * NaN count as moving. */
+   * NaN count as moving. Only the listed vertices can differ from prev
+   * (every vertex when idx is NULL); the rest are equal, so still. */
   double lim = max_move * max_move;
   int still = !disturbed;
-  for (size_t i = 0; i < n && still; i++) {
-    const double *a = x + 3 * i, *b = s->prev + 3 * i;
-    double d0 = a[0] - b[0], d1 = a[1] - b[1], d2 = a[2] - b[2];
+  size_t m = idx ? nidx : n;
+  for (size_t a = 0; a < m && still; a++) {
+    const size_t i = idx ? idx[a] : a;
+    if (i >= n) continue;
+    const double *p = x + 3 * i, *b = s->prev + 3 * i;
+    double d0 = p[0] - b[0], d1 = p[1] - b[1], d2 = p[2] - b[2];
     if (!(d0 * d0 + d1 * d1 + d2 * d2 <= lim)) still = 0;
   }
-  memcpy(s->prev, x, 3 * n * sizeof *x);
+  if (idx) {
+    for (size_t a = 0; a < nidx; a++)
+      if (idx[a] < n) memcpy(s->prev + 3 * (size_t)idx[a], x + 3 * (size_t)idx[a], 3 * sizeof *x);
+  } else {
+    memcpy(s->prev, x, 3 * n * sizeof *x);
+  }
   s->still = still ? s->still + 1 : 0;
   if (s->still >= need && need > 0 && !s->asleep) {
     s->asleep = 1;
@@ -61,6 +71,10 @@ int organ_sleep_observe(organ_sleep_t *s, const double *x, size_t n, double max_
     return 1;
   }
   return 0;
+}
+
+int organ_sleep_observe(organ_sleep_t *s, const double *x, size_t n, double max_move, uint32_t need, int disturbed) {
+  return organ_sleep_observe_listed(s, x, n, NULL, 0, max_move, need, disturbed);
 }
 
 int organ_sleep_box_near(const double lo[3], const double hi[3], const double p0[3], const double p1[3], double reach) {

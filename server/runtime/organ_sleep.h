@@ -51,6 +51,12 @@ void organ_sleep_free(organ_sleep_t *s);
  * organ falls asleep with this step (need still steps reached), else 0;
  * -1 on OOM (the organ then stays awake). */
 int organ_sleep_observe(organ_sleep_t *s, const double *x, size_t n, double max_move, uint32_t need, int disturbed);
+/* The same, the same result, for a caller that knows only the nidx
+ * vertices in idx can differ from the surface of the previous observation
+ * (a model's last_step_moved): O(nidx) instead of O(n). idx NULL: every
+ * vertex (organ_sleep_observe). */
+int organ_sleep_observe_listed(organ_sleep_t *s, const double *x, size_t n, const uint32_t *idx, size_t nidx,
+                               double max_move, uint32_t need, int disturbed);
 
 /* Wakes the organ (if asleep) and restarts the evidence of stillness. */
 void organ_sleep_wake(organ_sleep_t *s);

@@ -362,16 +362,32 @@ static void step_contact(runtime_t *rt) {
   }
 }
 
+/* The surface vertices the model's last step may have moved (model.h
+ * last_step_moved), SIZE_MAX when it cannot tell or the runtime asked for
+ * full scans (cull.force_scan). */
+static size_t last_moved(const runtime_t *rt, const model_t *m, const uint32_t **idx) {
+  if (rt->cull.force_scan || !m->ops->last_step_moved) return SIZE_MAX;
+  return m->ops->last_step_moved(m, idx);
+}
+
 /* Phase topology of organ i: after a cut (or a refinement) changed the
  * model's topology, everything built on its surface follows at once,
  * before anything reads the surface again; otherwise the tree is refit
  * (every step, rolled back or not: the proxy trusts the boxes). */
 static void organ_topology(runtime_t *rt, size_t i, const topo_anchor_t anchors[SCENE_MAX_TOOLS]) {
   organ_rt_t *o = &rt->organs[i];
-  if (o->model->topology_version != o->topology_version)
+  if (o->model->topology_version != o->topology_version) {
     follow_organ(rt, i, anchors);
-  else if (o->tree.ntris)
-    aabb_tree_refit(&o->tree, o->model->surf_x);
+  } else if (o->tree.ntris) {
+    /* Over the vertices the step may have moved when the model can tell
+     * (a pressed organ's still part is most of it); otherwise every one. */
+    const uint32_t *moved = NULL;
+    size_t nmoved = last_moved(rt, o->model, &moved);
+    if (nmoved != SIZE_MAX)
+      aabb_tree_refit_listed(&o->tree, o->model->surf_x, moved, nmoved);
+    else
+      aabb_tree_refit(&o->tree, o->model->surf_x);
+  }
 }
 
 /* Puts organ i's nodes back at their rest positions with zero velocity
@@ -382,6 +398,7 @@ static void organ_to_rest(organ_rt_t *o) {
   if (m->x != m->x_rest) memmove(m->x, m->x_rest, 3 * m->nnodes * sizeof(double));
   memset(m->v, 0, 3 * m->nnodes * sizeof(double));
   if (m->surf_x != m->x && m->surf_x != m->surf_rest) memmove(m->surf_x, m->surf_rest, 3 * m->nsurf * sizeof(double));
+  model_note_outside_write(m);
 }
 
 /* Phase models: each organ that is not asleep steps its model (the hook
@@ -429,9 +446,13 @@ static int step_models(runtime_t *rt) {
     scalpel_after_organ_step(rt, i); /* phase cut: may change the topology */
     organ_topology(rt, i, anchors);  /* phase topology */
     /* A rolled-back or re-meshed step is no evidence of rest. */
-    if (sleeping)
-      organ_sleep_observe(&o->sleep, o->model->surf_x, o->model->nsurf, rt->scene.sleep_speed * dt, need,
-                          disturbed || bad || o->topology_version != topo);
+    if (sleeping) {
+      const uint32_t *moved = NULL;
+      size_t nmoved = o->topology_version == topo ? last_moved(rt, o->model, &moved) : SIZE_MAX;
+      organ_sleep_observe_listed(&o->sleep, o->model->surf_x, o->model->nsurf, nmoved == SIZE_MAX ? NULL : moved,
+                                 nmoved, rt->scene.sleep_speed * dt, need,
+                                 disturbed || bad || o->topology_version != topo);
+    }
   }
   return rolled;
 }

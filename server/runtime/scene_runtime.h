@@ -45,7 +45,8 @@ typedef struct runtime {
   uint32_t organs_reset;
   /* The vertex culls of the contact patch and the shafts' node test
    * (runtime/vertex_cull.h): how often each culled or scanned every vertex,
-   * and two knobs for tests: force_scan (1: always scan, the reference)
+   * and two knobs for tests: force_scan (1: always scan, the reference;
+   * the tree refit and the organ sleep watch then look at every vertex too)
    * and patch_scale, shaft_scale (1 at init; a test shrinks the culls'
    * radii with them to show that a cull short of its proven radius misses
    * vertices). */

@@ -73,6 +73,8 @@ typedef struct server {
   double *step_us;                    /* ring of recent step times */
   double *step_cpu_us;                /* the same steps' thread CPU times */
   unsigned char *step_awake;          /* the same steps: 1 when an organ was stepped (not all asleep, not paused) */
+  double *step_tissue_us;             /* the same steps: thread CPU inside the runtime's step (contact and organs) */
+  uint64_t tissue_ns;                 /* the current step's, summed over runtime_step_begin and _finish */
   size_t nstep_us;
   uint64_t publish_every, metrics_every; /* steps between frames, between metrics */
   server_stats_t *stats;
@@ -254,7 +256,8 @@ static int setup(server_t *s, const scene_t *scene, verr_t *err) {
   s->step_us = calloc(STEP_RING, sizeof(double));
   s->step_cpu_us = calloc(STEP_RING, sizeof(double));
   s->step_awake = calloc(STEP_RING, 1);
-  if (!s->step_us || !s->step_cpu_us || !s->step_awake) return verr_set(err, "out of memory");
+  s->step_tissue_us = calloc(STEP_RING, sizeof(double));
+  if (!s->step_us || !s->step_cpu_us || !s->step_awake || !s->step_tissue_us) return verr_set(err, "out of memory");
   return 0;
 }
 
@@ -268,6 +271,7 @@ static void teardown(server_t *s) {
   free(s->step_us);
   free(s->step_cpu_us);
   free(s->step_awake);
+  free(s->step_tissue_us);
 }
 
 /* Releases every tool whose commanding writer lost its liveliness (the
@@ -894,6 +898,7 @@ static long rss_kb(void) {
 /* The step's wall and CPU time since t0, c0 (the step-time rings). */
 static void record_step_time(server_t *s, uint64_t t0, uint64_t c0, uint64_t t1) {
   s->step_cpu_us[s->nstep_us % STEP_RING] = (double)(vtime_thread_cpu_ns() - c0) * 1e-3;
+  s->step_tissue_us[s->nstep_us % STEP_RING] = (double)s->tissue_ns * 1e-3;
   int awake = !s->control.paused && s->rt.organs_stepped > 0;
   s->step_awake[s->nstep_us % STEP_RING] = (unsigned char)awake;
   if (!s->control.paused && !awake) s->stats->steps_all_asleep++;
@@ -951,14 +956,23 @@ static int session_step(server_t *s, uint64_t t0, uint64_t c0, uint64_t *t1) {
    * runtime_step), so its ContactFeedback does not wait for the organs. */
   int rolled = 0;
   uint32_t early = 0;
+  /* The runtime's share of the step's CPU (its contact phase and organs)
+   * is kept apart from the messages around it (stats: step_tissue_cpu). */
+  s->tissue_ns = 0;
   if (!s->control.paused) {
+    uint64_t b0 = vtime_thread_cpu_ns();
     runtime_step_begin(&s->rt);
+    s->tissue_ns = vtime_thread_cpu_ns() - b0;
     early = publish_feedback_early(s, fresh);
   }
   /* Before the tissue step it precedes (after the early answers, which
    * wait for nothing; the sample's content was fixed at the take). */
   applied_input_flush(&s->ai);
-  if (!s->control.paused) rolled = runtime_step_finish(&s->rt);
+  if (!s->control.paused) {
+    uint64_t f0 = vtime_thread_cpu_ns();
+    rolled = runtime_step_finish(&s->rt);
+    s->tissue_ns += vtime_thread_cpu_ns() - f0;
+  }
   if (rolled) report_rollbacks(s, rolled);
   /* Out: keyframes after a topology change, the ContactFeedback of every
    * driven tool not answered before the step (its force, tip and normal
@@ -1141,6 +1155,18 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
   stats->step_us_median = st.median;
   stats->step_us_p99 = st.p99;
   stats->step_us_max = st.max;
+  /* The rest of each step (commands, feedback, frames), before the rings are sorted. */
+  double *other = malloc((n + 1) * sizeof *other);
+  if (other) {
+    for (size_t i = 0; i < n; i++) other[i] = s.step_cpu_us[i] - s.step_tissue_us[i];
+    vstats_summary_t so = vstats_summarise(other, n);
+    stats->step_other_cpu_us_median = so.median;
+    stats->step_other_cpu_us_p99 = so.p99;
+    free(other);
+  }
+  vstats_summary_t stt = vstats_summarise(s.step_tissue_us, n);
+  stats->step_tissue_cpu_us_median = stt.median;
+  stats->step_tissue_cpu_us_p99 = stt.p99;
   vstats_summary_t sc = vstats_summarise(s.step_cpu_us, n);
   stats->step_cpu_us_median = sc.median;
   stats->step_cpu_us_p99 = sc.p99;

@@ -59,6 +59,11 @@ static void print_stats(const scene_t *scene, const server_opts_t *opts, const s
           s->steps, s->step_us_median, s->step_us_p99, s->step_us_max, s->overruns, s->rollbacks);
   fprintf(stderr, "server: step CPU time median %.1f us p99 %.1f us; %.3f simulated s per wall s\n",
           s->step_cpu_us_median, s->step_cpu_us_p99, s->realtime_ratio);
+  fprintf(stderr,
+          "server: step CPU split: tissue (contact and organs) median %.1f us p99 %.1f us; the rest (commands, "
+          "feedback, inputs, frames) median %.1f us p99 %.1f us\n",
+          s->step_tissue_cpu_us_median, s->step_tissue_cpu_us_p99, s->step_other_cpu_us_median,
+          s->step_other_cpu_us_p99);
   if (scene->sleep_speed > 0)
     fprintf(stderr,
             "server: organs slept %" PRIu64 " times, woke %" PRIu64 " times; every organ asleep in %" PRIu64

@@ -66,6 +66,7 @@ static void one_model(const mesh_t *mesh, const char *model, const char *integra
   m->hook_ctx = &hook;
   /* Get it moving first, so "as before" is not simply the rest state. */
   for (size_t i = 0; i < n3; i++) m->x[i] += 1e-3 * stab_rand();
+  model_note_outside_write(m);
   for (int s = 0; s < 5; s++) CHECK(m->ops->step(m, 1e-3) == 0);
 
   /* NaN force in the second sub-step. */
@@ -85,6 +86,7 @@ static void one_model(const mesh_t *mesh, const char *model, const char *integra
   memcpy(sx, m->surf_x, s3 * sizeof(double));
   CHECK(m->ops->step(m, 1e-3) == 0 && stab_finite(m->x, n3));
   m->x[3 * (m->nnodes / 2) + 1] = NAN;
+  model_note_outside_write(m);
   CHECK(m->ops->step(m, 1e-3) == -1);
   CHECK(rolled_back_to(m, 2, x, v, sx));
 
@@ -94,6 +96,7 @@ static void one_model(const mesh_t *mesh, const char *model, const char *integra
   memcpy(sx, m->surf_x, s3 * sizeof(double));
   CHECK(m->ops->step(m, 1e-3) == 0);
   m->v[0] = INFINITY;
+  model_note_outside_write(m);
   CHECK(m->ops->step(m, 1e-3) == -1);
   CHECK(rolled_back_to(m, 3, x, v, sx));
   for (int s = 0; s < 20; s++) CHECK(m->ops->step(m, 1e-3) == 0);
@@ -128,9 +131,11 @@ static void runtime_case(void) {
     memcpy(x, m->x, n3 * sizeof(double));
     CHECK(runtime_step(&rt) == 0);
     other->x[0] += 1e-3; /* the other organ moves in this step */
+    model_note_outside_write(other);
     double other_before = other->x[0];
     uint64_t other_rollbacks = other->rollbacks;
     m->x[5] = NAN;
+    model_note_outside_write(m);
     CHECK(runtime_step(&rt) == 1);
     CHECK(m->rollbacks == 1 && same(m->x, x, n3));
     CHECK(other->rollbacks == other_rollbacks && other->x[0] != other_before &&

@@ -21,6 +21,7 @@ static void displace(model_t *m) {
     m->x[c] = m->x_rest[c] + AMP * stab_rand();
     m->v[c] = 0;
   }
+  model_note_outside_write(m);
 }
 
 static double max_offset(const model_t *m) {

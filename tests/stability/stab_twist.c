@@ -118,6 +118,7 @@ static run_t run_model(const char *yaml, const mesh_t *box, const tet_mesh_t *tm
   }
   twist(tm->x, tm->nnodes, turns, m->x);
   memset(m->v, 0, 3 * m->nnodes * sizeof(double));
+  model_note_outside_write(m);
   r.inverted_max = inverted(tm, m->x, &r.min_ratio);
   double e = r.e0 = m->ops->energy(m);
   for (int k = 0; k < (int)(T_END / DT + 0.5); k++) {

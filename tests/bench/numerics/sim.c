@@ -192,6 +192,7 @@ sim_t *sim_model(model_t *m, verr_t *err) {
 void sim_reset(sim_t *s) {
   memcpy(s->x, s->x_init, 3 * s->n * sizeof(double));
   memcpy(s->v, s->v_init, 3 * s->n * sizeof(double));
+  if (s->step == model_sim_step) model_note_outside_write((model_t *)s->impl);
 }
 
 void sim_capture(sim_t *s) {

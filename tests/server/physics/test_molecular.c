@@ -627,6 +627,7 @@ static void test_model(void) {
   memcpy(good, m->x, bytes);
   CHECK(m->ops->step(m, 1e-3) == 0);
   m->x[3] = NAN;
+  model_note_outside_write(m);
   CHECK(m->ops->step(m, 1e-3) == -1);
   CHECK(m->rollbacks == 1);
   CHECK(all_finite(m->x, 3 * m->nnodes) && all_finite(m->v, 3 * m->nnodes));

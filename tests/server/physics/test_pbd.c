@@ -672,6 +672,7 @@ static void test_model(void) {
   CHECK(worst < 1e-4);
   /* A NaN in a node: rolled back, counted, the surface stays finite. */
   m->x[0] = NAN;
+  model_note_outside_write(m);
   CHECK(m->ops->step(m, 0.002) == -1);
   CHECK(m->rollbacks == 1);
   for (size_t c = 0; c < 3 * m->nsurf; c++) CHECK(isfinite(m->surf_x[c]));

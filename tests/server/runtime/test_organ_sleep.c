@@ -13,13 +13,18 @@
  *   never-sleeping one (1e-9 N) through a press; after the probe leaves it
  *   sleeps again, and the surfaces differ by less than the mesh
  *   quantisation (1e-5 m); a shaft reaching the organ with its tip far
- *   keeps it awake. */
+ *   keeps it awake;
+ * - organ_sleep_observe_listed, told which vertices changed (with others
+ *   and an index past the end among them), decides and records exactly as
+ *   the full observation over 400 random steps (still, moving, disturbed,
+ *   falling asleep and woken); a list missing a mover calls it still. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "check.h"
+#include "test_rng.h"
 #include "test_runtime.h"
 #include "runtime/organ_sleep.h"
 #include "runtime/scene_runtime.h"
@@ -70,6 +75,52 @@ static void test_evidence(void) {
   for (int i = 0; i < 2; i++) CHECK(organ_sleep_observe(&s, y, 3, lim, 3, 0) == 0);
   CHECK(organ_sleep_observe(&s, y, 3, lim, 3, 0) == 1);
   organ_sleep_free(&s);
+}
+
+static void test_listed(void) {
+  enum { N = 500 };
+  static double x[3 * N];
+  uint32_t list[64];
+  uint64_t rng = 0x9e3779b97f4a7c15ull;
+  organ_sleep_t a, b;
+  CHECK(organ_sleep_init(&a, N, &e) == 0 && organ_sleep_init(&b, N, &e) == 0);
+  for (size_t i = 0; i < 3 * N; i++) x[i] = test_rng_uniform(&rng);
+  const double lim = 1e-4;
+  CHECK(organ_sleep_observe(&a, x, N, lim, 5, 0) == 0);
+  CHECK(organ_sleep_observe_listed(&b, x, N, NULL, 0, lim, 5, 0) == 0);
+  size_t differ = 0, sleeps = 0;
+  for (int step = 0; step < 400; step++) {
+    /* Mostly still (creeps below the limit), now and then a mover. */
+    size_t n = 0;
+    int moving = test_rng_uniform(&rng) < 0.2;
+    for (int j = 0; j < 30; j++) {
+      uint32_t i = (uint32_t)(test_rng_uniform(&rng) * N);
+      double amp = (moving && j == 0) ? 10 * lim : 0.5 * lim;
+      for (int k = 0; k < 3; k++) x[3 * i + (uint32_t)k] += (test_rng_uniform(&rng) - 0.5) * amp;
+      list[n++] = i;
+    }
+    for (int j = 0; j < 5; j++) list[n++] = (uint32_t)(test_rng_uniform(&rng) * N);
+    list[n++] = N; /* past the end: ignored */
+    int disturbed = test_rng_uniform(&rng) < 0.1;
+    int ra = organ_sleep_observe(&a, x, N, lim, 5, disturbed);
+    int rb = organ_sleep_observe_listed(&b, x, N, list, n, lim, 5, disturbed);
+    differ += ra != rb || a.still != b.still || a.asleep != b.asleep || memcmp(a.prev, b.prev, sizeof x) != 0;
+    if (ra == 1) {
+      sleeps++;
+      organ_sleep_wake(&a);
+      organ_sleep_wake(&b);
+    }
+  }
+  printf("listed observation: 400 steps, %zu differ from the full one, %zu sleeps\n", differ, sleeps);
+  CHECK(differ == 0 && sleeps > 0);
+  /* A mover left off the list goes unseen. */
+  x[0] += 10 * lim;
+  uint32_t other = 7;
+  int still_before = (int)b.still;
+  organ_sleep_observe_listed(&b, x, N, &other, 1, lim, 1000, 0);
+  CHECK((int)b.still == still_before + 1);
+  organ_sleep_free(&a);
+  organ_sleep_free(&b);
 }
 
 static void test_reach(void) {
@@ -187,6 +238,7 @@ static void test_runtime(void) {
 
 int main(void) {
   test_evidence();
+  test_listed();
   test_reach();
   test_keys();
   test_runtime();

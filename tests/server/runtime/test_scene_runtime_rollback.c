@@ -21,6 +21,7 @@ static void check_model(const char *mesh, const char *keys) {
   model_t *m = rt.organs[0].model;
   m->v[0] = 1e308; /* finite, so the guard saves it; any step from it overflows */
   m->v[4] = -1e308;
+  model_note_outside_write(m);
   int rolled = 0, reset_at = -1;
   for (int i = 0; i < RUNTIME_ROLLBACK_RESET + 50; i++) {
     int r = runtime_step(&rt);
