@@ -45,9 +45,8 @@ typedef struct server_stats {
   double step_cpu_us_median, step_cpu_us_p99;
   /* That CPU time split per step: the runtime's step (contact phase and
    * organs: the physics) and the rest (taking commands, writing feedback,
-   * inputs, events and frames: mostly DDS). On a shared machine the second
-   * part grows most, as its sends wake other processes (docs/numerics.md
-   * §11). Paused steps count as all "rest". */
+   * inputs, events and frames: mostly DDS). On a crowded machine both
+   * grow (docs/numerics.md §11.2). Paused steps count as all "rest". */
   double step_tissue_cpu_us_median, step_tissue_cpu_us_p99, step_other_cpu_us_median, step_other_cpu_us_p99;
   double realtime_ratio; /* simulated s per wall s over the run */
   /* Organ sleeping (organ_sleep.h): steps in which every organ slept, over

@@ -6,7 +6,8 @@
 # The server must put the kidney to sleep while the probe is away (before
 # and after the press), wake it before the probe arrives so the trainee
 # feels the press (peak above the 0.5 N ST threshold, the ST crossing
-# logged), and report the sleeping steps in its summary. The scene's
+# logged), and report the sleeping steps in its summary (and its step CPU
+# split into the tissue step and the rest). The scene's
 # publish_keepalive (1 s): most MeshDelta frames of the still kidney are
 # skipped, and a viewer joining after the kidney fell asleep again still
 # gets the current shape (the last delta written, transient-local): its
@@ -42,6 +43,15 @@ read -r sleeps wakes asleep steps < <(sed -n 's/^server: organs slept \([0-9]*\)
 # well over a third of the steps asleep.
 awk -v a="$asleep" -v s="$steps" 'BEGIN { exit !(s > 0 && a / s > 0.35) }' ||
   fail "every organ asleep in only $asleep of $steps steps"
+# The step's CPU split (tissue step, the rest): both parts measured, the
+# pressed steps' tissue work visible at the p99, neither above the whole.
+split=$(grep '^server: step CPU split' "$OUT/server.log") || fail "no step CPU split in the server log"
+echo "$split"
+read -r tmed tp99 rmed < <(sed -n 's/^server: step CPU split: tissue (contact and organs) median \([0-9.]*\) us p99 \([0-9.]*\) us; the rest ([^)]*) median \([0-9.]*\) us.*/\1 \2 \3/p' "$OUT/server.log")
+cmed=$(sed -n 's/^server: step CPU time median \([0-9.]*\) us.*/\1/p' "$OUT/server.log")
+awk -v t="${tmed:-x}" -v tp="${tp99:-x}" -v r="${rmed:-x}" -v c="${cmed:-x}" \
+  'BEGIN { exit !(tp + 0 > 0 && r + 0 > 0 && t + 0 <= c + 0 && r + 0 <= c + 0) }' ||
+  fail "step CPU split not plausible: tissue median ${tmed:-?} p99 ${tp99:-?}, rest ${rmed:-?}, whole ${cmed:-?} us"
 peak=$(sed -n 's/^SUMMARY .*peak_force=\([0-9.]*\).*/\1/p' "$OUT/haptic.log")
 echo "trainee's peak force ${peak:-none} N"
 awk -v p="${peak:-0}" 'BEGIN { exit !(p > 0.5) }' || fail "the trainee felt ${peak:-no} N: the kidney did not wake for the press"
