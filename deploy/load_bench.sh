@@ -36,6 +36,9 @@
 # BASELINE s: its step times are the reference that "step time unchanged" is
 # judged against (with no subscriber the seat alone would skip the mesh
 # writes a lab seat makes for its readers).
+# The seats' step CPU medians are compared with it as a whole and in the two
+# parts the server's log splits them into (its "step CPU split" line: the
+# tissue step, and the rest: commands, feedback, inputs, frames).
 #
 # usage: deploy/load_bench.sh [--build DIR] [--out DIR] [--seats N] [--subscribers M] [--duration S]
 #                             [--baseline S] [--rt-priority S] [--haptic-rt-priority H]
