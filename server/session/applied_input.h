@@ -10,7 +10,8 @@
  * state when its first entry was added; a full buffer is published and a
  * new sample started with the state then (a rebuild in between moves the
  * step back to 0 and the epoch on). Plain buffers, no allocation; the
- * server thread only. */
+ * server thread only. With an outbox (applied_outbox.h) a closed sample is
+ * queued for its writer thread instead of written here. */
 #ifndef VISCERA_APPLIED_INPUT_H
 #define VISCERA_APPLIED_INPUT_H
 
@@ -19,6 +20,7 @@
 #include <stdint.h>
 
 #include "runtime/scene_runtime.h"
+#include "session/applied_outbox.h"
 #include "viscera.h"
 
 #define APPLIED_MAX_TOOLS (2 * SCENE_MAX_TOOLS)
@@ -26,6 +28,7 @@
 
 typedef struct applied_input {
   dds_entity_t writer;      /* 0: collect only (tests) */
+  applied_outbox_t *outbox; /* NULL: written here; else queued (its counts join published/failed at its stop) */
   const runtime_t *rt;      /* the server's runtime (its address survives a rebuild) */
   const int *paused;        /* the session's pause flag */
   uint64_t tick;            /* the current loop iteration, from 1 */

@@ -242,6 +242,9 @@ static int setup(server_t *s, const scene_t *scene, verr_t *err) {
   writer_stations_init(&s->stations);
   s->control.roles = &s->roles;
   applied_input_init(&s->ai, s->w_applied, &s->rt, &s->control.paused);
+  /* The samples go out from a thread of their own (applied_outbox.h). */
+  s->ai.outbox = applied_outbox_start(s->w_applied, APPLIED_OUTBOX_PERIOD_NS, err);
+  if (!s->ai.outbox) return -1;
   for (size_t i = 0; i < s->rt.norgans; i++) {
     organ_rt_t *o = &s->rt.organs[i];
     if (mesh_publisher_init(&s->pubs[i], o->id, o->model->nsurf, o->model->surf_tris, o->model->nsurf_tris,
@@ -261,7 +264,18 @@ static int setup(server_t *s, const scene_t *scene, verr_t *err) {
   return 0;
 }
 
+/* Writes what the outbox still holds and stops its thread; its counts join
+ * applied_input's. Before the writer goes (vdds_close). */
+static void stop_applied_outbox(server_t *s) {
+  uint64_t published = 0, failed = 0;
+  applied_outbox_stop(s->ai.outbox, &published, &failed);
+  s->ai.outbox = NULL;
+  s->ai.published += published;
+  s->ai.failed += failed;
+}
+
 static void teardown(server_t *s) {
+  stop_applied_outbox(s);
   free(s->resume.p);
   for (size_t i = 0; i < s->rt.norgans; i++) mesh_publisher_destroy(&s->pubs[i]);
   runtime_destroy(&s->rt);
@@ -1132,6 +1146,7 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
 
   stats->steps = s.rt.steps;
   applied_input_flush(&s.ai);
+  stop_applied_outbox(&s);
   stats->published[VT_APPLIED_INPUT] = s.ai.published;
   for (size_t i = 0; i < s.rt.norgans; i++) {
     stats->published[VT_MESH_STATE] += s.pubs[i].keyframes;
