@@ -53,8 +53,8 @@ static void make(viscera_AppliedInput *s, uint64_t i, uint32_t nt, uint32_t nc) 
 
 /* 1 when r is sample i as make() built it. */
 static int same(const viscera_AppliedInput *r, uint64_t i, uint32_t nt, uint32_t nc) {
-  int ok = r->tick == i && r->step == 3 * i && r->sim_time_ns == 1000000 * i && r->seq == i &&
-           r->tools._length == nt && r->controls._length == nc;
+  int ok = r->tick == i && r->step == 3 * i && r->sim_time_ns == 1000000 * i && r->seq == i && r->tools._length == nt &&
+           r->controls._length == nc;
   for (uint32_t k = 0; ok && k < nt; k++)
     ok = r->tools._buffer[k].tool_id == k && r->tools._buffer[k].position[0] == (double)i * 1e-3 + k &&
          r->tools._buffer[k].cmd_seq == 100 * i + k;
