@@ -365,10 +365,9 @@ static void refit(aabb_tree_t *t, const double *x, const uint32_t *cand, size_t 
 void aabb_tree_refit(aabb_tree_t *t, const double *x) { refit(t, x, NULL, t->nverts); }
 
 void aabb_tree_refit_listed(aabb_tree_t *t, const double *x, const uint32_t *idx, size_t n) {
-  if (x != t->x || t->full) {
-    refit(t, x, NULL, t->nverts);
-    return;
-  }
+  /* Another array: nothing is known about its unlisted vertices. (A tree
+   * due a full refit sweeps everything whatever the list.) */
+  if (x != t->x) idx = NULL, n = t->nverts;
   refit(t, x, idx, n);
 }
 

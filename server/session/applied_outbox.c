@@ -7,8 +7,6 @@
 #include <string.h>
 #include <time.h>
 
-#include "session/applied_input.h"
-
 /* A queued sample: this header, then the sample's struct (its sequences'
  * buffers meaningless), its tools, its controls; len covers all of it and
  * is a multiple of 8, so every record starts 8-aligned. len 0 marks the
@@ -40,10 +38,6 @@ static size_t record_len(uint32_t ntools, uint32_t ncontrols) {
 
 int applied_outbox_push(applied_outbox_t *o, const viscera_AppliedInput *s) {
   const uint32_t nt = s->tools._length, nc = s->controls._length;
-  if (nt > APPLIED_MAX_TOOLS || nc > APPLIED_MAX_CONTROLS) {
-    o->dropped++;
-    return -1;
-  }
   const size_t need = record_len(nt, nc), cap = APPLIED_OUTBOX_BYTES;
   uint64_t head = atomic_load_explicit(&o->head, memory_order_relaxed);
   const uint64_t tail = atomic_load_explicit(&o->tail, memory_order_acquire);
@@ -70,13 +64,13 @@ int applied_outbox_push(applied_outbox_t *o, const viscera_AppliedInput *s) {
   return 0;
 }
 
-/* Writes every record queued now, in order. */
+/* Writes every record queued now, in order. The sample's sequences point
+ * into the ring (records are 8-aligned; the producer does not reuse a
+ * record's bytes before tail passes it, after the write). */
 static void drain(applied_outbox_t *o) {
   const size_t cap = APPLIED_OUTBOX_BYTES;
   const uint64_t head = atomic_load_explicit(&o->head, memory_order_acquire);
   uint64_t tail = atomic_load_explicit(&o->tail, memory_order_relaxed);
-  viscera_AppliedTool tools[APPLIED_MAX_TOOLS];
-  viscera_AppliedControl controls[APPLIED_MAX_CONTROLS];
   while (tail < head) {
     const unsigned char *p = o->ring + tail % cap;
     record_t r;
@@ -90,13 +84,11 @@ static void drain(applied_outbox_t *o) {
     viscera_AppliedInput s;
     memcpy(&s, p, sizeof s);
     p += sizeof s;
-    memcpy(tools, p, r.ntools * sizeof *tools);
-    p += r.ntools * sizeof *tools;
-    memcpy(controls, p, r.ncontrols * sizeof *controls);
-    s.tools._buffer = tools;
+    s.tools._buffer = (viscera_AppliedTool *)(uintptr_t)p;
+    p += r.ntools * sizeof(viscera_AppliedTool);
+    s.controls._buffer = (viscera_AppliedControl *)(uintptr_t)p;
     s.tools._length = s.tools._maximum = r.ntools;
     s.tools._release = false;
-    s.controls._buffer = controls;
     s.controls._length = s.controls._maximum = r.ncontrols;
     s.controls._release = false;
     if (dds_write(o->writer, &s) >= 0)

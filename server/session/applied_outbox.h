@@ -12,7 +12,7 @@
  * writes what is queued, in order.
  *
  * Nothing is lost while the thread keeps up: the ring holds about a second
- * and a half of one-tool samples. If it ever fills (the thread starved that
+ * of one-tool samples (more than 1,200). If it ever fills (the thread starved that
  * long), the sample is dropped and counted as a failed write; its
  * AppliedInput.seq is missing from the recording, as for any lost sample.
  *
