@@ -19,6 +19,10 @@
 # Writes OUT/load.csv (server samples), OUT/cpu.csv (every process, every
 # second) and OUT/summary.txt.
 #
+# --one-server: the seats run as threads of one viscera-server process
+# (--seats N: partitions load/seat01..) instead of one process each; its
+# log is split per seat afterwards, so the figures read the same.
+#
 # Scheduling: the servers' physics loops run SCHED_FIFO at --rt-priority S
 # (default 70) and the trainees' 1 kHz loops at --haptic-rt-priority H
 # (default 80: the haptic tick is the most latency-critical thread and is
@@ -42,7 +46,7 @@
 #
 # usage: deploy/load_bench.sh [--build DIR] [--out DIR] [--seats N] [--subscribers M] [--duration S]
 #                             [--baseline S] [--rt-priority S] [--haptic-rt-priority H]
-#                             [--scene FILE] [--busy]
+#                             [--scene FILE] [--busy] [--one-server]
 # (the press is at x 12 mm, y 4 mm from above, 8 mm deep into an organ whose
 # top is at z = 35 mm: the shipped kidney and gallbladder; classroom
 # scenes: classroom_kidney.yaml, classroom_gallbladder.yaml)
@@ -51,7 +55,7 @@
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD="$ROOT/build" OUT="$ROOT/out/load" SEATS=5 SUBS=30 DURATION=600 BASELINE=30 RTPRIO=70 HRTPRIO=80
-SCENE="$ROOT/assets/scenes/classroom_kidney.yaml" BUSY=0
+SCENE="$ROOT/assets/scenes/classroom_kidney.yaml" BUSY=0 ONE=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --build) BUILD="$2"; shift 2 ;;
@@ -64,7 +68,8 @@ while [ $# -gt 0 ]; do
     --haptic-rt-priority) HRTPRIO="$2"; shift 2 ;;
     --scene) SCENE="$2"; shift 2 ;;
     --busy) BUSY=1; shift ;;
-    -h|--help) sed -n 3,43p "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --one-server) ONE=1; shift ;;
+    -h|--help) sed -n 3,48p "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "load_bench.sh: unknown option '$1'" >&2; exit 2 ;;
   esac
 done
@@ -140,13 +145,19 @@ trap cleanup EXIT
 register() { echo "$1 $2 $3 $4" >> "$OUT/procs.txt"; }
 now_us() { echo "${EPOCHREALTIME/[.,]/}"; } # bash 5; the decimal sign follows the locale
 T0=$(now_us)
-servers=()
-for i in $(seq 1 "$SEATS"); do
-  s=$(printf 'seat%02d' "$i")
-  "$BUILD/server/viscera-server" --scene "$SCENE" --partition "load/$s" --duration $((DURATION + 3)) --quiet \
-    "${SRV_RT[@]}" > "$OUT/$s-server.out" 2> "$OUT/$s-server.log" &
-  servers+=($!); pids+=($!); register $! server "$s" viscera-server
-done
+servers=() srvnames=()
+if [ "$ONE" = 1 ]; then
+  "$BUILD/server/viscera-server" --scene "$SCENE" --partition load --seats "$SEATS" --duration $((DURATION + 3)) \
+    --quiet "${SRV_RT[@]}" > "$OUT/seats-server.out" 2> "$OUT/seats-server.log" &
+  servers+=($!); srvnames+=(seats); pids+=($!); register $! server seats viscera-server
+else
+  for i in $(seq 1 "$SEATS"); do
+    s=$(printf 'seat%02d' "$i")
+    "$BUILD/server/viscera-server" --scene "$SCENE" --partition "load/$s" --duration $((DURATION + 3)) --quiet \
+      "${SRV_RT[@]}" > "$OUT/$s-server.out" 2> "$OUT/$s-server.log" &
+    servers+=($!); srvnames+=("$s"); pids+=($!); register $! server "$s" viscera-server
+  done
+fi
 sleep 1
 for i in $(seq 1 "$SEATS"); do
   s=$(printf 'seat%02d' "$i")
@@ -172,12 +183,13 @@ sample() { # servers' CPU time and resident memory -> load.csv
   local t=$1 i=0 p st cpu rss
   for p in "${servers[@]}"; do
     i=$((i + 1))
+    local name=${srvnames[$((i - 1))]}
     st=$(cat /proc/"$p"/stat 2>/dev/null) || continue
     # utime + stime in clock ticks (fields 14, 15; 12, 13 after the command name).
     cpu=$(echo "${st##*) }" | awk -v hz="$HZ" '{ print ($12 + $13) / hz }')
     rss=$(awk '/VmRSS/ { print $2 }' /proc/"$p"/status 2>/dev/null || true)
     [ -n "$rss" ] || continue # ended between the two reads (a zombie has no VmRSS)
-    echo "$t,seat$(printf %02d $i),$p,$cpu,$rss" >> "$OUT/load.csv"
+    echo "$t,$name,$p,$cpu,$rss" >> "$OUT/load.csv"
   done
 }
 sample_cpu() { # every registered process still there (a zombie too: its times are final) -> cpu.csv
@@ -206,6 +218,16 @@ done
 sample $t
 sample_cpu
 wait "${servers[@]}" 2>/dev/null || true
+if [ "$ONE" = 1 ]; then
+  # One log per seat, as one process per seat writes: each seat's figures
+  # follow a "server: seat 'load/seatKK' (k of N):" line (and on stdout a
+  # SEAT line); what comes before the first is the process's own.
+  awk -v out="$OUT" '/^server: seat .load\/seat[0-9]+. \([0-9]+ of [0-9]+\):$/ {
+      n = $3; sub(/.*\//, "", n); sub(/[^a-z0-9]+$/, "", n); f = out "/" n "-server.log"; next }
+    { if (f) print > f; else print > (out "/seats-server.head.log") }' "$OUT/seats-server.log"
+  awk -v out="$OUT" '/^SEAT partition=load\/seat[0-9]+ / { n = $2; sub(/.*\//, "", n); f = out "/" n "-server.out"; next }
+    { if (f) print > f }' "$OUT/seats-server.out"
+fi
 # The subscribers and trainees end with the run too; wait (at most 15 s) until
 # each has written its summary line, or the report would miss the last ones.
 for _ in $(seq 1 15); do
@@ -216,7 +238,7 @@ for _ in $(seq 1 15); do
 done
 pids=()
 {
-  echo "load_bench: $SEATS seats x $SCENE_NAME ($(sed -n 's/.*organ .\(.*\).: model \([a-z_]*\),.* \([0-9]*\) nodes.*/\1, \2, \3 nodes/p' "$OUT/check.txt" | head -1 | grep . || echo "see the scene"), 1 kHz physics), $([ "$BUSY" = 1 ] && echo "every seat pressed all the time" || echo "press and release every 4 s"), $SUBS subscribers ($late late), $DURATION s"
+  echo "load_bench: $SEATS seats x $SCENE_NAME $([ "$ONE" = 1 ] && echo "in one server process (threads) " || echo "in a server process each ")($(sed -n 's/.*organ .\(.*\).: model \([a-z_]*\),.* \([0-9]*\) nodes.*/\1, \2, \3 nodes/p' "$OUT/check.txt" | head -1 | grep . || echo "see the scene"), 1 kHz physics), $([ "$BUSY" = 1 ] && echo "every seat pressed all the time" || echo "press and release every 4 s"), $SUBS subscribers ($late late), $DURATION s"
   sched() { # what PRIO LOG...: the policy asked and how many processes refused it
     local what=$1 prio=$2; shift 2
     if [ "$prio" = 0 ]; then echo "$what normal scheduling"; return; fi

@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 #include "dds/vdds_subject.h"
 
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -70,24 +71,30 @@ static X509 *cert_from_config(void) {
   return x;
 }
 
-size_t vdds_subject_self(uint8_t der[VDDS_SUBJECT_DER_MAX]) {
-  static uint8_t cached[VDDS_SUBJECT_DER_MAX];
-  static size_t cached_len;
-  static int done;
-  if (!done) {
-    done = 1;
-    X509 *x = cert_from_config();
-    unsigned char *d = NULL;
-    int n = x ? i2d_X509_NAME(X509_get_subject_name(x), &d) : -1;
-    if (n > 0 && (size_t)n <= sizeof cached) {
-      memcpy(cached, d, (size_t)n);
-      cached_len = (size_t)n;
-    }
-    OPENSSL_free(d);
-    X509_free(x);
+/* The identity's subject, read once per process: seats of one server run
+ * as threads (server_app.h), and each opens its participant. */
+static struct {
+  uint8_t der[VDDS_SUBJECT_DER_MAX];
+  size_t len;
+} g_self;
+static pthread_once_t g_self_once = PTHREAD_ONCE_INIT;
+
+static void read_self(void) {
+  X509 *x = cert_from_config();
+  unsigned char *d = NULL;
+  int n = x ? i2d_X509_NAME(X509_get_subject_name(x), &d) : -1;
+  if (n > 0 && (size_t)n <= sizeof g_self.der) {
+    memcpy(g_self.der, d, (size_t)n);
+    g_self.len = (size_t)n;
   }
-  memcpy(der, cached, cached_len);
-  return cached_len;
+  OPENSSL_free(d);
+  X509_free(x);
+}
+
+size_t vdds_subject_self(uint8_t der[VDDS_SUBJECT_DER_MAX]) {
+  pthread_once(&g_self_once, read_self);
+  memcpy(der, g_self.der, g_self.len);
+  return g_self.len;
 }
 
 bool vdds_subject_matches_guid(const uint8_t guid[16], const uint8_t *der, size_t len) {

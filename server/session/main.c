@@ -10,27 +10,34 @@
 #include "vrt.h"
 
 static void usage(FILE *f) {
-  fprintf(f, "usage: viscera-server --scene FILE [options]\n"
-             "  --scene FILE        scene file (YAML, see assets/scenes/README.md)\n"
-             "  --domain N          DDS domain id 0..230 (default: $VISCERA_DOMAIN or 0)\n" CLI_HELP_INSECURE
-             "  --partition P       session partition (default: " VDDS_DEFAULT_PARTITION ")\n"
-             "  --duration S        stop after S seconds (default: run until SIGINT/SIGTERM)\n"
-             "  --tool-timeout S    release a tool after S s without commands (default 0.5)\n"
-             "  --final-mesh PATH   on exit write the last published frame's exact positions (OBJ)\n"
-             "  --checkpoint FILE   resume from FILE when it holds this scene's state (kill -9, crash), and\n"
-             "                      write the state there every --checkpoint-every s and at exit\n"
-             "  --checkpoint-every S  simulated seconds between checkpoints (default 1)\n"
-             "  --check             load and validate the scene, build its models, print per organ the model,\n"
-             "                      integrator, nodes, tetrahedra, sub-steps and stable dt, exit\n"
-             "  --rt-priority N     run the physics loop's thread (only it; DDS threads stay normal)\n"
-             "                      SCHED_FIFO at priority N (1..99) with memory locked (needs root,\n"
-             "                      CAP_SYS_NICE or LimitRTPRIO; if refused: a warning naming the reason,\n"
-             "                      normal priority)\n"
-             "  --quiet             only errors and warnings on stderr\n"
-             "  --help              this text\n"
-             "  --version           print the version and exit\n"
-             "DDS configuration comes from CYCLONEDDS_URI (unset: deploy/cyclonedds-loopback.xml, one machine).\n"
-             "Exit status: 0 done (or --check passed), 1 bad scene or runtime error, 2 usage error.\n");
+  fprintf(f,
+          "usage: viscera-server --scene FILE [options]\n"
+          "  --scene FILE        scene file (YAML, see assets/scenes/README.md)\n"
+          "  --domain N          DDS domain id 0..230 (default: $VISCERA_DOMAIN or 0)\n" CLI_HELP_INSECURE
+          "  --partition P       session partition (default: " VDDS_DEFAULT_PARTITION ")\n"
+          "  --duration S        stop after S seconds (default: run until SIGINT/SIGTERM)\n"
+          "  --tool-timeout S    release a tool after S s without commands (default 0.5)\n"
+          "  --final-mesh PATH   on exit write the last published frame's exact positions (OBJ)\n"
+          "  --checkpoint FILE   resume from FILE when it holds this scene's state (kill -9, crash), and\n"
+          "                      write the state there every --checkpoint-every s and at exit\n"
+          "  --checkpoint-every S  simulated seconds between checkpoints (default 1)\n"
+          "  --check             load and validate the scene, build its models, print per organ the model,\n"
+          "                      integrator, nodes, tetrahedra, sub-steps and stable dt, exit\n"
+          "  --rt-priority N     run the physics loop's thread (only it; DDS threads stay normal)\n"
+          "                      SCHED_FIFO at priority N (1..99) with memory locked (needs root,\n"
+          "                      CAP_SYS_NICE or LimitRTPRIO; if refused: a warning naming the reason,\n"
+          "                      normal priority)\n"
+          "  --seats N           run N seats of the scene in this one process (1..%d, default 1), each\n"
+          "                      its own session on partition P/seatKK (P: --partition), with its own\n"
+          "                      physics thread; seats in one process share a core's caches better\n"
+          "                      than one process per seat (docs/numerics.md §11.3). Not with\n"
+          "                      --checkpoint or --final-mesh\n"
+          "  --quiet             only errors and warnings on stderr\n"
+          "  --help              this text\n"
+          "  --version           print the version and exit\n"
+          "DDS configuration comes from CYCLONEDDS_URI (unset: deploy/cyclonedds-loopback.xml, one machine).\n"
+          "Exit status: 0 done (or --check passed), 1 bad scene or runtime error, 2 usage error.\n",
+          SERVER_APP_MAX_SEATS);
 }
 
 enum {
@@ -41,7 +48,8 @@ enum {
   OPT_CHECK = 'c',
   OPT_CHECKPOINT = 'K',
   OPT_CHECKPOINT_EVERY = 'E',
-  OPT_RT_PRIORITY = 'R'
+  OPT_RT_PRIORITY = 'R',
+  OPT_SEATS = 'S'
 };
 
 /* A number of seconds: >= 0 when `zero_ok`, else > 0. */
@@ -82,6 +90,16 @@ static int on_option(void *ctx, int code, const char *arg) {
   case OPT_CHECK:
     o->check_only = 1;
     return 0;
+  case OPT_SEATS: {
+    char *end = NULL;
+    long n = strtol(arg, &end, 10);
+    if (end == arg || *end || n < 1 || n > SERVER_APP_MAX_SEATS) {
+      fprintf(stderr, "viscera-server: --seats '%s' is not a number of seats 1..%d\n", arg, SERVER_APP_MAX_SEATS);
+      return 2;
+    }
+    o->seats = (int)n;
+    return 0;
+  }
   }
   return 0; /* not reached: cli_parse passes only the codes above */
 }
@@ -96,6 +114,7 @@ int main(int argc, char **argv) {
                                      {"checkpoint", required_argument, 0, OPT_CHECKPOINT},
                                      {"checkpoint-every", required_argument, 0, OPT_CHECKPOINT_EVERY},
                                      {"rt-priority", required_argument, 0, OPT_RT_PRIORITY},
+                                     {"seats", required_argument, 0, OPT_SEATS},
                                      {0, 0, 0, 0}};
   const cli_spec_t spec = {.program = "viscera-server",
                            .common = CLI_DOMAIN | CLI_DOMAIN_ENV | CLI_PARTITION | CLI_QUIET,
@@ -103,7 +122,7 @@ int main(int argc, char **argv) {
                            .options = lo,
                            .option = on_option,
                            .usage = usage};
-  server_app_options_t o = {.opts = {.duration = 0, .tool_timeout = 0.5, .checkpoint_every = 1.0}};
+  server_app_options_t o = {.seats = 1, .opts = {.duration = 0, .tool_timeout = 0.5, .checkpoint_every = 1.0}};
   cli_common_t common = {0};
   int rc = cli_parse(&spec, argc, argv, &common, &o);
   if (rc != CLI_RUN) return rc;
@@ -113,6 +132,11 @@ int main(int argc, char **argv) {
   if (!o.scene_path) {
     fprintf(stderr, "viscera-server: --scene FILE is required\n");
     usage(stderr);
+    return 2;
+  }
+  if (o.seats > 1 && (o.opts.checkpoint || o.opts.final_mesh)) {
+    fprintf(stderr, "viscera-server: --seats %d takes neither --checkpoint nor --final-mesh (one file per process)\n",
+            o.seats);
     return 2;
   }
   return server_app_run(&o);

@@ -5,9 +5,12 @@
 #include "session/server_app.h"
 
 #include <inttypes.h>
+#include <pthread.h>
 #include <signal.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+#include <sys/prctl.h>
 
 #include "data_path.h"
 #include "dds/vdds.h"
@@ -141,6 +144,87 @@ static void print_summary(const scene_t *scene, const server_stats_t *s) {
     printf("OBJECT object=%s removed=%d\n", scene->objects[i].name, s->stone_removed[i]);
 }
 
+/* One seat of a multi-seat process. */
+typedef struct seat_run {
+  const scene_t *scene;
+  server_opts_t opts;
+  char partition[128];
+  char name[16]; /* the thread's, for ps and top */
+  server_stats_t st;
+  verr_t err;
+  int rc;
+} seat_run_t;
+
+static void *seat_main(void *arg) {
+  seat_run_t *r = arg;
+  prctl(PR_SET_NAME, r->name, 0, 0, 0);
+  r->rc = server_run(r->scene, &r->opts, &g_stop, &r->st, &r->err);
+  if (r->rc) fprintf(stderr, "viscera-server: seat '%s': %s\n", r->partition, r->err.msg);
+  return NULL;
+}
+
+/* --seats N: the sessions in threads, then each one's figures. */
+static int run_seats(const scene_t *scene, const server_app_options_t *o) {
+  const int n = o->seats;
+  const char *base = o->opts.partition ? o->opts.partition : VDDS_DEFAULT_PARTITION;
+  seat_run_t *seats = calloc((size_t)n, sizeof *seats);
+  pthread_t *th = calloc((size_t)n, sizeof *th);
+  int *started = calloc((size_t)n, sizeof *started);
+  if (!seats || !th || !started) {
+    fprintf(stderr, "viscera-server: out of memory for %d seats\n", n);
+    free(seats);
+    free(th);
+    free(started);
+    return 1;
+  }
+  /* A thread's default stack follows RLIMIT_STACK; a session keeps its
+   * runtime (tens of kB per organ and tool) on it, as the main thread does. */
+  pthread_attr_t attr;
+  pthread_attr_init(&attr);
+  pthread_attr_setstacksize(&attr, (size_t)16 << 20);
+  int rc = 0;
+  for (int k = 0; k < n; k++) {
+    seat_run_t *r = &seats[k];
+    r->scene = scene;
+    r->opts = o->opts;
+    int len = snprintf(r->partition, sizeof r->partition, "%s/seat%02d", base, k + 1);
+    if (len < 0 || (size_t)len >= sizeof r->partition) {
+      fprintf(stderr, "viscera-server: partition '%s' too long for its seats\n", base);
+      rc = 1;
+      break;
+    }
+    r->opts.partition = r->partition;
+    snprintf(r->name, sizeof r->name, "seat%02d", k + 1);
+    int e = pthread_create(&th[k], &attr, seat_main, r);
+    if (e) {
+      fprintf(stderr, "viscera-server: seat '%s' not started: %s\n", r->partition, strerror(e));
+      rc = 1;
+      break;
+    }
+    started[k] = 1;
+  }
+  pthread_attr_destroy(&attr);
+  /* A seat that did not start is reported above; those that did keep serving. */
+  for (int k = 0; k < n; k++)
+    if (started[k]) pthread_join(th[k], NULL);
+  for (int k = 0; k < n; k++) {
+    const seat_run_t *r = &seats[k];
+    if (!started[k]) continue;
+    if (r->rc) {
+      rc = 1;
+      continue;
+    }
+    fprintf(stderr, "server: seat '%s' (%d of %d):\n", r->partition, k + 1, n);
+    print_stats(scene, &r->opts, &r->st);
+    printf("SEAT partition=%s index=%d of=%d\n", r->partition, k + 1, n);
+    print_summary(scene, &r->st);
+  }
+  free(seats);
+  free(th);
+  free(started);
+  return rc;
+}
+
 int server_app_run(const server_app_options_t *o) {
   static scene_t scene;
   verr_t err;
@@ -156,6 +240,7 @@ int server_app_run(const server_app_options_t *o) {
   }
   if (o->check_only) return check_scene(&scene);
   vsignal_on_stop(on_signal, 0);
+  if (o->seats > 1) return run_seats(&scene, o);
   server_stats_t st;
   if (server_run(&scene, &o->opts, &g_stop, &st, &err)) {
     fprintf(stderr, "viscera-server: %s\n", err.msg);

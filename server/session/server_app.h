@@ -1,19 +1,31 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* server_app: what viscera-server does once its command line is parsed
  * (session/main.c): load the scene, then either check it (--check) or run
- * the session until a signal or --duration, and print the summary. */
+ * the session until a signal or --duration, and print the summary.
+ * With --seats N > 1 the process runs N sessions of the scene, one per
+ * partition P/seat01..P/seatNN, each server_run in its own thread (its
+ * physics loop; DDS threads are shared by the process's participants).
+ * Why: several seats' servers on one core run each step after the others
+ * have run; as separate processes every step also starts in another
+ * address space (docs/numerics.md §11.3 measures what that costs). A seat
+ * whose set-up fails is reported at once and the others keep serving; the
+ * summaries follow per seat at the end, each headed by its partition. */
 #ifndef VISCERA_SESSION_SERVER_APP_H
 #define VISCERA_SESSION_SERVER_APP_H
 
 #include "session/server.h"
 
+enum { SERVER_APP_MAX_SEATS = 32 };
+
 typedef struct server_app_options {
   const char *scene_path; /* --scene FILE */
+  int seats;              /* --seats N: 1..SERVER_APP_MAX_SEATS */
   int check_only;         /* --check */
   server_opts_t opts;     /* everything server_run takes */
 } server_app_options_t;
 
-/* Returns the exit code: 0 done, 1 scene or runtime error. */
+/* Returns the exit code: 0 done, 1 scene or runtime error (with seats: any
+ * seat's). */
 int server_app_run(const server_app_options_t *o);
 
 #endif

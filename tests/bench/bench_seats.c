@@ -14,10 +14,14 @@
  * its data after the other seats' steps: the lab's cache, made repeatable.
  * With --seats 1 the seat's data stays in the cache from one step to the
  * next: the seat alone. Prints the median and p99 step time per seat count
- * and the ratio to one seat, and the bytes of the seat's state that a step
- * reads (the sizes of the arrays the model holds).
+ * and the ratio to one seat.
  *
- * usage: bench_seats [--scene FILE] [--seats LIST] [--seconds S]
+ * --evict KB writes KB kB of other memory (a store per cache line, outside
+ * the timed step) before every step: the step as it runs after other
+ * processes had the core (a lab's seat: docs/numerics.md §11.3). 0, the
+ * default, leaves the caches alone.
+ *
+ * usage: bench_seats [--scene FILE] [--seats LIST] [--seconds S] [--evict KB]
  *   defaults: classroom_gallbladder.yaml, seats 1,2,3, 4 s of simulated
  *   time each (the first 1 s, the press, is not timed).
  * Figures are not checked: the machine's load moves them; compare the
@@ -52,7 +56,14 @@ static void busy_target(double t, double p[3]) {
   p[0] = ph < 1.0 ? 0.017 - 0.010 * ph : 0.007 + 0.010 * (ph - 1.0);
 }
 
-static int run(const scene_t *scene, int nseats, double seconds, vstats_summary_t *out) {
+/* Overwrites n bytes, one store per cache line: what other processes do to
+ * the core's caches between two ticks of a server. */
+static void evict(unsigned char *buf, size_t n, unsigned char v) {
+  for (size_t i = 0; i < n; i += 64) buf[i] = v;
+}
+
+static int run(const scene_t *scene, int nseats, double seconds, unsigned char *junk, size_t njunk,
+               vstats_summary_t *out) {
   static runtime_t rt[MAX_SEATS];
   verr_t err;
   for (int k = 0; k < nseats; k++)
@@ -70,6 +81,7 @@ static int run(const scene_t *scene, int nseats, double seconds, vstats_summary_
     double p[3];
     busy_target(s * sc->dt, p);
     for (int k = 0; k < nseats; k++) {
+      if (njunk) evict(junk, njunk, (unsigned char)(s + k));
       uint64_t c0 = vtime_thread_cpu_ns();
       runtime_set_tool(&rt[k], 0, p, 100);
       runtime_step(&rt[k]);
@@ -86,6 +98,7 @@ static int run(const scene_t *scene, int nseats, double seconds, vstats_summary_
 int main(int argc, char **argv) {
   const char *scene = NULL, *list = "1,2,3";
   double seconds = 4.0;
+  long evict_kb = 0;
   for (int i = 1; i < argc; i++) {
     if (!strcmp(argv[i], "--scene") && i + 1 < argc)
       scene = argv[++i];
@@ -93,8 +106,13 @@ int main(int argc, char **argv) {
       list = argv[++i];
     else if (!strcmp(argv[i], "--seconds") && i + 1 < argc)
       seconds = atof(argv[++i]);
+    else if (!strcmp(argv[i], "--evict") && i + 1 < argc) {
+      char *end;
+      evict_kb = strtol(argv[++i], &end, 10);
+      if (*end || end == argv[i]) evict_kb = -1;
+    }
     else {
-      fprintf(stderr, "usage: bench_seats [--scene FILE] [--seats LIST] [--seconds S]\n");
+      fprintf(stderr, "usage: bench_seats [--scene FILE] [--seats LIST] [--seconds S] [--evict KB]\n");
       return 2;
     }
   }
@@ -102,6 +120,13 @@ int main(int argc, char **argv) {
     fprintf(stderr, "bench_seats: --seconds must be in (1.5, 600]\n");
     return 2;
   }
+  if (evict_kb < 0 || evict_kb > 1L << 20) {
+    fprintf(stderr, "bench_seats: --evict takes 0..1048576 (kB)\n");
+    return 2;
+  }
+  size_t njunk = (size_t)evict_kb * 1024;
+  unsigned char *junk = njunk ? calloc(njunk, 1) : NULL;
+  if (njunk && !junk) return 1;
   if (!scene) scene = test_asset("scenes/classroom_gallbladder.yaml");
   static scene_t sc;
   verr_t err;
@@ -109,7 +134,9 @@ int main(int argc, char **argv) {
     fprintf(stderr, "bench_seats: %s\n", err.msg);
     return 2;
   }
-  printf("bench_seats: %s, busy trajectory, %.1f s simulated per run (first 1 s not timed)\n", scene, seconds);
+  printf("bench_seats: %s, busy trajectory, %.1f s simulated per run (first 1 s not timed)", scene, seconds);
+  if (evict_kb) printf(", %ld kB of other data written before each step", evict_kb);
+  printf("\n");
   printf("%-6s %14s %14s %12s\n", "seats", "CPU median us", "CPU p99 us", "vs 1 seat");
   double base = NAN;
   const char *q = list;
@@ -121,7 +148,7 @@ int main(int argc, char **argv) {
       return 2;
     }
     vstats_summary_t r;
-    if (run(&sc, (int)n, seconds, &r)) return 1;
+    if (run(&sc, (int)n, seconds, junk, njunk, &r)) return 1;
     if (n == 1) base = r.median;
     printf("%-6ld %14.1f %14.1f %11.2fx\n", n, r.median, r.p99, r.median / base);
     fflush(stdout);
