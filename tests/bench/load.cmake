@@ -7,6 +7,12 @@ add_test(NAME load_bench_smoke COMMAND bash ${PROJECT_SOURCE_DIR}/deploy/load_be
          --out ${CMAKE_CURRENT_BINARY_DIR}/load_smoke --seats 2 --subscribers 4 --duration 12 --baseline 3)
 set_tests_properties(load_bench_smoke PROPERTIES LABELS bench TIMEOUT 120
   ENVIRONMENT "CYCLONEDDS_URI=file://${VISCERA_DDS_CONFIG};VISCERA_DOMAIN=148")
+# The same with the seats as threads of one server (--one-server, issue 17
+# item 6): the process's log must come apart into one figures block per seat.
+add_test(NAME load_bench_one_server_smoke COMMAND bash -c
+         "bash '${PROJECT_SOURCE_DIR}/deploy/load_bench.sh' --build '${PROJECT_BINARY_DIR}' --out '${CMAKE_CURRENT_BINARY_DIR}/load_one' --seats 2 --subscribers 2 --duration 8 --baseline 2 --one-server && grep -Eq '^  seat01: [0-9]{4,} steps, .*real-time ratio' '${CMAKE_CURRENT_BINARY_DIR}/load_one/summary.txt' && grep -Eq '^  seat02: [0-9]{4,} steps, .*real-time ratio' '${CMAKE_CURRENT_BINARY_DIR}/load_one/summary.txt' && grep -q 'in one server process' '${CMAKE_CURRENT_BINARY_DIR}/load_one/summary.txt'")
+set_tests_properties(load_bench_one_server_smoke PROPERTIES LABELS bench TIMEOUT 120
+  ENVIRONMENT "CYCLONEDDS_URI=file://${VISCERA_DDS_CONFIG};VISCERA_DOMAIN=172")
 # What sharing a core costs a busy seat's step, without DDS (issue 17 item 6).
 add_executable(bench_seats ${CMAKE_CURRENT_LIST_DIR}/bench_seats.c)
 target_link_libraries(bench_seats PRIVATE viscera_sim viscera_test_support)
