@@ -30,6 +30,11 @@
 #   --rt-priority N     every server's physics loop SCHED_FIFO at N (1..99; default 0: normal
 #                       scheduling); needs root or CAP_SYS_NICE, else each server warns and runs on
 #   --haptic-rt-priority N  the same for the trainees' 1 kHz loops (with --trainees)
+#   --one-server        every seat as a thread of one viscera-server (--seats N
+#                       --first-seat K): seats sharing cores cost each other less
+#                       in one process (docs/numerics.md §11.3); its log is split
+#                       into seatNN-server.log at the end. Not with --secure (one
+#                       process cannot hold each seat's identity)
 # SIGINT (Ctrl-C) or SIGTERM stops the lab: every process it started gets
 # SIGTERM (SIGKILL if still running 10 s later), then the summary is printed.
 # Exit status: 0 when every process ended cleanly, 1 when one failed (named
@@ -43,7 +48,7 @@
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD="$ROOT/build" OUT="$ROOT/out/lab" SEATS=3 FIRST=1 PREFIX=lab SCENE="$ROOT/assets/scenes/default.yaml"
-TRAINEES=0 VIEWERS=1 DURATION=20 SECURE=0 INSECURE=0 RECORD=1 PKI="" RTPRIO=0 HRTPRIO=0
+TRAINEES=0 VIEWERS=1 DURATION=20 SECURE=0 INSECURE=0 RECORD=1 PKI="" RTPRIO=0 HRTPRIO=0 ONE=0
 STOP_GRACE_S="${VISCERA_LAB_STOP_GRACE:-10}"
 usage() { awk 'NR > 2 && /^#/ { sub(/^# ?/, ""); print; next } NR > 2 { exit }' "$0"; }
 while [ $# -gt 0 ]; do
@@ -63,6 +68,7 @@ while [ $# -gt 0 ]; do
     --no-record) RECORD=0; shift ;;
     --rt-priority) RTPRIO="$2"; shift 2 ;;
     --haptic-rt-priority) HRTPRIO="$2"; shift 2 ;;
+    --one-server) ONE=1; shift ;;
     -h|--help) usage; exit 0 ;;
     *) echo "lab.sh: unknown option '$1'" >&2; usage >&2; exit 2 ;;
   esac
@@ -89,6 +95,8 @@ NET="${CYCLONEDDS_URI:-file://$ROOT/deploy/cyclonedds-loopback.xml}"
 # Off loopback, secure by default (issue 14): a network configuration runs
 # with DDS Security, or only behind an explicit --insecure that says so.
 [ $SECURE = 1 ] && [ $INSECURE = 1 ] && { echo "lab.sh: --secure and --insecure exclude each other" >&2; exit 2; }
+[ $SECURE = 1 ] && [ $ONE = 1 ] &&
+  { echo "lab.sh: --one-server runs without DDS Security: each seat's identity may publish only in its own seat, and one process has one" >&2; exit 2; }
 # shellcheck source=net_guard.sh
 source "$ROOT/deploy/net_guard.sh"
 net_guard lab.sh "$NET" $SECURE $INSECURE || exit 2
@@ -182,11 +190,16 @@ if [ $RECORD = 1 ]; then
   start recorder recorder "$BUILD/client/recorder/viscera-recorder" --partition "$PREFIX/*" \
     --out "$OUT/lab.db" --scene "$PREFIX" $(dur DURATION+2) --quiet
 fi
+if [ $ONE = 1 ]; then
+  # shellcheck disable=SC2046
+  start seats-server "server-$(printf 'seat%02d' "$FIRST")" "$BUILD/server/viscera-server" --scene "$SCENE" \
+    --partition "$PREFIX" --seats "$SEATS" --first-seat "$FIRST" $(dur DURATION) "${SRV_RT[@]}"
+fi
 for i in $(seq "$FIRST" "$LAST"); do
   s=$(printf 'seat%02d' "$i")
   # shellcheck disable=SC2046
-  start "$s-server" "server-$s" "$BUILD/server/viscera-server" --scene "$SCENE" --partition "$PREFIX/$s" $(dur DURATION) \
-    "${SRV_RT[@]}"
+  [ $ONE = 1 ] || start "$s-server" "server-$s" "$BUILD/server/viscera-server" --scene "$SCENE" \
+    --partition "$PREFIX/$s" $(dur DURATION) "${SRV_RT[@]}"
   for k in $(seq 1 "$VIEWERS"); do
     rm -rf "$OUT/$s-frames$k"
     # shellcheck disable=SC2046
@@ -219,11 +232,23 @@ for i in "${!pids[@]}"; do
   fi
 done
 echo "lab: ${stop_sig:+stopped by $stop_sig, }done"
+if [ $ONE = 1 ]; then
+  # One log per seat as one server per seat writes: each seat's figures
+  # follow its "server: seat 'PREFIX/seatNN' (k of N):" line and its
+  # "SEAT partition=PREFIX/seatNN ..." line.
+  awk -v out="$OUT" -v pre="$PREFIX" '
+    $0 ~ "^server: seat ." pre "/seat[0-9]+. \\([0-9]+ of [0-9]+\\):$" { n = $3; sub(/.*\//, "", n); sub(/[^a-z0-9]+$/, "", n)
+      f = out "/" n "-server.log"; next }
+    $0 ~ "^SEAT partition=" pre "/seat[0-9]+ " { n = $2; sub(/.*\//, "", n); f = out "/" n "-server.log"; next }
+    f { print > f }' "$OUT/seats-server.log"
+fi
 for i in $(seq "$FIRST" "$LAST"); do
   s=$(printf 'seat%02d' "$i")
   peak=$(sed -n 's/.*peak_force=\([0-9.]*\).*/\1/p' "$OUT/$s-haptic.log" 2>/dev/null || true)
   frames=$(cat "$OUT/$s"-frames*/frames.csv 2>/dev/null | grep -c png || true)
-  step=$(grep -o 'step [^;]*median[^;,]*' "$OUT/$s-server.log" | tail -1 || true)
+  # the step's wall time line (the server's log has further "median" lines since)
+  step=$(sed -n 's/^server: [0-9]* steps, \(step time median [0-9.]* us p99 [0-9.]* us\).*/\1/p' "$OUT/$s-server.log" \
+    2>/dev/null | tail -1 || true)
   echo "  $s: frames $frames${peak:+, trainee peak force $peak N}${step:+, $step}"
 done
 if [ $RECORD = 1 ]; then

@@ -27,11 +27,13 @@ static void usage(FILE *f) {
           "                      SCHED_FIFO at priority N (1..99) with memory locked (needs root,\n"
           "                      CAP_SYS_NICE or LimitRTPRIO; if refused: a warning naming the reason,\n"
           "                      normal priority)\n"
-          "  --seats N           run N seats of the scene in this one process (1..%d, default 1), each\n"
+          "  --seats N           run N seats of the scene in this one process (1..%d), each\n"
           "                      its own session on partition P/seatKK (P: --partition), with its own\n"
           "                      physics thread; seats in one process share a core's caches better\n"
           "                      than one process per seat (docs/numerics.md §11.3). Not with\n"
           "                      --checkpoint or --final-mesh\n"
+          "  --first-seat K      with --seats: the first seat's number (default 1): seats K..K+N-1,\n"
+          "                      at most 99\n"
           "  --quiet             only errors and warnings on stderr\n"
           "  --help              this text\n"
           "  --version           print the version and exit\n"
@@ -49,7 +51,8 @@ enum {
   OPT_CHECKPOINT = 'K',
   OPT_CHECKPOINT_EVERY = 'E',
   OPT_RT_PRIORITY = 'R',
-  OPT_SEATS = 'S'
+  OPT_SEATS = 'S',
+  OPT_FIRST_SEAT = 'F'
 };
 
 /* A number of seconds: >= 0 when `zero_ok`, else > 0. */
@@ -100,6 +103,16 @@ static int on_option(void *ctx, int code, const char *arg) {
     o->seats = (int)n;
     return 0;
   }
+  case OPT_FIRST_SEAT: {
+    char *end = NULL;
+    long n = strtol(arg, &end, 10);
+    if (end == arg || *end || n < 1 || n > 99) {
+      fprintf(stderr, "viscera-server: --first-seat '%s' is not a seat number 1..99\n", arg);
+      return 2;
+    }
+    o->first_seat = (int)n;
+    return 0;
+  }
   }
   return 0; /* not reached: cli_parse passes only the codes above */
 }
@@ -115,6 +128,7 @@ int main(int argc, char **argv) {
                                      {"checkpoint-every", required_argument, 0, OPT_CHECKPOINT_EVERY},
                                      {"rt-priority", required_argument, 0, OPT_RT_PRIORITY},
                                      {"seats", required_argument, 0, OPT_SEATS},
+                                     {"first-seat", required_argument, 0, OPT_FIRST_SEAT},
                                      {0, 0, 0, 0}};
   const cli_spec_t spec = {.program = "viscera-server",
                            .common = CLI_DOMAIN | CLI_DOMAIN_ENV | CLI_PARTITION | CLI_QUIET,
@@ -122,7 +136,8 @@ int main(int argc, char **argv) {
                            .options = lo,
                            .option = on_option,
                            .usage = usage};
-  server_app_options_t o = {.seats = 1, .opts = {.duration = 0, .tool_timeout = 0.5, .checkpoint_every = 1.0}};
+  server_app_options_t o = {
+      .seats = 0, .first_seat = 0, .opts = {.duration = 0, .tool_timeout = 0.5, .checkpoint_every = 1.0}};
   cli_common_t common = {0};
   int rc = cli_parse(&spec, argc, argv, &common, &o);
   if (rc != CLI_RUN) return rc;
@@ -132,6 +147,15 @@ int main(int argc, char **argv) {
   if (!o.scene_path) {
     fprintf(stderr, "viscera-server: --scene FILE is required\n");
     usage(stderr);
+    return 2;
+  }
+  if (o.first_seat && !o.seats) {
+    fprintf(stderr, "viscera-server: --first-seat needs --seats\n");
+    return 2;
+  }
+  if (!o.first_seat) o.first_seat = 1;
+  if (o.seats && o.first_seat + o.seats - 1 > 99) {
+    fprintf(stderr, "viscera-server: --seats %d from --first-seat %d goes past seat 99\n", o.seats, o.first_seat);
     return 2;
   }
   if (o.seats > 1 && (o.opts.checkpoint || o.opts.final_mesh)) {

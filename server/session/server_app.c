@@ -163,7 +163,8 @@ static void *seat_main(void *arg) {
   return NULL;
 }
 
-/* --seats N: the sessions in threads, then each one's figures. */
+/* --seats N (also 1: the seat's partition is P/seatKK): the sessions in
+ * threads, then each one's figures. */
 static int run_seats(const scene_t *scene, const server_app_options_t *o) {
   const int n = o->seats;
   const char *base = o->opts.partition ? o->opts.partition : VDDS_DEFAULT_PARTITION;
@@ -187,14 +188,14 @@ static int run_seats(const scene_t *scene, const server_app_options_t *o) {
     seat_run_t *r = &seats[k];
     r->scene = scene;
     r->opts = o->opts;
-    int len = snprintf(r->partition, sizeof r->partition, "%s/seat%02d", base, k + 1);
+    int len = snprintf(r->partition, sizeof r->partition, "%s/seat%02d", base, o->first_seat + k);
     if (len < 0 || (size_t)len >= sizeof r->partition) {
       fprintf(stderr, "viscera-server: partition '%s' too long for its seats\n", base);
       rc = 1;
       break;
     }
     r->opts.partition = r->partition;
-    snprintf(r->name, sizeof r->name, "seat%02d", k + 1);
+    snprintf(r->name, sizeof r->name, "seat%02d", o->first_seat + k);
     int e = pthread_create(&th[k], &attr, seat_main, r);
     if (e) {
       fprintf(stderr, "viscera-server: seat '%s' not started: %s\n", r->partition, strerror(e));
@@ -240,7 +241,7 @@ int server_app_run(const server_app_options_t *o) {
   }
   if (o->check_only) return check_scene(&scene);
   vsignal_on_stop(on_signal, 0);
-  if (o->seats > 1) return run_seats(&scene, o);
+  if (o->seats > 0) return run_seats(&scene, o);
   server_stats_t st;
   if (server_run(&scene, &o->opts, &g_stop, &st, &err)) {
     fprintf(stderr, "viscera-server: %s\n", err.msg);

@@ -2,8 +2,10 @@
 /* server_app: what viscera-server does once its command line is parsed
  * (session/main.c): load the scene, then either check it (--check) or run
  * the session until a signal or --duration, and print the summary.
- * With --seats N > 1 the process runs N sessions of the scene, one per
- * partition P/seat01..P/seatNN, each server_run in its own thread (its
+ * With --seats N the process runs N sessions of the scene, one per
+ * partition P/seatKK..P/seat(K+N-1) (K: --first-seat, default 1; two
+ * digits, as deploy/lab.sh and deploy/pki.sh name seats), each server_run
+ * in its own thread (its
  * physics loop; DDS threads are shared by the process's participants).
  * Why: several seats' servers on one core run each step after the others
  * have run; as separate processes every step also starts in another
@@ -19,7 +21,8 @@ enum { SERVER_APP_MAX_SEATS = 32 };
 
 typedef struct server_app_options {
   const char *scene_path; /* --scene FILE */
-  int seats;              /* --seats N: 1..SERVER_APP_MAX_SEATS */
+  int seats;              /* --seats N: 1..SERVER_APP_MAX_SEATS; 0: not given (one session on the partition as given) */
+  int first_seat;         /* --first-seat K: the first seat's number (seatKK), 1..99 with K + N - 1 <= 99 */
   int check_only;         /* --check */
   server_opts_t opts;     /* everything server_run takes */
 } server_app_options_t;

@@ -1,0 +1,76 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
+# deploy/lab.sh --one-server (issue 17 item 6) on loopback: seats 2-3
+# (--first 2) as threads of one viscera-server, a scripted trainee and a
+# viewer per seat, the lab recorder, until Ctrl-C. Asserts: one server
+# process in the lab, serving both seats (each seat recorded from its own
+# partition and participant, no writer in two partitions, ToolCommands in
+# both), every viewer wrote frames, both trainees felt force, the process's
+# log split into seat02-server.log and seat03-server.log with each seat's
+# figures, the lab's summary line per seat with its step time, exit 0 after
+# SIGINT with nothing left running. --one-server with --secure is refused
+# (exit 2, naming --one-server).
+# usage: lab_one_server_test.sh BUILD SRC OUT
+set -euo pipefail
+BUILD="$1"; SRC="$2"; OUT="$3"
+# shellcheck source=lab_checks.sh
+. "$(dirname "$0")/lab_checks.sh"
+L=""
+cleanup() {
+  local p
+  [ -n "$L" ] || return 0
+  kill -TERM "$L" 2>/dev/null || true
+  sleep 3
+  for p in $(ps -o pid= -s "$L" 2>/dev/null); do kill -KILL "$p" 2>/dev/null || true; done
+}
+trap cleanup EXIT
+fail() {
+  echo "FAIL: $*" >&2
+  for f in "$OUT"/*.out "$OUT"/*/*.log; do [ -f "$f" ] && { echo "--- $f"; tail -6 "$f"; }; done >&2
+  exit 1
+}
+rm -rf "$OUT"; mkdir -p "$OUT"
+command -v sqlite3 > /dev/null || fail "sqlite3 missing (deploy/install_deps.sh installs it)"
+rc=0; bash "$SRC/deploy/lab.sh" --build "$BUILD" --out "$OUT/refused" --one-server --secure > "$OUT/refused.out" 2>&1 || rc=$?
+[ "$rc" = 2 ] || fail "lab.sh --one-server --secure exited $rc, not 2"
+grep -q -- "--one-server" "$OUT/refused.out" || fail "the refusal does not name --one-server: $(cat "$OUT/refused.out")"
+
+launch_lab L "$OUT/lab.out" --out "$OUT/l" --one-server --first 2 --seats 2 --trainees --viewers 1 --duration 0
+# Both trainees finish their palpation (about 5 s each after a 2 s start delay).
+done_n=0
+for ((t = 0; t < 600; t++)); do
+  done_n=$(cat "$OUT"/l/seat0[23]-haptic.log 2>/dev/null | grep -c '^SUMMARY' || true)
+  [ "$done_n" = 2 ] && break
+  kill -0 "$L" 2>/dev/null || fail "the lab ended on its own"
+  sleep 0.1
+done
+[ "$done_n" = 2 ] || fail "the trainees did not finish within 60 s"
+servers=$(ps -o args= -s "$L" | grep -c '^[^ ]*/viscera-server ' || true)
+[ "$servers" = 1 ] || fail "$servers server processes in the lab, expected one for both seats"
+sleep 1 # a few more MeshDeltas of every seat reach the recorder
+kill -INT "$L"
+for ((t = 0; t < 300; t++)); do kill -0 "$L" 2>/dev/null || break; sleep 0.1; done
+kill -0 "$L" 2>/dev/null && fail "lab.sh still running 30 s after SIGINT"
+st=0; wait "$L" || st=$?
+cat "$OUT/lab.out"
+[ "$st" = 0 ] || fail "the lab exited with $st after SIGINT, expected 0"
+expect_nothing_left "$L" "the lab"
+L=""
+
+DB="$OUT/l/lab.db"
+recorded_by_partition "$DB" | tee "$OUT/by_partition.txt"
+expect_closed "$DB"
+expect_seats_recorded "$DB" lab 2 3
+for s in 02 03; do
+  grep -q "^lab/seat$s viscera_ToolCommand [1-9]" "$OUT/by_partition.txt" || fail "no ToolCommand recorded in lab/seat$s"
+done
+for s in seat02 seat03; do
+  expect_frames "$OUT/l/$s-frames1"
+  expect_trainee_force "$OUT/l/$s-haptic.log"
+  grep -q '^server: [0-9]* steps, step time median' "$OUT/l/$s-server.log" || fail "no step figures in $s-server.log"
+  grep -q '^SUMMARY steps=[0-9]' "$OUT/l/$s-server.log" || fail "no SUMMARY line in $s-server.log"
+  grep -Eq "^  $s: frames [1-9][0-9]*, trainee peak force [0-9.]+ N, step time median [0-9.]+ us" "$OUT/lab.out" ||
+    fail "the lab's summary has no full line for $s"
+done
+expect_logs "$OUT/l" recorder seats-server seat02-viewer1 seat02-haptic seat03-viewer1 seat03-haptic
+echo PASS
