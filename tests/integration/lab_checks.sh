@@ -99,3 +99,18 @@ expect_recorded_pids_gone() {
     case "$cmd" in "$BUILD"/*) fail "pid $p ($cmd) from the recording still runs" ;; esac
   done
 }
+
+# wait_trainees LAB_PID NAME LOG...: every trainee log has its SUMMARY line
+# (their palpation takes about 5 s after the lab's 2 s start delay; 60 s at
+# most); fails if the lab ends first.
+wait_trainees() {
+  local lab="$1" name="$2" t n=0
+  shift 2
+  for ((t = 0; t < 600; t++)); do
+    n=$(cat "$@" 2>/dev/null | grep -c '^SUMMARY' || true)
+    [ "$n" = $# ] && return 0
+    kill -0 "$lab" 2>/dev/null || fail "$name ended on its own"
+    sleep 0.1
+  done
+  fail "the trainees did not finish within 60 s ($n of $# did)"
+}

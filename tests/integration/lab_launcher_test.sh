@@ -57,14 +57,7 @@ LABS+=("$A")
 launch_lab B "$OUT/lab_b.out" --out "$OUT/b" --first 3 --seats 2 --viewers 0 --no-record --duration 0
 LABS+=("$B")
 
-# Both trainees finish their palpation (about 5 s each after a 2 s start delay).
-for ((t = 0; t < 600; t++)); do
-  done_n=$(cat "$OUT"/a/seat0[12]-haptic.log 2>/dev/null | grep -c '^SUMMARY' || true)
-  [ "$done_n" = 2 ] && break
-  kill -0 "$A" 2>/dev/null || fail "lab A ended on its own"
-  sleep 0.1
-done
-[ "$done_n" = 2 ] || fail "the trainees did not finish within 60 s"
+wait_trainees "$A" "lab A" "$OUT"/a/seat01-haptic.log "$OUT"/a/seat02-haptic.log
 sleep 1 # a few more MeshDeltas of every seat reach the recorder
 
 # B: a frozen server, then SIGTERM.

@@ -36,15 +36,7 @@ rc=0; bash "$SRC/deploy/lab.sh" --build "$BUILD" --out "$OUT/refused" --one-serv
 grep -q -- "--one-server" "$OUT/refused.out" || fail "the refusal does not name --one-server: $(cat "$OUT/refused.out")"
 
 launch_lab L "$OUT/lab.out" --out "$OUT/l" --one-server --first 2 --seats 2 --trainees --viewers 1 --duration 0
-# Both trainees finish their palpation (about 5 s each after a 2 s start delay).
-done_n=0
-for ((t = 0; t < 600; t++)); do
-  done_n=$(cat "$OUT"/l/seat0[23]-haptic.log 2>/dev/null | grep -c '^SUMMARY' || true)
-  [ "$done_n" = 2 ] && break
-  kill -0 "$L" 2>/dev/null || fail "the lab ended on its own"
-  sleep 0.1
-done
-[ "$done_n" = 2 ] || fail "the trainees did not finish within 60 s"
+wait_trainees "$L" "the lab" "$OUT"/l/seat02-haptic.log "$OUT"/l/seat03-haptic.log
 servers=$(ps -o args= -s "$L" | grep -c '^[^ ]*/viscera-server ' || true)
 [ "$servers" = 1 ] || fail "$servers server processes in the lab, expected one for both seats"
 sleep 1 # a few more MeshDeltas of every seat reach the recorder
