@@ -23,6 +23,8 @@ static void usage(FILE *f) {
              "                    read it (taken only with the recorded sha256)\n"
              "  --tolerance M     largest per-coordinate error allowed, m (default: quant_step/2 + 5e-8)\n"
              "  --csv FILE        one line per compared frame: step,sim_time_s,organ,kind,max_err_m,rms_err_m,exact\n"
+             "  --partition P     the session of partition P (a lab's recording holds every seat's session,\n"
+             "                    e.g. lab/seat03); needed when the recording holds more than one\n"
              "  --quiet           no progress lines\n"
              "  --help            this text\n"
              "  --version         print the version and exit\n"
@@ -64,7 +66,9 @@ int main(int argc, char **argv) {
                                      {"mesh-dir", required_argument, 0, OPT_MESH_DIR},
                                      {0, 0, 0, 0}};
   const cli_spec_t spec = {.program = "viscera-resim",
-                           .common = CLI_QUIET,
+                           .common = CLI_QUIET | CLI_PARTITION,
+                           .partition_error = "--partition needs 1..255 characters",
+                           .partition_max = 256,
                            .shortopts = "s:t:c:m:qh",
                            .options = lo,
                            .option = on_option,
@@ -74,6 +78,7 @@ int main(int argc, char **argv) {
   int rc = cli_parse(&spec, argc, argv, &common, &o);
   if (rc != CLI_RUN) return rc;
   o.quiet = common.quiet;
+  o.partition = common.partition;
   if (optind != argc - 1) {
     fprintf(stderr, "viscera-resim: expected one recording REC.db\n");
     usage(stderr);

@@ -207,7 +207,7 @@ int resim_app_run(const resim_options_t *o) {
     scene_path = scene_buf;
   }
   static resim_recording_t rec;
-  if (resim_recording_load(&rec, o->rec_path, &err)) {
+  if (resim_recording_load(&rec, o->rec_path, o->partition, &err)) {
     fprintf(stderr, "viscera-resim: %s\n", err.msg);
     return 2;
   }
@@ -217,6 +217,7 @@ int resim_app_run(const resim_options_t *o) {
     return 2;
   }
   print_build(&rec);
+  if (rec.partition[0]) printf("SESSION partition=%s\n", rec.partition);
   if (rec.warnings[0]) fprintf(stderr, "viscera-resim: warning: %s\n", rec.warnings);
   if (rec.skipped)
     fprintf(stderr, "viscera-resim: warning: %" PRIu64 " sample(s) skipped; first: %s\n", rec.skipped, rec.first_skip);

@@ -10,6 +10,7 @@ typedef struct resim_options {
   const char *rec_path;   /* the recording */
   double tolerance;       /* --tolerance, m; < 0: quant_step/2 + float slack */
   int quiet;              /* --quiet */
+  const char *partition;  /* --partition P, or NULL: the recording's only session */
 } resim_options_t;
 
 /* Exit code: 0 within tolerance, 1 beyond, 2 on an error. */

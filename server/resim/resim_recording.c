@@ -10,6 +10,7 @@
 #include "recording/recfile.h"
 #include "recording/rec_decode.h"
 #include "interaction/events.h"
+#include "resim/resim_session.h"
 #include "viscera.h"
 
 typedef struct caps {
@@ -462,10 +463,33 @@ static void skip_undecodable(resim_recording_t *rec, const char *topic, const re
   rec->skipped += rep->undecodable - 1;
 }
 
-int resim_recording_load(resim_recording_t *rec, const char *path, verr_t *err) {
+/* A topic pass restricted to the chosen session's writers. */
+typedef struct session_filter {
+  const resim_session_t *session;
+  rec_decode_cb cb;
+  void *arg;
+  uint64_t kept; /* samples of the session passed on */
+} session_filter_t;
+
+static int in_session(void *arg, const void *sample, const recfile_row_t *row) {
+  session_filter_t *f = arg;
+  if (!resim_session_has(f->session, row->writer_id)) return 0;
+  f->kept++;
+  return f->cb(f->arg, sample, row);
+}
+
+int resim_recording_load(resim_recording_t *rec, const char *path, const char *partition, verr_t *err) {
   memset(rec, 0, sizeof *rec);
   recfile_t *rf = NULL;
   if (recfile_open(&rf, path, err)) return -1;
+  resim_session_t session;
+  if (resim_session_pick(rf, partition, &session, err)) {
+    verr_t e = *err;
+    verr_set(err, "%s: %s", path, e.msg);
+    recfile_close(rf);
+    return -1;
+  }
+  snprintf(rec->partition, sizeof rec->partition, "%s", session.partition);
   snprintf(rec->warnings, sizeof rec->warnings, "%s", recfile_warnings(rf));
   load_ctx_t ctx = {.rec = rec};
   /* SceneInfo first: dt turns every sim time into a step, and the organ and
@@ -485,12 +509,14 @@ int resim_recording_load(resim_recording_t *rec, const char *path, verr_t *err) 
   int rc = 0;
   for (size_t p = 0; p < sizeof passes / sizeof passes[0] && !rc; p++) {
     rec_decode_report_t rep;
-    if (rec_decode_topic(rf, passes[p].name, passes[p].desc, passes[p].cb, &ctx, &rep) < 0) ctx.oom = 1;
+    session_filter_t f = {&session, passes[p].cb, &ctx, 0};
+    if (rec_decode_topic(rf, passes[p].name, passes[p].desc, in_session, &f, &rep) < 0) ctx.oom = 1;
     if (rep.topic_missing) {
       if (p == 0) rc = verr_set(err, "%s: no SceneInfo topic recorded: cannot tell which scene this is", path);
       continue; /* e.g. no tool ever connected: nothing to schedule */
     }
-    if (passes[p].count) *passes[p].count = rep.decoded + rep.undecodable;
+    /* (undecodable samples are counted whichever session wrote them) */
+    if (passes[p].count) *passes[p].count = f.kept + rep.undecodable;
     skip_undecodable(rec, passes[p].name, &rep);
     if (ctx.oom)
       rc = verr_set(err, "%s: out of memory reading %s", path, passes[p].name);
@@ -502,6 +528,7 @@ int resim_recording_load(resim_recording_t *rec, const char *path, verr_t *err) 
                     rep.scan.damaged ? "; the file is damaged: " : "", rep.scan.damaged ? rep.scan.first_error : "");
   }
   recfile_close(rf);
+  resim_session_free(&session);
   free(ctx.rebuild_ts);
   /* The server numbers its samples from 1: a missing one is a lost input
    * (duplicates, which a reliable reader does not deliver, would hide one). */

@@ -172,12 +172,15 @@ typedef struct resim_recording {
   uint64_t n_commands, n_feedback, n_events, n_states, n_deltas, n_applied, n_objects, n_metrics;
   uint64_t skipped;
   char first_skip[256];
-  char warnings[512]; /* from the recording reader (damage, missing pragmas) */
+  char warnings[512];  /* from the recording reader (damage, missing pragmas) */
+  char partition[256]; /* the session read (resim_session.h), "" when the recording holds only one */
 } resim_recording_t;
 
-/* Returns 0, or -1 with err naming the file and what is wrong (not a
- * recording, no SceneInfo, unreadable). */
-int resim_recording_load(resim_recording_t *rec, const char *path, verr_t *err);
+/* Reads the session of `partition` (NULL: the recording's only one; a
+ * lab's recording of several seats needs one, resim_session.h).
+ * Returns 0, or -1 with err naming the file and what is wrong (not a
+ * recording, no SceneInfo, unreadable, several sessions and none chosen). */
+int resim_recording_load(resim_recording_t *rec, const char *path, const char *partition, verr_t *err);
 void resim_recording_free(resim_recording_t *rec);
 
 #endif

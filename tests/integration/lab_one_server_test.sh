@@ -8,7 +8,9 @@
 # both), every viewer wrote frames, both trainees felt force, the process's
 # log split into seat02-server.log and seat03-server.log with each seat's
 # figures, the lab's summary line per seat with its step time, exit 0 after
-# SIGINT with nothing left running. --one-server with --secure is refused
+# SIGINT with nothing left running; the lab's recording re-simulates each
+# seat bit for bit with viscera-resim --partition, and without it names the
+# two sessions and exits 2. --one-server with --secure is refused
 # (exit 2, naming --one-server).
 # usage: lab_one_server_test.sh BUILD SRC OUT
 set -euo pipefail
@@ -63,6 +65,19 @@ for s in seat02 seat03; do
   grep -q '^SUMMARY steps=[0-9]' "$OUT/l/$s-server.log" || fail "no SUMMARY line in $s-server.log"
   grep -Eq "^  $s: frames [1-9][0-9]*, trainee peak force [0-9.]+ N, step time median [0-9.]+ us" "$OUT/lab.out" ||
     fail "the lab's summary has no full line for $s"
+done
+# The lab's one recording holds both seats' sessions: viscera-resim asks
+# which one, and re-simulates each bit for bit.
+rc=0; "$BUILD/server/viscera-resim" "$DB" --quiet > "$OUT/resim_any.out" 2>&1 || rc=$?
+[ "$rc" = 2 ] || fail "viscera-resim on the two-seat recording without --partition exited $rc, not 2"
+grep -q "holds 2 sessions (partitions lab/seat02, lab/seat03): choose one with --partition" "$OUT/resim_any.out" ||
+  fail "viscera-resim did not name the sessions: $(cat "$OUT/resim_any.out")"
+for s in seat02 seat03; do
+  "$BUILD/server/viscera-resim" "$DB" --quiet --partition "lab/$s" > "$OUT/resim_$s.out" 2>&1 ||
+    fail "viscera-resim --partition lab/$s failed: $(tail -3 "$OUT/resim_$s.out")"
+  grep -q '^RESIM PASS .*bit_exact=1' "$OUT/resim_$s.out" || fail "lab/$s not re-simulated bit for bit: $(grep RESIM "$OUT/resim_$s.out")"
+  grep -q "^INPUTS mode=applied commands=[1-9][0-9]* .* lost=0" "$OUT/resim_$s.out" ||
+    fail "lab/$s: $(grep INPUTS "$OUT/resim_$s.out")"
 done
 expect_logs "$OUT/l" recorder seats-server seat02-viewer1 seat02-haptic seat03-viewer1 seat03-haptic
 echo PASS

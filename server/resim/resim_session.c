@@ -1,0 +1,97 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+#include "resim/resim_session.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "recording/rec_writers.h"
+
+/* True when the comma-separated list `parts` names `p`. */
+static bool lists(const char *parts, const char *p) {
+  size_t lp = strlen(p);
+  for (const char *s = parts; *s;) {
+    const char *e = strchr(s, ',');
+    size_t l = e ? (size_t)(e - s) : strlen(s);
+    if (l == lp && !memcmp(s, p, l)) return true;
+    if (!e) break;
+    s = e + 1;
+  }
+  return false;
+}
+
+static int cmp_id(const void *a, const void *b) {
+  int64_t x = *(const int64_t *)a, y = *(const int64_t *)b;
+  return (x > y) - (x < y);
+}
+
+/* The partitions of the SceneInfo writers (one per session), as "a, b, c"
+ * (at most `cap` bytes, "..." when cut), and how many differ. */
+static size_t sessions(const rec_writer_t *w, size_t n, int64_t scene_topic, char *names, size_t cap) {
+  size_t count = 0, used = 0;
+  names[0] = 0;
+  for (size_t i = 0; i < n; i++) {
+    if (w[i].topic_id != scene_topic) continue;
+    bool seen = false;
+    for (size_t j = 0; j < i && !seen; j++)
+      seen = w[j].topic_id == scene_topic && !strcmp(w[j].partitions, w[i].partitions);
+    if (seen) continue;
+    count++;
+    const char *name = w[i].partitions[0] ? w[i].partitions : "(no partition)";
+    int k = snprintf(names + used, cap - used, "%s%s", used ? ", " : "", name);
+    if (k < 0 || (size_t)k >= cap - used) {
+      if (cap > 4) strcpy(names + cap - 4, "...");
+      used = cap - 1;
+    } else {
+      used += (size_t)k;
+    }
+  }
+  return count;
+}
+
+int resim_session_pick(recfile_t *rf, const char *partition, resim_session_t *out, verr_t *err) {
+  memset(out, 0, sizeof *out);
+  const recfile_topic_t *t = recfile_topic_by_name(rf, "viscera_SceneInfo");
+  rec_writer_t *w = NULL;
+  size_t n = 0;
+  if (rec_writers_load(rf, &w, &n, err)) return -1;
+  char names[200];
+  size_t count = t ? sessions(w, n, t->id, names, sizeof names) : 0;
+  if (!partition || !*partition) {
+    free(w);
+    if (count > 1)
+      return verr_set(err, "the recording holds %zu sessions (partitions %s): choose one with --partition", count,
+                      names);
+    return 0; /* one session (or none: the SceneInfo check says so) */
+  }
+  out->ids = malloc((n ? n : 1) * sizeof *out->ids);
+  if (!out->ids) {
+    free(w);
+    return verr_set(err, "out of memory for %zu writers", n);
+  }
+  bool scene = false;
+  for (size_t i = 0; i < n; i++) {
+    if (!lists(w[i].partitions, partition)) continue;
+    out->ids[out->n++] = w[i].id;
+    scene |= t && w[i].topic_id == t->id;
+  }
+  free(w);
+  if (!scene) {
+    resim_session_free(out);
+    return verr_set(err, "no session in partition '%.100s' (the recording's: %s)", partition, count ? names : "none");
+  }
+  qsort(out->ids, out->n, sizeof *out->ids, cmp_id);
+  out->filter = true;
+  snprintf(out->partition, sizeof out->partition, "%s", partition);
+  return 0;
+}
+
+bool resim_session_has(const resim_session_t *s, int64_t writer_id) {
+  if (!s->filter) return true;
+  return bsearch(&writer_id, s->ids, s->n, sizeof *s->ids, cmp_id) != NULL;
+}
+
+void resim_session_free(resim_session_t *s) {
+  free(s->ids);
+  memset(s, 0, sizeof *s);
+}
