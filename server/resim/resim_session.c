@@ -25,27 +25,31 @@ static int cmp_id(const void *a, const void *b) {
   return (x > y) - (x < y);
 }
 
-/* The partitions of the SceneInfo writers (one per session), as "a, b, c"
- * (at most `cap` bytes, "..." when cut), and how many differ. */
+static int cmp_str(const void *a, const void *b) { return strcmp(*(const char *const *)a, *(const char *const *)b); }
+
+/* The partitions of the SceneInfo writers (one per session), sorted, as
+ * "a, b, c" (at most `cap` bytes, "..." when cut), and how many differ. */
 static size_t sessions(const rec_writer_t *w, size_t n, int64_t scene_topic, char *names, size_t cap) {
+  const char **p = malloc((n ? n : 1) * sizeof *p);
   size_t count = 0, used = 0;
   names[0] = 0;
+  if (!p) return 0;
   for (size_t i = 0; i < n; i++) {
     if (w[i].topic_id != scene_topic) continue;
     bool seen = false;
-    for (size_t j = 0; j < i && !seen; j++)
-      seen = w[j].topic_id == scene_topic && !strcmp(w[j].partitions, w[i].partitions);
-    if (seen) continue;
-    count++;
-    const char *name = w[i].partitions[0] ? w[i].partitions : "(no partition)";
-    int k = snprintf(names + used, cap - used, "%s%s", used ? ", " : "", name);
+    for (size_t j = 0; j < count && !seen; j++) seen = !strcmp(p[j], w[i].partitions);
+    if (!seen) p[count++] = w[i].partitions;
+  }
+  qsort(p, count, sizeof *p, cmp_str);
+  for (size_t i = 0; i < count; i++) {
+    int k = snprintf(names + used, cap - used, "%s%s", used ? ", " : "", p[i][0] ? p[i] : "(no partition)");
     if (k < 0 || (size_t)k >= cap - used) {
       if (cap > 4) strcpy(names + cap - 4, "...");
-      used = cap - 1;
-    } else {
-      used += (size_t)k;
+      break;
     }
+    used += (size_t)k;
   }
+  free(p);
   return count;
 }
 

@@ -35,6 +35,7 @@
 
 typedef struct server {
   const server_opts_t *opts;
+  const char *tag; /* what the log lines start with: opts->log_tag or "server" */
   runtime_t rt;
   vdds_t dds;
   dds_entity_t w_scene, w_state, w_delta, w_feedback, w_event, w_metrics, r_cmd, r_control;
@@ -157,7 +158,7 @@ static void publish_scene_info(server_t *s) {
 static void publish_scene_source(server_t *s) {
   viscera_SceneSource src;
   verr_t e;
-  if (scene_source_fill(&src, &s->rt.scene, NULL, &e)) fprintf(stderr, "server: warning: %s\n", e.msg);
+  if (scene_source_fill(&src, &s->rt.scene, NULL, &e)) fprintf(stderr, "%s: warning: %s\n", s->tag, e.msg);
   /* borrowed for the write only */
   src.resume_state._buffer = s->resume.p;
   src.resume_state._length = src.resume_state._maximum = (uint32_t)s->resume.len;
@@ -231,7 +232,7 @@ static int setup(server_t *s, const scene_t *scene, verr_t *err) {
   if (s->w_chunk < 0) {
     /* Permissions made by an older deploy/pki.sh do not grant this topic:
      * keyframes then go as MeshState only (slower over a lossy link). */
-    fprintf(stderr, "server: keyframe chunks off (%s); keyframes go as MeshState only\n", err->msg);
+    fprintf(stderr, "%s: keyframe chunks off (%s); keyframes go as MeshState only\n", s->tag, err->msg);
     s->w_chunk = 0;
   }
   if (s->w_scene < 0 || s->w_state < 0 || s->w_delta < 0 || s->w_feedback < 0 || s->w_event < 0 || s->w_metrics < 0 ||
@@ -303,9 +304,9 @@ static void release_lost_writers(server_t *s, uint64_t now) {
          * liveliness_watch.h). Keep the tool; say so a few times. */
         if (++s->stats->liveliness_blips <= 3 && !s->opts->quiet)
           fprintf(stderr,
-                  "server: tool %zu: client liveliness lapsed while it kept sending (machine overloaded?); "
+                  "%s: tool %zu: client liveliness lapsed while it kept sending (machine overloaded?); "
                   "kept\n",
-                  t);
+                  s->tag, t);
         continue;
       }
       /* One side of a guided tool gone: its hand stops counting at once and
@@ -320,7 +321,7 @@ static void release_lost_writers(server_t *s, uint64_t now) {
        * releases it unless the guide is driving right now. */
       if (side == TOOL_SIDE_GUIDE || tool_roles_effective(&s->roles, t, now, &eff)) {
         if (!s->opts->quiet)
-          fprintf(stderr, "server: tool %zu: %s client (%s) lost: the %s drives on alone\n", t,
+          fprintf(stderr, "%s: tool %zu: %s client (%s) lost: the %s drives on alone\n", s->tag, t,
                   side ? "guide" : "owner", who, side ? "owner" : "guide");
         continue;
       }
@@ -339,7 +340,7 @@ static void release_lost_writers(server_t *s, uint64_t now) {
                  heard_ms, VDDS_TOOL_LEASE_MS, released_ms);
       else
         snprintf(text, sizeof text, "haptic client left (its command writer was deleted): tool released");
-      if (!s->opts->quiet) fprintf(stderr, "server: tool %zu: %s\n", t, text);
+      if (!s->opts->quiet) fprintf(stderr, "%s: tool %zu: %s\n", s->tag, t, text);
       publish_event(s, viscera_EVENT_CLIENT_LOST, -1, (int)t, (double)(now - last) * 1e-9, text);
     }
   }
@@ -352,7 +353,7 @@ static void drive_tool(server_t *s, size_t t, uint64_t now) {
   if (!tool_roles_effective(&s->roles, t, now, &eff)) return;
   if (s->tool[t].lost) {
     s->tool[t].lost = 0;
-    if (!s->opts->quiet) fprintf(stderr, "server: tool %zu: haptic client back\n", t);
+    if (!s->opts->quiet) fprintf(stderr, "%s: tool %zu: haptic client back\n", s->tag, t);
   }
   const double *was = s->rt.tools[t].cmd.pos;
   double d[3] = {eff.cmd.pos[0] - was[0], eff.cmd.pos[1] - was[1], eff.cmd.pos[2] - was[2]};
@@ -390,7 +391,7 @@ static void report_rejected(server_t *s, tool_cmd_verdict_t v, uint32_t tool, co
   else
     snprintf(text, sizeof text, "ToolCommand from tool %u rejected%s: %s (%" PRIu64 " rejected so far)", tool, how,
              tool_command_verdict_str(v), r);
-  if (!s->opts->quiet) fprintf(stderr, "server: %s\n", text);
+  if (!s->opts->quiet) fprintf(stderr, "%s: %s\n", s->tag, text);
   publish_event(s, viscera_EVENT_INPUT_REJECTED, -1, (int)(tool < 1u << 30 ? tool : 0), (double)r, text);
 }
 
@@ -477,7 +478,7 @@ static void release_lost_tools(server_t *s, uint64_t now) {
       applied_input_release(&s->ai, t);
       s->tool[t].lost = 1;
       if (!s->opts->quiet)
-        fprintf(stderr, "server: tool %zu: no commands for %.1f s, released\n", t, s->opts->tool_timeout);
+        fprintf(stderr, "%s: tool %zu: no commands for %.1f s, released\n", s->tag, t, s->opts->tool_timeout);
       publish_event(s, viscera_EVENT_CLIENT_LOST, -1, (int)t, s->opts->tool_timeout,
                     "haptic client lost (no commands): tool released");
     }
@@ -500,7 +501,7 @@ static int rebuild_runtime(server_t *s, const scene_t *sc, const scene_t *old, v
     verr_t e2;
     runtime_destroy(&s->rt);
     if (runtime_init(&s->rt, old, &e2)) {
-      fprintf(stderr, "server: cannot rebuild the scene after a refused change: %s\n", e2.msg);
+      fprintf(stderr, "%s: cannot rebuild the scene after a refused change: %s\n", s->tag, e2.msg);
       return -2;
     }
     rc = -1;
@@ -518,7 +519,7 @@ static int rebuild_runtime(server_t *s, const scene_t *sc, const scene_t *old, v
     verr_t e;
     if (mesh_publisher_retopo(&s->pubs[i], o->topology_version, m->nsurf, m->surf_tris, m->nsurf_tris, m->surf_x,
                               sim_ns(s), &e))
-      fprintf(stderr, "server: %s\n", e.msg);
+      fprintf(stderr, "%s: %s\n", s->tag, e.msg);
   }
   return rc;
 }
@@ -595,7 +596,7 @@ static int read_controls(server_t *s) {
       applied_input_control(&s->ai, c, result, task);
       free(edit);
       free(old);
-      if (!s->opts->quiet) fprintf(stderr, "server: %s\n", text);
+      if (!s->opts->quiet) fprintf(stderr, "%s: %s\n", s->tag, text);
       publish_event(s, r == 0 ? viscera_EVENT_CONTROL_APPLIED : viscera_EVENT_INPUT_REJECTED, c->organ_id, c->tool_id,
                     (double)c->kind, text);
     }
@@ -682,7 +683,7 @@ static void track_thresholds(server_t *s) {
       snprintf(text, sizeof text, "%s %s: tool '%s' force %.3f N %s %.3f N", thr_name(ev[i].which),
                ev[i].up ? "crossed up" : "crossed down", tool->cfg->name, f, ev[i].up ? "above" : "back below",
                ev[i].level);
-      if (!s->opts->quiet) fprintf(stderr, "server: %s\n", text);
+      if (!s->opts->quiet) fprintf(stderr, "%s: %s\n", s->tag, text);
       publish_event(s, ev[i].up ? viscera_EVENT_THRESHOLD_CROSSED_UP : viscera_EVENT_THRESHOLD_CROSSED_DOWN,
                     contact ? tool->fb_organ : -1, (int)t, ev[i].level, text);
     }
@@ -797,7 +798,7 @@ static void publish_interactions(server_t *s) {
       break;
     }
     }
-    if (!s->opts->quiet) fprintf(stderr, "server: %s\n", text);
+    if (!s->opts->quiet) fprintf(stderr, "%s: %s\n", s->tag, text);
     bool about_task = e->kind == IEV_TASK_STARTED || e->kind == IEV_TASK_COMPLETED;
     publish_task_event(s, kind, e->organ, e->tool, e->value, text, about_task ? e->task : -1);
   }
@@ -806,7 +807,7 @@ static void publish_interactions(server_t *s) {
   char msg[240];
   uint64_t r = scalpel_take_error(&s->rt, msg, sizeof msg);
   if (r && (r <= 5 || r % 100 == 0) && !s->opts->quiet)
-    fprintf(stderr, "server: %s (%" PRIu64 " refused so far)\n", msg, r);
+    fprintf(stderr, "%s: %s (%" PRIu64 " refused so far)\n", s->tag, msg, r);
 }
 
 static void publish_objects(server_t *s) {
@@ -869,12 +870,12 @@ static void follow_topology(server_t *s) {
     char text[200];
     if (mesh_publisher_retopo(mp, o->topology_version, m->nsurf, m->surf_tris, m->nsurf_tris, m->surf_x, sim_ns(s),
                               &e)) {
-      fprintf(stderr, "server: %s\n", e.msg);
+      fprintf(stderr, "%s: %s\n", s->tag, e.msg);
       continue;
     }
     snprintf(text, sizeof text, "organ '%s': topology %u: %zu vertices, %zu triangles", o->cfg->name,
              mp->topology_version, m->nsurf, m->nsurf_tris);
-    if (!s->opts->quiet && mp->retopos <= 5) fprintf(stderr, "server: %s\n", text);
+    if (!s->opts->quiet && mp->retopos <= 5) fprintf(stderr, "%s: %s\n", s->tag, text);
     publish_event(s, viscera_EVENT_TOPOLOGY_CHANGED, (int)i, -1, (double)m->nsurf, text);
   }
 }
@@ -895,7 +896,7 @@ static void write_final_mesh(server_t *s) {
     snprintf(comment, sizeof comment, "organ %zu topology %u keyframe %u frame %u", i, s->pubs[i].topology_version,
              s->pubs[i].keyframe_seq, s->pubs[i].frame_seq);
     verr_t e;
-    if (mesh_write_obj(&m, path, comment, &e)) fprintf(stderr, "server: %s\n", e.msg);
+    if (mesh_write_obj(&m, path, comment, &e)) fprintf(stderr, "%s: %s\n", s->tag, e.msg);
   }
 }
 
@@ -929,7 +930,7 @@ static void report_rollbacks(server_t *s, int rolled) {
     char text[160];
     snprintf(text, sizeof text, "non-finite state: %" PRIu64 " organ step(s) rolled back since the last report", n);
     publish_event(s, viscera_EVENT_STEP_ROLLED_BACK, -1, -1, (double)n, text);
-    if (!s->opts->quiet) fprintf(stderr, "server: step %" PRIu64 ": %s\n", s->rt.steps, text);
+    if (!s->opts->quiet) fprintf(stderr, "%s: step %" PRIu64 ": %s\n", s->tag, s->rt.steps, text);
   }
   for (size_t i = 0; i < s->rt.norgans; i++) {
     if (!(s->rt.organs_reset & (1u << i))) continue;
@@ -938,7 +939,7 @@ static void report_rollbacks(server_t *s, int rolled) {
              "organ '%.60s' reset to rest after %d consecutive rolled-back steps (%" PRIu64 " so far)",
              s->rt.organs[i].cfg->name, RUNTIME_ROLLBACK_RESET, s->rt.organs[i].rest_resets);
     publish_event(s, viscera_EVENT_STEP_ROLLED_BACK, (int)i, -1, RUNTIME_ROLLBACK_RESET, text);
-    fprintf(stderr, "server: step %" PRIu64 ": %s\n", s->rt.steps, text);
+    fprintf(stderr, "%s: step %" PRIu64 ": %s\n", s->tag, s->rt.steps, text);
   }
 }
 
@@ -1018,6 +1019,7 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
   memset(&s, 0, sizeof s);
   memset(stats, 0, sizeof *stats);
   s.opts = opts;
+  s.tag = opts->log_tag ? opts->log_tag : "server";
   s.stats = stats;
   if (setup(&s, scene, err)) {
     teardown(&s);
@@ -1028,18 +1030,18 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
       const organ_rt_t *o = &s.rt.organs[i];
       const model_t *m = o->model;
       fprintf(stderr,
-              "server: organ '%s': %s, %s, %zu nodes, %zu tetrahedra, surface %zu vertices / %zu triangles, "
+              "%s: organ '%s': %s, %s, %zu nodes, %zu tetrahedra, surface %zu vertices / %zu triangles, "
               "%d sub-step(s) per %.3g ms (stable below %.3g ms)\n",
-              o->cfg->name, m->ops->name, o->cfg->integrator, m->nnodes, m->ntets, m->nsurf, m->nsurf_tris, m->substeps,
-              scene->dt * 1e3, m->stable_dt * 1e3);
-      if (o->mesh_note[0]) fprintf(stderr, "server: organ '%s': mesh repaired: %s\n", o->cfg->name, o->mesh_note);
+              s.tag, o->cfg->name, m->ops->name, o->cfg->integrator, m->nnodes, m->ntets, m->nsurf, m->nsurf_tris,
+              m->substeps, scene->dt * 1e3, m->stable_dt * 1e3);
+      if (o->mesh_note[0]) fprintf(stderr, "%s: organ '%s': mesh repaired: %s\n", s.tag, o->cfg->name, o->mesh_note);
       if (m->substeps > 0 && scene->dt / m->substeps > m->stable_dt)
         fprintf(stderr,
-                "server: organ '%s': warning: solver.substeps %d gives %.3g ms sub-steps, above the "
+                "%s: organ '%s': warning: solver.substeps %d gives %.3g ms sub-steps, above the "
                 "stable %.3g ms: expect rollbacks\n",
-                o->cfg->name, m->substeps, scene->dt / m->substeps * 1e3, m->stable_dt * 1e3);
+                s.tag, o->cfg->name, m->substeps, scene->dt / m->substeps * 1e3, m->stable_dt * 1e3);
     }
-    fprintf(stderr, "server: scene '%s' running on domain %d, partition '%s'\n", scene->name, opts->domain,
+    fprintf(stderr, "%s: scene '%s' running on domain %d, partition '%s'\n", s.tag, scene->name, opts->domain,
             opts->partition ? opts->partition : VDDS_DEFAULT_PARTITION);
   }
   for (size_t t = 0; t < s.rt.ntools; t++) {
@@ -1060,7 +1062,7 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
       return -1;
     }
     if (r < 0) {
-      fprintf(stderr, "server: %s\n", e.msg);
+      fprintf(stderr, "%s: %s\n", s.tag, e.msg);
       /* A topology restore that failed midway rebuilt the runtime: the
        * publishers must drop the old models' surfaces they borrow. */
       for (size_t i = 0; i < s.rt.norgans; i++) {
@@ -1068,17 +1070,17 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
         if (s.pubs[i].tris != m->surf_tris &&
             mesh_publisher_retopo(&s.pubs[i], s.rt.organs[i].topology_version, m->nsurf, m->surf_tris, m->nsurf_tris,
                                   m->surf_x, 0, &e))
-          fprintf(stderr, "server: %s\n", e.msg);
+          fprintf(stderr, "%s: %s\n", s.tag, e.msg);
       }
     } else if (r == 1) {
       stats->resumed = 1;
       snprintf(resumed, sizeof resumed, "resumed from checkpoint %s at t = %.3f s (step %llu)", opts->checkpoint,
                s.rt.sim_time, (unsigned long long)s.rt.steps);
-      if (!opts->quiet) fprintf(stderr, "server: %s\n", resumed);
+      if (!opts->quiet) fprintf(stderr, "%s: %s\n", s.tag, resumed);
       follow_topology(&s); /* a restored cut: keyframes of its topology before anything else */
       if (checkpoint_resume_state(&s.resume, &s.rt, s.tool, &e) || s.resume.bad) {
         /* the session runs on; its recording cannot be re-simulated */
-        fprintf(stderr, "server: warning: the resumed state cannot be recorded: %s\n",
+        fprintf(stderr, "%s: warning: the resumed state cannot be recorded: %s\n", s.tag,
                 s.resume.bad ? "out of memory" : e.msg);
         free(s.resume.p);
         s.resume = (state_blob_t){0};
@@ -1139,7 +1141,7 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
   if (ckpt) {
     checkpointer_submit(ckpt, &s.rt, s.tool, &s.roles);
     verr_t e;
-    if (checkpointer_stop(ckpt, &stats->checkpoints_written, &e)) fprintf(stderr, "server: %s\n", e.msg);
+    if (checkpointer_stop(ckpt, &stats->checkpoints_written, &e)) fprintf(stderr, "%s: %s\n", s.tag, e.msg);
   }
   if (opts->final_mesh) write_final_mesh(&s);
   publish_event(&s, viscera_EVENT_SESSION_STOPPED, -1, -1, 0, scene->name);

@@ -25,6 +25,7 @@ typedef struct server_opts {
   const char *checkpoint;  /* state file: resumed from at start when it fits the scene, written periodically */
   double checkpoint_every; /* s of simulated time between checkpoints */
   int rt_priority;         /* 1..99: the step loop's thread runs SCHED_FIFO at it (vrt.h); 0 = normal */
+  const char *log_tag;     /* the log lines' "TAG: " (NULL: "server"); a seat's own among several (server_app.h) */
 } server_opts_t;
 
 typedef struct server_stats {

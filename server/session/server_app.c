@@ -150,6 +150,7 @@ typedef struct seat_run {
   server_opts_t opts;
   char partition[128];
   char name[16]; /* the thread's, for ps and top */
+  char tag[160];  /* its log lines' prefix: "server P/seatKK" */
   server_stats_t st;
   verr_t err;
   int rc;
@@ -195,6 +196,8 @@ static int run_seats(const scene_t *scene, const server_app_options_t *o) {
       break;
     }
     r->opts.partition = r->partition;
+    snprintf(r->tag, sizeof r->tag, "server %s", r->partition);
+    r->opts.log_tag = r->tag;
     snprintf(r->name, sizeof r->name, "seat%02d", o->first_seat + k);
     int e = pthread_create(&th[k], &attr, seat_main, r);
     if (e) {

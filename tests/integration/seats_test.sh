@@ -39,8 +39,11 @@ h1=$!; PIDS+=("$h1")
   --quiet > "$OUT/shallow.log" 2>&1 || fail "the seat02 trainee failed: $(tail -3 "$OUT/shallow.log")"
 wait "$h1" || fail "the seat01 trainee failed: $(tail -3 "$OUT/deep.log")"
 kill -INT "$srv"; wait "$srv" || fail "the server exited with an error: $(tail -5 "$OUT/server.log")"
-grep -q "running on domain .*, partition 'seats/seat01'" "$OUT/server.log" || fail "seat01 did not start"
-grep -q "running on domain .*, partition 'seats/seat02'" "$OUT/server.log" || fail "seat02 did not start"
+# Each seat's log lines name it (one log for the process).
+grep -q "^server seats/seat01: scene .* running on domain .*, partition 'seats/seat01'" "$OUT/server.log" ||
+  fail "seat01 did not start (or its lines do not name it)"
+grep -q "^server seats/seat02: scene .* running on domain .*, partition 'seats/seat02'" "$OUT/server.log" ||
+  fail "seat02 did not start (or its lines do not name it)"
 felt() { sed -n 's/^SUMMARY .*peak_force=\([0-9.]*\).*/\1/p' "$1"; }
 deep=$(felt "$OUT/deep.log"); shallow=$(felt "$OUT/shallow.log")
 # The seat's own summary: the lines after its SEAT line, up to the next.
