@@ -69,7 +69,7 @@ while [ $# -gt 0 ]; do
     --scene) SCENE="$2"; shift 2 ;;
     --busy) BUSY=1; shift ;;
     --one-server) ONE=1; shift ;;
-    -h|--help) sed -n 3,48p "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) awk 'NR > 2 && /^#/ { sub(/^# ?/, ""); print; next } NR > 2 { exit }' "$0"; exit 0 ;;
     *) echo "load_bench.sh: unknown option '$1'" >&2; exit 2 ;;
   esac
 done

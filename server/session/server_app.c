@@ -150,7 +150,7 @@ typedef struct seat_run {
   server_opts_t opts;
   char partition[128];
   char name[16]; /* the thread's, for ps and top */
-  char tag[160];  /* its log lines' prefix: "server P/seatKK" */
+  char tag[160]; /* its log lines' prefix: "server P/seatKK" */
   server_stats_t st;
   verr_t err;
   int rc;

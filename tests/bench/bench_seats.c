@@ -110,8 +110,7 @@ int main(int argc, char **argv) {
       char *end;
       evict_kb = strtol(argv[++i], &end, 10);
       if (*end || end == argv[i]) evict_kb = -1;
-    }
-    else {
+    } else {
       fprintf(stderr, "usage: bench_seats [--scene FILE] [--seats LIST] [--seconds S] [--evict KB]\n");
       return 2;
     }
