@@ -1113,7 +1113,7 @@ int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_ato
    * core for good. The kernel's RT throttling (sched_rt_runtime_us: 950 ms of
    * every second by default) is the safety net that still lets the other
    * tasks (this server's DDS threads, a shell to stop it) run there. */
-  if (opts->rt_priority) vrt_make_realtime(opts->rt_priority, "server", "physics loop", opts->quiet, stderr);
+  if (opts->rt_priority) vrt_make_realtime(opts->rt_priority, s.tag, "physics loop", opts->quiet, stderr);
   /* A SCHED_OTHER loop wakes up to the thread's timer slack (50 us by
    * default) after each tick: every command would wait that much longer
    * for its step and its answer (issue 17 item 5). 1 ns: on time. */
