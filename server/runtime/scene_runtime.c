@@ -479,7 +479,8 @@ static void settle_contact(runtime_t *rt) {
  * tasks) = finish. Between the two the preview may run: it settles copies
  * of the tool records on the surfaces as they are (settle_tool, the
  * settle phase's own code) and runs the outputs' feedback part
- * (interact_feedback) on those copies, never on rt. */
+ * (interact_feedback) on those copies, never on rt's state (only the
+ * culls' working memory). */
 void runtime_step_begin(runtime_t *rt) {
   rt->organs_stepped = 0;
   rt->organs_reset = 0;
@@ -488,7 +489,7 @@ void runtime_step_begin(runtime_t *rt) {
   step_contact(rt);
 }
 
-void runtime_feedback_preview(const runtime_t *rt, tool_rt_t tools[SCENE_MAX_TOOLS]) {
+void runtime_feedback_preview(runtime_t *rt, tool_rt_t tools[SCENE_MAX_TOOLS]) {
   memcpy(tools, rt->tools, rt->ntools * sizeof *tools);
   for (size_t t = 0; t < rt->ntools; t++) settle_tool(rt, &tools[t]);
   interact_feedback(rt, tools);

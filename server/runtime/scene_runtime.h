@@ -115,8 +115,9 @@ int runtime_step_finish(runtime_t *rt);
  * of rt->tools, settles each copy's proxy on the current surfaces and runs
  * the outputs phase's feedback part on the copies (interact_feedback:
  * fb_contact, fb_organ, fb_pos, fb_normal, force; the copies' peak_force is
- * raised, not rt's). Reads rt only: no event, no peak, no tally, no state
- * of the step changes. */
-void runtime_feedback_preview(const runtime_t *rt, tool_rt_t tools[SCENE_MAX_TOOLS]);
+ * raised, not rt's). No event, no peak, no tally, no state of the step
+ * changes in rt: it writes only the culls' working memory (rt->cull's
+ * counters, each organ's cull scratch), which is why rt is not const. */
+void runtime_feedback_preview(runtime_t *rt, tool_rt_t tools[SCENE_MAX_TOOLS]);
 
 #endif

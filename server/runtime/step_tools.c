@@ -313,14 +313,14 @@ static void add_nothing(void *ctx, uint32_t i, const double f[3]) {
 /* The shaft's reaction at the end of the step (from->shaft): added to
  * what the tip feels; a shaft touching while the tip is free is a contact
  * of its own. */
-static void shaft_contribution(const runtime_t *rt, tool_rt_t *tool, size_t t) {
+static void shaft_contribution(runtime_t *rt, tool_rt_t *tool, size_t t) {
   tool_forces_t *from = &tool->from;
   double p0[3], p1[3];
   v3_set(from->shaft, 0, 0, 0);
   if (!shaft_of(rt, tool, t, p0, p1)) return;
   double radius = SHAFT_RADIUS_FRACTION * tool->cfg->radius;
   for (size_t i = 0; i < rt->norgans; i++) {
-    organ_rt_t *o = (organ_rt_t *)&rt->organs[i];
+    organ_rt_t *o = &rt->organs[i];
     const model_t *m = o->model;
     /* After the step the runtime has refit (or rebuilt) the tree. */
     shaft_surface_t surf = {m->surf_x,
@@ -331,9 +331,9 @@ static void shaft_contribution(const runtime_t *rt, tool_rt_t *tool, size_t t) {
                             0,
                             NULL,
                             0};
-    /* The culls' scratch and counters are the runtime's working memory,
-     * not its state: a preview's read-only pass may use them. */
-    shaft_candidates((runtime_t *)rt, o, p0, p1, radius, 0, &surf);
+    /* Writes only the culls' scratch and counters (working memory, not
+     * state of the step): a preview may run it. */
+    shaft_candidates(rt, o, p0, p1, radius, 0, &surf);
     size_t h = tip_on(tool, i)
                    ? (surf.cand ? shaft_push_list(p0, p1, radius, tool->cfg->stiffness, m->surf_x, surf.cand,
                                                   surf.ncand, add_nothing, NULL, from->shaft)
@@ -368,7 +368,7 @@ static void stone_touch(const runtime_t *rt, tool_rt_t *tool) {
 /* What the outputs phase adds to tool t's contributions: the grasp's pull
  * or the held stone's reaction, an extractor's touch of a free stone, the
  * shaft's reaction. */
-static void contributions(const runtime_t *rt, tool_rt_t *tool, size_t t) {
+static void contributions(runtime_t *rt, tool_rt_t *tool, size_t t) {
   tool_forces_t *from = &tool->from;
   from->pull = from->touch = from->tool_tool = 0;
   from->pull_organ = from->shaft_organ = -1;
@@ -506,7 +506,7 @@ static void tool_tool_feedback(tool_rt_t *tool) {
   }
 }
 
-void interact_feedback(const runtime_t *rt, tool_rt_t *tools) {
+void interact_feedback(runtime_t *rt, tool_rt_t *tools) {
   for (size_t t = 0; t < rt->ntools; t++) {
     contributions(rt, &tools[t], t);
     tip_feedback(&tools[t]);

@@ -41,8 +41,9 @@ void interact_outputs(runtime_t *rt);
  * of them, indexed like rt->tools): each tool's contributions, what its
  * client is told (fb_*), tool-tool contact, the hand force. interact_outputs
  * runs it on rt->tools; runtime_feedback_preview on copies, so it reads rt
- * (organs, stones, the scalpel) and writes only `tools`. */
-void interact_feedback(const runtime_t *rt, tool_rt_t *tools);
+ * (organs, stones, the scalpel) and writes only `tools` and the culls'
+ * working memory (rt->cull's counters, the organs' cull scratch). */
+void interact_feedback(runtime_t *rt, tool_rt_t *tools);
 /* The tool's client is gone: drop whatever it holds, stop acting (tool
  * inactive, no force). The god-object keeps its contact, so a client back
  * with its hand inside the organ feels it again (docs/remote.md). */
