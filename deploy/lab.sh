@@ -99,6 +99,8 @@ NET="${CYCLONEDDS_URI:-file://$ROOT/deploy/cyclonedds-loopback.xml}"
   { echo "lab.sh: --one-server runs without DDS Security: each seat's identity may publish only in its own seat, and one process has one" >&2; exit 2; }
 # shellcheck source=net_guard.sh
 source "$ROOT/deploy/net_guard.sh"
+# shellcheck source=seat_logs.sh
+source "$ROOT/deploy/seat_logs.sh"
 net_guard lab.sh "$NET" $SECURE $INSECURE || exit 2
 mkdir -p "$OUT"
 OUT="$(cd "$OUT" && pwd)" # children get absolute paths
@@ -233,14 +235,7 @@ for i in "${!pids[@]}"; do
 done
 echo "lab: ${stop_sig:+stopped by $stop_sig, }done"
 if [ $ONE = 1 ]; then
-  # One log per seat as one server per seat writes: each seat's figures
-  # follow its "server: seat 'PREFIX/seatNN' (k of N):" line and its
-  # "SEAT partition=PREFIX/seatNN ..." line.
-  awk -v out="$OUT" -v pre="$PREFIX" '
-    $0 ~ "^server: seat ." pre "/seat[0-9]+. \\([0-9]+ of [0-9]+\\):$" { n = $3; sub(/.*\//, "", n); sub(/[^a-z0-9]+$/, "", n)
-      f = out "/" n "-server.log"; next }
-    $0 ~ "^SEAT partition=" pre "/seat[0-9]+ " { n = $2; sub(/.*\//, "", n); f = out "/" n "-server.log"; next }
-    f { print > f }' "$OUT/seats-server.log"
+  split_seat_log "$OUT/seats-server.log" "$OUT" "$PREFIX" server.log # seat_logs.sh
 fi
 for i in $(seq "$FIRST" "$LAST"); do
   s=$(printf 'seat%02d' "$i")

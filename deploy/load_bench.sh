@@ -89,6 +89,8 @@ export CYCLONEDDS_URI="${CYCLONEDDS_URI:-file://$ROOT/deploy/cyclonedds-loopback
 # Another configuration than loopback: with a security fragment, or VISCERA_INSECURE=1 (warns).
 # shellcheck source=net_guard.sh
 source "$ROOT/deploy/net_guard.sh"
+# shellcheck source=seat_logs.sh
+source "$ROOT/deploy/seat_logs.sh"
 net_guard load_bench.sh "$CYCLONEDDS_URI" 0 "${VISCERA_INSECURE:-0}" \
   "add an identity fragment from deploy/pki.sh to it, or set VISCERA_INSECURE=1 to run without DDS Security" || exit 2
 export VISCERA_DOMAIN="${VISCERA_DOMAIN:-0}"
@@ -219,14 +221,9 @@ sample $t
 sample_cpu
 wait "${servers[@]}" 2>/dev/null || true
 if [ "$ONE" = 1 ]; then
-  # One log per seat, as one process per seat writes: each seat's figures
-  # follow a "server: seat 'load/seatKK' (k of N):" line (and on stdout a
-  # SEAT line); what comes before the first is the process's own.
-  awk -v out="$OUT" '/^server: seat .load\/seat[0-9]+. \([0-9]+ of [0-9]+\):$/ {
-      n = $3; sub(/.*\//, "", n); sub(/[^a-z0-9]+$/, "", n); f = out "/" n "-server.log"; next }
-    { if (f) print > f; else print > (out "/seats-server.head.log") }' "$OUT/seats-server.log"
-  awk -v out="$OUT" '/^SEAT partition=load\/seat[0-9]+ / { n = $2; sub(/.*\//, "", n); f = out "/" n "-server.out"; next }
-    { if (f) print > f }' "$OUT/seats-server.out"
+  # One log per seat, as one process per seat writes (seat_logs.sh).
+  split_seat_log "$OUT/seats-server.log" "$OUT" load server.log
+  split_seat_log "$OUT/seats-server.out" "$OUT" load server.out
 fi
 # The subscribers and trainees end with the run too; wait (at most 15 s) until
 # each has written its summary line, or the report would miss the last ones.

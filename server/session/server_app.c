@@ -171,12 +171,10 @@ static int run_seats(const scene_t *scene, const server_app_options_t *o) {
   const char *base = o->opts.partition ? o->opts.partition : VDDS_DEFAULT_PARTITION;
   seat_run_t *seats = calloc((size_t)n, sizeof *seats);
   pthread_t *th = calloc((size_t)n, sizeof *th);
-  int *started = calloc((size_t)n, sizeof *started);
-  if (!seats || !th || !started) {
+  if (!seats || !th) {
     fprintf(stderr, "viscera-server: out of memory for %d seats\n", n);
     free(seats);
     free(th);
-    free(started);
     return 1;
   }
   /* A thread's default stack follows RLIMIT_STACK; a session keeps its
@@ -184,7 +182,7 @@ static int run_seats(const scene_t *scene, const server_app_options_t *o) {
   pthread_attr_t attr;
   pthread_attr_init(&attr);
   pthread_attr_setstacksize(&attr, (size_t)16 << 20);
-  int rc = 0;
+  int rc = 0, started = 0; /* seats 0..started-1 run: the first failure stops the starting */
   for (int k = 0; k < n; k++) {
     seat_run_t *r = &seats[k];
     r->scene = scene;
@@ -205,15 +203,13 @@ static int run_seats(const scene_t *scene, const server_app_options_t *o) {
       rc = 1;
       break;
     }
-    started[k] = 1;
+    started++;
   }
   pthread_attr_destroy(&attr);
   /* A seat that did not start is reported above; those that did keep serving. */
-  for (int k = 0; k < n; k++)
-    if (started[k]) pthread_join(th[k], NULL);
-  for (int k = 0; k < n; k++) {
+  for (int k = 0; k < started; k++) pthread_join(th[k], NULL);
+  for (int k = 0; k < started; k++) {
     const seat_run_t *r = &seats[k];
-    if (!started[k]) continue;
     if (r->rc) {
       rc = 1;
       continue;
@@ -225,7 +221,6 @@ static int run_seats(const scene_t *scene, const server_app_options_t *o) {
   }
   free(seats);
   free(th);
-  free(started);
   return rc;
 }
 
