@@ -33,8 +33,9 @@
 #   --one-server        every seat as a thread of one viscera-server (--seats N
 #                       --first-seat K): seats sharing cores cost each other less
 #                       in one process (docs/numerics.md §11.3); its log is split
-#                       into seatNN-server.log at the end. Not with --secure (one
-#                       process cannot hold each seat's identity)
+#                       into seatNN-server.log at the end. With --secure its
+#                       identity is server-seatKK-MM (pki.sh --server-group K-M:
+#                       the server's role in those seats only)
 # SIGINT (Ctrl-C) or SIGTERM stops the lab: every process it started gets
 # SIGTERM (SIGKILL if still running 10 s later), then the summary is printed.
 # Exit status: 0 when every process ended cleanly, 1 when one failed (named
@@ -95,8 +96,6 @@ NET="${CYCLONEDDS_URI:-file://$ROOT/deploy/cyclonedds-loopback.xml}"
 # Off loopback, secure by default (issue 14): a network configuration runs
 # with DDS Security, or only behind an explicit --insecure that says so.
 [ $SECURE = 1 ] && [ $INSECURE = 1 ] && { echo "lab.sh: --secure and --insecure exclude each other" >&2; exit 2; }
-[ $SECURE = 1 ] && [ $ONE = 1 ] &&
-  { echo "lab.sh: --one-server runs without DDS Security: each seat's identity may publish only in its own seat, and one process has one" >&2; exit 2; }
 # shellcheck source=net_guard.sh
 source "$ROOT/deploy/net_guard.sh"
 # shellcheck source=seat_logs.sh
@@ -106,14 +105,22 @@ mkdir -p "$OUT"
 OUT="$(cd "$OUT" && pwd)" # children get absolute paths
 LAST=$((FIRST + SEATS - 1))
 PKI="${PKI:-$OUT/pki}"
+# One server process for several seats holds one identity, granted the
+# server's role in those seats only (pki.sh --server-group).
+PKI_ARGS=(--seats "$LAST" --prefix "$PREFIX")
+SEATS_ID="server-$(printf 'seat%02d' "$FIRST")"
+if [ $ONE = 1 ] && [ "$SEATS" -gt 1 ]; then
+  PKI_ARGS+=(--server-group "$FIRST-$LAST")
+  SEATS_ID="$(printf 'server-seat%02d-%02d' "$FIRST" "$LAST")"
+fi
 if [ $SECURE = 1 ] && [ ! -f "$PKI/permissions.p7s" ]; then
-  bash "$ROOT/deploy/pki.sh" "$PKI" --seats "$LAST" --prefix "$PREFIX"
+  bash "$ROOT/deploy/pki.sh" "$PKI" "${PKI_ARGS[@]}"
 fi
 as() {
   if [ $SECURE = 0 ]; then echo "$NET"; return; fi
   local f="$PKI/identities/$1/security.xml"
   # A PKI made for fewer seats (or another prefix) lacks the identity: say which.
-  [ -f "$f" ] || { echo "lab.sh: no identity '$1' in $PKI (make the PKI with pki.sh --seats $LAST --prefix $PREFIX)" >&2; return 1; }
+  [ -f "$f" ] || { echo "lab.sh: no identity '$1' in $PKI (make the PKI with pki.sh ${PKI_ARGS[*]})" >&2; return 1; }
   echo "$NET,file://$f"
 }
 # With --duration 0 the children run until stopped.
@@ -194,7 +201,7 @@ if [ $RECORD = 1 ]; then
 fi
 if [ $ONE = 1 ]; then
   # shellcheck disable=SC2046
-  start seats-server "server-$(printf 'seat%02d' "$FIRST")" "$BUILD/server/viscera-server" --scene "$SCENE" \
+  start seats-server "$SEATS_ID" "$BUILD/server/viscera-server" --scene "$SCENE" \
     --partition "$PREFIX" --seats "$SEATS" --first-seat "$FIRST" $(dur DURATION) "${SRV_RT[@]}"
 fi
 for i in $(seq "$FIRST" "$LAST"); do

@@ -7,9 +7,14 @@
 # configuration fragment that turns security on for a process using it.
 #
 # Usage: deploy/pki.sh OUT_DIR [--seats N] [--prefix lab] [--days D] [--org NAME]
+#                      [--server-group K-M ...]
 #
 # Identities (one per process: Cyclone applies security per process):
 #   server-seatNN   publishes the seat's scene state, reads its commands
+#   server-seatKK-MM  (--server-group K-M, repeatable) the same for seats K..M
+#                   at once: one viscera-server --seats M-K+1 --first-seat K
+#                   process, whose seats share its identity (they share its
+#                   memory anyway; lab.sh --one-server --secure)
 #   trainee-seatNN  publishes ToolCommand in its own seat only
 #   instructor      publishes SessionControl and ToolCommand (take-over) in every seat
 #   observer        reads every seat, publishes nothing
@@ -21,22 +26,28 @@
 # account (the script makes it 0700). Needs openssl only.
 set -euo pipefail
 
-usage() { sed -n 3,23p "$0" | sed 's/^# \{0,1\}//'; }
+usage() { sed -n 3,28p "$0" | sed 's/^# \{0,1\}//'; }
 [ $# -ge 1 ] || { usage >&2; exit 2; }
 case "$1" in -h|--help) usage; exit 0 ;; esac
 OUT="$1"; shift
-SEATS=2 PREFIX=lab DAYS=3650 ORG=viscera
+SEATS=2 PREFIX=lab DAYS=3650 ORG=viscera GROUPS_=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --seats) SEATS="$2"; shift 2 ;;
     --prefix) PREFIX="$2"; shift 2 ;;
     --days) DAYS="$2"; shift 2 ;;
     --org) ORG="$2"; shift 2 ;;
+    --server-group) GROUPS_+=("$2"); shift 2 ;;
     *) echo "pki.sh: unknown option '$1'" >&2; usage >&2; exit 2 ;;
   esac
 done
 [[ "$SEATS" =~ ^[0-9]+$ ]] && [ "$SEATS" -ge 1 ] && [ "$SEATS" -le 99 ] || { echo "pki.sh: --seats must be 1..99" >&2; exit 2; }
 [[ "$PREFIX" =~ ^[A-Za-z0-9_-]+$ ]] || { echo "pki.sh: --prefix: letters, digits, '-' and '_' only" >&2; exit 2; }
+for g in "${GROUPS_[@]}"; do
+  [[ "$g" =~ ^([0-9]{1,2})-([0-9]{1,2})$ ]] && [ "$((10#${BASH_REMATCH[1]}))" -ge 1 ] &&
+    [ "$((10#${BASH_REMATCH[1]}))" -lt "$((10#${BASH_REMATCH[2]}))" ] && [ "$((10#${BASH_REMATCH[2]}))" -le "$SEATS" ] ||
+    { echo "pki.sh: --server-group '$g': K-M with 1 <= K < M <= --seats ($SEATS)" >&2; exit 2; }
+done
 [[ "$ORG" =~ ^[A-Za-z0-9_-]+$ ]] || { echo "pki.sh: --org: letters, digits, '-' and '_' only" >&2; exit 2; }
 command -v openssl >/dev/null || { echo "pki.sh: openssl not found (bash deploy/install_deps.sh installs it)" >&2; exit 1; }
 
@@ -63,11 +74,15 @@ ALL_TOPICS='<topic>viscera_*</topic>'
 STATE_TOPICS='<topic>viscera_SceneInfo</topic><topic>viscera_MeshState</topic><topic>viscera_MeshKeyChunk</topic><topic>viscera_MeshDelta</topic><topic>viscera_ContactFeedback</topic><topic>viscera_SessionEvent</topic><topic>viscera_Metrics</topic><topic>viscera_ObjectState</topic><topic>viscera_ToolMetrics</topic><topic>viscera_ToolRole</topic><topic>viscera_AppliedInput</topic><topic>viscera_SceneSource</topic>'
 INPUT_TOPICS='<topic>viscera_ToolCommand</topic><topic>viscera_SessionControl</topic>'
 
-# grant NAME PUB_TOPICS PUB_PARTITION SUB_TOPICS SUB_PARTITION
+# grant NAME PUB_TOPICS PUB_PARTITIONS SUB_TOPICS SUB_PARTITIONS (partitions: space-separated)
 grant() {
-  local pub=""
+  local pub="" p pubp="" subp="" pa sa
+  read -ra pa <<< "$3" # read, not an unquoted $3: "lab/*" must not glob
+  read -ra sa <<< "$5"
+  for p in "${pa[@]}"; do pubp+="<partition>$p</partition>"; done
+  for p in "${sa[@]}"; do subp+="<partition>$p</partition>"; done
   if [ -n "$2" ]; then
-    pub="<publish><topics>$2</topics><partitions><partition>$3</partition></partitions></publish>"
+    pub="<publish><topics>$2</topics><partitions>$pubp</partitions></publish>"
   fi
   cat <<XML
     <grant name="$1">
@@ -76,7 +91,7 @@ grant() {
       <allow_rule>
         <domains><id_range><min>0</min><max>230</max></id_range></domains>
         $pub
-        <subscribe><topics>$4</topics><partitions><partition>$5</partition></partitions></subscribe>
+        <subscribe><topics>$4</topics><partitions>$subp</partitions></subscribe>
       </allow_rule>
       <default>DENY</default>
     </grant>
@@ -98,6 +113,13 @@ identities=(instructor observer recorder)
     # SessionControl, so it knows when the seat is paused) and writes only its tool.
     grant "trainee-$s" '<topic>viscera_ToolCommand</topic>' "$PREFIX/$s" "$ALL_TOPICS" "$PREFIX/$s"
     identities+=("server-$s" "trainee-$s")
+  done
+  for g in "${GROUPS_[@]}"; do
+    k=$((10#${g%-*})) m=$((10#${g#*-})) parts=""
+    for i in $(seq "$k" "$m"); do parts+="$PREFIX/$(printf 'seat%02d' "$i") "; done
+    name="$(printf 'server-seat%02d-%02d' "$k" "$m")"
+    grant "$name" "$STATE_TOPICS" "$parts" "$INPUT_TOPICS" "$parts"
+    identities+=("$name")
   done
   echo '  </permissions>'
   echo '</dds>'

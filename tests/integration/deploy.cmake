@@ -8,3 +8,5 @@ viscera_integration_test(systemd_units 164 systemd_units_test.sh)
 set_tests_properties(systemd_units PROPERTIES SKIP_RETURN_CODE 77)
 # lab.sh --one-server: the seats as threads of one server (issue 17 item 6). Domain 173.
 viscera_integration_test(lab_one_server 173 lab_one_server_test.sh)
+# lab.sh --one-server --secure: one group identity for the process's seats. Domain 174.
+viscera_integration_test(lab_one_server_secure 174 lab_one_server_secure_test.sh)
