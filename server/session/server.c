@@ -25,6 +25,7 @@
 #include "session/writer_stations.h"
 #include "sha256.h"
 #include "dds/vdds_gate.h"
+#include "dds/vdds_subject.h"
 #include "viscera.h"
 #include "vmath.h"
 #include "vrt.h"
@@ -206,11 +207,26 @@ static dds_entity_t control_reader(server_t *s, verr_t *err) {
   return r;
 }
 
-static int setup(server_t *s, const scene_t *scene, verr_t *err) {
-  liveliness_watch_init(&s->lw); /* first: teardown always destroys them */
-  vdds_gate_init(&s->cmd_gate, 0, command_gate_check, &s->cmd_check);
-  rollback_report_init(&s->rb, (uint64_t)fmax(1.0, floor(1.0 / scene->dt + 0.5)));
-  if (runtime_init(&s->rt, scene, err)) return -1;
+/* A writer or reader the permissions refuse: names the identity and the
+ * partition, the usual cause being an identity of another seat (or a
+ * group identity without this seat, deploy/pki.sh --server-group).
+ * Returns -1. */
+static int security_hint(const server_t *s, verr_t *err) {
+  uint8_t der[VDDS_SUBJECT_DER_MAX];
+  char who[VDDS_SUBJECT_TEXT_MAX] = "";
+  size_t n = vdds_subject_self(der);
+  if (!strstr(err->msg, "Not Allowed By Security") || !n || vdds_subject_text(der, n, who, sizeof who) < 0) return -1;
+  char msg[VERR_MSG_LEN];
+  snprintf(msg, sizeof msg, "%s", err->msg);
+  return verr_set(err,
+                  "%s: identity '%s' may not serve partition '%s' (deploy/pki.sh: server-seatNN serves its seat, "
+                  "server-seatKK-MM seats K..M)",
+                  msg, who, s->opts->partition ? s->opts->partition : "");
+}
+
+/* The session's participant, writers and readers (under opts->dds_setup_lock
+ * when given). Returns 0, or -1 with err. */
+static int setup_dds(server_t *s, verr_t *err) {
   if (vdds_open(&s->dds, s->opts->domain, s->opts->partition, err)) return -1;
   s->w_scene = vdds_writer(&s->dds, VT_SCENE_INFO, err);
   s->w_state = vdds_writer(&s->dds, VT_MESH_STATE, err);
@@ -228,6 +244,10 @@ static int setup(server_t *s, const scene_t *scene, verr_t *err) {
   s->w_role = vdds_writer(&s->dds, VT_TOOL_ROLE, err);
   s->w_applied = vdds_writer(&s->dds, VT_APPLIED_INPUT, err);
   s->w_source = vdds_writer(&s->dds, VT_SCENE_SOURCE, err);
+  if (s->w_scene < 0 || s->w_state < 0 || s->w_delta < 0 || s->w_feedback < 0 || s->w_event < 0 || s->w_metrics < 0 ||
+      s->r_cmd < 0 || s->r_control < 0 || s->w_objects < 0 || s->w_tool_metrics < 0 || s->w_role < 0 ||
+      s->w_applied < 0 || s->w_source < 0)
+    return security_hint(s, err);
   s->w_chunk = vdds_writer(&s->dds, VT_MESH_KEY_CHUNK, err);
   if (s->w_chunk < 0) {
     /* Permissions made by an older deploy/pki.sh do not grant this topic:
@@ -235,10 +255,18 @@ static int setup(server_t *s, const scene_t *scene, verr_t *err) {
     fprintf(stderr, "%s: keyframe chunks off (%s); keyframes go as MeshState only\n", s->tag, err->msg);
     s->w_chunk = 0;
   }
-  if (s->w_scene < 0 || s->w_state < 0 || s->w_delta < 0 || s->w_feedback < 0 || s->w_event < 0 || s->w_metrics < 0 ||
-      s->r_cmd < 0 || s->r_control < 0 || s->w_objects < 0 || s->w_tool_metrics < 0 || s->w_role < 0 ||
-      s->w_applied < 0 || s->w_source < 0)
-    return -1;
+  return 0;
+}
+
+static int setup(server_t *s, const scene_t *scene, verr_t *err) {
+  liveliness_watch_init(&s->lw); /* first: teardown always destroys them */
+  vdds_gate_init(&s->cmd_gate, 0, command_gate_check, &s->cmd_check);
+  rollback_report_init(&s->rb, (uint64_t)fmax(1.0, floor(1.0 / scene->dt + 0.5)));
+  if (runtime_init(&s->rt, scene, err)) return -1;
+  if (s->opts->dds_setup_lock) pthread_mutex_lock(s->opts->dds_setup_lock);
+  int rc = setup_dds(s, err);
+  if (s->opts->dds_setup_lock) pthread_mutex_unlock(s->opts->dds_setup_lock);
+  if (rc) return -1;
   tool_roles_init(&s->roles, &s->rt.scene);
   writer_stations_init(&s->stations);
   s->control.roles = &s->roles;
@@ -280,7 +308,9 @@ static void teardown(server_t *s) {
   free(s->resume.p);
   for (size_t i = 0; i < s->rt.norgans; i++) mesh_publisher_destroy(&s->pubs[i]);
   runtime_destroy(&s->rt);
+  if (s->opts->dds_setup_lock) pthread_mutex_lock(s->opts->dds_setup_lock); /* not beside another's setup_dds */
   vdds_close(&s->dds); /* stops the listener before the watch goes */
+  if (s->opts->dds_setup_lock) pthread_mutex_unlock(s->opts->dds_setup_lock);
   liveliness_watch_destroy(&s->lw);
   vdds_gate_destroy(&s->cmd_gate);
   free(s->step_us);

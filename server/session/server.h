@@ -6,6 +6,7 @@
 #ifndef VISCERA_SERVER_H
 #define VISCERA_SERVER_H
 
+#include <pthread.h>
 #include <signal.h>
 #include <stdint.h>
 
@@ -26,6 +27,12 @@ typedef struct server_opts {
   double checkpoint_every; /* s of simulated time between checkpoints */
   int rt_priority;         /* 1..99: the step loop's thread runs SCHED_FIFO at it (vrt.h); 0 = normal */
   const char *log_tag;     /* the log lines' "TAG: " (NULL: "server"); a seat's own among several (server_app.h) */
+  /* Sessions sharing a process (server_app.h) share this lock, held while a
+   * session creates its participant, readers and writers: with DDS Security
+   * on, Cyclone 0.10.2 failed a participant created at the same time as
+   * another of the process ("get_identity_token: Invalid handle provided").
+   * NULL: one session, no lock. Owned by the caller. */
+  pthread_mutex_t *dds_setup_lock;
 } server_opts_t;
 
 typedef struct server_stats {

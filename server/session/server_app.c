@@ -182,6 +182,7 @@ static int run_seats(const scene_t *scene, const server_app_options_t *o) {
   pthread_attr_t attr;
   pthread_attr_init(&attr);
   pthread_attr_setstacksize(&attr, (size_t)16 << 20);
+  pthread_mutex_t dds_setup_lock = PTHREAD_MUTEX_INITIALIZER; /* server.h: opts.dds_setup_lock */
   int rc = 0, started = 0; /* seats 0..started-1 run: the first failure stops the starting */
   for (int k = 0; k < n; k++) {
     seat_run_t *r = &seats[k];
@@ -196,6 +197,7 @@ static int run_seats(const scene_t *scene, const server_app_options_t *o) {
     r->opts.partition = r->partition;
     snprintf(r->tag, sizeof r->tag, "server %s", r->partition);
     r->opts.log_tag = r->tag;
+    r->opts.dds_setup_lock = &dds_setup_lock;
     snprintf(r->name, sizeof r->name, "seat%02d", o->first_seat + k);
     int e = pthread_create(&th[k], &attr, seat_main, r);
     if (e) {
@@ -219,6 +221,7 @@ static int run_seats(const scene_t *scene, const server_app_options_t *o) {
     printf("SEAT partition=%s index=%d of=%d\n", r->partition, k + 1, n);
     print_summary(scene, &r->st);
   }
+  pthread_mutex_destroy(&dds_setup_lock);
   free(seats);
   free(th);
   return rc;

@@ -11,7 +11,8 @@
 # without identity recorded nothing, each seat re-simulates bit for bit,
 # exit 0 with nothing left. Then what the group identity may not do: a
 # server holding it for seats 1-3 serves 2 and 3 and is refused seat 1 by
-# DDS Security (exit 1, "Not Allowed By Security"); and a lab whose PKI
+# DDS Security (exit 1, "Not Allowed By Security", the identity and the
+# partition named); and a lab whose PKI
 # lacks the group identity names it and the pki.sh command that makes it.
 # usage: lab_one_server_secure_test.sh BUILD SRC OUT
 set -euo pipefail
@@ -81,8 +82,8 @@ CYCLONEDDS_URI="file://$SRC/deploy/cyclonedds-loopback.xml,file://$PKI/identitie
   "$BUILD/server/viscera-server" --scene "$SRC/assets/scenes/default.yaml" --partition lab --seats 3 --first-seat 1 \
   --duration 2 > "$OUT/outside.out" 2> "$OUT/outside.log" || rc=$?
 [ "$rc" = 1 ] || fail "a server holding server-seat02-03 for seats 1-3 exited $rc, not 1"
-grep -q "seat 'lab/seat01': .*Not Allowed By Security" "$OUT/outside.log" ||
-  fail "seat01 was not refused by DDS Security: $(grep -m3 seat01 "$OUT/outside.log")"
+grep -q "seat 'lab/seat01': .*Not Allowed By Security: identity 'CN=server-seat02-03,O=viscera,C=NL' may not serve partition 'lab/seat01'" \
+  "$OUT/outside.log" || fail "seat01 was not refused by DDS Security, naming the identity: $(grep -m3 seat01 "$OUT/outside.log")"
 for s in 02 03; do
   grep -q "^SEAT partition=lab/seat$s " "$OUT/outside.out" || fail "seat$s did not serve beside the refused seat01"
 done
