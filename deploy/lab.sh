@@ -120,7 +120,11 @@ as() {
   if [ $SECURE = 0 ]; then echo "$NET"; return; fi
   local f="$PKI/identities/$1/security.xml"
   # A PKI made for fewer seats (or another prefix) lacks the identity: say which.
-  [ -f "$f" ] || { echo "lab.sh: no identity '$1' in $PKI (make the PKI with pki.sh ${PKI_ARGS[*]})" >&2; return 1; }
+  [ -f "$f" ] || {
+    echo "lab.sh: no identity '$1' in $PKI (make the PKI with pki.sh ${PKI_ARGS[*]}; a lab over several" \
+      "machines makes one PKI with every machine's --server-group and copies it to each)" >&2
+    return 1
+  }
   echo "$NET,file://$f"
 }
 # With --duration 0 the children run until stopped.

@@ -96,7 +96,7 @@ st=0; wait "$M" || st=$?
 PIDS=()
 cat "$OUT/lab13.out"
 [ "$st" = 1 ] || fail "lab.sh with the group identity missing from the PKI exited with $st, expected 1"
-grep -q "no identity 'server-seat01-03' in $PKI (make the PKI with pki.sh --seats 3 --prefix lab --server-group 1-3)" \
+grep -q "no identity 'server-seat01-03' in $PKI (make the PKI with pki.sh --seats 3 --prefix lab --server-group 1-3;" \
   "$OUT/lab13.out" || fail "the missing group identity and the pki.sh command were not named"
 expect_nothing_left "$M" "lab.sh stopped by an error"
 echo PASS
