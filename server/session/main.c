@@ -30,8 +30,8 @@ static void usage(FILE *f) {
           "  --seats N           run N seats of the scene in this one process (1..%d), each\n"
           "                      its own session on partition P/seatKK (P: --partition), with its own\n"
           "                      physics thread; seats in one process share a core's caches better\n"
-          "                      than one process per seat (docs/numerics.md §11.3). Not with\n"
-          "                      --checkpoint or --final-mesh\n"
+          "                      than one process per seat (docs/numerics.md §11.3); --checkpoint\n"
+          "                      and --final-mesh PATH then name each seat's PATH.seatKK\n"
           "  --first-seat K      with --seats: the first seat's number (default 1): seats K..K+N-1,\n"
           "                      at most 99\n"
           "  --quiet             only errors and warnings on stderr\n"
@@ -156,11 +156,6 @@ int main(int argc, char **argv) {
   if (!o.first_seat) o.first_seat = 1;
   if (o.seats && o.first_seat + o.seats - 1 > 99) {
     fprintf(stderr, "viscera-server: --seats %d from --first-seat %d goes past seat 99\n", o.seats, o.first_seat);
-    return 2;
-  }
-  if (o.seats > 1 && (o.opts.checkpoint || o.opts.final_mesh)) {
-    fprintf(stderr, "viscera-server: --seats %d takes neither --checkpoint nor --final-mesh (one file per process)\n",
-            o.seats);
     return 2;
   }
   return server_app_run(&o);

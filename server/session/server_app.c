@@ -149,8 +149,9 @@ typedef struct seat_run {
   const scene_t *scene;
   server_opts_t opts;
   char partition[128];
-  char name[16]; /* the thread's, for ps and top */
-  char tag[160]; /* its log lines' prefix: "server P/seatKK" */
+  char name[16];                                                         /* the thread's, for ps and top */
+  char tag[160];                                                         /* its log lines' prefix: "server P/seatKK" */
+  char checkpoint[SERVER_APP_PATH_MAX], final_mesh[SERVER_APP_PATH_MAX]; /* the seat's own files */
   server_stats_t st;
   verr_t err;
   int rc;
@@ -162,6 +163,16 @@ static void *seat_main(void *arg) {
   r->rc = server_run(r->scene, &r->opts, &g_stop, &r->st, &r->err);
   if (r->rc) fprintf(stderr, "viscera-server: seat '%s': %s\n", r->partition, r->err.msg);
   return NULL;
+}
+
+/* A seat's own file: PATH.seatKK (server_app.h); NULL stays NULL. Returns
+ * 0, or -1 when it does not fit. */
+static int seat_file(char out[SERVER_APP_PATH_MAX], const char *path, int seat, const char **set) {
+  if (!path) return 0;
+  int len = snprintf(out, SERVER_APP_PATH_MAX, "%s.seat%02d", path, seat);
+  if (len < 0 || len >= SERVER_APP_PATH_MAX) return -1;
+  *set = out;
+  return 0;
 }
 
 /* --seats N (also 1: the seat's partition is P/seatKK): the sessions in
@@ -198,6 +209,12 @@ static int run_seats(const scene_t *scene, const server_app_options_t *o) {
     snprintf(r->tag, sizeof r->tag, "server %s", r->partition);
     r->opts.log_tag = r->tag;
     r->opts.dds_setup_lock = &dds_setup_lock;
+    if (seat_file(r->checkpoint, o->opts.checkpoint, o->first_seat + k, &r->opts.checkpoint) ||
+        seat_file(r->final_mesh, o->opts.final_mesh, o->first_seat + k, &r->opts.final_mesh)) {
+      fprintf(stderr, "viscera-server: --checkpoint / --final-mesh path too long for its seats\n");
+      rc = 1;
+      break;
+    }
     snprintf(r->name, sizeof r->name, "seat%02d", o->first_seat + k);
     int e = pthread_create(&th[k], &attr, seat_main, r);
     if (e) {

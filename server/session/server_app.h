@@ -11,13 +11,16 @@
  * have run; as separate processes every step also starts in another
  * address space (docs/numerics.md §11.3 measures what that costs). A seat
  * whose set-up fails is reported at once and the others keep serving; the
- * summaries follow per seat at the end, each headed by its partition. */
+ * summaries follow per seat at the end, each headed by its partition.
+ * Files: with --seats, --checkpoint PATH and --final-mesh PATH name each
+ * seat's own file PATH.seatKK (a crashed process's seats each resume from
+ * their own state). */
 #ifndef VISCERA_SESSION_SERVER_APP_H
 #define VISCERA_SESSION_SERVER_APP_H
 
 #include "session/server.h"
 
-enum { SERVER_APP_MAX_SEATS = 32 };
+enum { SERVER_APP_MAX_SEATS = 32, SERVER_APP_PATH_MAX = 1024 };
 
 typedef struct server_app_options {
   const char *scene_path; /* --scene FILE */

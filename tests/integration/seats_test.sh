@@ -6,22 +6,21 @@
 # trainees press at the same time, one 8 mm deep in seat01, one 3 mm in
 # seat02: each seat must answer its own trainee only (the deep press feels
 # more than the shallow one, and each seat's summary has the peak its own
-
-# with one summary per seat, headed by its partition. Options one process
-# cannot honour for several seats are usage errors (exit 2), as are seat
-# counts out of range.
+# trainee felt), each seat's log lines name it, and the figures come
+# with one summary per seat, headed by its partition. Seat counts out of
+# range are usage errors (exit 2). Then a crash with --checkpoint: each seat
+# resumes from its own file.
 set -euo pipefail
 # shellcheck source=prelude.sh
 source "$(dirname "${BASH_SOURCE[0]}")/prelude.sh"
 SCENE="$SRC/assets/scenes/classroom_kidney.yaml"
 SRV="$BUILD/server/viscera-server"
-for bad in "--seats 0" "--seats 33" "--seats two" "--seats 2 --checkpoint $OUT/c.ckpt" "--seats 2 --final-mesh $OUT/f.obj"; do
+for bad in "--seats 0" "--seats 33" "--seats two"; do
   # shellcheck disable=SC2086 # the options are meant to split
   rc=0; "$SRV" --scene "$SCENE" $bad --duration 1 > /dev/null 2> "$OUT/bad.log" || rc=$?
   [ "$rc" = 2 ] || fail "viscera-server $bad exited $rc, not 2 (usage error): $(cat "$OUT/bad.log")"
   grep -q -- "--seats" "$OUT/bad.log" || fail "viscera-server $bad: the error does not name --seats: $(cat "$OUT/bad.log")"
 done
-[ -f "$OUT/c.ckpt" ] && fail "a refused --seats run wrote its checkpoint"
 press() { # depth z of the probe tip (m) -> trajectory: away 0.5 s, down in 1 s, hold 1 s, up
   printf '%s\n' "0 0.012 0.004 0.07" "0.5 0.012 0.004 0.07" "1.5 0.012 0.004 $1" "2.5 0.012 0.004 $1" \
     "3.0 0.012 0.004 0.07"
@@ -79,4 +78,55 @@ for pair in "${c1:-0} ${t1:-0} seat01" "${c2:-0} ${t2:-0} seat02"; do
 done
 [ "$(grep -c '^server: seat .seats/seat0[12]. ([12] of 2):$' "$OUT/server.log")" = 2 ] ||
   fail "the server log has not one figures block per seat"
-echo "PASS: two seats in one process, each answering its own trainee (${deep} N and ${shallow} N)"
+echo "two seats in one process, each answering its own trainee (${deep} N and ${shallow} N)"
+
+# A crash of the process (kill -9, the trainees with it) while both trainees
+# hold their presses, with --checkpoint: each seat writes its own file
+# (PATH.seatKK) and after the restart resumes from it, with its own
+# session's measures (seat01 the deep press's peak force, seat02 the shallow
+# one's: a seat resumed from the other's file, or one file for both, would
+# show the same peak in both). --final-mesh writes one file per seat too.
+hold() { printf '%s\n' "0 0.012 0.004 0.07" "0.5 0.012 0.004 0.07" "1.5 0.012 0.004 $1" "60 0.012 0.004 $1"; }
+hold 0.027 > "$OUT/deep_hold.traj"
+hold 0.032 > "$OUT/shallow_hold.traj"
+CK="$OUT/c.ckpt"
+"$SRV" --scene "$SCENE" --partition seats --seats 2 --checkpoint "$CK" --checkpoint-every 0.1 > "$OUT/crash.out" \
+  2> "$OUT/crash.log" &
+srv=$!; PIDS+=("$srv")
+hp=()
+for what in deep shallow; do
+  s=$([ $what = deep ] && echo 1 || echo 2)
+  "$BUILD/client/haptic/viscera-haptic" --partition "seats/seat0$s" --trajectory "$OUT/${what}_hold.traj" \
+    --wait-server 60 > "$OUT/${what}_hold.log" 2>&1 &
+  hp+=("$!"); PIDS+=("$!")
+done
+# Both trainees driving (each says so once its seat's scene is there), then
+# the press down (1.5 s into the trajectory) and checkpoints into the hold.
+for ((t = 0; t < 600; t++)); do
+  [ "$(cat "$OUT"/deep_hold.log "$OUT"/shallow_hold.log | grep -c '^haptic: scene')" = 2 ] && break
+  kill -0 "$srv" 2> /dev/null || fail "the server ended before the trainees started"
+  sleep 0.1
+done
+sleep 3
+kill -9 "$srv" "${hp[@]}"
+wait "$srv" "${hp[@]}" 2> /dev/null || true
+for s in seat01 seat02; do [ -s "$CK.$s" ] || fail "no checkpoint $CK.$s after the crash"; done
+[ -e "$CK" ] && fail "a --seats run wrote the unsuffixed checkpoint $CK"
+"$SRV" --scene "$SCENE" --partition seats --seats 2 --checkpoint "$CK" --final-mesh "$OUT/f.obj" --duration 0.2 \
+  > "$OUT/resume.out" 2> "$OUT/resume.log" || fail "the restarted server failed"
+for s in seat01 seat02; do
+  grep -q "^server seats/$s: resumed from checkpoint $CK.$s at t = " "$OUT/resume.log" ||
+    fail "$s did not resume from its own checkpoint $CK.$s"
+  grep -q "^# 2000 vertices" "$OUT/f.obj.$s" || fail "no final mesh $OUT/f.obj.$s"
+done
+[ -e "$OUT/f.obj" ] && fail "a --seats run wrote the unsuffixed final mesh"
+r1=$(awk '/^SEAT / { on = ($2 == "partition=seats/seat01") } on && /^PALPATION/' "$OUT/resume.out" |
+  sed -n 's/.* peak_force=\([0-9.]*\) .*/\1/p')
+r2=$(awk '/^SEAT / { on = ($2 == "partition=seats/seat02") } on && /^PALPATION/' "$OUT/resume.out" |
+  sed -n 's/.* peak_force=\([0-9.]*\) .*/\1/p')
+echo "restarted after the crash: seat01 resumed with its peak ${r1:-?} N (its press ${deep} N), seat02 ${r2:-?} N (${shallow} N)"
+awk -v a="${r1:-0}" -v b="${deep:-0}" 'BEGIN { exit !(a > 0.85 * b && a < 1.15 * b) }' ||
+  fail "seat01 did not resume its own session (peak ${r1:-none} N, its trainee's press ${deep} N)"
+awk -v a="${r2:-0}" -v b="${shallow:-0}" 'BEGIN { exit !(a > 0.85 * b && a < 1.15 * b) }' ||
+  fail "seat02 did not resume its own session (peak ${r2:-none} N, its trainee's press ${shallow} N)"
+echo "PASS: two seats in one process, each answering its own trainee and resuming its own state after a crash"
