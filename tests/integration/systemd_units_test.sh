@@ -13,7 +13,9 @@
 #      instance seat01 on domain 164: the server serves PARTITION from the
 #      env file, the recorder records it into STATE/seat01-<UTC time>.db, and
 #      SIGTERM (what `systemctl stop` sends) ends both cleanly; the server
-#      leaves its checkpoint in the state directory.
+#      leaves its checkpoint in the state directory;
+#   4. the seats unit (viscera-seats@lab: --seats from the env file) serves
+#      both seats in one process and leaves a checkpoint per seat.
 # Exit 77 (skipped) only when systemd-analyze is not installed.
 # usage: systemd_units_test.sh BUILD SRC OUT
 set -euo pipefail
@@ -124,4 +126,28 @@ echo "recorder unit: $(basename "${dbs[0]}"), scene '$scene', partition '$part',
 [ "$closed" = 1 ] || fail "the recording has no end time"
 [ "${deltas:-0}" -gt 10 ] || fail "the recorder unit recorded ${deltas:-0} MeshDelta samples"
 [ -s "$OUT/state/seat01.ckpt" ] || fail "the server unit wrote no checkpoint into its state directory"
+
+# 4. The seats unit, instance lab: one process serving unit/seat02 and
+# unit/seat03 from the env file, a checkpoint per seat in the state directory.
+cat > "$OUT/etc/lab.env" << EOF
+SCENE=$SRC/assets/scenes/default.yaml
+PREFIX=unit
+SEATS=2
+FIRST=2
+VISCERA_DOMAIN=$VISCERA_DOMAIN
+CYCLONEDDS_URI=$CYCLONEDDS_URI
+EOF
+run_unit "$OUT/units/viscera-seats@.service" lab "$OUT/seats.log"
+PIDS+=("$UNIT_PID")
+sleep 3
+kill -0 "$UNIT_PID" 2>/dev/null || fail "the seats unit's command exited early"
+kill -TERM "$UNIT_PID"
+wait "$UNIT_PID" || fail "the seats unit's command did not stop cleanly on SIGTERM"
+PIDS=()
+for s in seat02 seat03; do
+  grep -q "^server unit/$s: scene .* running on domain $VISCERA_DOMAIN, partition 'unit/$s'" "$OUT/seats.log" ||
+    fail "the seats unit did not serve unit/$s"
+  [ -s "$OUT/state/lab.ckpt.$s" ] || fail "the seats unit wrote no checkpoint lab.ckpt.$s into its state directory"
+done
+echo "seats unit: unit/seat02 and unit/seat03 in one process, a checkpoint each"
 echo PASS
