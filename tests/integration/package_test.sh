@@ -38,7 +38,8 @@ done
 for f in usr/share/viscera/assets/scenes/default.yaml usr/share/viscera/assets/meshes/kidney.obj \
   usr/share/viscera/assets/trajectories/palpate_kidney.traj usr/share/viscera/deploy/cyclonedds-loopback.xml \
   usr/share/viscera/deploy/cyclonedds-lan.xml usr/lib/systemd/system/viscera-server@.service \
-  usr/lib/systemd/system/viscera-recorder@.service usr/lib/sysusers.d/viscera.conf usr/share/doc/viscera/copyright; do
+  usr/lib/systemd/system/viscera-recorder@.service usr/lib/systemd/system/viscera-seats@.service \
+  usr/lib/sysusers.d/viscera.conf usr/share/doc/viscera/copyright; do
   grep -qx "$f" "$OUT/contents.txt" || fail "the package lacks $f"
 done
 echo "package: $(wc -l < "$OUT/contents.txt") entries, $(wc -l <<< "$bins") binaries, $(du -k "$DEB" | cut -f1) kB"
