@@ -34,6 +34,21 @@ recorded_by_partition() {
     JOIN topics t ON t.id = s.topic_id WHERE s.kind = 0 GROUP BY 1, 2 ORDER BY 1, 2"
 }
 
+# expect_lab_recorded DB FIRST LAST DRIVEN...: the lab's recording (PREFIX
+# lab) is closed, holds seats FIRST..LAST each from its own server
+# (expect_seats_recorded) and ToolCommands in each DRIVEN seat (two digits);
+# "partition topic samples" lines go to OUT/by_partition.txt (and stdout).
+expect_lab_recorded() {
+  local db="$1" first="$2" last="$3" s
+  shift 3
+  recorded_by_partition "$db" | tee "$OUT/by_partition.txt"
+  expect_closed "$db"
+  expect_seats_recorded "$db" lab "$first" "$last"
+  for s in "$@"; do
+    grep -q "^lab/seat$s viscera_ToolCommand [1-9]" "$OUT/by_partition.txt" || fail "no ToolCommand recorded in lab/seat$s"
+  done
+}
+
 # expect_seats_recorded DB PREFIX FIRST LAST: every seat's server published
 # in its own partition: MeshDelta samples from PREFIX/seatNN for each seat,
 # written by one participant per seat (GUID prefix, the first 24 hex digits)

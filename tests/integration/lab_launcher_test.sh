@@ -83,12 +83,7 @@ expect_nothing_left "$A" "lab A"
 LABS=()
 
 DB="$OUT/a/lab.db"
-recorded_by_partition "$DB" | tee "$OUT/by_partition.txt"
-expect_closed "$DB"
-expect_seats_recorded "$DB" lab 1 4
-for s in 01 02; do
-  grep -q "^lab/seat$s viscera_ToolCommand [1-9]" "$OUT/by_partition.txt" || fail "no ToolCommand recorded in lab/seat$s"
-done
+expect_lab_recorded "$DB" 1 4 01 02
 grep -q "^lab/seat0[34] viscera_ToolCommand" "$OUT/by_partition.txt" && fail "ToolCommands recorded in seats without trainees"
 expect_recorded_pids_gone "$DB"
 for s in seat01 seat02; do

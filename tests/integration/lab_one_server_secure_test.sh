@@ -16,18 +16,13 @@
 # lacks the group identity names it and the pki.sh command that makes it.
 # usage: lab_one_server_secure_test.sh BUILD SRC OUT
 set -euo pipefail
-BUILD="$1"; SRC="$2"; OUT="$3"
+# shellcheck source=prelude.sh
+source "$(dirname "${BASH_SOURCE[0]}")/prelude.sh"
 # shellcheck source=lab_checks.sh
 . "$(dirname "$0")/lab_checks.sh"
-PIDS=()
+FAIL_LOGS="$OUT/*.out $OUT/l/*.log"
+# lab.sh stops what it started on SIGTERM (prelude's cleanup would kill -9 it alone)
 cleanup() { for p in "${PIDS[@]}"; do kill -TERM "$p" 2>/dev/null || true; done; }
-trap cleanup EXIT
-fail() {
-  echo "FAIL: $*" >&2
-  for f in "$OUT"/*.out "$OUT"/*.log "$OUT"/l/*.log; do [ -f "$f" ] && { echo "--- $f"; tail -6 "$f"; }; done >&2
-  exit 1
-}
-rm -rf "$OUT"; mkdir -p "$OUT"
 command -v sqlite3 > /dev/null || fail "sqlite3 missing (deploy/install_deps.sh installs it)"
 command -v openssl > /dev/null || fail "openssl missing (deploy/install_deps.sh installs it)"
 
@@ -54,12 +49,7 @@ PIDS=()
 grep -q "server-seat02-03" "$OUT/l/pki/permissions.xml" || fail "lab.sh made no group identity for seats 2-3"
 
 DB="$OUT/l/lab.db"
-recorded_by_partition "$DB" | tee "$OUT/by_partition.txt"
-expect_closed "$DB"
-expect_seats_recorded "$DB" lab 2 3
-for s in 02 03; do
-  grep -q "^lab/seat$s viscera_ToolCommand [1-9]" "$OUT/by_partition.txt" || fail "no ToolCommand recorded in lab/seat$s"
-done
+expect_lab_recorded "$DB" 2 3 02 03
 plain_n=$(sqlite3 "$OUT/plain.db" "SELECT count(*) FROM samples")
 [ "$plain_n" = 0 ] || fail "a recorder without identity recorded $plain_n samples of the secure lab"
 "$BUILD/client/recorder/viscera-recinfo" "$DB" > "$OUT/recinfo.out" || fail "viscera-recinfo failed on the lab's recording"
