@@ -42,7 +42,12 @@
 # writes a lab seat makes for its readers).
 # The seats' step CPU medians are compared with it as a whole and in the two
 # parts the server's log splits them into (its "step CPU split" line: the
-# tissue step, and the rest: commands, feedback, inputs, frames).
+# tissue step, and the rest: commands, feedback, inputs, frames). The seat
+# alone runs again after the lab: the two runs' difference is the
+# reference's own spread, and a line says "unchanged within noise" when
+# every seat's median lies within the two runs' span widened on each side by
+# their difference, "slower than the seat alone beyond noise" when one lies
+# above it, "no slower ... (faster beyond noise)" when one lies below it.
 #
 # usage: deploy/load_bench.sh [--build DIR] [--out DIR] [--seats N] [--subscribers M] [--duration S]
 #                             [--baseline S] [--rt-priority S] [--haptic-rt-priority H]
@@ -121,24 +126,29 @@ step_line() { # server log -> "N steps, step wall time ...; step CPU time ...; r
   cpu=$(sed -n 's/^server: step CPU time median \([0-9.]*\) us p99 \([0-9.]*\) us; \([0-9.]*\) simulated.*/step CPU time median \1 us, p99 \2 us; real-time ratio \3/p' "$1")
   echo "$wall; $cpu"
 }
-# The reference: one seat alone, scheduled as the lab's seats are.
-echo "load_bench: baseline, one seat alone for $BASELINE s" >&2
-"$BUILD/server/viscera-server" --scene "$SCENE" --partition "load/alone" --duration $((BASELINE + 2)) --quiet \
-  "${SRV_RT[@]}" > "$OUT/alone-server.out" 2> "$OUT/alone-server.log" &
-alone=$!
-sleep 1
-# Its share of the lab's subscribers (a seat's step writes the meshes they read).
-alone_subs=()
-for k in $(seq 1 $(( (SUBS + SEATS - 1) / SEATS ))); do
-  "$BUILD/tests/bench/delta_sub" --partition "load/alone" --duration "$BASELINE" --name "alone-sub$k" \
-    > "$OUT/alone-sub$k.out" 2>&1 &
-  alone_subs+=($!)
-done
-"$BUILD/client/haptic/viscera-haptic" --partition "load/alone" --trajectory "$TRAJ" --duration "$BASELINE" --quiet \
-  "${HAP_RT[@]}" > "$OUT/alone-haptic.log" 2>&1 || true
-wait "$alone" || true
-for p in "${alone_subs[@]}"; do kill -TERM "$p" 2>/dev/null || true; done
-wait "${alone_subs[@]}" 2>/dev/null || true
+# The reference: one seat alone, scheduled as the lab's seats are; run
+# before the lab (TAG alone) and again after it (alone2): the two runs'
+# difference is the reference's own run-to-run spread.
+run_alone() { # TAG: files OUT/TAG-*
+  local tag=$1 srv p subs=()
+  echo "load_bench: $([ "$tag" = alone ] && echo baseline || echo "baseline again"), one seat alone for $BASELINE s" >&2
+  "$BUILD/server/viscera-server" --scene "$SCENE" --partition "load/$tag" --duration $((BASELINE + 2)) --quiet \
+    "${SRV_RT[@]}" > "$OUT/$tag-server.out" 2> "$OUT/$tag-server.log" &
+  srv=$!
+  sleep 1
+  # Its share of the lab's subscribers (a seat's step writes the meshes they read).
+  for k in $(seq 1 $(( (SUBS + SEATS - 1) / SEATS ))); do
+    "$BUILD/tests/bench/delta_sub" --partition "load/$tag" --duration "$BASELINE" --name "$tag-sub$k" \
+      > "$OUT/$tag-sub$k.out" 2>&1 &
+    subs+=($!)
+  done
+  "$BUILD/client/haptic/viscera-haptic" --partition "load/$tag" --trajectory "$TRAJ" --duration "$BASELINE" --quiet \
+    "${HAP_RT[@]}" > "$OUT/$tag-haptic.log" 2>&1 || true
+  wait "$srv" || true
+  for p in "${subs[@]}"; do kill -TERM "$p" 2>/dev/null || true; done
+  wait "${subs[@]}" 2>/dev/null || true
+}
+run_alone alone
 pids=()
 cleanup() { for p in "${pids[@]}"; do kill -TERM "$p" 2>/dev/null || true; done; wait 2>/dev/null || true; }
 trap cleanup EXIT
@@ -234,6 +244,7 @@ for _ in $(seq 1 15); do
   sleep 1
 done
 pids=()
+run_alone alone2
 {
   echo "load_bench: $SEATS seats x $SCENE_NAME $([ "$ONE" = 1 ] && echo "in one server process (threads) " || echo "in a server process each ")($(sed -n 's/.*organ .\(.*\).: model \([a-z_]*\),.* \([0-9]*\) nodes.*/\1, \2, \3 nodes/p' "$OUT/check.txt" | head -1 | grep . || echo "see the scene"), 1 kHz physics), $([ "$BUSY" = 1 ] && echo "every seat pressed all the time" || echo "press and release every 4 s"), $SUBS subscribers ($late late), $DURATION s"
   sched() { # what PRIO LOG...: the policy asked and how many processes refused it
@@ -243,6 +254,7 @@ pids=()
   }
   echo "  scheduling: $(sched "servers' physics loops" "$RTPRIO" "$OUT"/*-server.log), $(sched "trainees' loops" "$HRTPRIO" "$OUT"/*-haptic.log)"
   echo "  alone (baseline, $BASELINE s): $(step_line "$OUT/alone-server.log")"
+  echo "  alone again after the lab: $(step_line "$OUT/alone2-server.log")"
   for i in $(seq 1 "$SEATS"); do
     s=$(printf 'seat%02d' "$i")
     echo "  $s: $(step_line "$OUT/$s-server.log")"
@@ -251,13 +263,26 @@ pids=()
   # unchanged from one seat alone"), step CPU medians: the whole step, then
   # its two parts (the server's "step CPU split" line: the runtime's tissue
   # step, and the rest: commands, feedback, inputs, frames).
+  # "Unchanged within noise": every seat's median inside the span of the two
+  # runs of the seat alone, widened on each side by their difference (the
+  # reference's spread as measured in this run; see the header).
   against_alone() { # label, sed expression printing one number from a server log
-    local base
-    base=$(sed -n "$2" "$OUT/alone-server.log")
+    local a1 a2
+    a1=$(sed -n "$2" "$OUT/alone-server.log")
+    a2=$(sed -n "$2" "$OUT/alone2-server.log")
     for i in $(seq 1 "$SEATS"); do sed -n "$2" "$OUT/$(printf 'seat%02d' "$i")-server.log"; done | sort -g |
-      awk -v b="$base" -v what="$1" 'NF { v[++n] = $1 } END { if (n && b > 0)
-        printf "  %s, seats against the seat alone: %+.0f %% to %+.0f %% (%.1f-%.1f us against %.1f us)\n",
-          what, 100 * (v[1] / b - 1), 100 * (v[n] / b - 1), v[1], v[n], b }'
+      awk -v a1="${a1:-0}" -v a2="${a2:-0}" -v what="$1" 'NF { v[++n] = $1 } END {
+        if (!n || a1 <= 0) exit
+        printf "  %s, seats against the seat alone: %+.0f %% to %+.0f %% (%.1f-%.1f us against %.1f us)", what,
+          100 * (v[1] / a1 - 1), 100 * (v[n] / a1 - 1), v[1], v[n], a1
+        if (a2 > 0) {
+          lo = (a1 < a2 ? a1 : a2); hi = (a1 < a2 ? a2 : a1); d = hi - lo
+          verdict = "unchanged within noise"
+          if (v[1] < lo - d) verdict = "no slower than the seat alone (faster beyond noise)"
+          if (v[n] > hi + d) verdict = "slower than the seat alone beyond noise"
+          printf "; alone again %.1f us (%+.0f %%): %s", a2, 100 * (a2 / a1 - 1), verdict
+        }
+        printf "\n" }'
   }
   against_alone "step CPU median" 's/^server: step CPU time median \([0-9.]*\) us.*/\1/p'
   against_alone "  of it the tissue step" 's/^server: step CPU split: tissue (contact and organs) median \([0-9.]*\) us.*/\1/p'

@@ -3,8 +3,10 @@
 # light subscribers (delta_sub); the smoke test runs it for a few seconds.
 add_executable(delta_sub ${CMAKE_CURRENT_LIST_DIR}/delta_sub.c)
 target_link_libraries(delta_sub PRIVATE viscera_dds)
-add_test(NAME load_bench_smoke COMMAND bash ${PROJECT_SOURCE_DIR}/deploy/load_bench.sh --build ${PROJECT_BINARY_DIR}
-         --out ${CMAKE_CURRENT_BINARY_DIR}/load_smoke --seats 2 --subscribers 4 --duration 12 --baseline 3)
+# The summary judges the seats against the seat alone, run before and after
+# the lab: both runs' lines and a verdict against their spread.
+add_test(NAME load_bench_smoke COMMAND bash -c
+         "bash '${PROJECT_SOURCE_DIR}/deploy/load_bench.sh' --build '${PROJECT_BINARY_DIR}' --out '${CMAKE_CURRENT_BINARY_DIR}/load_smoke' --seats 2 --subscribers 4 --duration 12 --baseline 3 && grep -Eq '^  alone again after the lab: [0-9]{4,} steps, .*real-time ratio' '${CMAKE_CURRENT_BINARY_DIR}/load_smoke/summary.txt' && grep -Eq '^  step CPU median, seats against the seat alone: .*; alone again [0-9.]+ us [(][-+][0-9]+ %[)]: (unchanged within noise|slower than the seat alone beyond noise|no slower than the seat alone [(]faster beyond noise[)])$' '${CMAKE_CURRENT_BINARY_DIR}/load_smoke/summary.txt'")
 set_tests_properties(load_bench_smoke PROPERTIES LABELS bench TIMEOUT 120
   ENVIRONMENT "CYCLONEDDS_URI=file://${VISCERA_DDS_CONFIG};VISCERA_DOMAIN=148")
 # The same with the seats as threads of one server (--one-server, issue 17
