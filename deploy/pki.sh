@@ -26,7 +26,7 @@
 # account (the script makes it 0700). Needs openssl only.
 set -euo pipefail
 
-usage() { sed -n 3,28p "$0" | sed 's/^# \{0,1\}//'; }
+usage() { awk 'NR > 2 && /^#/ { sub(/^# ?/, ""); print; next } NR > 2 { exit }' "$0"; } # the header
 [ $# -ge 1 ] || { usage >&2; exit 2; }
 case "$1" in -h|--help) usage; exit 0 ;; esac
 OUT="$1"; shift

@@ -207,7 +207,8 @@ static dds_entity_t control_reader(server_t *s, verr_t *err) {
   return r;
 }
 
-/* A writer or reader the permissions refuse: names the identity and the
+/* A writer or reader the permissions refused (DDS_RETCODE_NOT_ALLOWED_BY_SECURITY,
+ * the message of err): names the identity and the
  * partition, the usual cause being an identity of another seat (or a
  * group identity without this seat, deploy/pki.sh --server-group).
  * Returns -1. */
@@ -215,7 +216,7 @@ static int security_hint(const server_t *s, verr_t *err) {
   uint8_t der[VDDS_SUBJECT_DER_MAX];
   char who[VDDS_SUBJECT_TEXT_MAX] = "";
   size_t n = vdds_subject_self(der);
-  if (!strstr(err->msg, "Not Allowed By Security") || !n || vdds_subject_text(der, n, who, sizeof who) < 0) return -1;
+  if (!n || vdds_subject_text(der, n, who, sizeof who) < 0) return -1;
   char msg[VERR_MSG_LEN];
   snprintf(msg, sizeof msg, "%s", err->msg);
   return verr_set(err,
@@ -244,10 +245,11 @@ static int setup_dds(server_t *s, verr_t *err) {
   s->w_role = vdds_writer(&s->dds, VT_TOOL_ROLE, err);
   s->w_applied = vdds_writer(&s->dds, VT_APPLIED_INPUT, err);
   s->w_source = vdds_writer(&s->dds, VT_SCENE_SOURCE, err);
-  if (s->w_scene < 0 || s->w_state < 0 || s->w_delta < 0 || s->w_feedback < 0 || s->w_event < 0 || s->w_metrics < 0 ||
-      s->r_cmd < 0 || s->r_control < 0 || s->w_objects < 0 || s->w_tool_metrics < 0 || s->w_role < 0 ||
-      s->w_applied < 0 || s->w_source < 0)
-    return security_hint(s, err);
+  const dds_entity_t needed[] = {s->w_scene,   s->w_state,   s->w_delta,   s->w_feedback, s->w_event,
+                                 s->w_metrics, s->r_cmd,     s->r_control, s->w_objects,  s->w_tool_metrics,
+                                 s->w_role,    s->w_applied, s->w_source};
+  for (size_t k = 0; k < sizeof needed / sizeof needed[0]; k++)
+    if (needed[k] < 0) return needed[k] == DDS_RETCODE_NOT_ALLOWED_BY_SECURITY ? security_hint(s, err) : -1;
   s->w_chunk = vdds_writer(&s->dds, VT_MESH_KEY_CHUNK, err);
   if (s->w_chunk < 0) {
     /* Permissions made by an older deploy/pki.sh do not grant this topic:
