@@ -22,6 +22,10 @@
 # --one-server: the seats run as threads of one viscera-server process
 # (--seats N: partitions load/seat01..) instead of one process each; its
 # log is split per seat afterwards, so the figures read the same.
+# --seat-threads K (with --one-server): the process steps its seats on K
+# physics threads, each stepping its seats one after the other every tick
+# (viscera-server --seat-threads; server/session/seat_group.h); default the
+# server's own, one per online CPU; K = SEATS: a thread per seat.
 #
 # Scheduling: the servers' physics loops run SCHED_FIFO at --rt-priority S
 # (default 70) and the trainees' 1 kHz loops at --haptic-rt-priority H
@@ -51,7 +55,7 @@
 #
 # usage: deploy/load_bench.sh [--build DIR] [--out DIR] [--seats N] [--subscribers M] [--duration S]
 #                             [--baseline S] [--rt-priority S] [--haptic-rt-priority H]
-#                             [--scene FILE] [--busy] [--one-server]
+#                             [--scene FILE] [--busy] [--one-server [--seat-threads K]]
 # (the press is at x 12 mm, y 4 mm from above, 8 mm deep into an organ whose
 # top is at z = 35 mm: the shipped kidney and gallbladder; classroom
 # scenes: classroom_kidney.yaml, classroom_gallbladder.yaml)
@@ -60,7 +64,7 @@
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD="$ROOT/build" OUT="$ROOT/out/load" SEATS=5 SUBS=30 DURATION=600 BASELINE=30 RTPRIO=70 HRTPRIO=80
-SCENE="$ROOT/assets/scenes/classroom_kidney.yaml" BUSY=0 ONE=0
+SCENE="$ROOT/assets/scenes/classroom_kidney.yaml" BUSY=0 ONE=0 SEATTH=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --build) BUILD="$2"; shift 2 ;;
@@ -74,11 +78,19 @@ while [ $# -gt 0 ]; do
     --scene) SCENE="$2"; shift 2 ;;
     --busy) BUSY=1; shift ;;
     --one-server) ONE=1; shift ;;
+    --seat-threads) SEATTH="$2"; shift 2 ;;
     -h|--help) awk 'NR > 2 && /^#/ { sub(/^# ?/, ""); print; next } NR > 2 { exit }' "$0"; exit 0 ;;
     *) echo "load_bench.sh: unknown option '$1'" >&2; exit 2 ;;
   esac
 done
 for v in SEATS SUBS DURATION BASELINE; do [[ "${!v}" =~ ^[0-9]+$ ]] && [ "${!v}" -ge 1 ] || { echo "load_bench.sh: bad ${v,,}" >&2; exit 2; }; done
+[[ "$SEATTH" =~ ^[0-9]+$ ]] && [ "$SEATTH" -le "$SEATS" ] ||
+  { echo "load_bench.sh: --seat-threads '$SEATTH' is not a number of threads 1..$SEATS" >&2; exit 2; }
+SEATTH=$((10#$SEATTH))
+[ "$SEATTH" = 0 ] || [ "$ONE" = 1 ] || { echo "load_bench.sh: --seat-threads needs --one-server" >&2; exit 2; }
+GROUPS_OPT=() NTHREADS=$SEATTH
+[ "$SEATTH" -gt 0 ] && GROUPS_OPT=(--seat-threads "$SEATTH")
+[ "$NTHREADS" -gt 0 ] || NTHREADS=$(( $(nproc) < SEATS ? $(nproc) : SEATS )) # the server's default
 check_prio() {
   [[ "$2" =~ ^[0-9]{1,2}$ ]] ||
     { echo "load_bench.sh: $1 '$2' is not 0 (normal scheduling) or a SCHED_FIFO priority 1..99" >&2; exit 2; }
@@ -160,7 +172,7 @@ T0=$(now_us)
 servers=() srvnames=()
 if [ "$ONE" = 1 ]; then
   "$BUILD/server/viscera-server" --scene "$SCENE" --partition load --seats "$SEATS" --duration $((DURATION + 3)) \
-    --quiet "${SRV_RT[@]}" > "$OUT/seats-server.out" 2> "$OUT/seats-server.log" &
+    --quiet "${SRV_RT[@]}" "${GROUPS_OPT[@]}" > "$OUT/seats-server.out" 2> "$OUT/seats-server.log" &
   servers+=($!); srvnames+=(seats); pids+=($!); register $! server seats viscera-server
 else
   for i in $(seq 1 "$SEATS"); do
@@ -246,7 +258,7 @@ done
 pids=()
 run_alone alone2
 {
-  echo "load_bench: $SEATS seats x $SCENE_NAME $([ "$ONE" = 1 ] && echo "in one server process (threads) " || echo "in a server process each ")($(sed -n 's/.*organ .\(.*\).: model \([a-z_]*\),.* \([0-9]*\) nodes.*/\1, \2, \3 nodes/p' "$OUT/check.txt" | head -1 | grep . || echo "see the scene"), 1 kHz physics), $([ "$BUSY" = 1 ] && echo "every seat pressed all the time" || echo "press and release every 4 s"), $SUBS subscribers ($late late), $DURATION s"
+  echo "load_bench: $SEATS seats x $SCENE_NAME $([ "$ONE" = 1 ] && { [ "$NTHREADS" -lt "$SEATS" ] && echo "in one server process ($NTHREADS physics threads, each stepping its seats in turn) " || echo "in one server process (a physics thread per seat) "; } || echo "in a server process each ")($(sed -n 's/.*organ .\(.*\).: model \([a-z_]*\),.* \([0-9]*\) nodes.*/\1, \2, \3 nodes/p' "$OUT/check.txt" | head -1 | grep . || echo "see the scene"), 1 kHz physics), $([ "$BUSY" = 1 ] && echo "every seat pressed all the time" || echo "press and release every 4 s"), $SUBS subscribers ($late late), $DURATION s"
   sched() { # what PRIO LOG...: the policy asked and how many processes refused it
     local what=$1 prio=$2; shift 2
     if [ "$prio" = 0 ]; then echo "$what normal scheduling"; return; fi

@@ -28,12 +28,18 @@ static void usage(FILE *f) {
           "                      CAP_SYS_NICE or LimitRTPRIO; if refused: a warning naming the reason,\n"
           "                      normal priority)\n"
           "  --seats N           run N seats of the scene in this one process (1..%d), each\n"
-          "                      its own session on partition P/seatKK (P: --partition), with its own\n"
-          "                      physics thread; seats in one process share a core's caches better\n"
-          "                      than one process per seat (docs/numerics.md §11.3); --checkpoint\n"
-          "                      and --final-mesh PATH then name each seat's PATH.seatKK\n"
+          "                      its own session on partition P/seatKK (P: --partition); seats in\n"
+          "                      one process share a core's caches better than one process per\n"
+          "                      seat (docs/numerics.md §11.3); --checkpoint and --final-mesh PATH\n"
+          "                      then name each seat's PATH.seatKK\n"
           "  --first-seat K      with --seats: the first seat's number (default 1): seats K..K+N-1,\n"
           "                      at most 99\n"
+          "  --seat-threads K    with --seats: K physics threads (1..N), each stepping its share of\n"
+          "                      the seats one after the other every tick (default: one per online\n"
+          "                      CPU, at most N); fewer threads than seats keep each seat's step\n"
+          "                      as cheap as alone on a crowded machine (docs/numerics.md §11.3),\n"
+          "                      but a seat's long step (a cut) delays the seats of its thread;\n"
+          "                      K = N: a thread per seat\n"
           "  --quiet             only errors and warnings on stderr\n"
           "  --help              this text\n"
           "  --version           print the version and exit\n"
@@ -52,7 +58,8 @@ enum {
   OPT_CHECKPOINT_EVERY = 'E',
   OPT_RT_PRIORITY = 'R',
   OPT_SEATS = 'S',
-  OPT_FIRST_SEAT = 'F'
+  OPT_FIRST_SEAT = 'F',
+  OPT_SEAT_THREADS = 'G'
 };
 
 /* A number of seconds: >= 0 when `zero_ok`, else > 0. */
@@ -103,6 +110,17 @@ static int on_option(void *ctx, int code, const char *arg) {
     o->seats = (int)n;
     return 0;
   }
+  case OPT_SEAT_THREADS: {
+    char *end = NULL;
+    long n = strtol(arg, &end, 10);
+    if (end == arg || *end || n < 1 || n > SERVER_APP_MAX_SEATS) {
+      fprintf(stderr, "viscera-server: --seat-threads '%s' is not a number of threads 1..%d\n", arg,
+              SERVER_APP_MAX_SEATS);
+      return 2;
+    }
+    o->seat_threads = (int)n;
+    return 0;
+  }
   case OPT_FIRST_SEAT: {
     char *end = NULL;
     long n = strtol(arg, &end, 10);
@@ -129,6 +147,7 @@ int main(int argc, char **argv) {
                                      {"rt-priority", required_argument, 0, OPT_RT_PRIORITY},
                                      {"seats", required_argument, 0, OPT_SEATS},
                                      {"first-seat", required_argument, 0, OPT_FIRST_SEAT},
+                                     {"seat-threads", required_argument, 0, OPT_SEAT_THREADS},
                                      {0, 0, 0, 0}};
   const cli_spec_t spec = {.program = "viscera-server",
                            .common = CLI_DOMAIN | CLI_DOMAIN_ENV | CLI_PARTITION | CLI_QUIET,
@@ -151,6 +170,14 @@ int main(int argc, char **argv) {
   }
   if (o.first_seat && !o.seats) {
     fprintf(stderr, "viscera-server: --first-seat needs --seats\n");
+    return 2;
+  }
+  if (o.seat_threads && !o.seats) {
+    fprintf(stderr, "viscera-server: --seat-threads needs --seats\n");
+    return 2;
+  }
+  if (o.seat_threads > o.seats) {
+    fprintf(stderr, "viscera-server: --seat-threads %d is more than the %d seats\n", o.seat_threads, o.seats);
     return 2;
   }
   if (!o.first_seat) o.first_seat = 1;

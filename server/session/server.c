@@ -34,7 +34,7 @@
 
 #define STEP_RING 65536
 
-typedef struct server {
+struct server {
   const server_opts_t *opts;
   const char *tag; /* what the log lines start with: opts->log_tag or "server" */
   runtime_t rt;
@@ -77,6 +77,18 @@ typedef struct server {
   unsigned char *step_awake;          /* the same steps: 1 when an organ was stepped (not all asleep, not paused) */
   double *step_tissue_us;             /* the same steps: thread CPU inside the runtime's step (contact and organs) */
   uint64_t tissue_ns;                 /* the current step's, summed over runtime_step_begin and _finish */
+  /* The current step's thread CPU and wall time, summed over its phases
+   * (server_step_begin, _tissue, _end): with several sessions on one
+   * thread (seat_group.h) the other sessions' phases run in between. */
+  uint64_t step_cpu_ns, step_wall_ns;
+  uint32_t early;       /* tools answered before the tissue step (publish_feedback_early) */
+  int rolled;           /* the tissue step's rolled-back organs */
+  uint64_t started_ns;  /* monotonic time of the first step (0 before): the real-time ratio's start */
+  uint64_t last_end_ns; /* the end of the last step's publishing: the ratio's end */
+  double sim0;          /* simulated time at the first step (a resumed run starts at its checkpoint's) */
+  checkpointer_t *ckpt;
+  uint64_t ckpt_every; /* steps between checkpoints */
+  char resumed[300];   /* "resumed from checkpoint ..." or empty */
   size_t nstep_us;
   uint64_t publish_every, metrics_every; /* steps between frames, between metrics */
   server_stats_t *stats;
@@ -84,7 +96,7 @@ typedef struct server {
    * digest, recorded in SceneSource (checkpoint_resume_state). */
   state_blob_t resume;
   char resume_sha256[SHA256_HEX_LEN];
-} server_t;
+};
 
 static uint64_t sim_ns(const server_t *s) { return (uint64_t)(s->rt.sim_time * 1e9); }
 
@@ -942,14 +954,14 @@ static long rss_kb(void) {
   return resident * (sysconf(_SC_PAGESIZE) / 1024);
 }
 
-/* The step's wall and CPU time since t0, c0 (the step-time rings). */
-static void record_step_time(server_t *s, uint64_t t0, uint64_t c0, uint64_t t1) {
-  s->step_cpu_us[s->nstep_us % STEP_RING] = (double)(vtime_thread_cpu_ns() - c0) * 1e-3;
+/* The step's wall and CPU time, summed over its phases (the step-time rings). */
+static void record_step_time(server_t *s) {
+  s->step_cpu_us[s->nstep_us % STEP_RING] = (double)s->step_cpu_ns * 1e-3;
   s->step_tissue_us[s->nstep_us % STEP_RING] = (double)s->tissue_ns * 1e-3;
   int awake = !s->control.paused && s->rt.organs_stepped > 0;
   s->step_awake[s->nstep_us % STEP_RING] = (unsigned char)awake;
   if (!s->control.paused && !awake) s->stats->steps_all_asleep++;
-  s->step_us[s->nstep_us++ % STEP_RING] = (double)(t1 - t0) * 1e-3;
+  s->step_us[s->nstep_us++ % STEP_RING] = (double)s->step_wall_ns * 1e-3;
 }
 
 /* Rolled-back steps (runtime_step): an event and a log line at most once
@@ -979,7 +991,15 @@ static void report_rollbacks(server_t *s, int rolled) {
  * CPU time then): the walk of a ToolCommand from the DDS take to the
  * ContactFeedback write. t1 is when the step's work was done (before the
  * metrics). -1 when the scene could not be rebuilt after a control. */
-static int session_step(server_t *s, uint64_t t0, uint64_t c0, uint64_t *t1) {
+/* server.h: the first phase of a step. */
+int server_step_begin(server_t *s, uint64_t t0) {
+  uint64_t c0 = vtime_thread_cpu_ns();
+  if (!s->started_ns) s->started_ns = t0;
+  s->step_cpu_ns = 0;
+  s->step_wall_ns = 0;
+  s->tissue_ns = 0;
+  s->early = 0;
+  s->rolled = 0;
   /* In: take and convert the commands, check them, note each side's latest. */
   applied_input_tick(&s->ai);
   uint32_t fresh = take_commands(s, t0);
@@ -997,44 +1017,58 @@ static int session_step(server_t *s, uint64_t t0, uint64_t c0, uint64_t *t1) {
     publish_roles(s);
   }
   /* Step: paused, the organs and the measures freeze; commands are still
-   * read (so nothing queues up) and the last contact model keeps going out. */
-  /* A tool with a fresh command is answered between the step's contact
+   * read (so nothing queues up) and the last contact model keeps going out.
+   * A tool with a fresh command is answered between the step's contact
    * phase and its tissue step (runtime_step_begin/finish: the same step as
-   * runtime_step), so its ContactFeedback does not wait for the organs. */
-  int rolled = 0;
-  uint32_t early = 0;
-  /* The runtime's share of the step's CPU (its contact phase and organs)
+   * runtime_step), so its ContactFeedback does not wait for the organs.
+   * The runtime's share of the step's CPU (its contact phase and organs)
    * is kept apart from the messages around it (stats: step_tissue_cpu). */
-  s->tissue_ns = 0;
   if (!s->control.paused) {
     uint64_t b0 = vtime_thread_cpu_ns();
     runtime_step_begin(&s->rt);
     s->tissue_ns = vtime_thread_cpu_ns() - b0;
-    early = publish_feedback_early(s, fresh);
+    s->early = publish_feedback_early(s, fresh);
   }
   /* Before the tissue step it precedes (after the early answers, which
    * wait for nothing; the sample's content was fixed at the take). */
   applied_input_flush(&s->ai);
-  if (!s->control.paused) {
-    uint64_t f0 = vtime_thread_cpu_ns();
-    rolled = runtime_step_finish(&s->rt);
-    s->tissue_ns += vtime_thread_cpu_ns() - f0;
-  }
-  if (rolled) report_rollbacks(s, rolled);
+  s->step_cpu_ns += vtime_thread_cpu_ns() - c0;
+  s->step_wall_ns += vtime_mono_ns() - t0;
+  return 0;
+}
+
+/* server.h: the tissue step. */
+void server_step_tissue(server_t *s) {
+  if (s->control.paused) return;
+  uint64_t w0 = vtime_mono_ns(), f0 = vtime_thread_cpu_ns();
+  s->rolled = runtime_step_finish(&s->rt);
+  uint64_t d = vtime_thread_cpu_ns() - f0;
+  s->tissue_ns += d;
+  s->step_cpu_ns += d;
+  s->step_wall_ns += vtime_mono_ns() - w0;
+}
+
+/* server.h: the step's messages out. */
+uint64_t server_step_end(server_t *s) {
+  uint64_t w0 = vtime_mono_ns(), c0 = vtime_thread_cpu_ns();
+  if (s->rolled) report_rollbacks(s, s->rolled);
   /* Out: keyframes after a topology change, the ContactFeedback of every
    * driven tool not answered before the step (its force, tip and normal
    * from the core record), the trainee measures, the step's events, frames
    * and metrics. */
   follow_topology(s);
-  publish_feedback(s, early);
+  publish_feedback(s, s->early);
   if (!s->control.paused) {
     track_thresholds(s);
     for (size_t t = 0; t < s->rt.ntools; t++) tool_tally_update(&s->tool[t].tally, &s->rt.tools[t], s->rt.scene.dt);
     publish_interactions(s); /* the events of the step just taken */
   }
   if (s->rt.steps % s->publish_every == 0) publish_frames(s);
-  *t1 = vtime_mono_ns();
-  record_step_time(s, t0, c0, *t1);
+  uint64_t t1 = vtime_mono_ns();
+  s->step_cpu_ns += vtime_thread_cpu_ns() - c0;
+  s->step_wall_ns += t1 - w0;
+  s->last_end_ns = t1;
+  record_step_time(s);
   if (s->rt.steps % s->metrics_every == 0) {
     long kb = rss_kb();
     if (!s->stats->rss_start_kb) s->stats->rss_start_kb = kb;
@@ -1042,192 +1076,224 @@ static int session_step(server_t *s, uint64_t t0, uint64_t c0, uint64_t *t1) {
     publish_metrics(s, s->metrics_every);
     publish_tool_metrics(s);
   }
-  return 0;
+  if (s->ckpt && s->rt.steps % s->ckpt_every == 0) checkpointer_submit(s->ckpt, &s->rt, s->tool, &s->roles);
+  return t1;
 }
 
-int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_atomic_t *stop, server_stats_t *stats,
-               verr_t *err) {
-  server_t s;
-  memset(&s, 0, sizeof s);
-  memset(stats, 0, sizeof *stats);
-  s.opts = opts;
-  s.tag = opts->log_tag ? opts->log_tag : "server";
-  s.stats = stats;
-  if (setup(&s, scene, err)) {
-    teardown(&s);
-    return -1;
-  }
-  if (!opts->quiet) {
-    for (size_t i = 0; i < s.rt.norgans; i++) {
-      const organ_rt_t *o = &s.rt.organs[i];
-      const model_t *m = o->model;
+uint64_t server_dt_ns(const server_t *s) { return (uint64_t)(s->rt.scene.dt * 1e9); }
+
+void server_note_overrun(server_t *s) { s->stats->overruns++; }
+
+/* Logs what each organ runs (not with opts->quiet). */
+static void log_organs(const server_t *s, const scene_t *scene) {
+  const server_opts_t *opts = s->opts;
+  for (size_t i = 0; i < s->rt.norgans; i++) {
+    const organ_rt_t *o = &s->rt.organs[i];
+    const model_t *m = o->model;
+    fprintf(stderr,
+            "%s: organ '%s': %s, %s, %zu nodes, %zu tetrahedra, surface %zu vertices / %zu triangles, "
+            "%d sub-step(s) per %.3g ms (stable below %.3g ms)\n",
+            s->tag, o->cfg->name, m->ops->name, o->cfg->integrator, m->nnodes, m->ntets, m->nsurf, m->nsurf_tris,
+            m->substeps, scene->dt * 1e3, m->stable_dt * 1e3);
+    if (o->mesh_note[0]) fprintf(stderr, "%s: organ '%s': mesh repaired: %s\n", s->tag, o->cfg->name, o->mesh_note);
+    if (m->substeps > 0 && scene->dt / m->substeps > m->stable_dt)
       fprintf(stderr,
-              "%s: organ '%s': %s, %s, %zu nodes, %zu tetrahedra, surface %zu vertices / %zu triangles, "
-              "%d sub-step(s) per %.3g ms (stable below %.3g ms)\n",
-              s.tag, o->cfg->name, m->ops->name, o->cfg->integrator, m->nnodes, m->ntets, m->nsurf, m->nsurf_tris,
-              m->substeps, scene->dt * 1e3, m->stable_dt * 1e3);
-      if (o->mesh_note[0]) fprintf(stderr, "%s: organ '%s': mesh repaired: %s\n", s.tag, o->cfg->name, o->mesh_note);
-      if (m->substeps > 0 && scene->dt / m->substeps > m->stable_dt)
-        fprintf(stderr,
-                "%s: organ '%s': warning: solver.substeps %d gives %.3g ms sub-steps, above the "
-                "stable %.3g ms: expect rollbacks\n",
-                s.tag, o->cfg->name, m->substeps, scene->dt / m->substeps * 1e3, m->stable_dt * 1e3);
-    }
-    fprintf(stderr, "%s: scene '%s' running on domain %d, partition '%s'\n", s.tag, scene->name, opts->domain,
-            opts->partition ? opts->partition : VDDS_DEFAULT_PARTITION);
+              "%s: organ '%s': warning: solver.substeps %d gives %.3g ms sub-steps, above the "
+              "stable %.3g ms: expect rollbacks\n",
+              s->tag, o->cfg->name, m->substeps, scene->dt / m->substeps * 1e3, m->stable_dt * 1e3);
   }
-  for (size_t t = 0; t < s.rt.ntools; t++) {
-    const scene_tool_t *c = s.rt.tools[t].cfg;
-    thr_init(&s.tool[t].thr, c->st, c->mpf, c->sft);
-  }
-  checkpointer_t *ckpt = NULL;
-  char resumed[300] = "";
-  if (opts->checkpoint) {
-    verr_t e;
-    /* the digest of the file as it is loaded: the checkpointer rewrites it later */
-    uint64_t ckpt_size = 0;
-    if (sha256_file(opts->checkpoint, s.resume_sha256, &ckpt_size, &e)) s.resume_sha256[0] = 0;
-    int r = checkpoint_load(opts->checkpoint, &s.rt, s.tool, &s.roles, &e);
-    if (r == -2) {
-      verr_set(err, "%s (cannot rebuild the scene after it)", e.msg);
-      teardown(&s);
-      return -1;
+  fprintf(stderr, "%s: scene '%s' running on domain %d, partition '%s'\n", s->tag, scene->name, opts->domain,
+          opts->partition ? opts->partition : VDDS_DEFAULT_PARTITION);
+}
+
+/* Resumes from opts->checkpoint when it fits and starts the checkpointer.
+ * Returns 0, or -1 with err (the session cannot run). */
+static int open_checkpoint(server_t *s, verr_t *err) {
+  const server_opts_t *opts = s->opts;
+  server_stats_t *stats = s->stats;
+  verr_t e;
+  /* the digest of the file as it is loaded: the checkpointer rewrites it later */
+  uint64_t ckpt_size = 0;
+  if (sha256_file(opts->checkpoint, s->resume_sha256, &ckpt_size, &e)) s->resume_sha256[0] = 0;
+  int r = checkpoint_load(opts->checkpoint, &s->rt, s->tool, &s->roles, &e);
+  if (r == -2) return verr_set(err, "%s (cannot rebuild the scene after it)", e.msg);
+  if (r < 0) {
+    fprintf(stderr, "%s: %s\n", s->tag, e.msg);
+    /* A topology restore that failed midway rebuilt the runtime: the
+     * publishers must drop the old models' surfaces they borrow. */
+    for (size_t i = 0; i < s->rt.norgans; i++) {
+      const model_t *m = s->rt.organs[i].model;
+      if (s->pubs[i].tris != m->surf_tris &&
+          mesh_publisher_retopo(&s->pubs[i], s->rt.organs[i].topology_version, m->nsurf, m->surf_tris, m->nsurf_tris,
+                                m->surf_x, 0, &e))
+        fprintf(stderr, "%s: %s\n", s->tag, e.msg);
     }
-    if (r < 0) {
-      fprintf(stderr, "%s: %s\n", s.tag, e.msg);
-      /* A topology restore that failed midway rebuilt the runtime: the
-       * publishers must drop the old models' surfaces they borrow. */
-      for (size_t i = 0; i < s.rt.norgans; i++) {
-        const model_t *m = s.rt.organs[i].model;
-        if (s.pubs[i].tris != m->surf_tris &&
-            mesh_publisher_retopo(&s.pubs[i], s.rt.organs[i].topology_version, m->nsurf, m->surf_tris, m->nsurf_tris,
-                                  m->surf_x, 0, &e))
-          fprintf(stderr, "%s: %s\n", s.tag, e.msg);
-      }
-    } else if (r == 1) {
-      stats->resumed = 1;
-      snprintf(resumed, sizeof resumed, "resumed from checkpoint %s at t = %.3f s (step %llu)", opts->checkpoint,
-               s.rt.sim_time, (unsigned long long)s.rt.steps);
-      if (!opts->quiet) fprintf(stderr, "%s: %s\n", s.tag, resumed);
-      follow_topology(&s); /* a restored cut: keyframes of its topology before anything else */
-      if (checkpoint_resume_state(&s.resume, &s.rt, s.tool, &e) || s.resume.bad) {
-        /* the session runs on; its recording cannot be re-simulated */
-        fprintf(stderr, "%s: warning: the resumed state cannot be recorded: %s\n", s.tag,
-                s.resume.bad ? "out of memory" : e.msg);
-        free(s.resume.p);
-        s.resume = (state_blob_t){0};
-      }
-    }
-    if (r != 1) s.resume_sha256[0] = 0; /* from rest: nothing resumed */
-    if (!(ckpt = checkpointer_start(opts->checkpoint, err))) {
-      teardown(&s);
-      return -1;
+  } else if (r == 1) {
+    stats->resumed = 1;
+    snprintf(s->resumed, sizeof s->resumed, "resumed from checkpoint %s at t = %.3f s (step %llu)", opts->checkpoint,
+             s->rt.sim_time, (unsigned long long)s->rt.steps);
+    if (!opts->quiet) fprintf(stderr, "%s: %s\n", s->tag, s->resumed);
+    follow_topology(s); /* a restored cut: keyframes of its topology before anything else */
+    if (checkpoint_resume_state(&s->resume, &s->rt, s->tool, &e) || s->resume.bad) {
+      /* the session runs on; its recording cannot be re-simulated */
+      fprintf(stderr, "%s: warning: the resumed state cannot be recorded: %s\n", s->tag,
+              s->resume.bad ? "out of memory" : e.msg);
+      free(s->resume.p);
+      s->resume = (state_blob_t){0};
     }
   }
-  uint64_t ckpt_every = (uint64_t)fmax(1.0, floor(opts->checkpoint_every / scene->dt + 0.5));
-  publish_scene_info(&s);
-  publish_scene_source(&s);
-  publish_roles(&s);
+  if (r != 1) s->resume_sha256[0] = 0; /* from rest: nothing resumed */
+  return (s->ckpt = checkpointer_start(opts->checkpoint, err)) ? 0 : -1;
+}
+
+server_t *server_open(const scene_t *scene, const server_opts_t *opts, server_stats_t *stats, verr_t *err) {
+  server_t *s = calloc(1, sizeof *s);
+  memset(stats, 0, sizeof *stats);
+  if (!s) {
+    verr_set(err, "out of memory for a session");
+    return NULL;
+  }
+  s->opts = opts;
+  s->tag = opts->log_tag ? opts->log_tag : "server";
+  s->stats = stats;
+  if (setup(s, scene, err)) {
+    teardown(s);
+    free(s);
+    return NULL;
+  }
+  if (!opts->quiet) log_organs(s, scene);
+  for (size_t t = 0; t < s->rt.ntools; t++) {
+    const scene_tool_t *c = s->rt.tools[t].cfg;
+    thr_init(&s->tool[t].thr, c->st, c->mpf, c->sft);
+  }
+  if (opts->checkpoint && open_checkpoint(s, err)) {
+    teardown(s);
+    free(s);
+    return NULL;
+  }
+  s->ckpt_every = (uint64_t)fmax(1.0, floor(opts->checkpoint_every / scene->dt + 0.5));
+  publish_scene_info(s);
+  publish_scene_source(s);
+  publish_roles(s);
   /* Stamped with the simulated time of the state: 0 from rest, the
    * checkpoint's when resumed (a re-simulation matches frames by step). */
-  for (size_t i = 0; i < s.rt.norgans; i++)
-    mesh_publisher_keyframe(&s.pubs[i], s.rt.organs[i].model->surf_x, sim_ns(&s));
-  publish_event(&s, viscera_EVENT_SESSION_STARTED, -1, -1, stats->resumed, resumed[0] ? resumed : scene->name);
+  for (size_t i = 0; i < s->rt.norgans; i++)
+    mesh_publisher_keyframe(&s->pubs[i], s->rt.organs[i].model->surf_x, sim_ns(s));
+  publish_event(s, viscera_EVENT_SESSION_STARTED, -1, -1, stats->resumed, s->resumed[0] ? s->resumed : scene->name);
+  s->publish_every = (uint64_t)fmax(1.0, floor(1.0 / (scene->publish_hz * scene->dt) + 0.5));
+  s->metrics_every = (uint64_t)fmax(1.0, floor(1.0 / scene->dt + 0.5));
+  s->sim0 = s->rt.sim_time; /* a resumed run starts where its checkpoint was */
+  return s;
+}
 
-  uint64_t dt_ns = (uint64_t)(scene->dt * 1e9);
-  s.publish_every = (uint64_t)fmax(1.0, floor(1.0 / (scene->publish_hz * scene->dt) + 0.5));
-  s.metrics_every = (uint64_t)fmax(1.0, floor(1.0 / scene->dt + 0.5));
-  /* Real time for this thread only, after every other thread (DDS, the
-   * checkpoint writer) has started, so they stay SCHED_OTHER. The loop sleeps
-   * to each tick in vtime_sleep_until, so FIFO costs the machine no more CPU
-   * than the steps; but a loop whose steps take longer than dt never sleeps
-   * (it catches up, resynchronising when 100 ms behind) and would hold its
-   * core for good. The kernel's RT throttling (sched_rt_runtime_us: 950 ms of
-   * every second by default) is the safety net that still lets the other
-   * tasks (this server's DDS threads, a shell to stop it) run there. */
-  if (opts->rt_priority) vrt_make_realtime(opts->rt_priority, s.tag, "physics loop", opts->quiet, stderr);
+void server_thread_prepare(const server_opts_t *opts, const char *tag) {
+  /* Real time for the calling thread only, after every other thread (DDS,
+   * the checkpoint writer) has started, so they stay SCHED_OTHER. The loop
+   * sleeps to each tick in vtime_sleep_until, so FIFO costs the machine no
+   * more CPU than the steps; but a loop whose steps take longer than dt
+   * never sleeps (it catches up, resynchronising when 100 ms behind) and
+   * would hold its core for good. The kernel's RT throttling
+   * (sched_rt_runtime_us: 950 ms of every second by default) is the safety
+   * net that still lets the other tasks (this server's DDS threads, a shell
+   * to stop it) run there. */
+  if (opts->rt_priority) vrt_make_realtime(opts->rt_priority, tag, "physics loop", opts->quiet, stderr);
   /* A SCHED_OTHER loop wakes up to the thread's timer slack (50 us by
    * default) after each tick: every command would wait that much longer
    * for its step and its answer (issue 17 item 5). 1 ns: on time. */
   prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
-  uint64_t start = vtime_mono_ns(), next = start;
-  double sim0 = s.rt.sim_time; /* a resumed run starts where its checkpoint was */
-  while (!*stop && (opts->duration <= 0 || (double)(vtime_mono_ns() - start) * 1e-9 < opts->duration)) {
-    uint64_t t0 = vtime_mono_ns(), c0 = vtime_thread_cpu_ns();
-    uint64_t t1;
-    if (session_step(&s, t0, c0, &t1)) {
-      stats->overruns++;
-      break; /* the scene could not be rebuilt: nothing left to simulate */
-    }
-    if (ckpt && s.rt.steps % ckpt_every == 0) checkpointer_submit(ckpt, &s.rt, s.tool, &s.roles);
-    next += dt_ns;
-    if (t1 > next + 100 * 1000000ull) { /* far behind (debugger, overload): resynchronise */
-      stats->overruns++;
-      next = t1;
-    }
-    vtime_sleep_until(next);
-  }
-  publish_frames(&s);
-  publish_metrics(&s, s.metrics_every);
-  publish_tool_metrics(&s);
-  if (ckpt) {
-    checkpointer_submit(ckpt, &s.rt, s.tool, &s.roles);
-    verr_t e;
-    if (checkpointer_stop(ckpt, &stats->checkpoints_written, &e)) fprintf(stderr, "%s: %s\n", s.tag, e.msg);
-  }
-  if (opts->final_mesh) write_final_mesh(&s);
-  publish_event(&s, viscera_EVENT_SESSION_STOPPED, -1, -1, 0, scene->name);
+}
 
-  stats->steps = s.rt.steps;
-  applied_input_flush(&s.ai);
-  stop_applied_outbox(&s);
-  stats->published[VT_APPLIED_INPUT] = s.ai.published;
-  for (size_t i = 0; i < s.rt.norgans; i++) {
-    stats->published[VT_MESH_STATE] += s.pubs[i].keyframes;
-    stats->published[VT_MESH_KEY_CHUNK] += s.pubs[i].chunk_samples;
-    stats->published[VT_MESH_DELTA] += s.pubs[i].frames;
-    stats->deltas_skipped += s.pubs[i].skipped;
+void server_close(server_t *s) {
+  const server_opts_t *opts = s->opts;
+  const scene_t *scene = &s->rt.scene;
+  server_stats_t *stats = s->stats;
+  publish_frames(s);
+  publish_metrics(s, s->metrics_every);
+  publish_tool_metrics(s);
+  if (s->ckpt) {
+    checkpointer_submit(s->ckpt, &s->rt, s->tool, &s->roles);
+    verr_t e;
+    if (checkpointer_stop(s->ckpt, &stats->checkpoints_written, &e)) fprintf(stderr, "%s: %s\n", s->tag, e.msg);
   }
-  stats->ntools = s.rt.ntools;
-  for (size_t t = 0; t < s.rt.ntools; t++) {
-    stats->thr[t] = s.tool[t].thr;
-    tool_metrics_fill(&stats->tools[t], &s.rt, t, &s.tool[t].thr, &s.tool[t].tally, sim_ns(&s));
+  if (opts->final_mesh) write_final_mesh(s);
+  publish_event(s, viscera_EVENT_SESSION_STOPPED, -1, -1, 0, scene->name);
+
+  stats->steps = s->rt.steps;
+  applied_input_flush(&s->ai);
+  stop_applied_outbox(s);
+  stats->published[VT_APPLIED_INPUT] = s->ai.published;
+  for (size_t i = 0; i < s->rt.norgans; i++) {
+    stats->published[VT_MESH_STATE] += s->pubs[i].keyframes;
+    stats->published[VT_MESH_KEY_CHUNK] += s->pubs[i].chunk_samples;
+    stats->published[VT_MESH_DELTA] += s->pubs[i].frames;
+    stats->deltas_skipped += s->pubs[i].skipped;
   }
-  stats->ntasks = s.rt.ntasks;
-  stats->sim_time = s.rt.sim_time;
-  memcpy(stats->tasks, s.rt.tasks, sizeof stats->tasks);
-  for (size_t i = 0; i < s.rt.nstones; i++) stats->stone_removed[i] = s.rt.stones[i].removed;
-  for (size_t t = 0; t < s.rt.ntools; t++) stats->peak_force = fmax(stats->peak_force, s.rt.tools[t].peak_force);
-  size_t n = s.nstep_us < STEP_RING ? s.nstep_us : STEP_RING;
-  summarise_awake(&s, n, stats); /* first: the summaries below sort the rings in place */
-  vstats_summary_t st = vstats_summarise(s.step_us, n);
+  stats->ntools = s->rt.ntools;
+  for (size_t t = 0; t < s->rt.ntools; t++) {
+    stats->thr[t] = s->tool[t].thr;
+    tool_metrics_fill(&stats->tools[t], &s->rt, t, &s->tool[t].thr, &s->tool[t].tally, sim_ns(s));
+  }
+  stats->ntasks = s->rt.ntasks;
+  stats->sim_time = s->rt.sim_time;
+  memcpy(stats->tasks, s->rt.tasks, sizeof stats->tasks);
+  for (size_t i = 0; i < s->rt.nstones; i++) stats->stone_removed[i] = s->rt.stones[i].removed;
+  for (size_t t = 0; t < s->rt.ntools; t++) stats->peak_force = fmax(stats->peak_force, s->rt.tools[t].peak_force);
+  size_t n = s->nstep_us < STEP_RING ? s->nstep_us : STEP_RING;
+  summarise_awake(s, n, stats); /* first: the summaries below sort the rings in place */
+  vstats_summary_t st = vstats_summarise(s->step_us, n);
   stats->step_us_median = st.median;
   stats->step_us_p99 = st.p99;
   stats->step_us_max = st.max;
   /* The rest of each step (commands, feedback, frames), before the rings are sorted. */
   double *other = malloc((n + 1) * sizeof *other);
   if (other) {
-    for (size_t i = 0; i < n; i++) other[i] = s.step_cpu_us[i] - s.step_tissue_us[i];
+    for (size_t i = 0; i < n; i++) other[i] = s->step_cpu_us[i] - s->step_tissue_us[i];
     vstats_summary_t so = vstats_summarise(other, n);
     stats->step_other_cpu_us_median = so.median;
     stats->step_other_cpu_us_p99 = so.p99;
     free(other);
   }
-  vstats_summary_t stt = vstats_summarise(s.step_tissue_us, n);
+  vstats_summary_t stt = vstats_summarise(s->step_tissue_us, n);
   stats->step_tissue_cpu_us_median = stt.median;
   stats->step_tissue_cpu_us_p99 = stt.p99;
-  vstats_summary_t sc = vstats_summarise(s.step_cpu_us, n);
+  vstats_summary_t sc = vstats_summarise(s->step_cpu_us, n);
   stats->step_cpu_us_median = sc.median;
   stats->step_cpu_us_p99 = sc.p99;
-  for (size_t i = 0; i < s.rt.norgans; i++) {
-    stats->organ_sleeps += s.rt.organs[i].sleep.sleeps;
-    stats->organ_wakes += s.rt.organs[i].sleep.wakes;
+  for (size_t i = 0; i < s->rt.norgans; i++) {
+    stats->organ_sleeps += s->rt.organs[i].sleep.sleeps;
+    stats->organ_wakes += s->rt.organs[i].sleep.wakes;
   }
-  double wall = (double)(vtime_mono_ns() - start) * 1e-9;
-  stats->realtime_ratio = wall > 0 ? (s.rt.sim_time - sim0) / wall : 0;
-  scalpel_print_summary(&s.rt, stdout);
+  /* Up to the end of the last step: a thread stepping several sessions
+   * closes them one after the other (seat_group.h). */
+  double wall = s->started_ns ? (double)(s->last_end_ns - s->started_ns) * 1e-9 : 0;
+  stats->realtime_ratio = wall > 0 ? (s->rt.sim_time - s->sim0) / wall : 0;
+  scalpel_print_summary(&s->rt, stdout);
   /* Give reliable late samples (last frame, stop event) a moment to leave. */
   dds_sleepfor(DDS_MSECS(100));
-  teardown(&s);
+  teardown(s);
+  free(s);
+}
+
+int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_atomic_t *stop, server_stats_t *stats,
+               verr_t *err) {
+  server_t *s = server_open(scene, opts, stats, err);
+  if (!s) return -1;
+  server_thread_prepare(opts, s->tag);
+  uint64_t dt_ns = server_dt_ns(s), start = vtime_mono_ns(), next = start;
+  while (!*stop && (opts->duration <= 0 || (double)(vtime_mono_ns() - start) * 1e-9 < opts->duration)) {
+    if (server_step_begin(s, vtime_mono_ns())) {
+      stats->overruns++;
+      break; /* the scene could not be rebuilt: nothing left to simulate */
+    }
+    server_step_tissue(s);
+    uint64_t t1 = server_step_end(s);
+    next += dt_ns;
+    if (t1 > next + SERVER_RESYNC_NS) { /* far behind (debugger, overload): resynchronise */
+      stats->overruns++;
+      next = t1;
+    }
+    vtime_sleep_until(next);
+  }
+  server_close(s);
   return 0;
 }

@@ -81,4 +81,42 @@ typedef struct server_stats {
 int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_atomic_t *stop, server_stats_t *stats,
                verr_t *err);
 
+/* A session stepped by its caller, for a thread that steps several
+ * sessions each tick (seat_group.h); server_run is the one-session loop
+ * built from them. All calls on one session come from one thread (the one
+ * that opened it); sessions of one process may be opened from several.
+ *
+ * server_open: set-up as server_run does it (DDS entities, the runtime,
+ * a checkpoint resumed when opts->checkpoint fits, the first keyframes and
+ * SessionEvent). stats is written through to server_close and must outlive
+ * the session; opts and scene must too. NULL with err when the session
+ * cannot run (nothing is left open).
+ *
+ * A step is three calls, in order: server_step_begin(t0) takes the
+ * commands and controls, runs the contact phase and writes the
+ * ContactFeedback of the tools with a fresh command (t0: the tick's
+ * monotonic ns); -1 when the session cannot go on (a scene rebuild
+ * failed): the caller stops stepping it and closes it. server_step_tissue
+ * steps the organs. server_step_end writes everything else (feedback not
+ * sent early, events, frames, metrics), submits a due checkpoint and
+ * returns the monotonic ns at which the step's publishing ended. Each
+ * session's step time (stats) counts only its own phases' wall and thread
+ * CPU time, so a caller may run other sessions' phases in between.
+ *
+ * server_close: final frame, metrics and event, the checkpoint and final
+ * mesh, the stats filled in; frees the session. */
+typedef struct server server_t;
+enum { SERVER_RESYNC_NS = 100000000 }; /* a loop this far behind its ticks starts again from now */
+server_t *server_open(const scene_t *scene, const server_opts_t *opts, server_stats_t *stats, verr_t *err);
+int server_step_begin(server_t *s, uint64_t t0);
+void server_step_tissue(server_t *s);
+uint64_t server_step_end(server_t *s);
+void server_close(server_t *s);
+uint64_t server_dt_ns(const server_t *s); /* the scene's step */
+void server_note_overrun(server_t *s);    /* its stats: the stepping thread fell behind and resynchronised */
+/* The calling thread as a physics loop: SCHED_FIFO at opts->rt_priority
+ * when set (vrt.h), timer slack 1 ns. Call after the sessions are open
+ * (their DDS threads stay at normal priority). */
+void server_thread_prepare(const server_opts_t *opts, const char *tag);
+
 #endif

@@ -11,11 +11,13 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/prctl.h>
+#include <unistd.h>
 
 #include "data_path.h"
 #include "dds/vdds.h"
 #include "scene.h"
 #include "session/scene_check.h"
+#include "session/seat_group.h"
 #include "vsignal.h"
 
 static volatile sig_atomic_t g_stop = 0;
@@ -146,22 +148,24 @@ static void print_summary(const scene_t *scene, const server_stats_t *s) {
 
 /* One seat of a multi-seat process. */
 typedef struct seat_run {
-  const scene_t *scene;
   server_opts_t opts;
   char partition[128];
-  char name[16];                                                         /* the thread's, for ps and top */
   char tag[160];                                                         /* its log lines' prefix: "server P/seatKK" */
   char checkpoint[SERVER_APP_PATH_MAX], final_mesh[SERVER_APP_PATH_MAX]; /* the seat's own files */
   server_stats_t st;
-  verr_t err;
-  int rc;
 } seat_run_t;
 
-static void *seat_main(void *arg) {
-  seat_run_t *r = arg;
-  prctl(PR_SET_NAME, r->name, 0, 0, 0);
-  r->rc = server_run(r->scene, &r->opts, &g_stop, &r->st, &r->err);
-  if (r->rc) fprintf(stderr, "viscera-server: seat '%s': %s\n", r->partition, r->err.msg);
+/* One physics thread and the seats it steps (seat_group.h). */
+typedef struct group_run {
+  seat_group_member_t *m;
+  int n;
+  char name[32]; /* the thread's, for ps and top (the kernel keeps 15 characters) */
+} group_run_t;
+
+static void *group_main(void *arg) {
+  group_run_t *g = arg;
+  prctl(PR_SET_NAME, g->name, 0, 0, 0);
+  seat_group_run(g->m, g->n, &g_stop);
   return NULL;
 }
 
@@ -175,71 +179,99 @@ static int seat_file(char out[SERVER_APP_PATH_MAX], const char *path, int seat, 
   return 0;
 }
 
-/* --seats N (also 1: the seat's partition is P/seatKK): the sessions in
- * threads, then each one's figures. */
+/* Seat k's options: its partition P/seatKK, log tag and files. Returns 0,
+ * or -1 (said on stderr) when a name does not fit. */
+static int seat_options(seat_run_t *r, const server_app_options_t *o, int k, pthread_mutex_t *lock) {
+  const char *base = o->opts.partition ? o->opts.partition : VDDS_DEFAULT_PARTITION;
+  r->opts = o->opts;
+  int len = snprintf(r->partition, sizeof r->partition, "%s/seat%02d", base, o->first_seat + k);
+  if (len < 0 || (size_t)len >= sizeof r->partition) {
+    fprintf(stderr, "viscera-server: partition '%s' too long for its seats\n", base);
+    return -1;
+  }
+  r->opts.partition = r->partition;
+  snprintf(r->tag, sizeof r->tag, "server %s", r->partition);
+  r->opts.log_tag = r->tag;
+  r->opts.dds_setup_lock = lock;
+  if (seat_file(r->checkpoint, o->opts.checkpoint, o->first_seat + k, &r->opts.checkpoint) ||
+      seat_file(r->final_mesh, o->opts.final_mesh, o->first_seat + k, &r->opts.final_mesh)) {
+    fprintf(stderr, "viscera-server: --checkpoint / --final-mesh path too long for its seats\n");
+    return -1;
+  }
+  return 0;
+}
+
+/* --seats N (also 1: the seat's partition is P/seatKK): the sessions on
+ * K physics threads (--seat-threads; default one per online CPU, at most
+ * one per seat), each stepping a contiguous group of seats, then each
+ * seat's figures. */
 static int run_seats(const scene_t *scene, const server_app_options_t *o) {
   const int n = o->seats;
-  const char *base = o->opts.partition ? o->opts.partition : VDDS_DEFAULT_PARTITION;
+  int kt = o->seat_threads;
+  if (kt <= 0) {
+    long cpus = sysconf(_SC_NPROCESSORS_ONLN);
+    kt = cpus > 0 && cpus < n ? (int)cpus : n;
+  }
+  if (kt > n) kt = n;
   seat_run_t *seats = calloc((size_t)n, sizeof *seats);
-  pthread_t *th = calloc((size_t)n, sizeof *th);
-  if (!seats || !th) {
-    fprintf(stderr, "viscera-server: out of memory for %d seats\n", n);
-    free(seats);
-    free(th);
-    return 1;
-  }
-  /* A thread's default stack follows RLIMIT_STACK; a session keeps its
-   * runtime (tens of kB per organ and tool) on it, as the main thread does. */
-  pthread_attr_t attr;
-  pthread_attr_init(&attr);
-  pthread_attr_setstacksize(&attr, (size_t)16 << 20);
+  seat_group_member_t *m = calloc((size_t)n, sizeof *m);
+  group_run_t *g = calloc((size_t)kt, sizeof *g);
+  pthread_t *th = calloc((size_t)kt, sizeof *th);
   pthread_mutex_t dds_setup_lock = PTHREAD_MUTEX_INITIALIZER; /* server.h: opts.dds_setup_lock */
-  int rc = 0, started = 0; /* seats 0..started-1 run: the first failure stops the starting */
-  for (int k = 0; k < n; k++) {
-    seat_run_t *r = &seats[k];
-    r->scene = scene;
-    r->opts = o->opts;
-    int len = snprintf(r->partition, sizeof r->partition, "%s/seat%02d", base, o->first_seat + k);
-    if (len < 0 || (size_t)len >= sizeof r->partition) {
-      fprintf(stderr, "viscera-server: partition '%s' too long for its seats\n", base);
-      rc = 1;
-      break;
-    }
-    r->opts.partition = r->partition;
-    snprintf(r->tag, sizeof r->tag, "server %s", r->partition);
-    r->opts.log_tag = r->tag;
-    r->opts.dds_setup_lock = &dds_setup_lock;
-    if (seat_file(r->checkpoint, o->opts.checkpoint, o->first_seat + k, &r->opts.checkpoint) ||
-        seat_file(r->final_mesh, o->opts.final_mesh, o->first_seat + k, &r->opts.final_mesh)) {
-      fprintf(stderr, "viscera-server: --checkpoint / --final-mesh path too long for its seats\n");
-      rc = 1;
-      break;
-    }
-    snprintf(r->name, sizeof r->name, "seat%02d", o->first_seat + k);
-    int e = pthread_create(&th[k], &attr, seat_main, r);
-    if (e) {
-      fprintf(stderr, "viscera-server: seat '%s' not started: %s\n", r->partition, strerror(e));
-      rc = 1;
-      break;
-    }
-    started++;
+  int rc = 0;
+  if (!seats || !m || !g || !th) {
+    fprintf(stderr, "viscera-server: out of memory for %d seats\n", n);
+    rc = 1;
   }
-  pthread_attr_destroy(&attr);
-  /* A seat that did not start is reported above; those that did keep serving. */
-  for (int k = 0; k < started; k++) pthread_join(th[k], NULL);
-  for (int k = 0; k < started; k++) {
-    const seat_run_t *r = &seats[k];
-    if (r->rc) {
-      rc = 1;
-      continue;
-    }
-    fprintf(stderr, "server: seat '%s' (%d of %d):\n", r->partition, k + 1, n);
-    print_stats(scene, &r->opts, &r->st);
-    printf("SEAT partition=%s index=%d of=%d\n", r->partition, k + 1, n);
-    print_summary(scene, &r->st);
+  for (int k = 0; k < n && !rc; k++) {
+    if (seat_options(&seats[k], o, k, &dds_setup_lock)) rc = 1;
+    m[k] = (seat_group_member_t){
+        .scene = scene, .opts = &seats[k].opts, .name = seats[k].partition, .stats = &seats[k].st, .rc = 1};
   }
+  int threads = 0;
+  if (!rc) {
+    /* A thread's default stack follows RLIMIT_STACK; a session keeps its
+     * runtime (tens of kB per organ and tool) on it, as the main thread does. */
+    pthread_attr_t attr;
+    pthread_attr_init(&attr);
+    pthread_attr_setstacksize(&attr, (size_t)16 << 20);
+    for (int t = 0; t < kt; t++) {
+      int lo = t * n / kt, hi = (t + 1) * n / kt, a = o->first_seat + lo, b = o->first_seat + hi - 1;
+      g[t] = (group_run_t){.m = m + lo, .n = hi - lo};
+      if (a == b)
+        snprintf(g[t].name, sizeof g[t].name, "seat%02d", a);
+      else
+        snprintf(g[t].name, sizeof g[t].name, "seats%02d-%02d", a, b);
+      int e = pthread_create(&th[t], &attr, group_main, &g[t]);
+      if (e) { /* the seats already started keep serving */
+        fprintf(stderr, "viscera-server: seats %d-%d not started: %s\n", a, o->first_seat + n - 1, strerror(e));
+        rc = 1;
+        break;
+      }
+      threads++;
+    }
+    pthread_attr_destroy(&attr);
+  }
+  for (int t = 0; t < threads; t++) pthread_join(th[t], NULL);
+  /* A seat that did not start was reported at once (seat_group.h); the
+   * others served: their figures. */
+  for (int t = 0; t < threads; t++)
+    for (int i = 0; i < g[t].n; i++) {
+      const seat_group_member_t *mk = &g[t].m[i];
+      int k = (int)(mk - m);
+      if (mk->rc) {
+        rc = 1;
+        continue;
+      }
+      fprintf(stderr, "server: seat '%s' (%d of %d):\n", seats[k].partition, k + 1, n);
+      print_stats(scene, &seats[k].opts, &seats[k].st);
+      printf("SEAT partition=%s index=%d of=%d\n", seats[k].partition, k + 1, n);
+      print_summary(scene, &seats[k].st);
+    }
   pthread_mutex_destroy(&dds_setup_lock);
   free(seats);
+  free(m);
+  free(g);
   free(th);
   return rc;
 }

@@ -4,14 +4,16 @@
  * the session until a signal or --duration, and print the summary.
  * With --seats N the process runs N sessions of the scene, one per
  * partition P/seatKK..P/seat(K+N-1) (K: --first-seat, default 1; two
- * digits, as deploy/lab.sh and deploy/pki.sh name seats), each server_run
- * in its own thread (its
- * physics loop; DDS threads are shared by the process's participants).
+ * digits, as deploy/lab.sh and deploy/pki.sh name seats), stepped by
+ * --seat-threads physics threads (default: one per online CPU, at most one
+ * per seat), each stepping a contiguous group of seats every tick
+ * (seat_group.h; DDS threads are shared by the process's participants).
  * Why: several seats' servers on one core run each step after the others
- * have run; as separate processes every step also starts in another
- * address space (docs/numerics.md §11.3 measures what that costs). A seat
- * whose set-up fails is reported at once and the others keep serving; the
- * summaries follow per seat at the end, each headed by its partition.
+ * have run; as separate processes, or as a thread per seat, every step
+ * also starts after other processes had the core (docs/numerics.md §11.3
+ * measures what each costs). A seat whose set-up fails is reported at once
+ * and the others keep serving; the summaries follow per seat at the end,
+ * each headed by its partition.
  * Files: with --seats, --checkpoint PATH and --final-mesh PATH name each
  * seat's own file PATH.seatKK (a crashed process's seats each resume from
  * their own state). */
@@ -26,6 +28,8 @@ typedef struct server_app_options {
   const char *scene_path; /* --scene FILE */
   int seats;              /* --seats N: 1..SERVER_APP_MAX_SEATS; 0: not given (one session on the partition as given) */
   int first_seat;         /* --first-seat K: the first seat's number (seatKK), 1..99 with K + N - 1 <= 99 */
+  int seat_threads;       /* --seat-threads K: with --seats, K physics threads each stepping a group of seats
+                             (seat_group.h); 0: one per online CPU, at most one per seat */
   int check_only;         /* --check */
   server_opts_t opts;     /* everything server_run takes */
 } server_app_options_t;

@@ -21,7 +21,13 @@
  * processes had the core (a lab's seat: docs/numerics.md §11.3). 0, the
  * default, leaves the caches alone.
  *
- * usage: bench_seats [--scene FILE] [--seats LIST] [--seconds S] [--evict KB]
+ * --tick sleeps to the next 1 ms tick before each round of seats, as a
+ * server's loop does (each round then starts from a wake-up; with several
+ * seats the round steps them one after the other, as a seat group's
+ * thread does: server/session/seat_group.h). Without it the rounds run
+ * back to back.
+ *
+ * usage: bench_seats [--scene FILE] [--seats LIST] [--seconds S] [--evict KB] [--tick]
  *   defaults: classroom_gallbladder.yaml, seats 1,2,3, 4 s of simulated
  *   time each (the first 1 s, the press, is not timed).
  * Figures are not checked: the machine's load moves them; compare the
@@ -62,7 +68,7 @@ static void evict(unsigned char *buf, size_t n, unsigned char v) {
   for (size_t i = 0; i < n; i += 64) buf[i] = v;
 }
 
-static int run(const scene_t *scene, int nseats, double seconds, unsigned char *junk, size_t njunk,
+static int run(const scene_t *scene, int nseats, double seconds, unsigned char *junk, size_t njunk, int tick,
                vstats_summary_t *out) {
   static runtime_t rt[MAX_SEATS];
   verr_t err;
@@ -77,7 +83,12 @@ static int run(const scene_t *scene, int nseats, double seconds, unsigned char *
   double *c = malloc((size_t)(steps - warm) * (size_t)nseats * sizeof *c);
   if (!c) return -1;
   size_t nc = 0;
+  uint64_t next = vtime_mono_ns();
   for (int s = 0; s < steps; s++) {
+    if (tick) {
+      next += 1000000;
+      vtime_sleep_until(next);
+    }
     double p[3];
     busy_target(s * sc->dt, p);
     for (int k = 0; k < nseats; k++) {
@@ -99,6 +110,7 @@ int main(int argc, char **argv) {
   const char *scene = NULL, *list = "1,2,3";
   double seconds = 4.0;
   long evict_kb = 0;
+  int tick = 0;
   for (int i = 1; i < argc; i++) {
     if (!strcmp(argv[i], "--scene") && i + 1 < argc)
       scene = argv[++i];
@@ -110,8 +122,10 @@ int main(int argc, char **argv) {
       char *end;
       evict_kb = strtol(argv[++i], &end, 10);
       if (*end || end == argv[i]) evict_kb = -1;
-    } else {
-      fprintf(stderr, "usage: bench_seats [--scene FILE] [--seats LIST] [--seconds S] [--evict KB]\n");
+    } else if (!strcmp(argv[i], "--tick"))
+      tick = 1;
+    else {
+      fprintf(stderr, "usage: bench_seats [--scene FILE] [--seats LIST] [--seconds S] [--evict KB] [--tick]\n");
       return 2;
     }
   }
@@ -135,6 +149,7 @@ int main(int argc, char **argv) {
   }
   printf("bench_seats: %s, busy trajectory, %.1f s simulated per run (first 1 s not timed)", scene, seconds);
   if (evict_kb) printf(", %ld kB of other data written before each step", evict_kb);
+  if (tick) printf(", each round of seats after a sleep to the next 1 ms tick");
   printf("\n");
   printf("%-6s %14s %14s %12s\n", "seats", "CPU median us", "CPU p99 us", "vs 1 seat");
   double base = NAN;
@@ -147,7 +162,7 @@ int main(int argc, char **argv) {
       return 2;
     }
     vstats_summary_t r;
-    if (run(&sc, (int)n, seconds, junk, njunk, &r)) return 1;
+    if (run(&sc, (int)n, seconds, junk, njunk, tick, &r)) return 1;
     if (n == 1) base = r.median;
     printf("%-6ld %14.1f %14.1f %11.2fx\n", n, r.median, r.p99, r.median / base);
     fflush(stdout);

@@ -1,15 +1,18 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: Apache-2.0
 # Several seats in one server process (issue 17 item 6): viscera-server
-# --seats 2 --partition seats runs two sessions of the classroom kidney, on
-# seats/seat01 and seats/seat02, each in its own thread. Two scripted
+# --seats 2 --seat-threads 1 --partition seats runs two sessions of the
+# classroom kidney, on seats/seat01 and seats/seat02, both stepped by one
+# physics thread (server/session/seat_group.h: the thread is there, named
+# for its seats, and both seats take the same steps). Two scripted
 # trainees press at the same time, one 8 mm deep in seat01, one 3 mm in
 # seat02: each seat must answer its own trainee only (the deep press feels
 # more than the shallow one, and each seat's summary has the peak its own
 # trainee felt), each seat's log lines name it, and the figures come
 # with one summary per seat, headed by its partition. Seat counts out of
-# range are usage errors (exit 2). Then a crash with --checkpoint: each seat
-# resumes from its own file.
+# range are usage errors (exit 2), as are --seat-threads beyond the seats or
+# without --seats. Then a crash with --checkpoint, a thread per seat
+# (--seat-threads 2): each seat resumes from its own file.
 set -euo pipefail
 # shellcheck source=prelude.sh
 source "$(dirname "${BASH_SOURCE[0]}")/prelude.sh"
@@ -21,14 +24,30 @@ for bad in "--seats 0" "--seats 33" "--seats two"; do
   [ "$rc" = 2 ] || fail "viscera-server $bad exited $rc, not 2 (usage error): $(cat "$OUT/bad.log")"
   grep -q -- "--seats" "$OUT/bad.log" || fail "viscera-server $bad: the error does not name --seats: $(cat "$OUT/bad.log")"
 done
+for bad in "--seats 2 --seat-threads 3" "--seats 2 --seat-threads 0" "--seat-threads 1"; do
+  # shellcheck disable=SC2086 # the options are meant to split
+  rc=0; "$SRV" --scene "$SCENE" $bad --duration 1 > /dev/null 2> "$OUT/bad.log" || rc=$?
+  [ "$rc" = 2 ] || fail "viscera-server $bad exited $rc, not 2 (usage error): $(cat "$OUT/bad.log")"
+  grep -q -- "--seat-threads" "$OUT/bad.log" ||
+    fail "viscera-server $bad: the error does not name --seat-threads: $(cat "$OUT/bad.log")"
+done
 press() { # depth z of the probe tip (m) -> trajectory: away 0.5 s, down in 1 s, hold 1 s, up
   printf '%s\n' "0 0.012 0.004 0.07" "0.5 0.012 0.004 0.07" "1.5 0.012 0.004 $1" "2.5 0.012 0.004 $1" \
     "3.0 0.012 0.004 0.07"
 }
 press 0.027 > "$OUT/deep.traj"    # 8 mm into the kidney (top at z = 35 mm)
 press 0.032 > "$OUT/shallow.traj" # 3 mm
-"$SRV" --scene "$SCENE" --partition seats --seats 2 > "$OUT/server.out" 2> "$OUT/server.log" &
+"$SRV" --scene "$SCENE" --partition seats --seats 2 --seat-threads 1 > "$OUT/server.out" 2> "$OUT/server.log" &
 srv=$!; PIDS+=("$srv")
+# One physics thread for both seats, named for them (ps, top); none per seat.
+threads=""
+for ((t = 0; t < 300; t++)); do
+  threads=$(cat /proc/"$srv"/task/*/comm 2> /dev/null | sort | tr '\n' ' ')
+  case " $threads" in *" seats01-02 "*) break ;; esac
+  sleep 0.1
+done
+case " $threads" in *" seats01-02 "*) ;; *) fail "no physics thread 'seats01-02' in the server: $threads" ;; esac
+case " $threads" in *" seat01 "* | *" seat02 "*) fail "a thread per seat with --seat-threads 1: $threads" ;; esac
 # Both trainees at once; each starts when its seat's scene is there (60 s at
 # most, a safety stop) and exits at the end of its trajectory.
 "$BUILD/client/haptic/viscera-haptic" --partition seats/seat01 --trajectory "$OUT/deep.traj" --wait-server 60 \
@@ -83,7 +102,13 @@ for pair in "${c1:-0} ${t1:-0} seat01" "${c2:-0} ${t2:-0} seat02"; do
 done
 [ "$(grep -c '^server: seat .seats/seat0[12]. ([12] of 2):$' "$OUT/server.log")" = 2 ] ||
   fail "the server log has not one figures block per seat"
-echo "two seats in one process, each answering its own trainee (${deep} N and ${shallow} N)"
+# Stepped together: every tick steps both (seat_group.h), so both took the
+# same number of steps (a seat skipped or stepped twice in a tick would not).
+n1=$(seat 1 SUMMARY | sed -n 's/^SUMMARY steps=\([0-9]*\) .*/\1/p')
+n2=$(seat 2 SUMMARY | sed -n 's/^SUMMARY steps=\([0-9]*\) .*/\1/p')
+[ -n "$n1" ] && [ "$n1" -gt 1000 ] && [ "$n1" = "$n2" ] ||
+  fail "the seats of one thread took ${n1:-?} and ${n2:-?} steps, not the same"
+echo "two seats on one thread, each answering its own trainee (${deep} N and ${shallow} N), ${n1} steps each"
 
 # A crash of the process (kill -9, the trainees with it) while both trainees
 # hold their presses, with --checkpoint: each seat writes its own file
@@ -95,8 +120,8 @@ hold() { printf '%s\n' "0 0.012 0.004 0.07" "0.5 0.012 0.004 0.07" "1.5 0.012 0.
 hold 0.027 > "$OUT/deep_hold.traj"
 hold 0.032 > "$OUT/shallow_hold.traj"
 CK="$OUT/c.ckpt"
-"$SRV" --scene "$SCENE" --partition seats --seats 2 --checkpoint "$CK" --checkpoint-every 0.1 > "$OUT/crash.out" \
-  2> "$OUT/crash.log" &
+"$SRV" --scene "$SCENE" --partition seats --seats 2 --seat-threads 2 --checkpoint "$CK" --checkpoint-every 0.1 \
+  > "$OUT/crash.out" 2> "$OUT/crash.log" &
 srv=$!; PIDS+=("$srv")
 hp=()
 for what in deep shallow; do
