@@ -30,9 +30,10 @@
 #   --rt-priority N     every server's physics loop SCHED_FIFO at N (1..99; default 0: normal
 #                       scheduling); needs root or CAP_SYS_NICE, else each server warns and runs on
 #   --haptic-rt-priority N  the same for the trainees' 1 kHz loops (with --trainees)
-#   --one-server        every seat as a thread of one viscera-server (--seats N
-#                       --first-seat K): seats sharing cores cost each other less
-#                       in one process (docs/numerics.md §11.3); its log is split
+#   --one-server        every seat in one viscera-server (--seats N --first-seat K),
+#                       stepped by one physics thread per CPU: busy seats sharing
+#                       cores then step as cheaply as one seat alone
+#                       (docs/numerics.md §11.3, §11.4); its log is split
 #                       into seatNN-server.log at the end. With --secure its
 #                       identity is server-seatKK-MM (pki.sh --server-group K-M:
 #                       the server's role in those seats only)
