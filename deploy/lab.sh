@@ -37,6 +37,9 @@
 #                       into seatNN-server.log at the end. With --secure its
 #                       identity is server-seatKK-MM (pki.sh --server-group K-M:
 #                       the server's role in those seats only)
+#   --seat-threads K    with --one-server: K physics threads (viscera-server
+#                       --seat-threads; default one per CPU, K = --seats: a
+#                       thread per seat)
 # SIGINT (Ctrl-C) or SIGTERM stops the lab: every process it started gets
 # SIGTERM (SIGKILL if still running 10 s later), then the summary is printed.
 # Exit status: 0 when every process ended cleanly, 1 when one failed (named
@@ -50,7 +53,7 @@
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD="$ROOT/build" OUT="$ROOT/out/lab" SEATS=3 FIRST=1 PREFIX=lab SCENE="$ROOT/assets/scenes/default.yaml"
-TRAINEES=0 VIEWERS=1 DURATION=20 SECURE=0 INSECURE=0 RECORD=1 PKI="" RTPRIO=0 HRTPRIO=0 ONE=0
+TRAINEES=0 VIEWERS=1 DURATION=20 SECURE=0 INSECURE=0 RECORD=1 PKI="" RTPRIO=0 HRTPRIO=0 ONE=0 SEATTH=""
 STOP_GRACE_S="${VISCERA_LAB_STOP_GRACE:-10}"
 usage() { awk 'NR > 2 && /^#/ { sub(/^# ?/, ""); print; next } NR > 2 { exit }' "$0"; }
 while [ $# -gt 0 ]; do
@@ -71,6 +74,7 @@ while [ $# -gt 0 ]; do
     --rt-priority) RTPRIO="$2"; shift 2 ;;
     --haptic-rt-priority) HRTPRIO="$2"; shift 2 ;;
     --one-server) ONE=1; shift ;;
+    --seat-threads) SEATTH="$2"; shift 2 ;;
     -h|--help) usage; exit 0 ;;
     *) echo "lab.sh: unknown option '$1'" >&2; usage >&2; exit 2 ;;
   esac
@@ -92,6 +96,11 @@ SRV_RT=() HAP_RT=()
 [[ "$PREFIX" =~ ^[A-Za-z0-9_-]+$ ]] || { echo "lab.sh: --prefix: letters, digits, '-' and '_' only" >&2; exit 2; }
 [ -f "$SCENE" ] || { echo "lab.sh: scene file not found: $SCENE" >&2; exit 2; }
 [ -x "$BUILD/server/viscera-server" ] || bash "$ROOT/deploy/build.sh" "$BUILD"
+GROUPS_OPT=()
+if [ -n "$SEATTH" ]; then
+  [ $ONE = 1 ] || { echo "lab.sh: --seat-threads needs --one-server" >&2; exit 2; }
+  GROUPS_OPT=(--seat-threads "$SEATTH") # the server checks the number
+fi
 export VISCERA_DOMAIN="${VISCERA_DOMAIN:-0}"
 NET="${CYCLONEDDS_URI:-file://$ROOT/deploy/cyclonedds-loopback.xml}"
 # Off loopback, secure by default (issue 14): a network configuration runs
@@ -207,7 +216,7 @@ fi
 if [ $ONE = 1 ]; then
   # shellcheck disable=SC2046
   start seats-server "$SEATS_ID" "$BUILD/server/viscera-server" --scene "$SCENE" \
-    --partition "$PREFIX" --seats "$SEATS" --first-seat "$FIRST" $(dur DURATION) "${SRV_RT[@]}"
+    --partition "$PREFIX" --seats "$SEATS" --first-seat "$FIRST" $(dur DURATION) "${SRV_RT[@]}" "${GROUPS_OPT[@]}"
 fi
 for i in $(seq "$FIRST" "$LAST"); do
   s=$(printf 'seat%02d' "$i")

@@ -6,7 +6,7 @@ viscera_integration_test(lab_launcher_secure 162 lab_launcher_secure_test.sh)
 viscera_integration_test(lan_config 163 lan_config_test.sh)
 viscera_integration_test(systemd_units 164 systemd_units_test.sh)
 set_tests_properties(systemd_units PROPERTIES SKIP_RETURN_CODE 77)
-# lab.sh --one-server: the seats as threads of one server (issue 17 item 6). Domain 173.
+# lab.sh --one-server: the seats in one server, on one physics thread (issue 17 item 6). Domain 173.
 viscera_integration_test(lab_one_server 173 lab_one_server_test.sh)
 # lab.sh --one-server --secure: one group identity for the process's seats. Domain 174.
 viscera_integration_test(lab_one_server_secure 174 lab_one_server_secure_test.sh)

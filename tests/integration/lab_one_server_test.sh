@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: Apache-2.0
-# deploy/lab.sh --one-server (issue 17 item 6) on loopback: seats 2-3
-# (--first 2) as threads of one viscera-server, a scripted trainee and a
+# deploy/lab.sh --one-server --seat-threads 1 (issue 17 item 6) on loopback:
+# seats 2-3 (--first 2) in one viscera-server, both stepped by one physics
+# thread (server/session/seat_group.h), a scripted trainee and a
 # viewer per seat, the lab recorder, until Ctrl-C. Asserts: one server
 # process in the lab, serving both seats (each seat recorded from its own
 # partition and participant, no writer in two partitions, ToolCommands in
@@ -32,10 +33,14 @@ fail() {
 }
 rm -rf "$OUT"; mkdir -p "$OUT"
 command -v sqlite3 > /dev/null || fail "sqlite3 missing (deploy/install_deps.sh installs it)"
-launch_lab L "$OUT/lab.out" --out "$OUT/l" --one-server --first 2 --seats 2 --trainees --viewers 1 --duration 0
+launch_lab L "$OUT/lab.out" --out "$OUT/l" --one-server --seat-threads 1 --first 2 --seats 2 --trainees --viewers 1 \
+  --duration 0
 wait_trainees "$L" "the lab" "$OUT"/l/seat02-haptic.log "$OUT"/l/seat03-haptic.log
 servers=$(ps -o args= -s "$L" | grep -c '^[^ ]*/viscera-server ' || true)
 [ "$servers" = 1 ] || fail "$servers server processes in the lab, expected one for both seats"
+srv=$(ps -o pid=,args= -s "$L" | awk '$2 ~ /\/viscera-server$/ { print $1 }')
+threads=$(cat /proc/"$srv"/task/*/comm 2> /dev/null | tr '\n' ' ')
+case " $threads" in *" seats02-03 "*) ;; *) fail "no physics thread 'seats02-03' for both seats: $threads" ;; esac
 sleep 1 # a few more MeshDeltas of every seat reach the recorder
 kill -INT "$L"
 for ((t = 0; t < 300; t++)); do kill -0 "$L" 2>/dev/null || break; sleep 0.1; done
