@@ -12,7 +12,7 @@ set_tests_properties(load_bench_smoke PROPERTIES LABELS bench TIMEOUT 120
 # The same with the seats as threads of one server (--one-server, issue 17
 # item 6): the process's log must come apart into one figures block per seat.
 add_test(NAME load_bench_one_server_smoke COMMAND bash -c
-         "bash '${PROJECT_SOURCE_DIR}/deploy/load_bench.sh' --build '${PROJECT_BINARY_DIR}' --out '${CMAKE_CURRENT_BINARY_DIR}/load_one' --seats 2 --subscribers 2 --duration 8 --baseline 2 --one-server && grep -Eq '^  seat01: [0-9]{4,} steps, .*real-time ratio' '${CMAKE_CURRENT_BINARY_DIR}/load_one/summary.txt' && grep -Eq '^  seat02: [0-9]{4,} steps, .*real-time ratio' '${CMAKE_CURRENT_BINARY_DIR}/load_one/summary.txt' && grep -q 'in one server process' '${CMAKE_CURRENT_BINARY_DIR}/load_one/summary.txt'")
+         "bash '${PROJECT_SOURCE_DIR}/deploy/load_bench.sh' --build '${PROJECT_BINARY_DIR}' --out '${CMAKE_CURRENT_BINARY_DIR}/load_one' --seats 2 --subscribers 2 --duration 8 --baseline 2 --one-server --seat-threads 1 && grep -Eq '^  seat01: [0-9]{4,} steps, .*real-time ratio' '${CMAKE_CURRENT_BINARY_DIR}/load_one/summary.txt' && grep -Eq '^  seat02: [0-9]{4,} steps, .*real-time ratio' '${CMAKE_CURRENT_BINARY_DIR}/load_one/summary.txt' && grep -q 'in one server process (1 physics thread, each stepping its seats in turn)' '${CMAKE_CURRENT_BINARY_DIR}/load_one/summary.txt'")
 set_tests_properties(load_bench_one_server_smoke PROPERTIES LABELS bench TIMEOUT 120
   ENVIRONMENT "CYCLONEDDS_URI=file://${VISCERA_DDS_CONFIG};VISCERA_DOMAIN=172")
 # What sharing a core costs a busy seat's step, without DDS (issue 17 item 6).
@@ -20,4 +20,7 @@ add_executable(bench_seats ${CMAKE_CURRENT_LIST_DIR}/bench_seats.c)
 target_link_libraries(bench_seats PRIVATE viscera_sim viscera_test_support)
 add_test(NAME bench_seats_smoke COMMAND bench_seats --seats 1,2 --seconds 1.6)
 set_tests_properties(bench_seats_smoke PROPERTIES LABELS bench TIMEOUT 120
+  ENVIRONMENT "VISCERA_SOURCE_DIR=${PROJECT_SOURCE_DIR}")
+add_test(NAME bench_seats_tick_smoke COMMAND bench_seats --seats 1,2 --seconds 1.6 --tick)
+set_tests_properties(bench_seats_tick_smoke PROPERTIES LABELS bench TIMEOUT 120
   ENVIRONMENT "VISCERA_SOURCE_DIR=${PROJECT_SOURCE_DIR}")

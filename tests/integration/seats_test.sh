@@ -12,7 +12,8 @@
 # with one summary per seat, headed by its partition. Seat counts out of
 # range are usage errors (exit 2), as are --seat-threads beyond the seats or
 # without --seats. Then a crash with --checkpoint, a thread per seat
-# (--seat-threads 2): each seat resumes from its own file.
+# (--seat-threads 2): each seat resumes from its own file (restarted with
+# both seats on one thread).
 set -euo pipefail
 # shellcheck source=prelude.sh
 source "$(dirname "${BASH_SOURCE[0]}")/prelude.sh"
@@ -142,8 +143,8 @@ kill -9 "$srv" "${hp[@]}"
 wait "$srv" "${hp[@]}" 2> /dev/null || true
 for s in seat01 seat02; do [ -s "$CK.$s" ] || fail "no checkpoint $CK.$s after the crash"; done
 [ -e "$CK" ] && fail "a --seats run wrote the unsuffixed checkpoint $CK"
-"$SRV" --scene "$SCENE" --partition seats --seats 2 --checkpoint "$CK" --final-mesh "$OUT/f.obj" --duration 0.2 \
-  > "$OUT/resume.out" 2> "$OUT/resume.log" || fail "the restarted server failed"
+"$SRV" --scene "$SCENE" --partition seats --seats 2 --seat-threads 1 --checkpoint "$CK" --final-mesh "$OUT/f.obj" \
+  --duration 0.2 > "$OUT/resume.out" 2> "$OUT/resume.log" || fail "the restarted server failed"
 for s in seat01 seat02; do
   grep -q "^server seats/$s: resumed from checkpoint $CK.$s at t = " "$OUT/resume.log" ||
     fail "$s did not resume from its own checkpoint $CK.$s"
