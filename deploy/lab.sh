@@ -32,7 +32,7 @@
 #   --haptic-rt-priority N  the same for the trainees' 1 kHz loops (with --trainees)
 #   --one-server        every seat in one viscera-server (--seats N --first-seat K),
 #                       stepped by one physics thread per CPU: busy seats sharing
-#                       cores then step as cheaply as one seat alone
+#                       cores then step closer to one seat alone, with less CPU
 #                       (docs/numerics.md §11.3, §11.4); its log is split
 #                       into seatNN-server.log at the end. With --secure its
 #                       identity is server-seatKK-MM (pki.sh --server-group K-M:
