@@ -44,4 +44,10 @@ typedef struct seat_group_member {
  * before it returns. */
 void seat_group_run(seat_group_member_t *m, int n, volatile sig_atomic_t *stop);
 
+/* One session, the same loop (a group of one): set-up, steps until *stop or
+ * opts->duration, shutdown. Returns 0, or -1 with err (not printed) when
+ * the session could not start. */
+int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_atomic_t *stop, server_stats_t *stats,
+               verr_t *err);
+
 #endif

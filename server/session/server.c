@@ -1273,27 +1273,3 @@ void server_close(server_t *s) {
   teardown(s);
   free(s);
 }
-
-int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_atomic_t *stop, server_stats_t *stats,
-               verr_t *err) {
-  server_t *s = server_open(scene, opts, stats, err);
-  if (!s) return -1;
-  server_thread_prepare(opts, s->tag);
-  uint64_t dt_ns = server_dt_ns(s), start = vtime_mono_ns(), next = start;
-  while (!*stop && (opts->duration <= 0 || (double)(vtime_mono_ns() - start) * 1e-9 < opts->duration)) {
-    if (server_step_begin(s, vtime_mono_ns())) {
-      stats->overruns++;
-      break; /* the scene could not be rebuilt: nothing left to simulate */
-    }
-    server_step_tissue(s);
-    uint64_t t1 = server_step_end(s);
-    next += dt_ns;
-    if (t1 > next + SERVER_RESYNC_NS) { /* far behind (debugger, overload): resynchronise */
-      stats->overruns++;
-      next = t1;
-    }
-    vtime_sleep_until(next);
-  }
-  server_close(s);
-  return 0;
-}

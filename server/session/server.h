@@ -76,17 +76,12 @@ typedef struct server_stats {
   uint64_t deltas_skipped;      /* MeshDelta frames not written: equal to the last one (mesh_publisher.h) */
 } server_stats_t;
 
-/* Runs a whole session: set-up, loop until *stop or the duration, shutdown.
- * Returns 0, or -1 with err on set-up failure. */
-int server_run(const scene_t *scene, const server_opts_t *opts, volatile sig_atomic_t *stop, server_stats_t *stats,
-               verr_t *err);
-
-/* A session stepped by its caller, for a thread that steps several
- * sessions each tick (seat_group.h); server_run is the one-session loop
- * built from them. All calls on one session come from one thread (the one
+/* A session stepped by its caller: a thread that steps one or several
+ * sessions each tick (seat_group.h: seat_group_run, and server_run for
+ * one session). All calls on one session come from one thread (the one
  * that opened it); sessions of one process may be opened from several.
  *
- * server_open: set-up as server_run does it (DDS entities, the runtime,
+ * server_open: the session's set-up (DDS entities, the runtime,
  * a checkpoint resumed when opts->checkpoint fits, the first keyframes and
  * SessionEvent). stats is written through to server_close and must outlive
  * the session; opts and scene must too. NULL with err when the session
