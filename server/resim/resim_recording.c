@@ -11,6 +11,7 @@
 #include "recording/rec_decode.h"
 #include "interaction/events.h"
 #include "resim/resim_session.h"
+#include "runtime/checkpoint_state.h"
 #include "viscera.h"
 
 typedef struct caps {
@@ -23,6 +24,7 @@ typedef struct load_ctx {
   caps_t caps; /* allocated lengths of the arrays in rec */
   int oom;
   int64_t scene_ts; /* source timestamp of the earliest SceneInfo: the server's sim time 0 (0 unknown) */
+  double start_s;   /* the sim time the session started at: a resumed one's checkpoint time, else 0 */
   /* Per object / tool: the last sample's sim time and epoch (a rebuild
    * restarts simulated time). */
   uint64_t obj_ns[SCENE_MAX_OBJECTS], met_ns[SCENE_MAX_TOOLS];
@@ -71,13 +73,15 @@ static int grow(void **arr, size_t *cap, size_t n, size_t size) {
  * runs ahead of the wall clock), so a sim time later than the sample's own
  * source timestamp minus the SceneInfo's, plus RESIM_SPAN_SLACK_S, is
  * garbled (one flipped bit in a MeshDelta header planned 17.6 million
- * steps). Both timestamps come from the server's clock. */
+ * steps). Both timestamps come from the server's clock. A session resumed
+ * from a checkpoint starts at the checkpoint's sim time (SceneSource's
+ * resume state), not 0: its span starts there. */
 static uint64_t step_of(const load_ctx_t *ctx, const recfile_row_t *row, uint64_t sim_time_ns) {
   const resim_recording_t *rec = ctx->rec;
   double s = (double)sim_time_ns * 1e-9;
   if (s > RESIM_MAX_SIM_S) return UINT64_MAX;
   if (ctx->scene_ts > 0 && row->source_ts_ns > 0) {
-    double span = (double)(row->source_ts_ns - ctx->scene_ts) * 1e-9 + RESIM_SPAN_SLACK_S;
+    double span = (double)(row->source_ts_ns - ctx->scene_ts) * 1e-9 + ctx->start_s + RESIM_SPAN_SLACK_S;
     if (s > span) return UINT64_MAX;
   }
   return (uint64_t)llround(s / rec->dt);
@@ -401,7 +405,8 @@ static int on_metrics(void *arg, const void *sample, const recfile_row_t *row) {
 
 static int on_source(void *arg, const void *sample, const recfile_row_t *row) {
   (void)row;
-  resim_source_t *src = &((load_ctx_t *)arg)->rec->source;
+  load_ctx_t *ctx = arg;
+  resim_source_t *src = &ctx->rec->source;
   const viscera_SceneSource *s = sample;
   char *text = strdup(s->text ? s->text : "");
   unsigned char *resume = s->resume_state._length ? malloc(s->resume_state._length) : NULL;
@@ -410,6 +415,11 @@ static int on_source(void *arg, const void *sample, const recfile_row_t *row) {
     return ((load_ctx_t *)arg)->oom = 1;
   }
   if (resume) memcpy(resume, s->resume_state._buffer, s->resume_state._length);
+  /* An unreadable start time leaves the span from 0: resim_resume names
+   * what is wrong with the state. */
+  double t0 = 0;
+  ctx->start_s =
+      resume && ckpt_state_sim_time(resume, s->resume_state._length, &t0) == 0 && t0 <= RESIM_MAX_SIM_S ? t0 : 0;
   free(src->text);
   free(src->resume);
   memset(src, 0, sizeof *src);
@@ -493,9 +503,11 @@ int resim_recording_load(resim_recording_t *rec, const char *path, const char *p
   snprintf(rec->warnings, sizeof rec->warnings, "%s", recfile_warnings(rf));
   load_ctx_t ctx = {.rec = rec};
   /* SceneInfo first: dt turns every sim time into a step, and the organ and
-   * tool counts bound every other sample. */
+   * tool counts bound every other sample; then SceneSource: a resumed
+   * session's start time bounds the sim times. */
   const topic_pass_t passes[] = {
       {"viscera_SceneInfo", &viscera_SceneInfo_desc, on_scene, NULL},
+      {"viscera_SceneSource", &viscera_SceneSource_desc, on_source, NULL},
       {"viscera_ToolCommand", &viscera_ToolCommand_desc, on_command, &rec->n_commands},
       {"viscera_ContactFeedback", &viscera_ContactFeedback_desc, on_feedback, &rec->n_feedback},
       {"viscera_SessionEvent", &viscera_SessionEvent_desc, on_event, &rec->n_events},
@@ -504,7 +516,6 @@ int resim_recording_load(resim_recording_t *rec, const char *path, const char *p
       {"viscera_AppliedInput", &viscera_AppliedInput_desc, on_applied, &rec->n_applied},
       {"viscera_ObjectState", &viscera_ObjectState_desc, on_object, &rec->n_objects},
       {"viscera_ToolMetrics", &viscera_ToolMetrics_desc, on_metrics, &rec->n_metrics},
-      {"viscera_SceneSource", &viscera_SceneSource_desc, on_source, NULL},
   };
   int rc = 0;
   for (size_t p = 0; p < sizeof passes / sizeof passes[0] && !rc; p++) {

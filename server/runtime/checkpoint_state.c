@@ -124,6 +124,16 @@ static int restore_topologies(runtime_t *rt, const state_blob_t *b, const organ_
   return 0;
 }
 
+int ckpt_state_sim_time(const void *p, size_t len, double *sim_time) {
+  state_blob_t b = {.p = (unsigned char *)p, .len = len, .cap = len};
+  char name[SCENE_NAME_LEN];
+  sb_get(&b, name, sizeof name);
+  double t = sb_get_f64(&b);
+  if (b.bad || !isfinite(t) || t < 0) return -1;
+  *sim_time = t;
+  return 0;
+}
+
 /* Refuses with `text`: -1. */
 static int refuse(char *what, size_t whatlen, const char *text) {
   snprintf(what, whatlen, "%s", text);

@@ -60,4 +60,10 @@ int ckpt_state_put(state_blob_t *b, const runtime_t *rt, const ckpt_session_io_t
 int ckpt_state_get(state_blob_t *b, runtime_t *rt, const ckpt_session_io_t *io, char *what, size_t whatlen,
                    verr_t *err);
 
+/* The simulated time (s) a state starts at, read from its header without
+ * restoring it (viscera-resim bounds a resumed recording's sim times by
+ * it). 0 with *sim_time set; -1 when the bytes are shorter than the header
+ * or the time is not finite and >= 0. The bytes are untrusted. */
+int ckpt_state_sim_time(const void *p, size_t len, double *sim_time);
+
 #endif

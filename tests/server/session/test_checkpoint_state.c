@@ -30,6 +30,7 @@
 #include "check.h"
 #include "test_runtime.h"
 #include "physics/pbd.h"
+#include "runtime/checkpoint_state.h"
 #include "session/checkpoint.h"
 #include "vtime.h"
 
@@ -134,6 +135,17 @@ static void test_objects_tasks_tallies(void) {
   CHECK(!strcmp(rb.tool[0].owner, "alice") && !strcmp(rb.tool[0].guide, "drsmith"));
   CHECK(rb.tool[0].authority == 0.5 && rb.tool[0].coupling == 150 && rb.tool[0].version == 2 && (rb.changed & 1u));
   CHECK(b.sim_time == a.sim_time && b.steps == a.steps);
+  { /* the resume state's start time, read without restoring it (viscera-resim's span) */
+    state_blob_t rs = {0};
+    CHECK(checkpoint_resume_state(&rs, &a, ta, &err) == 0);
+    double t0 = -1;
+    CHECK(a.sim_time > 1 && ckpt_state_sim_time(rs.p, rs.len, &t0) == 0 && t0 == a.sim_time);
+    CHECK(ckpt_state_sim_time(rs.p, SCENE_NAME_LEN + 7, &t0) == -1); /* header cut short */
+    double nan_t = NAN;
+    memcpy(rs.p + SCENE_NAME_LEN, &nan_t, sizeof nan_t);
+    CHECK(ckpt_state_sim_time(rs.p, rs.len, &t0) == -1);
+    free(rs.p);
+  }
   for (size_t k = 0; k < 2; k++) {
     CHECK(memcmp(b.stones[k].pos, a.stones[k].pos, sizeof a.stones[k].pos) == 0);
     CHECK(b.stones[k].removed == a.stones[k].removed);
