@@ -131,7 +131,12 @@ for sc in "${scenes[@]}"; do
   inputs=$(grep '^INPUTS ' "$d/resim.out")
   miss=$(exercised "$name")
   if [ -n "${miss// /}" ]; then
-    echo "FAIL $name: the session did not exercise the scene: $miss"; failures=$((failures + 1)); continue
+    echo "FAIL $name: the session did not exercise the scene: $miss"; failures=$((failures + 1))
+    # what the server and the hands saw (a stall of the server longer than a
+    # script's hold, or a hand that started late, shows here)
+    grep -E "grasp|stone|task|overrun|behind|steps, step time|simulated s per wall" "$d/server.log" | tail -8
+    for f in "$d"/haptic*.log; do echo "--- $f"; tail -3 "$f"; done
+    continue
   fi
   if [ $rc -eq 0 ] && echo "$line" | grep -q 'bit_exact=1' && echo "$inputs" | grep -q 'mode=applied' &&
     grep -q '^SCENE source=recording' "$d/resim.out"; then
