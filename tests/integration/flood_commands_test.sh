@@ -26,11 +26,11 @@ fi
 A=0.000,0.004,0.070
 printf '# holds still above the kidney\n0 %s\n100 %s\n' "${A//,/ }" "${A//,/ }" > "$OUT/trainee.traj"
 "$BUILD/server/viscera-server" --scene "$SRC/assets/scenes/default.yaml" --partition $PART --duration 30 \
-  > "$OUT/server.out" 2> "$OUT/server.log" & SRV=$!; PIDS+=($SRV)
+  > "$OUT/server.out" 2> "$OUT/server.log" & SRV=$!; PIDS+=("$SRV")
 "$BUILD/client/haptic/viscera-haptic" --partition $PART --tool 0 --station trainee --trajectory "$OUT/trainee.traj" \
-  --duration 18 --wait-server 20 --quiet > "$OUT/haptic.out" 2> "$OUT/haptic.log" & HAP=$!; PIDS+=($HAP)
+  --duration 18 --wait-server 20 --quiet > "$OUT/haptic.out" 2> "$OUT/haptic.log" & HAP=$!; PIDS+=("$HAP")
 "$BUILD/client/viewer/viscera-viewer" --partition $PART --out "$OUT/frames" --interval-ms 500 --duration 20 \
-  > "$OUT/viewer.out" 2> "$OUT/viewer.log" & VIEWER=$!; PIDS+=($VIEWER)
+  > "$OUT/viewer.out" 2> "$OUT/viewer.log" & VIEWER=$!; PIDS+=("$VIEWER")
 "$BUILD/client/control/viscera-control" --partition $PART --wait 15 assign 0 trainee > "$OUT/ctl.txt" 2>&1 \
   || fail "assign not applied"
 "$BUILD/tests/integration/flood_commands" flood "$VISCERA_DOMAIN" $PART $SRV,$HAP,$VIEWER "${FLOOD_COUNT:-75000}" 5 \

@@ -37,9 +37,9 @@ fail() { echo "FAIL: $*" >&2; for f in "$OUT"/*.log; do echo "--- $f"; tail -6 "
 run() {
   local n="$1" r="" t0=$SECONDS
   "$SRV" --scene "$SCENE" "${common[@]}" --checkpoint "$CK" >"$OUT/server$n.out" 2>"$OUT/server$n.log" &
-  local s=$!; PIDS+=($s)
+  local s=$!; PIDS+=("$s")
   if [ "${2:-}" = record ]; then
-    "$REC" "${common[@]}" --out "$OUT/session.db" >"$OUT/recorder.out" 2>"$OUT/recorder.log" & r=$!; PIDS+=($r)
+    "$REC" "${common[@]}" --out "$OUT/session.db" >"$OUT/recorder.out" 2>"$OUT/recorder.log" & r=$!; PIDS+=("$r")
     for _ in $(seq 1 200); do grep -q "recording topic viscera_AppliedInput" "$OUT/recorder.log" && break; sleep 0.1; done
   else
     for _ in $(seq 1 200); do grep -q "running on domain" "$OUT/server$n.log" && break; sleep 0.1; done
