@@ -30,6 +30,10 @@
 #   --rt-priority N     every server's physics loop SCHED_FIFO at N (1..99; default 0: normal
 #                       scheduling); needs root or CAP_SYS_NICE, else each server warns and runs on
 #   --haptic-rt-priority N  the same for the trainees' 1 kHz loops (with --trainees)
+#   --cpu-wake-latency US  servers and trainees hold a PM QoS bound: no CPU takes
+#                       longer than US us (0..10000) to wake from idle while they run
+#                       (0: idle CPUs poll; needs root, else each warns and runs on;
+#                       README "Wake-up latency")
 #   --one-server        every seat in one viscera-server (--seats N --first-seat K),
 #                       stepped by one physics thread per CPU: busy seats sharing
 #                       cores then step closer to one seat alone, with less CPU
@@ -53,7 +57,7 @@
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD="$ROOT/build" OUT="$ROOT/out/lab" SEATS=3 FIRST=1 PREFIX=lab SCENE="$ROOT/assets/scenes/default.yaml"
-TRAINEES=0 VIEWERS=1 DURATION=20 SECURE=0 INSECURE=0 RECORD=1 PKI="" RTPRIO=0 HRTPRIO=0 ONE=0 SEATTH=""
+TRAINEES=0 VIEWERS=1 DURATION=20 SECURE=0 INSECURE=0 RECORD=1 PKI="" RTPRIO=0 HRTPRIO=0 ONE=0 SEATTH="" WAKE=""
 STOP_GRACE_S="${VISCERA_LAB_STOP_GRACE:-10}"
 usage() { awk 'NR > 2 && /^#/ { sub(/^# ?/, ""); print; next } NR > 2 { exit }' "$0"; }
 while [ $# -gt 0 ]; do
@@ -73,6 +77,7 @@ while [ $# -gt 0 ]; do
     --no-record) RECORD=0; shift ;;
     --rt-priority) RTPRIO="$2"; shift 2 ;;
     --haptic-rt-priority) HRTPRIO="$2"; shift 2 ;;
+    --cpu-wake-latency) WAKE="$2"; shift 2 ;;
     --one-server) ONE=1; shift ;;
     --seat-threads) SEATTH="$2"; shift 2 ;;
     -h|--help) usage; exit 0 ;;
@@ -91,6 +96,11 @@ RTPRIO=$((10#$RTPRIO)) HRTPRIO=$((10#$HRTPRIO))
 SRV_RT=() HAP_RT=()
 [ "$RTPRIO" = 0 ] || SRV_RT=(--rt-priority "$RTPRIO")
 [ "$HRTPRIO" = 0 ] || HAP_RT=(--rt-priority "$HRTPRIO")
+if [ -n "$WAKE" ]; then
+  [[ "$WAKE" =~ ^[0-9]{1,5}$ ]] && [ "$((10#$WAKE))" -le 10000 ] ||
+    { echo "lab.sh: --cpu-wake-latency must be a number of microseconds 0..10000" >&2; exit 2; }
+  SRV_RT+=(--cpu-wake-latency "$((10#$WAKE))") HAP_RT+=(--cpu-wake-latency "$((10#$WAKE))")
+fi
 [[ "$STOP_GRACE_S" =~ ^[0-9]+$ ]] || { echo "lab.sh: VISCERA_LAB_STOP_GRACE must be a whole number" >&2; exit 2; }
 [ "$SEATS" -ge 1 ] && [ "$FIRST" -ge 1 ] && [ $((FIRST + SEATS - 1)) -le 99 ] || { echo "lab.sh: seats must lie in 1..99" >&2; exit 2; }
 [[ "$PREFIX" =~ ^[A-Za-z0-9_-]+$ ]] || { echo "lab.sh: --prefix: letters, digits, '-' and '_' only" >&2; exit 2; }

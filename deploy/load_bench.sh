@@ -27,6 +27,20 @@
 # (viscera-server --seat-threads; server/session/seat_group.h); default the
 # server's own, one per online CPU; K = SEATS: a thread per seat.
 #
+# --cpu-wake-latency US: the servers and trainees (alone and in the lab)
+# hold a PM QoS request that no CPU take longer than US us to wake from
+# idle (viscera-server --cpu-wake-latency; 0: idle CPUs poll): on a virtual
+# machine each sleep otherwise hands the core to the host and the step
+# after it pays (docs/numerics.md §11.5).
+#
+# --server-cpus LIST / --client-cpus LIST (taskset CPU lists): the servers,
+# and the trainees and subscribers, alone and in the lab, run on those CPUs
+# only. On one machine the clients otherwise share the physics threads'
+# cores, which a classroom's clients, at their own stations, do not: a
+# ContactFeedback written on loopback wakes its trainee's receive thread on
+# the writer's CPU, where it preempts the physics thread
+# (docs/numerics.md §11.5).
+#
 # Scheduling: the servers' physics loops run SCHED_FIFO at --rt-priority S
 # (default 70) and the trainees' 1 kHz loops at --haptic-rt-priority H
 # (default 80: the haptic tick is the most latency-critical thread and is
@@ -56,6 +70,7 @@
 # usage: deploy/load_bench.sh [--build DIR] [--out DIR] [--seats N] [--subscribers M] [--duration S]
 #                             [--baseline S] [--rt-priority S] [--haptic-rt-priority H]
 #                             [--scene FILE] [--busy] [--one-server [--seat-threads K]]
+#                             [--cpu-wake-latency US] [--server-cpus LIST] [--client-cpus LIST]
 # (the press is at x 12 mm, y 4 mm from above, 8 mm deep into an organ whose
 # top is at z = 35 mm: the shipped kidney and gallbladder; classroom
 # scenes: classroom_kidney.yaml, classroom_gallbladder.yaml)
@@ -64,7 +79,7 @@
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD="$ROOT/build" OUT="$ROOT/out/load" SEATS=5 SUBS=30 DURATION=600 BASELINE=30 RTPRIO=70 HRTPRIO=80
-SCENE="$ROOT/assets/scenes/classroom_kidney.yaml" BUSY=0 ONE=0 SEATTH=0
+SCENE="$ROOT/assets/scenes/classroom_kidney.yaml" BUSY=0 ONE=0 SEATTH=0 WAKE="" SRVCPUS="" CLICPUS=""
 while [ $# -gt 0 ]; do
   case "$1" in
     --build) BUILD="$2"; shift 2 ;;
@@ -79,6 +94,9 @@ while [ $# -gt 0 ]; do
     --busy) BUSY=1; shift ;;
     --one-server) ONE=1; shift ;;
     --seat-threads) SEATTH="$2"; shift 2 ;;
+    --cpu-wake-latency) WAKE="$2"; shift 2 ;;
+    --server-cpus) SRVCPUS="$2"; shift 2 ;;
+    --client-cpus) CLICPUS="$2"; shift 2 ;;
     -h|--help) awk 'NR > 2 && /^#/ { sub(/^# ?/, ""); print; next } NR > 2 { exit }' "$0"; exit 0 ;;
     *) echo "load_bench.sh: unknown option '$1'" >&2; exit 2 ;;
   esac
@@ -101,6 +119,23 @@ RTPRIO=$((10#$RTPRIO)) HRTPRIO=$((10#$HRTPRIO))
 SRV_RT=() HAP_RT=()
 [ "$RTPRIO" -gt 0 ] && SRV_RT=(--rt-priority "$RTPRIO")
 [ "$HRTPRIO" -gt 0 ] && HAP_RT=(--rt-priority "$HRTPRIO")
+if [ -n "$WAKE" ]; then
+  [[ "$WAKE" =~ ^[0-9]{1,5}$ ]] && [ "$((10#$WAKE))" -le 10000 ] ||
+    { echo "load_bench.sh: --cpu-wake-latency '$WAKE' is not a number of microseconds 0..10000" >&2; exit 2; }
+  WAKE=$((10#$WAKE))
+  SRV_RT+=(--cpu-wake-latency "$WAKE") HAP_RT+=(--cpu-wake-latency "$WAKE")
+fi
+# CPU placement (taskset): servers on --server-cpus, trainees and subscribers
+# on --client-cpus (alone and in the lab); none given: the scheduler's.
+SRV_PIN=() CLI_PIN=()
+for v in server:"$SRVCPUS" client:"$CLICPUS"; do
+  l=${v#*:}
+  [ -z "$l" ] && continue
+  [[ "$l" =~ ^[0-9]+([,-][0-9]+)*$ ]] && taskset -c "$l" true 2>/dev/null ||
+    { echo "load_bench.sh: --${v%%:*}-cpus '$l' is not a CPU list of this machine (taskset -c)" >&2; exit 2; }
+done
+[ -n "$SRVCPUS" ] && SRV_PIN=(taskset -c "$SRVCPUS")
+[ -n "$CLICPUS" ] && CLI_PIN=(taskset -c "$CLICPUS")
 [ -x "$BUILD/tests/bench/delta_sub" ] || { echo "load_bench.sh: $BUILD/tests/bench/delta_sub missing (build with -DVISCERA_BUILD_BENCH=ON)" >&2; exit 1; }
 export CYCLONEDDS_URI="${CYCLONEDDS_URI:-file://$ROOT/deploy/cyclonedds-loopback.xml}"
 # Another configuration than loopback: with a security fragment, or VISCERA_INSECURE=1 (warns).
@@ -144,17 +179,17 @@ step_line() { # server log -> "N steps, step wall time ...; step CPU time ...; r
 run_alone() { # TAG: files OUT/TAG-*
   local tag=$1 srv p subs=()
   echo "load_bench: $([ "$tag" = alone ] && echo baseline || echo "baseline again"), one seat alone for $BASELINE s" >&2
-  "$BUILD/server/viscera-server" --scene "$SCENE" --partition "load/$tag" --duration $((BASELINE + 2)) --quiet \
+  "${SRV_PIN[@]}" "$BUILD/server/viscera-server" --scene "$SCENE" --partition "load/$tag" --duration $((BASELINE + 2)) --quiet \
     "${SRV_RT[@]}" > "$OUT/$tag-server.out" 2> "$OUT/$tag-server.log" &
   srv=$!
   sleep 1
   # Its share of the lab's subscribers (a seat's step writes the meshes they read).
   for k in $(seq 1 $(( (SUBS + SEATS - 1) / SEATS ))); do
-    "$BUILD/tests/bench/delta_sub" --partition "load/$tag" --duration "$BASELINE" --name "$tag-sub$k" \
+    "${CLI_PIN[@]}" "$BUILD/tests/bench/delta_sub" --partition "load/$tag" --duration "$BASELINE" --name "$tag-sub$k" \
       > "$OUT/$tag-sub$k.out" 2>&1 &
     subs+=($!)
   done
-  "$BUILD/client/haptic/viscera-haptic" --partition "load/$tag" --trajectory "$TRAJ" --duration "$BASELINE" --quiet \
+  "${CLI_PIN[@]}" "$BUILD/client/haptic/viscera-haptic" --partition "load/$tag" --trajectory "$TRAJ" --duration "$BASELINE" --quiet \
     "${HAP_RT[@]}" > "$OUT/$tag-haptic.log" 2>&1 || true
   wait "$srv" || true
   for p in "${subs[@]}"; do kill -TERM "$p" 2>/dev/null || true; done
@@ -171,13 +206,13 @@ now_us() { echo "${EPOCHREALTIME/[.,]/}"; } # bash 5; the decimal sign follows t
 T0=$(now_us)
 servers=() srvnames=()
 if [ "$ONE" = 1 ]; then
-  "$BUILD/server/viscera-server" --scene "$SCENE" --partition load --seats "$SEATS" --duration $((DURATION + 3)) \
+  "${SRV_PIN[@]}" "$BUILD/server/viscera-server" --scene "$SCENE" --partition load --seats "$SEATS" --duration $((DURATION + 3)) \
     --quiet "${SRV_RT[@]}" "${GROUPS_OPT[@]}" > "$OUT/seats-server.out" 2> "$OUT/seats-server.log" &
   servers+=($!); srvnames+=(seats); pids+=($!); register $! server seats viscera-server
 else
   for i in $(seq 1 "$SEATS"); do
     s=$(printf 'seat%02d' "$i")
-    "$BUILD/server/viscera-server" --scene "$SCENE" --partition "load/$s" --duration $((DURATION + 3)) --quiet \
+    "${SRV_PIN[@]}" "$BUILD/server/viscera-server" --scene "$SCENE" --partition "load/$s" --duration $((DURATION + 3)) --quiet \
       "${SRV_RT[@]}" > "$OUT/$s-server.out" 2> "$OUT/$s-server.log" &
     servers+=($!); srvnames+=("$s"); pids+=($!); register $! server "$s" viscera-server
   done
@@ -185,14 +220,14 @@ fi
 sleep 1
 for i in $(seq 1 "$SEATS"); do
   s=$(printf 'seat%02d' "$i")
-  "$BUILD/client/haptic/viscera-haptic" --partition "load/$s" --trajectory "$TRAJ" --duration "$DURATION" --quiet \
+  "${CLI_PIN[@]}" "$BUILD/client/haptic/viscera-haptic" --partition "load/$s" --trajectory "$TRAJ" --duration "$DURATION" --quiet \
     "${HAP_RT[@]}" > "$OUT/$s-haptic.log" 2>&1 &
   pids+=($!); register $! trainee "$s" viscera-haptic
 done
 late=$((SUBS / 3)); early=$((SUBS - late))
 start_sub() { # index, duration
   local s; s=$(printf 'seat%02d' $(( ($1 % SEATS) + 1 )))
-  "$BUILD/tests/bench/delta_sub" --partition "load/$s" --duration "$2" --name "sub$1-$s" > "$OUT/sub$1.out" 2>&1 &
+  "${CLI_PIN[@]}" "$BUILD/tests/bench/delta_sub" --partition "load/$s" --duration "$2" --name "sub$1-$s" > "$OUT/sub$1.out" 2>&1 &
   pids+=($!); register $! subscriber "sub$1-$s" delta_sub
 }
 for k in $(seq 1 "$early"); do start_sub "$k" "$DURATION"; done
@@ -265,6 +300,12 @@ run_alone alone2
     echo "$what SCHED_FIFO $prio (refused in $(grep -l 'warning: SCHED_FIFO [0-9]* refused' "$@" 2>/dev/null | wc -l) of $#)"
   }
   echo "  scheduling: $(sched "servers' physics loops" "$RTPRIO" "$OUT"/*-server.log), $(sched "trainees' loops" "$HRTPRIO" "$OUT"/*-haptic.log)"
+  if [ -n "$WAKE" ]; then # the servers' and trainees' own words (refused: a warning each)
+    echo "  CPU wake-up latency <= $WAKE us (PM QoS), alone and in the lab: refused by $(grep -l 'cpu-wake-latency .* refused' "$OUT"/*-server.log "$OUT"/*-haptic.log 2>/dev/null | wc -l) of $(ls "$OUT"/*-server.log "$OUT"/*-haptic.log | wc -l) processes"
+  else
+    echo "  CPU wake-up latency: the machine's own (no PM QoS request; --cpu-wake-latency)"
+  fi
+  echo "  CPUs: servers on ${SRVCPUS:-any}, trainees and subscribers on ${CLICPUS:-any}"
   echo "  alone (baseline, $BASELINE s): $(step_line "$OUT/alone-server.log")"
   echo "  alone again after the lab: $(step_line "$OUT/alone2-server.log")"
   for i in $(seq 1 "$SEATS"); do

@@ -7,6 +7,7 @@
 
 #include "station.h"
 #include "cli.h"
+#include "cpu_wake.h"
 #include "dds/vdds.h"
 #include "vrt.h"
 
@@ -39,12 +40,16 @@ void haptic_usage(FILE *f) {
           "  --rt-priority N     run the loop thread (only it) SCHED_FIFO at priority N (1..99) with\n"
           "                      memory locked (needs root, CAP_SYS_NICE or LimitRTPRIO; if refused:\n"
           "                      a warning naming the reason, normal priority)\n"
+          "  --cpu-wake-latency US  while running, ask that no CPU take longer than US microseconds\n"
+          "                      (0..%d) to wake from idle (PM QoS: needs root or write access to\n"
+          "                      /dev/cpu_dma_latency; if refused: a warning); 0: idle CPUs poll\n"
+          "                      instead of sleeping, the loop wakes on time; costs power\n"
           "  --quiet             only the summary\n"
           "  --help              this text\n"
           "  --version           print the version and exit\n"
           "Exit status: 0 done (trajectory ended, --duration or SIGINT/SIGTERM), 1 device, DDS or\n"
           "output error (or no server within --wait-server), 2 usage error.\n",
-          device_names());
+          device_names(), CPU_WAKE_MAX_US);
 }
 
 enum {
@@ -63,6 +68,7 @@ enum {
   OPT_WORKSPACE_SCALE = 'S',
   OPT_WORKSPACE_OFFSET = 'O',
   OPT_GUIDE_RTT = 'G',
+  OPT_CPU_WAKE = 'W',
 };
 
 static const struct option haptic_long_options[] = {{"trajectory", required_argument, 0, OPT_TRAJECTORY},
@@ -75,6 +81,7 @@ static const struct option haptic_long_options[] = {{"trajectory", required_argu
                                                     {"duration", required_argument, 0, OPT_DURATION},
                                                     {"force-csv", required_argument, 0, OPT_FORCE_CSV},
                                                     {"rt-priority", required_argument, 0, OPT_RT_PRIORITY},
+                                                    {"cpu-wake-latency", required_argument, 0, OPT_CPU_WAKE},
                                                     {"device", required_argument, 0, OPT_DEVICE},
                                                     {"guide-rtt", required_argument, 0, OPT_GUIDE_RTT},
                                                     {"device-index", required_argument, 0, OPT_DEVICE_INDEX},
@@ -178,6 +185,13 @@ static int on_option(void *ctx, int code, const char *arg) {
       return 2;
     }
     return 0;
+  case OPT_CPU_WAKE:
+    if (cpu_wake_parse(arg, &o->cpu_wake_us)) {
+      fprintf(stderr, "viscera-haptic: --cpu-wake-latency '%s' is not a number of microseconds 0..%d\n", arg,
+              CPU_WAKE_MAX_US);
+      return 2;
+    }
+    return 0;
   case OPT_DEVICE:
     o->device = arg;
     return 0;
@@ -202,8 +216,13 @@ static int on_option(void *ctx, int code, const char *arg) {
 }
 
 int haptic_options_parse(haptic_options_t *o, int argc, char **argv) {
-  *o = (haptic_options_t){
-      .device = "scripted", .rate = 1000, .max_force = 4, .max_stiffness = 0, .wait_server = 10, .duration = -1};
+  *o = (haptic_options_t){.device = "scripted",
+                          .rate = 1000,
+                          .max_force = 4,
+                          .max_stiffness = 0,
+                          .wait_server = 10,
+                          .duration = -1,
+                          .cpu_wake_us = -1};
   device_config_default(&o->dcfg);
   const cli_spec_t spec = {.program = "viscera-haptic",
                            .common = CLI_DOMAIN | CLI_DOMAIN_ENV | CLI_PARTITION | CLI_QUIET,

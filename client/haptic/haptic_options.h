@@ -18,6 +18,7 @@ typedef struct haptic_options {
   device_config_t dcfg;   /* --device-index, --workspace-scale/-offset, and the fields below once parsed */
   double guide_rtt;       /* --guide-rtt S: least round trip to a guiding peer (guide_force.h) */
   int domain, quiet, rt_priority;
+  int cpu_wake_us;                     /* --cpu-wake-latency US (cpu_wake.h); -1: not asked */
   unsigned tool;                       /* --tool N */
   double rate;                         /* --rate HZ, loop rate */
   double max_force;                    /* --max-force N */

@@ -9,6 +9,7 @@
  * haptic_dds.c, the loop haptic_loop.c and the exit figures
  * haptic_summary.c. */
 #include "cli.h"
+#include "cpu_wake.h"
 #include "dds/vdds.h"
 #include "haptic_options.h"
 #include "haptic_run.h"
@@ -18,5 +19,13 @@ int main(int argc, char **argv) {
   haptic_options_t o;
   int rc = haptic_options_parse(&o, argc, argv);
   if (rc != CLI_RUN) return rc;
-  return haptic_run(&o);
+  /* Held for the whole run, released at exit (main owns it: machine-wide). */
+  cpu_wake_t wake = {.fd = -1};
+  if (o.cpu_wake_us >= 0) {
+    cpu_wake_hold(&wake, o.cpu_wake_us);
+    cpu_wake_report(&wake, "haptic", o.quiet, stderr);
+  }
+  rc = haptic_run(&o);
+  cpu_wake_release(&wake);
+  return rc;
 }

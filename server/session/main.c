@@ -5,6 +5,7 @@
 #include <stdlib.h>
 
 #include "cli.h"
+#include "cpu_wake.h"
 #include "dds/vdds.h"
 #include "session/server_app.h"
 #include "vrt.h"
@@ -27,6 +28,11 @@ static void usage(FILE *f) {
           "                      SCHED_FIFO at priority N (1..99) with memory locked (needs root,\n"
           "                      CAP_SYS_NICE or LimitRTPRIO; if refused: a warning naming the reason,\n"
           "                      normal priority)\n"
+          "  --cpu-wake-latency US  while running, ask that no CPU take longer than US microseconds\n"
+          "                      (0..%d) to wake from idle (PM QoS, /dev/cpu_dma_latency: needs\n"
+          "                      root or write access; if refused: a warning, nothing else changes);\n"
+          "                      0: idle CPUs poll instead of sleeping, so the step after each\n"
+          "                      1 ms sleep keeps its caches (docs/numerics.md §11.5); costs power\n"
           "  --seats N           run N seats of the scene in this one process (1..%d), each\n"
           "                      its own session on partition P/seatKK (P: --partition); seats in\n"
           "                      one process share a core's caches better than one process per\n"
@@ -46,7 +52,7 @@ static void usage(FILE *f) {
           "  --version           print the version and exit\n"
           "DDS configuration comes from CYCLONEDDS_URI (unset: deploy/cyclonedds-loopback.xml, one machine).\n"
           "Exit status: 0 done (or --check passed), 1 bad scene or runtime error, 2 usage error.\n",
-          SERVER_APP_MAX_SEATS);
+          CPU_WAKE_MAX_US, SERVER_APP_MAX_SEATS);
 }
 
 enum {
@@ -60,7 +66,8 @@ enum {
   OPT_RT_PRIORITY = 'R',
   OPT_SEATS = 'S',
   OPT_FIRST_SEAT = 'F',
-  OPT_SEAT_THREADS = 'G'
+  OPT_SEAT_THREADS = 'G',
+  OPT_CPU_WAKE = 'W'
 };
 
 /* A number of seconds: >= 0 when `zero_ok`, else > 0. */
@@ -95,6 +102,13 @@ static int on_option(void *ctx, int code, const char *arg) {
   case OPT_RT_PRIORITY:
     if (vrt_parse_priority(arg, &o->opts.rt_priority)) {
       fprintf(stderr, "viscera-server: --rt-priority '%s' is not a SCHED_FIFO priority 1..99\n", arg);
+      return 2;
+    }
+    return 0;
+  case OPT_CPU_WAKE:
+    if (cpu_wake_parse(arg, &o->cpu_wake_us)) {
+      fprintf(stderr, "viscera-server: --cpu-wake-latency '%s' is not a number of microseconds 0..%d\n", arg,
+              CPU_WAKE_MAX_US);
       return 2;
     }
     return 0;
@@ -149,6 +163,7 @@ int main(int argc, char **argv) {
                                      {"seats", required_argument, 0, OPT_SEATS},
                                      {"first-seat", required_argument, 0, OPT_FIRST_SEAT},
                                      {"seat-threads", required_argument, 0, OPT_SEAT_THREADS},
+                                     {"cpu-wake-latency", required_argument, 0, OPT_CPU_WAKE},
                                      {0, 0, 0, 0}};
   const cli_spec_t spec = {.program = "viscera-server",
                            .common = CLI_DOMAIN | CLI_DOMAIN_ENV | CLI_PARTITION | CLI_QUIET,
@@ -156,8 +171,10 @@ int main(int argc, char **argv) {
                            .options = lo,
                            .option = on_option,
                            .usage = usage};
-  server_app_options_t o = {
-      .seats = 0, .first_seat = 0, .opts = {.duration = 0, .tool_timeout = 0.5, .checkpoint_every = 1.0}};
+  server_app_options_t o = {.seats = 0,
+                            .first_seat = 0,
+                            .cpu_wake_us = -1,
+                            .opts = {.duration = 0, .tool_timeout = 0.5, .checkpoint_every = 1.0}};
   cli_common_t common = {0};
   int rc = cli_parse(&spec, argc, argv, &common, &o);
   if (rc != CLI_RUN) return rc;
@@ -186,5 +203,13 @@ int main(int argc, char **argv) {
     fprintf(stderr, "viscera-server: --seats %d from --first-seat %d goes past seat 99\n", o.seats, o.first_seat);
     return 2;
   }
-  return server_app_run(&o);
+  /* Held for the whole run, released at exit (main owns it: machine-wide). */
+  cpu_wake_t wake = {.fd = -1};
+  if (o.cpu_wake_us >= 0 && !o.check_only) {
+    cpu_wake_hold(&wake, o.cpu_wake_us);
+    cpu_wake_report(&wake, "server", o.opts.quiet, stderr);
+  }
+  rc = server_app_run(&o);
+  cpu_wake_release(&wake);
+  return rc;
 }

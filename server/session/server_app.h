@@ -31,6 +31,7 @@ typedef struct server_app_options {
   int seat_threads;       /* --seat-threads K: with --seats, K physics threads each stepping a group of seats
                              (seat_group.h); 0: one per online CPU, at most one per seat */
   int check_only;         /* --check */
+  int cpu_wake_us;        /* --cpu-wake-latency US (cpu_wake.h, held by main); -1: not asked */
   server_opts_t opts;     /* everything server_run (seat_group.h) takes */
 } server_app_options_t;
 
