@@ -16,7 +16,8 @@ _viscera() {
       return 0
       ;;
     --domain | --partition | --duration | --seats | --first | --prefix | --tool | --station | --speed | --seek | \
-      --wait | --rt-priority | --tile | --size | --cols | --width | --height | --interval-ms | --max-frames)
+      --wait | --rt-priority | --cpu-wake-latency | --seat-threads | --first-seat | --tile | --size | --cols | \
+      --width | --height | --interval-ms | --max-frames)
       return 0 # a value the user types
       ;;
   esac
