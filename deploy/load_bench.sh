@@ -35,7 +35,9 @@
 #
 # --server-cpus LIST / --client-cpus LIST (taskset CPU lists): the servers,
 # and the trainees and subscribers, alone and in the lab, run on those CPUs
-# only. On one machine the clients otherwise share the physics threads'
+# only; --physics-cpus LIST then keeps the servers' physics loops alone on
+# their CPUs (viscera-server --physics-cpus), their DDS threads staying on
+# --server-cpus. On one machine the clients otherwise share the physics threads'
 # cores, which a classroom's clients, at their own stations, do not: a
 # ContactFeedback written on loopback wakes its trainee's receive thread on
 # the writer's CPU, where it preempts the physics thread
@@ -71,6 +73,7 @@
 #                             [--baseline S] [--rt-priority S] [--haptic-rt-priority H]
 #                             [--scene FILE] [--busy] [--one-server [--seat-threads K]]
 #                             [--cpu-wake-latency US] [--server-cpus LIST] [--client-cpus LIST]
+#                             [--physics-cpus LIST]
 # (the press is at x 12 mm, y 4 mm from above, 8 mm deep into an organ whose
 # top is at z = 35 mm: the shipped kidney and gallbladder; classroom
 # scenes: classroom_kidney.yaml, classroom_gallbladder.yaml)
@@ -79,7 +82,7 @@
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD="$ROOT/build" OUT="$ROOT/out/load" SEATS=5 SUBS=30 DURATION=600 BASELINE=30 RTPRIO=70 HRTPRIO=80
-SCENE="$ROOT/assets/scenes/classroom_kidney.yaml" BUSY=0 ONE=0 SEATTH=0 WAKE="" SRVCPUS="" CLICPUS=""
+SCENE="$ROOT/assets/scenes/classroom_kidney.yaml" BUSY=0 ONE=0 SEATTH=0 WAKE="" SRVCPUS="" CLICPUS="" PHYCPUS=""
 while [ $# -gt 0 ]; do
   case "$1" in
     --build) BUILD="$2"; shift 2 ;;
@@ -96,6 +99,7 @@ while [ $# -gt 0 ]; do
     --seat-threads) SEATTH="$2"; shift 2 ;;
     --cpu-wake-latency) WAKE="$2"; shift 2 ;;
     --server-cpus) SRVCPUS="$2"; shift 2 ;;
+    --physics-cpus) PHYCPUS="$2"; shift 2 ;;
     --client-cpus) CLICPUS="$2"; shift 2 ;;
     -h|--help) awk 'NR > 2 && /^#/ { sub(/^# ?/, ""); print; next } NR > 2 { exit }' "$0"; exit 0 ;;
     *) echo "load_bench.sh: unknown option '$1'" >&2; exit 2 ;;
@@ -128,7 +132,7 @@ fi
 # CPU placement (taskset): servers on --server-cpus, trainees and subscribers
 # on --client-cpus (alone and in the lab); none given: the scheduler's.
 SRV_PIN=() CLI_PIN=()
-for v in server:"$SRVCPUS" client:"$CLICPUS"; do
+for v in server:"$SRVCPUS" client:"$CLICPUS" physics:"$PHYCPUS"; do
   l=${v#*:}
   [ -z "$l" ] && continue
   [[ "$l" =~ ^[0-9]+([,-][0-9]+)*$ ]] && taskset -c "$l" true 2>/dev/null ||
@@ -136,6 +140,7 @@ for v in server:"$SRVCPUS" client:"$CLICPUS"; do
 done
 [ -n "$SRVCPUS" ] && SRV_PIN=(taskset -c "$SRVCPUS")
 [ -n "$CLICPUS" ] && CLI_PIN=(taskset -c "$CLICPUS")
+[ -n "$PHYCPUS" ] && SRV_RT+=(--physics-cpus "$PHYCPUS")
 [ -x "$BUILD/tests/bench/delta_sub" ] || { echo "load_bench.sh: $BUILD/tests/bench/delta_sub missing (build with -DVISCERA_BUILD_BENCH=ON)" >&2; exit 1; }
 export CYCLONEDDS_URI="${CYCLONEDDS_URI:-file://$ROOT/deploy/cyclonedds-loopback.xml}"
 # Another configuration than loopback: with a security fragment, or VISCERA_INSECURE=1 (warns).
@@ -305,7 +310,7 @@ run_alone alone2
   else
     echo "  CPU wake-up latency: the machine's own (no PM QoS request; --cpu-wake-latency)"
   fi
-  echo "  CPUs: servers on ${SRVCPUS:-any}, trainees and subscribers on ${CLICPUS:-any}"
+  echo "  CPUs: servers on ${SRVCPUS:-any}$([ -n "$PHYCPUS" ] && echo " (their physics loops on $PHYCPUS)"), trainees and subscribers on ${CLICPUS:-any}"
   echo "  alone (baseline, $BASELINE s): $(step_line "$OUT/alone-server.log")"
   echo "  alone again after the lab: $(step_line "$OUT/alone2-server.log")"
   for i in $(seq 1 "$SEATS"); do

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 
 #include "cli.h"
+#include "cpu_pin.h"
 #include "cpu_wake.h"
 #include "dds/vdds.h"
 #include "session/server_app.h"
@@ -33,6 +34,10 @@ static void usage(FILE *f) {
           "                      root or write access; if refused: a warning, nothing else changes);\n"
           "                      0: idle CPUs poll instead of sleeping, so the step after each\n"
           "                      1 ms sleep keeps its caches (docs/numerics.md §11.5); costs power\n"
+          "  --physics-cpus LIST keep the physics loop's thread(s) on these CPUs (taskset -c form:\n"
+          "                      1, 0-3,6; DDS threads stay where they are); with the rest of the\n"
+          "                      machine kept off them (taskset, cpusets) the loop has its cores\n"
+          "                      to itself (docs/numerics.md §11.5); refused: a warning\n"
           "  --seats N           run N seats of the scene in this one process (1..%d), each\n"
           "                      its own session on partition P/seatKK (P: --partition); seats in\n"
           "                      one process share a core's caches better than one process per\n"
@@ -67,7 +72,8 @@ enum {
   OPT_SEATS = 'S',
   OPT_FIRST_SEAT = 'F',
   OPT_SEAT_THREADS = 'G',
-  OPT_CPU_WAKE = 'W'
+  OPT_CPU_WAKE = 'W',
+  OPT_PHYSICS_CPUS = 'P'
 };
 
 /* A number of seconds: >= 0 when `zero_ok`, else > 0. */
@@ -112,6 +118,14 @@ static int on_option(void *ctx, int code, const char *arg) {
       return 2;
     }
     return 0;
+  case OPT_PHYSICS_CPUS: {
+    char why[160];
+    if (cpu_pin_parse(arg, &o->physics_cpus, why, sizeof why)) {
+      fprintf(stderr, "viscera-server: --physics-cpus: %s\n", why);
+      return 2;
+    }
+    return 0;
+  }
   case OPT_CHECK:
     o->check_only = 1;
     return 0;
@@ -164,6 +178,7 @@ int main(int argc, char **argv) {
                                      {"first-seat", required_argument, 0, OPT_FIRST_SEAT},
                                      {"seat-threads", required_argument, 0, OPT_SEAT_THREADS},
                                      {"cpu-wake-latency", required_argument, 0, OPT_CPU_WAKE},
+                                     {"physics-cpus", required_argument, 0, OPT_PHYSICS_CPUS},
                                      {0, 0, 0, 0}};
   const cli_spec_t spec = {.program = "viscera-server",
                            .common = CLI_DOMAIN | CLI_DOMAIN_ENV | CLI_PARTITION | CLI_QUIET,
@@ -181,6 +196,7 @@ int main(int argc, char **argv) {
   o.opts.domain = common.domain;
   o.opts.partition = common.partition;
   o.opts.quiet = common.quiet;
+  if (o.physics_cpus.count) o.opts.physics_cpus = &o.physics_cpus;
   if (!o.scene_path) {
     fprintf(stderr, "viscera-server: --scene FILE is required\n");
     usage(stderr);

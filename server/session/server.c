@@ -1196,6 +1196,14 @@ void server_thread_prepare(const server_opts_t *opts, const char *tag) {
    * (sched_rt_runtime_us: 950 ms of every second by default) is the safety
    * net that still lets the other tasks (this server's DDS threads, a shell
    * to stop it) run there. */
+  if (opts->physics_cpus) {
+    char why[160];
+    if (cpu_pin_self(opts->physics_cpus, why, sizeof why))
+      fprintf(stderr, "%s: warning: --physics-cpus refused: %s; the physics loop runs where the scheduler puts it\n",
+              tag, why);
+    else if (!opts->quiet)
+      fprintf(stderr, "%s: physics loop kept on CPUs %s\n", tag, opts->physics_cpus->text);
+  }
   if (opts->rt_priority) vrt_make_realtime(opts->rt_priority, tag, "physics loop", opts->quiet, stderr);
   /* A SCHED_OTHER loop wakes up to the thread's timer slack (50 us by
    * default) after each tick: every command would wait that much longer

@@ -12,6 +12,7 @@
 
 #include "dds/vdds.h"
 #include "runtime/scene_runtime.h"
+#include "cpu_pin.h"
 #include "session/mesh_publisher.h"
 #include "training/thresholds.h"
 #include "viscera.h"
@@ -22,11 +23,13 @@ typedef struct server_opts {
   double duration;        /* s of wall time; 0 = until stopped */
   const char *final_mesh; /* write exact positions of the last published frame here (OBJ) */
   int quiet;
-  double tool_timeout;     /* s without a command before a tool is released */
-  const char *checkpoint;  /* state file: resumed from at start when it fits the scene, written periodically */
-  double checkpoint_every; /* s of simulated time between checkpoints */
-  int rt_priority;         /* 1..99: the step loop's thread runs SCHED_FIFO at it (vrt.h); 0 = normal */
-  const char *log_tag;     /* the log lines' "TAG: " (NULL: "server"); a seat's own among several (server_app.h) */
+  double tool_timeout;           /* s without a command before a tool is released */
+  const char *checkpoint;        /* state file: resumed from at start when it fits the scene, written periodically */
+  double checkpoint_every;       /* s of simulated time between checkpoints */
+  int rt_priority;               /* 1..99: the step loop's thread runs SCHED_FIFO at it (vrt.h); 0 = normal */
+  const cpu_pin_t *physics_cpus; /* the step loop's thread kept on these CPUs (cpu_pin.h); NULL: anywhere.
+                                    Owned by the caller */
+  const char *log_tag; /* the log lines' "TAG: " (NULL: "server"); a seat's own among several (server_app.h) */
   /* Sessions sharing a process (server_app.h) share this lock, held while a
    * session creates its participant, readers and writers: with DDS Security
    * on, Cyclone 0.10.2 failed a participant created at the same time as
@@ -109,8 +112,9 @@ uint64_t server_step_end(server_t *s);
 void server_close(server_t *s);
 uint64_t server_dt_ns(const server_t *s); /* the scene's step */
 void server_note_overrun(server_t *s);    /* its stats: the stepping thread fell behind and resynchronised */
-/* The calling thread as a physics loop: SCHED_FIFO at opts->rt_priority
- * when set (vrt.h), timer slack 1 ns. Call after the sessions are open
+/* The calling thread as a physics loop: on opts->physics_cpus when set
+ * (cpu_pin.h; refused: a warning), SCHED_FIFO at opts->rt_priority when set
+ * (vrt.h), timer slack 1 ns. Call after the sessions are open
  * (their DDS threads stay at normal priority). */
 void server_thread_prepare(const server_opts_t *opts, const char *tag);
 

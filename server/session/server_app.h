@@ -32,6 +32,7 @@ typedef struct server_app_options {
                              (seat_group.h); 0: one per online CPU, at most one per seat */
   int check_only;         /* --check */
   int cpu_wake_us;        /* --cpu-wake-latency US (cpu_wake.h, held by main); -1: not asked */
+  cpu_pin_t physics_cpus; /* --physics-cpus LIST (count 0: not given); opts.physics_cpus points here */
   server_opts_t opts;     /* everything server_run (seat_group.h) takes */
 } server_app_options_t;
 

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: Apache-2.0
-# cpu_wake: --cpu-wake-latency US of viscera-server and viscera-haptic (the
-# shared common/cpu_wake.c: a PM QoS request on /dev/cpu_dma_latency held
-# while the program runs), domain 175.
+# loop_cpus: where the 1 kHz loops run. --cpu-wake-latency US of
+# viscera-server and viscera-haptic (the shared common/cpu_wake.c: a PM QoS
+# request on /dev/cpu_dma_latency held while the program runs) and
+# viscera-server --physics-cpus LIST (common/cpu_pin.c), domain 175.
 #   1. --cpu-wake-latency -1, 10001 and x: exit 2 and a message naming the
 #      option and the range, for both binaries;
 #   2. a server and a scripted trainee, both --cpu-wake-latency 0, for a few
@@ -16,8 +17,12 @@
 #   3. the refusal path for sure, as root: the same pair as user nobody
 #      (setpriv): the warning with "Permission denied", and the session runs
 #      (skipped when nobody cannot reach the build or the scene, e.g. a clone
-#      under /root).
-# usage: cpu_wake_test.sh BUILD SRC OUT
+#      under /root);
+#   4. --physics-cpus: bad lists exit 2 naming what is wrong; on a machine of
+#      two or more CPUs, two seats on one physics thread kept on the last CPU:
+#      that thread (one of those named 'seats01-02') may run on that CPU only,
+#      the DDS receive thread keeps the process's CPUs, and both seats step.
+# usage: loop_cpus_test.sh BUILD SRC OUT
 set -euo pipefail
 # shellcheck source=prelude.sh
 source "$(dirname "$0")/prelude.sh"
@@ -115,5 +120,42 @@ else
   done
   ran nobody
   echo "refused as nobody, the session ran"
+fi
+
+# 4. The physics loop kept on a CPU.
+for bad in x 1- 3-1 "0,,1" 999 "$(nproc --all)"; do
+  rc=0
+  "$SRV" --scene "$SCENE" --physics-cpus "$bad" > /dev/null 2> "$OUT/badcpu.err" || rc=$?
+  [ "$rc" = 2 ] && grep -q -- "--physics-cpus: .*'$bad'" "$OUT/badcpu.err" ||
+    fail "--physics-cpus '$bad': exit $rc, expected 2 naming it: $(cat "$OUT/badcpu.err")"
+done
+echo "bad CPU lists exit 2 naming them"
+# allowed TID-DIR: the CPUs the thread may run on (/proc status)
+allowed() { sed -n 's/^Cpus_allowed_list:[[:space:]]*//p' "$1/status"; }
+if [ "$(nproc)" -ge 2 ]; then
+  last=$(($(nproc --all) - 1))
+  "$SRV" --scene "$SCENE" --partition cpuwake/pin --seats 2 --seat-threads 1 --physics-cpus "$last" --duration 4 \
+    > "$OUT/pin-server.out" 2> "$OUT/pin-server.log" & PIN=$!; PIDS+=("$PIN")
+  for _ in $(seq 1 100); do grep -q "physics loop kept on CPUs $last" "$OUT/pin-server.log" && break; sleep 0.1; done
+  grep -q "physics loop kept on CPUs $last" "$OUT/pin-server.log" ||
+    fail "the server did not say it keeps the physics loop on CPU $last: $(cat "$OUT/pin-server.log")"
+  sleep 0.5
+  phys="" recv=""
+  for t in /proc/"$PIN"/task/*; do
+    case "$(cat "$t/comm" 2> /dev/null)" in
+      # (threads the group thread started, its outbox drain among them, inherit
+      # its name but not its CPUs: they were started before it pinned itself)
+      seats01-02) [ "$(allowed "$t")" = "$last" ] && phys=ok || [ "$phys" = ok ] || phys="$(allowed "$t")" ;;
+      recv*) recv="$(allowed "$t")" ;;
+    esac
+  done
+  [ "$phys" = ok ] || fail "the physics thread 'seats01-02' may run on CPUs '${phys:-(no such thread)}', not $last only"
+  [ -n "$recv" ] && [ "$recv" != "$last" ] || fail "the DDS receive thread was pinned too (CPUs '$recv')"
+  wait "$PIN" || fail "the pinned server failed"
+  steps=$(sed -n 's/^SUMMARY steps=\([0-9]*\).*/\1/p' "$OUT/pin-server.out" | sort -n | head -1)
+  [ "${steps:-0}" -ge 1000 ] || fail "a pinned seat took ${steps:-no} steps"
+  echo "physics thread on CPU $last only, DDS receive thread on $recv; both seats stepped (>= $steps steps)"
+else
+  echo "part 4 (pinning) skipped: one CPU"
 fi
 echo PASS
