@@ -21,6 +21,13 @@ int cpu_wake_parse(const char *s, int *us) {
   return 0;
 }
 
+int cpu_wake_option(const char *prog, const char *arg, int *us) {
+  if (!cpu_wake_parse(arg, us)) return 0;
+  fprintf(stderr, "%s: --cpu-wake-latency '%s' is not a number of microseconds 0..%d\n", prog, arg ? arg : "",
+          CPU_WAKE_MAX_US);
+  return 2;
+}
+
 int cpu_wake_hold(cpu_wake_t *w, int max_us) {
   memset(w, 0, sizeof *w);
   w->fd = -1;
@@ -52,11 +59,10 @@ void cpu_wake_release(cpu_wake_t *w) {
   w->granted = 0;
 }
 
-void cpu_wake_report(const cpu_wake_t *w, const char *who, int quiet, FILE *log) {
+void cpu_wake_report(const cpu_wake_t *w, const char *who, FILE *log) {
   if (w->granted) {
-    if (!quiet)
-      fprintf(log, "%s: CPU wake-up latency held at <= %d us while running (PM QoS; idle CPUs %s)\n", who, w->max_us,
-              w->max_us == 0 ? "poll instead of sleeping" : "stay out of deeper idle states");
+    fprintf(log, "%s: CPU wake-up latency held at <= %d us while running (PM QoS; idle CPUs %s)\n", who, w->max_us,
+            w->max_us == 0 ? "poll instead of sleeping" : "stay out of deeper idle states");
     return;
   }
   fprintf(log,

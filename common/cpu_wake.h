@@ -37,6 +37,11 @@ typedef struct cpu_wake {
  * 0..CPU_WAKE_MAX_US. Returns 0 and sets *us, or -1 (us untouched). */
 int cpu_wake_parse(const char *s, int *us);
 
+/* cpu_wake_parse for a program's option parser: on a bad argument prints
+ * "PROG: --cpu-wake-latency 'ARG' is not a number of microseconds 0..MAX"
+ * to stderr and returns 2 (the usage-error exit status); else 0. */
+int cpu_wake_option(const char *prog, const char *arg, int *us);
+
 /* Asks that no CPU take longer than max_us to wake. Fills *w; returns 1
  * when the request is held, 0 when refused (w->why says why). */
 int cpu_wake_hold(cpu_wake_t *w, int max_us);
@@ -44,8 +49,9 @@ int cpu_wake_hold(cpu_wake_t *w, int max_us);
 /* Ends a held request (no-op otherwise). */
 void cpu_wake_release(cpu_wake_t *w);
 
-/* Prints the outcome to `log`, prefixed "WHO: ": one line when held (unless
- * quiet), a warning when refused whatever quiet says. */
-void cpu_wake_report(const cpu_wake_t *w, const char *who, int quiet, FILE *log);
+/* Prints the outcome to `log`, prefixed "WHO: ": one line when held, a
+ * warning when refused. Printed even by a --quiet program: the request is
+ * a machine-wide setting, and whoever reads the log should know it held. */
+void cpu_wake_report(const cpu_wake_t *w, const char *who, FILE *log);
 
 #endif

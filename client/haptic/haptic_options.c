@@ -186,12 +186,7 @@ static int on_option(void *ctx, int code, const char *arg) {
     }
     return 0;
   case OPT_CPU_WAKE:
-    if (cpu_wake_parse(arg, &o->cpu_wake_us)) {
-      fprintf(stderr, "viscera-haptic: --cpu-wake-latency '%s' is not a number of microseconds 0..%d\n", arg,
-              CPU_WAKE_MAX_US);
-      return 2;
-    }
-    return 0;
+    return cpu_wake_option("viscera-haptic", arg, &o->cpu_wake_us);
   case OPT_DEVICE:
     o->device = arg;
     return 0;

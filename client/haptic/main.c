@@ -23,7 +23,7 @@ int main(int argc, char **argv) {
   cpu_wake_t wake = {.fd = -1};
   if (o.cpu_wake_us >= 0) {
     cpu_wake_hold(&wake, o.cpu_wake_us);
-    cpu_wake_report(&wake, "haptic", o.quiet, stderr);
+    cpu_wake_report(&wake, "haptic", stderr);
   }
   rc = haptic_run(&o);
   cpu_wake_release(&wake);

@@ -112,12 +112,7 @@ static int on_option(void *ctx, int code, const char *arg) {
     }
     return 0;
   case OPT_CPU_WAKE:
-    if (cpu_wake_parse(arg, &o->cpu_wake_us)) {
-      fprintf(stderr, "viscera-server: --cpu-wake-latency '%s' is not a number of microseconds 0..%d\n", arg,
-              CPU_WAKE_MAX_US);
-      return 2;
-    }
-    return 0;
+    return cpu_wake_option("viscera-server", arg, &o->cpu_wake_us);
   case OPT_PHYSICS_CPUS: {
     char why[160];
     if (cpu_pin_parse(arg, &o->physics_cpus, why, sizeof why)) {
@@ -223,7 +218,7 @@ int main(int argc, char **argv) {
   cpu_wake_t wake = {.fd = -1};
   if (o.cpu_wake_us >= 0 && !o.check_only) {
     cpu_wake_hold(&wake, o.cpu_wake_us);
-    cpu_wake_report(&wake, "server", o.opts.quiet, stderr);
+    cpu_wake_report(&wake, "server", stderr);
   }
   rc = server_app_run(&o);
   cpu_wake_release(&wake);
