@@ -69,11 +69,21 @@
 # their difference, "slower than the seat alone beyond noise" when one lies
 # above it, "no slower ... (faster beyond noise)" when one lies below it.
 #
+# --rounds R: the whole (seat alone, lab, seat alone again) R times, each
+# round in OUT/roundK/ with its own summary; OUT/summary.txt then sets each
+# round's seats against that round's two runs of the seat alone and judges
+# the median over the rounds against the median of the rounds' own
+# alone-to-alone spread (the same band as one run's, see above). On a
+# virtual machine the seat alone's step drifts by a fifth over minutes
+# (docs/numerics.md §11.5): rounds taken one after the other see the lab and
+# its reference under the same drift, where one run's two references may
+# not.
+#
 # usage: deploy/load_bench.sh [--build DIR] [--out DIR] [--seats N] [--subscribers M] [--duration S]
 #                             [--baseline S] [--rt-priority S] [--haptic-rt-priority H]
 #                             [--scene FILE] [--busy] [--one-server [--seat-threads K]]
 #                             [--cpu-wake-latency US] [--server-cpus LIST] [--client-cpus LIST]
-#                             [--physics-cpus LIST]
+#                             [--physics-cpus LIST] [--rounds R]
 # (the press is at x 12 mm, y 4 mm from above, 8 mm deep into an organ whose
 # top is at z = 35 mm: the shipped kidney and gallbladder; classroom
 # scenes: classroom_kidney.yaml, classroom_gallbladder.yaml)
@@ -83,7 +93,13 @@ set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD="$ROOT/build" OUT="$ROOT/out/load" SEATS=5 SUBS=30 DURATION=600 BASELINE=30 RTPRIO=70 HRTPRIO=80
 SCENE="$ROOT/assets/scenes/classroom_kidney.yaml" BUSY=0 ONE=0 SEATTH=0 WAKE="" SRVCPUS="" CLICPUS="" PHYCPUS=""
+ROUNDS=1 ROUND_ARGS=() # every option but --out and --rounds, for each round's own run
 while [ $# -gt 0 ]; do
+  case "$1" in
+    --out | --rounds) ;;
+    --busy | --one-server) ROUND_ARGS+=("$1") ;;
+    *) ROUND_ARGS+=("$1" "${2-}") ;;
+  esac
   case "$1" in
     --build) BUILD="$2"; shift 2 ;;
     --out) OUT="$2"; shift 2 ;;
@@ -101,11 +117,12 @@ while [ $# -gt 0 ]; do
     --server-cpus) SRVCPUS="$2"; shift 2 ;;
     --physics-cpus) PHYCPUS="$2"; shift 2 ;;
     --client-cpus) CLICPUS="$2"; shift 2 ;;
+    --rounds) ROUNDS="$2"; shift 2 ;;
     -h|--help) awk 'NR > 2 && /^#/ { sub(/^# ?/, ""); print; next } NR > 2 { exit }' "$0"; exit 0 ;;
     *) echo "load_bench.sh: unknown option '$1'" >&2; exit 2 ;;
   esac
 done
-for v in SEATS SUBS DURATION BASELINE; do [[ "${!v}" =~ ^[0-9]+$ ]] && [ "${!v}" -ge 1 ] || { echo "load_bench.sh: bad ${v,,}" >&2; exit 2; }; done
+for v in SEATS SUBS DURATION BASELINE ROUNDS; do [[ "${!v}" =~ ^[0-9]+$ ]] && [ "${!v}" -ge 1 ] || { echo "load_bench.sh: bad ${v,,}" >&2; exit 2; }; done
 [[ "$SEATTH" =~ ^[0-9]+$ ]] && [ "$SEATTH" -le "$SEATS" ] ||
   { echo "load_bench.sh: --seat-threads '$SEATTH' is not a number of threads 1..$SEATS" >&2; exit 2; }
 SEATTH=$((10#$SEATTH))
@@ -153,6 +170,67 @@ net_guard load_bench.sh "$CYCLONEDDS_URI" 0 "${VISCERA_INSECURE:-0}" \
 export VISCERA_DOMAIN="${VISCERA_DOMAIN:-0}"
 [ -r "$SCENE" ] || { echo "load_bench.sh: cannot read the scene '$SCENE'" >&2; exit 2; }
 SCENE_NAME=$(basename "$SCENE" .yaml)
+# The medians a server log gives: the whole step's CPU time, and its two
+# parts (the server's "step CPU split" line: the runtime's tissue step, and
+# the rest: commands, feedback, inputs, frames).
+STEP_SED='s/^server: step CPU time median \([0-9.]*\) us.*/\1/p'
+TISSUE_SED='s/^server: step CPU split: tissue (contact and organs) median \([0-9.]*\) us.*/\1/p'
+REST_SED='s/^server: step CPU split: .* the rest ([^)]*) median \([0-9.]*\) us.*/\1/p'
+if [ "$ROUNDS" -gt 1 ]; then
+  rm -rf "$OUT"; mkdir -p "$OUT"
+  for k in $(seq 1 "$ROUNDS"); do
+    echo "load_bench: round $k of $ROUNDS" >&2
+    bash "$0" "${ROUND_ARGS[@]}" --out "$OUT/round$k" > "$OUT/round$k.txt" 2>&1 ||
+      { tail -5 "$OUT/round$k.txt" >&2; echo "load_bench.sh: round $k failed (its output: $OUT/round$k.txt)" >&2; exit 1; }
+  done
+  # label, sed expression: each round's seats against the mean of that
+  # round's two runs of the seat alone, then the median over the rounds
+  # against the median of the rounds' alone-to-alone spreads.
+  rounds_against_alone() {
+    local k i d
+    for k in $(seq 1 "$ROUNDS"); do
+      d="$OUT/round$k"
+      echo "$k a1 $(sed -n "$2" "$d/alone-server.log")"
+      echo "$k a2 $(sed -n "$2" "$d/alone2-server.log")"
+      for i in $(seq 1 "$SEATS"); do echo "$k seat $(sed -n "$2" "$d/$(printf 'seat%02d' "$i")-server.log")"; done
+    done | awk -v what="$1" -v R="$ROUNDS" '
+      function med(a, n,   i, j, t) { # sorts a[1..n], returns its median
+        for (i = 2; i <= n; i++) { t = a[i]; for (j = i - 1; j >= 1 && a[j] > t; j--) a[j + 1] = a[j]; a[j + 1] = t }
+        return n % 2 ? a[(n + 1) / 2] : (a[n / 2] + a[n / 2 + 1]) / 2 }
+      NF == 3 && $3 > 0 { if ($2 == "a1") a1[$1] = $3; else if ($2 == "a2") a2[$1] = $3; else v[$1, ++nv[$1]] = $3 }
+      END {
+        for (k = 1; k <= R; k++) {
+          if (!(k in a1) || !(k in a2) || !nv[k]) { printf "  %s, round %d: figures missing\n", what, k; continue }
+          ref = (a1[k] + a2[k]) / 2; d = (a1[k] > a2[k] ? a1[k] - a2[k] : a2[k] - a1[k]) / ref
+          n = 0; for (i = 1; i <= nv[k]; i++) r[++n] = v[k, i] / ref
+          m = med(r, n); L[++nr] = m; D[nr] = d
+          printf "  %s, round %d: alone %.1f / %.1f us (spread %.1f %%), seats %+.0f %% to %+.0f %% of their mean (median %+.0f %%)\n",
+            what, k, a1[k], a2[k], 100 * d, 100 * (r[1] - 1), 100 * (r[n] - 1), 100 * (m - 1)
+        }
+        if (!nr) exit
+        mL = med(L, nr); mD = med(D, nr); band = 1.5 * mD
+        verdict = "unchanged within noise"
+        if (mL - 1 > band) verdict = "slower than the seat alone beyond noise"
+        if (1 - mL > band) verdict = "no slower than the seat alone (faster beyond noise)"
+        printf "  %s over %d rounds: the seats %+.1f %% against the seat alone (rounds %+.0f %% to %+.0f %%); the seat alone'\''s own spread %.1f %% (rounds %.1f-%.1f %%), band +-%.1f %%: %s\n",
+          what, nr, 100 * (mL - 1), 100 * (L[1] - 1), 100 * (L[nr] - 1), 100 * mD, 100 * D[1], 100 * D[nr], 100 * band, verdict }'
+  }
+  {
+    echo "load_bench: $ROUNDS rounds of (the seat alone $BASELINE s, the lab $DURATION s, the seat alone again $BASELINE s); each round's summary in $OUT/roundK/summary.txt"
+    sed -n '1,4p' "$OUT/round1/summary.txt"
+    rounds_against_alone "step CPU median" "$STEP_SED"
+    rounds_against_alone "  of it the tissue step" "$TISSUE_SED"
+    rounds_against_alone "  the rest (commands, feedback, inputs, frames)" "$REST_SED"
+    for k in $(seq 1 "$ROUNDS"); do
+      rt=$(sed -n 's/^server: step CPU time median .*; \([0-9.]*\) simulated s per wall s.*/\1/p' "$OUT/round$k"/seat*-server.log | sort -g | head -1)
+      dl=$(sed -n 's/^  delta latency: median of the subscribers. medians \([0-9.n/a]*\) us, worst p99 \([0-9.n/a]*\) us/median \1 us, worst p99 \2 us/p' "$OUT/round$k/summary.txt")
+      kf=$(sed -n 's/^  time to first keyframe after joining: //p' "$OUT/round$k/summary.txt")
+      late=$(sed -n 's/^SUMMARY .* late_ticks=\([0-9]*\).*/\1/p' "$OUT/round$k"/seat*-haptic.log | sort -n | tail -1)
+      echo "  round $k: lowest real-time ratio ${rt:-n/a}; delta latency ${dl:-n/a}; first keyframe ${kf:-n/a}; trainees at most ${late:-n/a} ticks late"
+    done
+  } | tee "$OUT/summary.txt"
+  exit 0
+fi
 rm -rf "$OUT"; mkdir -p "$OUT"
 "$BUILD/server/viscera-server" --scene "$SCENE" --check > "$OUT/check.txt" ||
   { echo "load_bench.sh: the scene does not load" >&2; exit 2; }
@@ -342,9 +420,9 @@ run_alone alone2
         }
         printf "\n" }'
   }
-  against_alone "step CPU median" 's/^server: step CPU time median \([0-9.]*\) us.*/\1/p'
-  against_alone "  of it the tissue step" 's/^server: step CPU split: tissue (contact and organs) median \([0-9.]*\) us.*/\1/p'
-  against_alone "  the rest (commands, feedback, inputs, frames)" 's/^server: step CPU split: .* the rest ([^)]*) median \([0-9.]*\) us.*/\1/p'
+  against_alone "step CPU median" "$STEP_SED"
+  against_alone "  of it the tissue step" "$TISSUE_SED"
+  against_alone "  the rest (commands, feedback, inputs, frames)" "$REST_SED"
   if [ -n "$(awake_line "$OUT/alone-server.log")" ]; then
     echo "  organ sleeping: alone: $(awake_line "$OUT/alone-server.log")"
     for i in $(seq 1 "$SEATS"); do

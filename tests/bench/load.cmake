@@ -24,3 +24,8 @@ set_tests_properties(bench_seats_smoke PROPERTIES LABELS bench TIMEOUT 120
 add_test(NAME bench_seats_tick_smoke COMMAND bench_seats --seats 1,2 --seconds 1.6 --tick)
 set_tests_properties(bench_seats_tick_smoke PROPERTIES LABELS bench TIMEOUT 120
   ENVIRONMENT "VISCERA_SOURCE_DIR=${PROJECT_SOURCE_DIR}")
+# --rounds: the whole run twice and the verdict over the rounds (issue 17 item 6).
+add_test(NAME load_bench_rounds_smoke COMMAND bash ${CMAKE_CURRENT_LIST_DIR}/load_rounds_smoke.sh ${PROJECT_SOURCE_DIR}
+         ${PROJECT_BINARY_DIR} ${CMAKE_CURRENT_BINARY_DIR}/load_rounds)
+set_tests_properties(load_bench_rounds_smoke PROPERTIES LABELS bench TIMEOUT 180
+  ENVIRONMENT "CYCLONEDDS_URI=file://${VISCERA_DDS_CONFIG};VISCERA_DOMAIN=177")

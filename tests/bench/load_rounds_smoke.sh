@@ -1,0 +1,42 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
+# load_bench.sh --rounds: the whole (seat alone, lab, seat alone again) run
+# twice, each round in OUT/roundK/, and a summary over the rounds. Asserts:
+# --rounds 0 / x exit 2; both rounds ran (their own summaries, their seats
+# stepped); the summary's per-round figures are those rounds' own (the seat
+# alone's two medians as its two server logs give them) and their seats'
+# figures against the two; the verdict over the rounds for the whole step
+# and its two parts. Figures are not judged (a benchmark, not a timing test).
+# usage: load_rounds_smoke.sh SRC BUILD OUT
+set -euo pipefail
+SRC="$1" BUILD="$2" OUT="$3"
+rm -rf "$OUT"; mkdir -p "$(dirname "$OUT")"
+fail() { echo "FAIL: $*" >&2; [ -f "$OUT/summary.txt" ] && cat "$OUT/summary.txt" >&2; exit 1; }
+for bad in 0 x; do
+  rc=0
+  bash "$SRC/deploy/load_bench.sh" --build "$BUILD" --out "$OUT" --rounds "$bad" > /dev/null 2> "$OUT.err" || rc=$?
+  [ "$rc" = 2 ] && grep -q "bad rounds" "$OUT.err" || fail "--rounds $bad: exit $rc, expected 2: $(cat "$OUT.err")"
+done
+bash "$SRC/deploy/load_bench.sh" --build "$BUILD" --out "$OUT" --rounds 2 --seats 2 --subscribers 2 --duration 6 \
+  --baseline 2 --one-server --seat-threads 1 --rt-priority 0 --haptic-rt-priority 0 > "$OUT.log" 2>&1 ||
+  { tail -20 "$OUT.log" >&2; fail "load_bench.sh --rounds 2 failed"; }
+S="$OUT/summary.txt"
+med() { sed -n 's/^server: step CPU time median \([0-9.]*\) us.*/\1/p' "$1"; }
+for k in 1 2; do
+  grep -Eq '^  seat02: [0-9]{4,} steps' "$OUT/round$k/summary.txt" || fail "round $k: the lab's seats did not step"
+  a1=$(med "$OUT/round$k/alone-server.log") a2=$(med "$OUT/round$k/alone2-server.log")
+  line=$(grep "^  step CPU median, round $k: " "$S") || fail "no step CPU line for round $k"
+  want=$(printf 'alone %.1f / %.1f us' "$a1" "$a2")
+  case "$line" in *": $want "*) ;; *) fail "round $k: '$line' does not carry the seat alone's own medians ($want)" ;; esac
+  # The seats' range against the two runs' mean, as the round's seat logs give it.
+  lo=$(for s in seat01 seat02; do med "$OUT/round$k/$s-server.log"; done | sort -g | head -1)
+  want=$(awk -v lo="$lo" -v a1="$a1" -v a2="$a2" 'BEGIN { printf "seats %+.0f %% to", 100 * (lo / ((a1 + a2) / 2) - 1) }')
+  case "$line" in *"$want"*) ;; *) fail "round $k: '$line' does not set the seats against the mean ($want)" ;; esac
+  grep -Eq "^  round $k: lowest real-time ratio [0-9.]+; delta latency median [0-9.]+ us" "$S" || fail "no lab figures for round $k"
+done
+V='(unchanged within noise|slower than the seat alone beyond noise|no slower than the seat alone [(]faster beyond noise[)])$'
+for what in "step CPU median" "  of it the tissue step" "  the rest [(]commands, feedback, inputs, frames[)]"; do
+  grep -Eq "^  $what over 2 rounds: the seats [-+][0-9.]+ % against the seat alone .*band [+]-[0-9.]+ %: $V" "$S" ||
+    fail "no verdict over the rounds for '$what'"
+done
+echo "two rounds, their figures and the verdict over them: $(grep -E '^  step CPU median over' "$S")"
