@@ -21,6 +21,15 @@
  * processes had the core (a lab's seat: docs/numerics.md §11.3). 0, the
  * default, leaves the caches alone.
  *
+ * --neighbour KB runs a second thread that writes KB kB of its own memory
+ * over and over (a store per cache line) for as long as the seats step, on
+ * CPU --neighbour-cpu N (default: wherever the scheduler puts it): what a
+ * busy neighbour core costs a seat's step through what the cores share
+ * (the last-level cache, the memory bus), with nothing taking the seat's
+ * own core from it. Pin the bench itself elsewhere (taskset). A size that
+ * fits the neighbour's own L2 stays off the shared parts; a larger one
+ * does not (docs/numerics.md §11.5).
+ *
  * --tick sleeps to the next 1 ms tick before each round of seats, as a
  * server's loop does (each round then starts from a wake-up; with several
  * seats the round steps them one after the other, as a seat group's
@@ -28,11 +37,16 @@
  * back to back.
  *
  * usage: bench_seats [--scene FILE] [--seats LIST] [--seconds S] [--evict KB] [--tick]
+ *                    [--neighbour KB [--neighbour-cpu N]]
  *   defaults: classroom_gallbladder.yaml, seats 1,2,3, 4 s of simulated
  *   time each (the first 1 s, the press, is not timed).
  * Figures are not checked: the machine's load moves them; compare the
  * ratios of one run. */
+#define _GNU_SOURCE /* pthread_setaffinity_np, CPU_SET */
 #include <math.h>
+#include <pthread.h>
+#include <sched.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -66,6 +80,33 @@ static void busy_target(double t, double p[3]) {
  * the core's caches between two ticks of a server. */
 static void evict(unsigned char *buf, size_t n, unsigned char v) {
   for (size_t i = 0; i < n; i += 64) buf[i] = v;
+}
+
+/* The busy neighbour: writes its buffer until told to stop. Owned by main;
+ * the thread only reads buf, n, cpu and stop, and writes passes. */
+typedef struct neighbour {
+  unsigned char *buf;
+  size_t n;
+  int cpu; /* -1: not pinned */
+  atomic_int stop;
+  unsigned long passes;
+  int pinned; /* the pin was refused: 0 */
+} neighbour_t;
+
+static void *neighbour_main(void *arg) {
+  neighbour_t *nb = arg;
+  if (nb->cpu >= 0) {
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    CPU_SET(nb->cpu, &set);
+    nb->pinned = pthread_setaffinity_np(pthread_self(), sizeof set, &set) == 0;
+  }
+  unsigned char v = 1;
+  while (!atomic_load_explicit(&nb->stop, memory_order_relaxed)) {
+    evict(nb->buf, nb->n, v++);
+    nb->passes++;
+  }
+  return NULL;
 }
 
 static int run(const scene_t *scene, int nseats, double seconds, unsigned char *junk, size_t njunk, int tick,
@@ -109,7 +150,7 @@ static int run(const scene_t *scene, int nseats, double seconds, unsigned char *
 int main(int argc, char **argv) {
   const char *scene = NULL, *list = "1,2,3";
   double seconds = 4.0;
-  long evict_kb = 0;
+  long evict_kb = 0, neighbour_kb = 0, neighbour_cpu = -1;
   int tick = 0;
   for (int i = 1; i < argc; i++) {
     if (!strcmp(argv[i], "--scene") && i + 1 < argc)
@@ -122,10 +163,16 @@ int main(int argc, char **argv) {
       char *end;
       evict_kb = strtol(argv[++i], &end, 10);
       if (*end || end == argv[i]) evict_kb = -1;
+    } else if ((!strcmp(argv[i], "--neighbour") || !strcmp(argv[i], "--neighbour-cpu")) && i + 1 < argc) {
+      long *dst = argv[i][11] ? &neighbour_cpu : &neighbour_kb;
+      char *end;
+      *dst = strtol(argv[++i], &end, 10);
+      if (*end || end == argv[i] || *dst < 0) *dst = -2;
     } else if (!strcmp(argv[i], "--tick"))
       tick = 1;
     else {
-      fprintf(stderr, "usage: bench_seats [--scene FILE] [--seats LIST] [--seconds S] [--evict KB] [--tick]\n");
+      fprintf(stderr, "usage: bench_seats [--scene FILE] [--seats LIST] [--seconds S] [--evict KB] [--tick] "
+                      "[--neighbour KB [--neighbour-cpu N]]\n");
       return 2;
     }
   }
@@ -135,6 +182,10 @@ int main(int argc, char **argv) {
   }
   if (evict_kb < 0 || evict_kb > 1L << 20) {
     fprintf(stderr, "bench_seats: --evict takes 0..1048576 (kB)\n");
+    return 2;
+  }
+  if (neighbour_kb < 0 || neighbour_kb > 1L << 20 || neighbour_cpu < -1 || neighbour_cpu >= CPU_SETSIZE) {
+    fprintf(stderr, "bench_seats: --neighbour takes 0..1048576 (kB), --neighbour-cpu a CPU number\n");
     return 2;
   }
   size_t njunk = (size_t)evict_kb * 1024;
@@ -150,6 +201,17 @@ int main(int argc, char **argv) {
   printf("bench_seats: %s, busy trajectory, %.1f s simulated per run (first 1 s not timed)", scene, seconds);
   if (evict_kb) printf(", %ld kB of other data written before each step", evict_kb);
   if (tick) printf(", each round of seats after a sleep to the next 1 ms tick");
+  neighbour_t nb = {.n = (size_t)neighbour_kb * 1024, .cpu = (int)neighbour_cpu};
+  pthread_t nbt;
+  if (nb.n) {
+    nb.buf = calloc(nb.n, 1);
+    if (!nb.buf || pthread_create(&nbt, NULL, neighbour_main, &nb)) {
+      fprintf(stderr, "bench_seats: cannot start the neighbour\n");
+      return 1;
+    }
+    printf(", a neighbour thread writing %ld kB over and over", neighbour_kb);
+    if (neighbour_cpu >= 0) printf(" on CPU %ld", neighbour_cpu);
+  }
   printf("\n");
   printf("%-6s %14s %14s %12s\n", "seats", "CPU median us", "CPU p99 us", "vs 1 seat");
   double base = NAN;
@@ -168,5 +230,13 @@ int main(int argc, char **argv) {
     fflush(stdout);
     q = *end == ',' ? end + 1 : end;
   }
+  if (nb.n) {
+    atomic_store(&nb.stop, 1);
+    pthread_join(nbt, NULL);
+    printf("neighbour: %lu passes over %ld kB%s\n", nb.passes, neighbour_kb,
+           nb.cpu >= 0 && !nb.pinned ? " (its CPU pin was refused: it ran where the scheduler put it)" : "");
+    free(nb.buf);
+  }
+  free(junk);
   return 0;
 }
