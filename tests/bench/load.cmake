@@ -29,3 +29,9 @@ add_test(NAME load_bench_rounds_smoke COMMAND bash ${CMAKE_CURRENT_LIST_DIR}/loa
          ${PROJECT_BINARY_DIR} ${CMAKE_CURRENT_BINARY_DIR}/load_rounds)
 set_tests_properties(load_bench_rounds_smoke PROPERTIES LABELS bench TIMEOUT 180
   ENVIRONMENT "CYCLONEDDS_URI=file://${VISCERA_DDS_CONFIG};VISCERA_DOMAIN=177")
+# --neighbour: a second thread writes its own memory while the seats step;
+# it must have run (passes counted) and the seats still be timed.
+add_test(NAME bench_seats_neighbour_smoke COMMAND bench_seats --seats 1 --seconds 1.6 --neighbour 64)
+set_tests_properties(bench_seats_neighbour_smoke PROPERTIES LABELS bench TIMEOUT 120
+  ENVIRONMENT "VISCERA_SOURCE_DIR=${PROJECT_SOURCE_DIR}"
+  PASS_REGULAR_EXPRESSION "1 +[0-9.]+ +[0-9.]+ +1.00x.*neighbour: [1-9][0-9]* passes over 64 kB")
