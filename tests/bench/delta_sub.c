@@ -3,7 +3,10 @@
  * seat, waits for its MeshState keyframe (a late joiner must get one at
  * once: transient-local), then takes every MeshDelta as it arrives and
  * measures delivery latency (arrival minus the server's source timestamp;
- * same machine, same clock). Draws nothing, so 30 of them fit on 2 cores
+ * same machine, same clock). A delta written before it joined (kept in the
+ * writer's history and handed over at the join) is counted apart, not as a
+ * latency: its age is how long ago the organ last moved, not how long the
+ * network took. Draws nothing, so 30 of them fit on 2 cores
  * next to 5 servers. Prints one SUB line at exit. */
 #include <getopt.h>
 #include <inttypes.h>
@@ -26,10 +29,14 @@ int main(int argc, char **argv) {
   double duration = 10;
   int c;
   while ((c = getopt_long(argc, argv, "", opts, NULL)) != -1) {
-    if (c == 'p') partition = optarg;
-    else if (c == 'd') duration = atof(optarg);
-    else if (c == 'n') name = optarg;
-    else return 2;
+    if (c == 'p')
+      partition = optarg;
+    else if (c == 'd')
+      duration = atof(optarg);
+    else if (c == 'n')
+      name = optarg;
+    else
+      return 2;
   }
   verr_t err;
   int domain = cli_env_domain(&err);
@@ -49,7 +56,8 @@ int main(int argc, char **argv) {
   dds_waitset_attach(ws, cd, 1);
   size_t cap = 1 << 16, n = 0;
   double *lat = malloc(cap * sizeof *lat);
-  uint64_t t0 = vtime_mono_ns(), keyframes = 0, deltas = 0;
+  uint64_t t0 = vtime_mono_ns(), keyframes = 0, deltas = 0, history = 0;
+  const dds_time_t joined = dds_time();
   double first_key_ms = -1;
   while (lat && (double)(vtime_mono_ns() - t0) * 1e-9 < duration) {
     dds_waitset_wait(ws, NULL, 0, DDS_MSECS(100));
@@ -65,6 +73,10 @@ int main(int argc, char **argv) {
     for (int i = 0; i < k; i++) {
       if (!infos[i].valid_data) continue;
       deltas++;
+      if (infos[i].source_timestamp < joined) {
+        history++;
+        continue;
+      }
       if (n == cap) {
         double *more = realloc(lat, 2 * cap * sizeof *lat);
         if (!more) break;
@@ -76,8 +88,8 @@ int main(int argc, char **argv) {
   }
   vstats_summary_t st = vstats_summarise(lat, n);
   printf("SUB name=%s keyframes=%" PRIu64 " first_keyframe_ms=%.1f deltas=%" PRIu64
-         " latency_us_median=%.1f latency_us_p99=%.1f latency_us_max=%.1f\n",
-         name, keyframes, first_key_ms, deltas, st.median, st.p99, st.max);
+         " latency_us_median=%.1f latency_us_p99=%.1f latency_us_max=%.1f history=%" PRIu64 "\n",
+         name, keyframes, first_key_ms, deltas, st.median, st.p99, st.max, history);
   free(lat);
   vdds_close(&dds);
   return keyframes > 0 ? 0 : 3;
