@@ -17,7 +17,11 @@
 #   --first K           number of the first seat (default 1)
 #   --prefix P          partition prefix (default lab)
 #   --scene FILE        scene every seat runs (default assets/scenes/default.yaml)
-#   --trainees          a scripted haptic client per seat (palpate_kidney.traj)
+#   --trainees          a scripted haptic client per seat (palpate_kidney.traj: 4.5 s);
+#                       with --duration S > 0 each palpates over and over (viscera-haptic
+#                       --loop) until 1 s before the servers stop (at least one palpation),
+#                       so a dashboard or an instructor's command finds them at work; with
+#                       --duration 0, once (a script can wait for their summaries)
 #   --viewers K         offscreen viewers per seat (default 1; 0 for none)
 #   --duration S        seconds the lab runs (default 20; 0: until SIGINT/SIGTERM)
 #   --secure            DDS Security on (PKI in --pki DIR)
@@ -242,10 +246,13 @@ for i in $(seq "$FIRST" "$LAST"); do
 done
 if [ $TRAINEES = 1 ]; then
   [ -n "$stop_sig" ] || pause 2
+  # They start 2 s into the lab and stop 1 s before its servers.
+  TRAINEE_RUN=()
+  [ "$DURATION" -gt 0 ] && TRAINEE_RUN=(--loop --duration $((DURATION - 3 > 5 ? DURATION - 3 : 5)))
   for i in $(seq "$FIRST" "$LAST"); do
     s=$(printf 'seat%02d' "$i")
     start "$s-haptic" "trainee-$s" "$BUILD/client/haptic/viscera-haptic" --partition "$PREFIX/$s" \
-      --trajectory "$ROOT/assets/trajectories/palpate_kidney.traj" --quiet "${HAP_RT[@]}"
+      --trajectory "$ROOT/assets/trajectories/palpate_kidney.traj" "${TRAINEE_RUN[@]}" --quiet "${HAP_RT[@]}"
   done
 fi
 

@@ -65,9 +65,10 @@ typedef struct device_config {
   double scale;           /* scene metres per device metre (real devices; > 0) */
   double offset[3];       /* scene position of the device's workspace centre (real devices), m */
   int index;              /* which device of that kind, 0 = the first found */
+  int loop;               /* scripted: play the trajectory over and over (never finished) */
 } device_config_t;
 
-/* Defaults: max_force 4 N, max_stiffness 0 (no limit), scale 1, offset 0, index 0, no trajectory. */
+/* Defaults: max_force 4 N, max_stiffness 0 (no limit), scale 1, offset 0, index 0, no trajectory, no loop. */
 void device_config_default(device_config_t *c);
 
 /* Opens the device called `name`. Returns 0, or -1 with err naming the
@@ -78,8 +79,14 @@ int device_open(device_t *d, const char *name, const device_config_t *cfg, verr_
 /* The device names this build contains, e.g. "scripted dhd". */
 const char *device_names(void);
 
-/* Scripted device playing `trajectory_path`; max_force is its stated capability. */
-int device_scripted_open(device_t *d, const char *trajectory_path, double max_force, verr_t *err);
+/* Scripted device playing `trajectory_path`; max_force is its stated
+ * capability. loop != 0: the path starts again at its first sample each
+ * time its last sample's time has passed (a trainee who keeps palpating for
+ * a whole lab) and the device never reports finished; the path must then
+ * last > 0 s and end where it began (within DEVICE_LOOP_GAP_M, same
+ * buttons), or the tool would jump at every repeat: err says by how much. */
+#define DEVICE_LOOP_GAP_M 1e-4
+int device_scripted_open(device_t *d, const char *trajectory_path, double max_force, int loop, verr_t *err);
 
 #ifdef VISCERA_DEVICE_DHD
 int device_dhd_open(device_t *d, const device_config_t *cfg, verr_t *err);

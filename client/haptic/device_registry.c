@@ -66,7 +66,7 @@ static int open_named(device_t *d, const char *name, const device_config_t *cfg,
   if (!(cfg->max_force > 0)) return verr_set(err, "device '%s': max_force must be > 0", name);
   if (strcmp(name, "scripted") == 0) {
     if (!cfg->trajectory) return verr_set(err, "device 'scripted' needs a trajectory file (--trajectory FILE)");
-    return device_scripted_open(d, cfg->trajectory, cfg->max_force, err);
+    return device_scripted_open(d, cfg->trajectory, cfg->max_force, cfg->loop, err);
   }
   if (!(cfg->scale > 0)) return verr_set(err, "device '%s': workspace scale must be > 0", name);
 #ifdef VISCERA_DEVICE_DHD

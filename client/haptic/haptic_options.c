@@ -17,6 +17,8 @@ void haptic_usage(FILE *f) {
           "       viscera-haptic --device NAME [options]\n"
           "  --device NAME       scripted (default), dhd, hd or falcon; this build has: %s\n"
           "  --trajectory FILE   scripted device: play this path (t x y z [buttons] per line)\n"
+          "  --loop              scripted device: play it over and over until --duration or a signal\n"
+          "                      (the path must end where it begins)\n"
           "  --device-index N    real devices: which one of that kind (default 0)\n"
           "  --workspace-scale S real devices: scene metres per device metre (default 1)\n"
           "  --workspace-offset X,Y,Z  real devices: scene position (m) of the device's\n"
@@ -32,7 +34,8 @@ void haptic_usage(FILE *f) {
           "  --max-stiffness K   device stiffness rating, N/m: the server's contact stiffness is\n"
           "                      rendered clamped to it (default 0: no stated limit)\n"
           "  --wait-server S     wait up to S s for the server's scene before starting (default 10)\n"
-          "  --duration S        stop after S s (default: end of the trajectory + 0.5 s)\n"
+          "  --duration S        stop after S s (default: end of the trajectory + 0.5 s; with --loop\n"
+          "                      until a signal)\n"
           "  --force-csv FILE    write t,x,y,z,fx,fy,fz,in_contact,energy_j,step_n per tick\n"
           "  --guide-rtt S       guiding hand: round trip to the peer station, s, at least (default 0;\n"
           "                      the client also takes twice its own round trip to the server, and\n"
@@ -69,9 +72,11 @@ enum {
   OPT_WORKSPACE_OFFSET = 'O',
   OPT_GUIDE_RTT = 'G',
   OPT_CPU_WAKE = 'W',
+  OPT_LOOP = 'L',
 };
 
 static const struct option haptic_long_options[] = {{"trajectory", required_argument, 0, OPT_TRAJECTORY},
+                                                    {"loop", no_argument, 0, OPT_LOOP},
                                                     {"tool", required_argument, 0, OPT_TOOL},
                                                     {"station", required_argument, 0, OPT_STATION},
                                                     {"rate", required_argument, 0, OPT_RATE},
@@ -142,6 +147,9 @@ static int on_option(void *ctx, int code, const char *arg) {
   switch (code) {
   case OPT_TRAJECTORY:
     o->trajectory = arg;
+    return 0;
+  case OPT_LOOP:
+    o->dcfg.loop = 1;
     return 0;
   case OPT_TOOL:
     o->tool = (unsigned)v;
@@ -221,7 +229,7 @@ int haptic_options_parse(haptic_options_t *o, int argc, char **argv) {
   device_config_default(&o->dcfg);
   const cli_spec_t spec = {.program = "viscera-haptic",
                            .common = CLI_DOMAIN | CLI_DOMAIN_ENV | CLI_PARTITION | CLI_QUIET,
-                           .shortopts = "j:n:s:d:p:r:m:K:w:t:f:R:D:I:S:O:qh",
+                           .shortopts = "j:Ln:s:d:p:r:m:K:w:t:f:R:D:I:S:O:qh",
                            .options = haptic_long_options,
                            .option = on_option,
                            .usage = haptic_usage};
@@ -236,6 +244,11 @@ int haptic_options_parse(haptic_options_t *o, int argc, char **argv) {
             "viscera-haptic: --trajectory FILE is required for the scripted device (or choose --device: "
             "this build has %s)\n",
             device_names());
+    return 2;
+  }
+  if (o->dcfg.loop && strcmp(o->device, "scripted") != 0) {
+    fprintf(stderr, "viscera-haptic: --loop: only the scripted device plays a trajectory (--device is '%s')\n",
+            o->device);
     return 2;
   }
   if (!(o->rate >= 10 && o->rate <= 10000) || !(o->max_force > 0)) {

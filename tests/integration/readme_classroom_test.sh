@@ -7,8 +7,10 @@
 # CYCLONEDDS_URI unset as a new user has it and VISCERA_DOMAIN set to this
 # test's domain (the only way the block's default domain 0 moves, honoured by
 # every script and binary). Asserts: the block ends by itself with status 0,
-# the dashboard saw a scene in every seat, the pause reached seat 2, the lab
-# recorded every seat and the report was written.
+# the dashboard saw a scene in every seat and a trainee pressing in every
+# seat (lab.sh's trainees palpate for the whole lab, not once at its start),
+# the pause reached seat 2, the lab recorded every seat and the report was
+# written.
 # Then lab.sh --secure: the dashboard command it prints is run as printed:
 # it sees every seat; a dashboard without identity sees none and says why.
 # usage: readme_classroom_test.sh BUILD SRC OUT
@@ -45,6 +47,9 @@ csv="$OUT/root/out/dashboard/dashboard.csv"
 [ -f "$csv" ] || fail "the dashboard wrote no $csv"
 for s in 01 02 03; do
   grep -q "^[0-9]*,[0-9.]*,lab/seat$s,1," "$csv" || fail "the dashboard never saw a scene in lab/seat$s"
+  # Columns: frame, wall_s, seat, have_scene, force_n: a press is > 0.3 N.
+  awk -F, -v s="lab/seat$s" '$3 == s && $5 > 0.3 { n++ } END { exit !(n > 0) }' "$csv" ||
+    fail "the dashboard never saw lab/seat$s's trainee press (force_n > 0.3 N in no frame)"
 done
 grep -q "^applied: " "$OUT/block.log" || fail "viscera-control's pause was not applied"
 [ -f "$OUT/root/out/report/report.html" ] || fail "no report written"

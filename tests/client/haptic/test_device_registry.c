@@ -69,6 +69,42 @@ int main(void) {
   expect_error("scripted", &cfg, "max_force must be > 0");
   cfg.max_force = 4;
 
+  /* --loop: the path starts again after its last sample and never
+   * finishes; a path that does not end where it began is refused. */
+  f = fopen(path, "w");
+  fputs("0 0 0 0.05\n1 0 0 0.03 1\n2 0 0 0.05\n", f);
+  fclose(f);
+  cfg.trajectory = path;
+  CHECK(device_open(&d, "scripted", &cfg, &err) == 0); /* once */
+  CHECK(d.ops->finished(&d, 2.5));
+  d.ops->read(&d, 2.5, pos, q, &b);
+  CHECK_NEAR(pos[2], 0.05, 1e-12); /* held at the last sample */
+  d.ops->close(&d);
+  cfg.loop = 1;
+  CHECK(device_open(&d, "scripted", &cfg, &err) == 0);
+  CHECK(!d.ops->finished(&d, 2.5) && !d.ops->finished(&d, 1e6));
+  d.ops->read(&d, 2.5, pos, q, &b);
+  CHECK_NEAR(pos[2], 0.04, 1e-12); /* half-way down again */
+  CHECK(b == 0);
+  d.ops->read(&d, 5.0, pos, q, &b);
+  CHECK_NEAR(pos[2], 0.03, 1e-12); /* the third press, button held */
+  CHECK(b == 1);
+  d.ops->close(&d);
+  f = fopen(path, "w");
+  fputs("0 0 0 0.05\n1 0 0 0.03\n", f);
+  fclose(f);
+  expect_error("scripted", &cfg, "they are 20.0 mm apart");
+  f = fopen(path, "w");
+  fputs("0 0 0 0.05 1\n1 0 0 0.03\n2 0 0 0.05\n", f);
+  fclose(f);
+  expect_error("scripted", &cfg, "same buttons at the last sample as at the first (1, 0)");
+  f = fopen(path, "w");
+  fputs("0 0 0 0.05\n", f);
+  fclose(f);
+  expect_error("scripted", &cfg, "needs a path that lasts");
+  cfg.loop = 0;
+  unlink(path);
+
   expect_error("phantom", &cfg, "unknown device 'phantom' (this build has: scripted");
   /* Each SDK device: absent from this build -> says why; present -> with
    * no hardware attached its open fails naming the device. */
