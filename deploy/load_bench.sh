@@ -176,6 +176,11 @@ SCENE_NAME=$(basename "$SCENE" .yaml)
 STEP_SED='s/^server: step CPU time median \([0-9.]*\) us.*/\1/p'
 TISSUE_SED='s/^server: step CPU split: tissue (contact and organs) median \([0-9.]*\) us.*/\1/p'
 REST_SED='s/^server: step CPU split: .* the rest ([^)]*) median \([0-9.]*\) us.*/\1/p'
+# The physics work behind the tissue step (the server's "physics work" line:
+# node updates per step with an organ awake, and the tissue CPU mean of those
+# steps): a seat whose trainee's commands drag more tissue awake does more.
+WORK_SED='s/^server: physics work per step with an organ awake ([0-9]* steps): \([0-9.]*\) node updates.*/\1/p'
+TMEAN_SED='s/^server: physics work per step with an organ awake .* tissue CPU mean \([0-9.]*\) us$/\1/p'
 if [ "$ROUNDS" -gt 1 ]; then
   rm -rf "$OUT"; mkdir -p "$OUT"
   for k in $(seq 1 "$ROUNDS"); do
@@ -186,6 +191,7 @@ if [ "$ROUNDS" -gt 1 ]; then
   # label, sed expression: each round's seats against the mean of that
   # round's two runs of the seat alone, then the median over the rounds
   # against the median of the rounds' alone-to-alone spreads.
+  # A third argument "work": the verdict speaks of work, not of time.
   rounds_against_alone() {
     local k i d
     for k in $(seq 1 "$ROUNDS"); do
@@ -193,7 +199,7 @@ if [ "$ROUNDS" -gt 1 ]; then
       echo "$k a1 $(sed -n "$2" "$d/alone-server.log")"
       echo "$k a2 $(sed -n "$2" "$d/alone2-server.log")"
       for i in $(seq 1 "$SEATS"); do echo "$k seat $(sed -n "$2" "$d/$(printf 'seat%02d' "$i")-server.log")"; done
-    done | awk -v what="$1" -v R="$ROUNDS" '
+    done | awk -v what="$1" -v R="$ROUNDS" -v mode="${3:-time}" '
       function med(a, n,   i, j, t) { # sorts a[1..n], returns its median
         for (i = 2; i <= n; i++) { t = a[i]; for (j = i - 1; j >= 1 && a[j] > t; j--) a[j + 1] = a[j]; a[j + 1] = t }
         return n % 2 ? a[(n + 1) / 2] : (a[n / 2] + a[n / 2 + 1]) / 2 }
@@ -204,15 +210,78 @@ if [ "$ROUNDS" -gt 1 ]; then
           ref = (a1[k] + a2[k]) / 2; d = (a1[k] > a2[k] ? a1[k] - a2[k] : a2[k] - a1[k]) / ref
           n = 0; for (i = 1; i <= nv[k]; i++) r[++n] = v[k, i] / ref
           m = med(r, n); L[++nr] = m; D[nr] = d
-          printf "  %s, round %d: alone %.1f / %.1f us (spread %.1f %%), seats %+.0f %% to %+.0f %% of their mean (median %+.0f %%)\n",
-            what, k, a1[k], a2[k], 100 * d, 100 * (r[1] - 1), 100 * (r[n] - 1), 100 * (m - 1)
+          printf "  %s, round %d: alone %.1f / %.1f %s (spread %.1f %%), seats %+.0f %% to %+.0f %% of their mean (median %+.0f %%)\n",
+            what, k, a1[k], a2[k], mode == "work" ? "node updates" : "us", 100 * d, 100 * (r[1] - 1), 100 * (r[n] - 1), 100 * (m - 1)
+        }
+        if (!nr) exit
+        mL = med(L, nr); mD = med(D, nr); band = 1.5 * mD
+        verdict = "unchanged within noise"
+        if (mL - 1 > band) verdict = mode == "work" ? "more than the seat alone beyond noise" : "slower than the seat alone beyond noise"
+        if (1 - mL > band) verdict = mode == "work" ? "less than the seat alone beyond noise" : "no slower than the seat alone (faster beyond noise)"
+        printf "  %s over %d rounds: the seats %+.1f %% against the seat alone (rounds %+.0f %% to %+.0f %%); the seat alone'\''s own spread %.1f %% (rounds %.1f-%.1f %%), band +-%.1f %%: %s\n",
+          what, nr, 100 * (mL - 1), 100 * (L[1] - 1), 100 * (L[nr] - 1), 100 * mD, 100 * D[1], 100 * D[nr], 100 * band, verdict }'
+  }
+  # The tissue step at equal work: each round's seats' (work, tissue CPU
+  # mean) pairs on a line through their mean, with one slope for all rounds
+  # (least squares over every seat of every round, each round about its own
+  # mean: the CPU an extra node update costs is the machine's, and a round's
+  # seats may all have done about the same work), read at the work each run
+  # of the seat alone did, against that run's own tissue CPU mean; the band
+  # from the two runs of the seat alone set against each other along it.
+  rounds_at_equal_work() {
+    local k i d
+    for k in $(seq 1 "$ROUNDS"); do
+      d="$OUT/round$k"
+      echo "$k a1 $(sed -n "$WORK_SED" "$d/alone-server.log") $(sed -n "$TMEAN_SED" "$d/alone-server.log")"
+      echo "$k a2 $(sed -n "$WORK_SED" "$d/alone2-server.log") $(sed -n "$TMEAN_SED" "$d/alone2-server.log")"
+      for i in $(seq 1 "$SEATS"); do
+        f="$d/$(printf 'seat%02d' "$i")-server.log"
+        echo "$k seat $(sed -n "$WORK_SED" "$f") $(sed -n "$TMEAN_SED" "$f")"
+      done
+    done | awk -v R="$ROUNDS" '
+      function med(a, n,   i, j, t) {
+        for (i = 2; i <= n; i++) { t = a[i]; for (j = i - 1; j >= 1 && a[j] > t; j--) a[j + 1] = a[j]; a[j + 1] = t }
+        return n % 2 ? a[(n + 1) / 2] : (a[n / 2] + a[n / 2 + 1]) / 2 }
+      function abs(x) { return x < 0 ? -x : x }
+      NF == 4 && $3 > 0 && $4 > 0 {
+        if ($2 == "a1") { w1[$1] = $3; t1[$1] = $4 } else if ($2 == "a2") { w2[$1] = $3; t2[$1] = $4 }
+        else { n = ++ns[$1]; sw[$1, n] = $3; st[$1, n] = $4 } }
+      END {
+        what = "  tissue CPU mean at the seat alone'\''s work (a line through the seats'\'' work and tissue CPU)"
+        sxx = 0; sxy = 0; N = 0; W = 0
+        for (k = 1; k <= R; k++) {
+          n = ns[k]; if (!n) continue
+          mw = 0; mt = 0; for (i = 1; i <= n; i++) { mw += sw[k, i]; mt += st[k, i] }
+          MW[k] = mw / n; MT[k] = mt / n; N += n; W += mw
+          for (i = 1; i <= n; i++) { sxx += (sw[k, i] - MW[k]) ^ 2; sxy += (sw[k, i] - MW[k]) * (st[k, i] - MT[k]) }
+        }
+        b = sxx > 0 ? sxy / sxx : 0
+        # A slope needs seats whose work differs (a spread of 5 % of the
+        # work at least) and must come out positive; else no reading.
+        if (!N || sqrt(sxx / N) < 0.05 * W / N || b <= 0) {
+          printf "%s: not read: the seats'\'' work differs too little within the rounds to fit what a node update costs (spread %.1f %% of their work, slope %.1f ns); compare the physics work line above\n",
+            what, N ? 100 * sqrt(sxx / N) / (W / N) : 0, 1000 * b
+          exit
+        }
+        for (k = 1; k <= R; k++) {
+          n = ns[k]
+          if (!(k in w1) || !(k in w2) || !n) { printf "%s, round %d: figures missing\n", what, k; continue }
+          mw = MW[k]; mt = MT[k]; lo = sw[k, 1]; hi = lo
+          for (i = 1; i <= n; i++) { if (sw[k, i] < lo) lo = sw[k, i]; if (sw[k, i] > hi) hi = sw[k, i] }
+          p1 = mt + b * (w1[k] - mw); p2 = mt + b * (w2[k] - mw)
+          r = (p1 / t1[k] + p2 / t2[k]) / 2
+          dd = abs(t2[k] - (t1[k] + b * (w2[k] - w1[k]))) / ((t1[k] + t2[k]) / 2)
+          L[++nr] = r; D[nr] = dd
+          printf "%s, round %d: alone %.1f / %.1f us at %.0f / %.0f node updates (apart %.1f %% at equal work), seats %.0f-%.0f node updates, %.1f us at their mean %.0f: %+.0f %%\n",
+            what, k, t1[k], t2[k], w1[k], w2[k], 100 * dd, lo, hi, mt, mw, 100 * (r - 1)
         }
         if (!nr) exit
         mL = med(L, nr); mD = med(D, nr); band = 1.5 * mD
         verdict = "unchanged within noise"
         if (mL - 1 > band) verdict = "slower than the seat alone beyond noise"
         if (1 - mL > band) verdict = "no slower than the seat alone (faster beyond noise)"
-        printf "  %s over %d rounds: the seats %+.1f %% against the seat alone (rounds %+.0f %% to %+.0f %%); the seat alone'\''s own spread %.1f %% (rounds %.1f-%.1f %%), band +-%.1f %%: %s\n",
+        printf "%s: %.1f ns of tissue CPU per node update (one slope, %d rounds)\n", what, 1000 * b, nr
+        printf "%s over %d rounds: the seats %+.1f %% against the seat alone (rounds %+.0f %% to %+.0f %%); the seat alone'\''s own spread at equal work %.1f %% (rounds %.1f-%.1f %%), band +-%.1f %%: %s\n",
           what, nr, 100 * (mL - 1), 100 * (L[1] - 1), 100 * (L[nr] - 1), 100 * mD, 100 * D[1], 100 * D[nr], 100 * band, verdict }'
   }
   {
@@ -221,6 +290,10 @@ if [ "$ROUNDS" -gt 1 ]; then
     rounds_against_alone "step CPU median" "$STEP_SED"
     rounds_against_alone "  of it the tissue step" "$TISSUE_SED"
     rounds_against_alone "  the rest (commands, feedback, inputs, frames)" "$REST_SED"
+    if grep -q '^server: physics work per step' "$OUT/round1/alone-server.log"; then
+      rounds_against_alone "physics work (node updates per step with an organ awake)" "$WORK_SED" work
+      rounds_at_equal_work
+    fi
     for k in $(seq 1 "$ROUNDS"); do
       rt=$(sed -n 's/^server: step CPU time median .*; \([0-9.]*\) simulated s per wall s.*/\1/p' "$OUT/round$k"/seat*-server.log | sort -g | head -1)
       dl=$(sed -n 's/^  delta latency: median of the subscribers. medians \([0-9.n/a]*\) us, worst p99 \([0-9.n/a]*\) us/median \1 us, worst p99 \2 us/p' "$OUT/round$k/summary.txt")
@@ -423,6 +496,12 @@ run_alone alone2
   against_alone "step CPU median" "$STEP_SED"
   against_alone "  of it the tissue step" "$TISSUE_SED"
   against_alone "  the rest (commands, feedback, inputs, frames)" "$REST_SED"
+  if grep -q '^server: physics work per step' "$OUT/alone-server.log"; then # the tissue step's work (WORK_SED)
+    echo "  physics work (node updates per step with an organ awake): alone $(sed -n "$WORK_SED" "$OUT/alone-server.log"), seats $(
+      for i in $(seq 1 "$SEATS"); do sed -n "$WORK_SED" "$OUT/$(printf 'seat%02d' "$i")-server.log"; done | sort -g |
+        awk 'NF { v[++n] = $1 } END { if (n) printf "%s-%s", v[1], v[n]; else printf "n/a" }'
+    ), alone again $(sed -n "$WORK_SED" "$OUT/alone2-server.log")"
+  fi
   if [ -n "$(awake_line "$OUT/alone-server.log")" ]; then
     echo "  organ sleeping: alone: $(awake_line "$OUT/alone-server.log")"
     for i in $(seq 1 "$SEATS"); do

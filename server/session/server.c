@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "mesh.h"
+#include "runtime/region_work.h"
 #include "runtime/rollback_report.h"
 #include "runtime/step_cut.h"
 #include "session/applied_input.h"
@@ -961,6 +962,10 @@ static void record_step_time(server_t *s) {
   int awake = !s->control.paused && s->rt.organs_stepped > 0;
   s->step_awake[s->nstep_us % STEP_RING] = (unsigned char)awake;
   if (!s->control.paused && !awake) s->stats->steps_all_asleep++;
+  if (awake) {
+    s->stats->awake_steps++;
+    s->stats->awake_tissue_ns += s->tissue_ns;
+  }
   s->step_us[s->nstep_us++ % STEP_RING] = (double)s->step_wall_ns * 1e-3;
 }
 
@@ -1236,6 +1241,10 @@ void server_close(server_t *s) {
     stats->published[VT_MESH_DELTA] += s->pubs[i].frames;
     stats->deltas_skipped += s->pubs[i].skipped;
   }
+  region_work_t work = runtime_region_work(&s->rt);
+  stats->region_organs = work.organs;
+  stats->region_node_updates = work.node_updates;
+  stats->region_block_evals = work.block_evals;
   stats->ntools = s->rt.ntools;
   for (size_t t = 0; t < s->rt.ntools; t++) {
     stats->thr[t] = s->tool[t].thr;

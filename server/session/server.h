@@ -68,6 +68,14 @@ typedef struct server_stats {
   int sleep_enabled;                                     /* the scene's sleep_speed > 0 */
   size_t awake_samples;                                  /* how many of the recent steps stepped an organ */
   double awake_step_us_median, awake_step_us_p99, awake_step_cpu_us_median, awake_step_cpu_us_p99;
+  /* The physics work behind those steps, over the whole run: steps that
+   * stepped an organ, their tissue CPU time summed (ns), and what regional
+   * sleeping integrated in them (runtime/region_work.h; region_organs 0:
+   * no organ sleeps by regions). Two runs' tissue times compare only at
+   * equal work (docs/numerics.md §11.7). */
+  uint64_t awake_steps, awake_tissue_ns;
+  int region_organs;
+  uint64_t region_node_updates, region_block_evals;
   size_t ntools;
   thr_tracker_t thr[SCENE_MAX_TOOLS];         /* palpation measures per tool at the end */
   viscera_ToolMetrics tools[SCENE_MAX_TOOLS]; /* per-tool measures at the end */

@@ -77,6 +77,13 @@ static void print_stats(const scene_t *scene, const server_opts_t *opts, const s
             s->organ_sleeps, s->organ_wakes, s->steps_all_asleep, s->steps,
             s->steps ? 100.0 * (double)s->steps_all_asleep / (double)s->steps : 0.0, s->awake_samples,
             s->awake_step_us_median, s->awake_step_us_p99, s->awake_step_cpu_us_median, s->awake_step_cpu_us_p99);
+  if (s->region_organs && s->awake_steps)
+    fprintf(stderr,
+            "server: physics work per step with an organ awake (%" PRIu64 " steps): %.1f node updates, %.1f spring "
+            "blocks (regional sleeping, %d organ(s)); tissue CPU mean %.1f us\n",
+            s->awake_steps, (double)s->region_node_updates / (double)s->awake_steps,
+            (double)s->region_block_evals / (double)s->awake_steps, s->region_organs,
+            (double)s->awake_tissue_ns * 1e-3 / (double)s->awake_steps);
   fprintf(stderr, "server: %" PRIu64 " tool commands applied, %" PRIu64 " rejected (", s->commands, s->rejected_total);
   for (int v = 1; v < TOOLCMD_VERDICT_COUNT; v++)
     fprintf(stderr, "%s%s: %" PRIu64, v > 1 ? ", " : "", tool_command_verdict_str((tool_cmd_verdict_t)v),

@@ -35,3 +35,9 @@ add_test(NAME bench_seats_neighbour_smoke COMMAND bench_seats --seats 1 --second
 set_tests_properties(bench_seats_neighbour_smoke PROPERTIES LABELS bench TIMEOUT 120
   ENVIRONMENT "VISCERA_SOURCE_DIR=${PROJECT_SOURCE_DIR}"
   PASS_REGULAR_EXPRESSION "1 +[0-9.]+ +[0-9.]+ +1.00x.*neighbour: [1-9][0-9]* passes over 64 kB")
+# delta_sub counts a delta from before its join as history, not as a latency
+# (a resting organ's last delta would otherwise read as seconds of latency).
+add_test(NAME delta_sub_history COMMAND bash ${CMAKE_CURRENT_LIST_DIR}/delta_sub_history.sh ${PROJECT_SOURCE_DIR}
+         ${PROJECT_BINARY_DIR} ${CMAKE_CURRENT_BINARY_DIR}/delta_sub_history)
+set_tests_properties(delta_sub_history PROPERTIES LABELS bench TIMEOUT 120
+  ENVIRONMENT "CYCLONEDDS_URI=file://${VISCERA_DDS_CONFIG};VISCERA_DOMAIN=182")

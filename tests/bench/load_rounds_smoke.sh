@@ -6,7 +6,9 @@
 # stepped); the summary's per-round figures are those rounds' own (the seat
 # alone's two medians as its two server logs give them) and their seats'
 # figures against the two; the verdict over the rounds for the whole step
-# and its two parts. Figures are not judged (a benchmark, not a timing test).
+# and its two parts; the physics work behind the tissue step (each server's
+# own figure, a verdict in words of work) and the tissue step at equal work.
+# Figures are not judged (a benchmark, not a timing test).
 # usage: load_rounds_smoke.sh SRC BUILD OUT
 set -euo pipefail
 SRC="$1" BUILD="$2" OUT="$3"
@@ -39,4 +41,20 @@ for what in "step CPU median" "  of it the tissue step" "  the rest [(]commands,
   grep -Eq "^  $what over 2 rounds: the seats [-+][0-9.]+ % against the seat alone .*band [+]-[0-9.]+ %: $V" "$S" ||
     fail "no verdict over the rounds for '$what'"
 done
+# The physics work behind the tissue step: each server's own line, the
+# round's figures taken from it, a verdict in words of work, and the tissue
+# step at equal work either read or said why not.
+work() { sed -n 's/^server: physics work per step with an organ awake ([0-9]* steps): \([0-9.]*\) node updates, [0-9.]* spring blocks .*; tissue CPU mean [0-9.]* us$/\1/p' "$1"; }
+for k in 1 2; do
+  w1=$(work "$OUT/round$k/alone-server.log") w2=$(work "$OUT/round$k/alone2-server.log")
+  [ -n "$w1" ] && [ -n "$w2" ] || fail "round $k: a run of the seat alone has no physics work line"
+  for s in seat01 seat02; do [ -n "$(work "$OUT/round$k/$s-server.log")" ] || fail "round $k: $s has no physics work line"; done
+  want=$(printf 'alone %.1f / %.1f node updates' "$w1" "$w2")
+  grep -q "^  physics work (node updates per step with an organ awake), round $k: $want " "$S" ||
+    fail "round $k: the work line does not carry the seat alone's own work ($want)"
+done
+grep -Eq "^  physics work [(]node updates per step with an organ awake[)] over 2 rounds: .*: (unchanged within noise|more than the seat alone beyond noise|less than the seat alone beyond noise)$" "$S" ||
+  fail "no verdict over the rounds for the physics work"
+grep -Eq "^  tissue CPU mean at the seat alone's work .*(over 2 rounds: the seats [-+][0-9.]+ % against the seat alone .*: $V|: not read: the seats' work differs too little)" "$S" ||
+  fail "no reading (nor its reason) of the tissue step at equal work"
 echo "two rounds, their figures and the verdict over them: $(grep -E '^  step CPU median over' "$S")"

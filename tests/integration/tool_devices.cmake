@@ -16,3 +16,12 @@ if(NOT VISCERA_DEVICE_FALCON)
   set_tests_properties(haptic_device_absent PROPERTIES LABELS integration TIMEOUT 20
     PASS_REGULAR_EXPRESSION "device 'falcon' \\(Novint Falcon \\(libnifalcon\\)\\) is not in this build.*VISCERA_DEVICE_FALCON")
 endif()
+# --loop: only a scripted path plays over and over, and only one that ends
+# where it begins (push_hold_kidney.traj ends 43 mm below its start).
+add_test(NAME haptic_loop_refused COMMAND viscera-haptic --loop --device hd)
+set_tests_properties(haptic_loop_refused PROPERTIES LABELS integration TIMEOUT 20
+  PASS_REGULAR_EXPRESSION "--loop: only the scripted device plays a trajectory \\(--device is 'hd'\\)")
+add_test(NAME haptic_loop_open_path COMMAND viscera-haptic --loop --wait-server 0.1
+         --trajectory ${PROJECT_SOURCE_DIR}/assets/trajectories/push_hold_kidney.traj)
+set_tests_properties(haptic_loop_open_path PROPERTIES LABELS integration TIMEOUT 20
+  PASS_REGULAR_EXPRESSION "push_hold_kidney.traj: --loop needs the last sample back at the first: they are 43.0 mm apart")
