@@ -5,6 +5,7 @@
 
 #include "device.h"
 #include "trajectory.h"
+#include "vmath.h"
 
 typedef struct scripted {
   trajectory_t tr;
@@ -44,9 +45,7 @@ static int check_loop(const trajectory_t *tr, const char *path, verr_t *err) {
   const trajectory_sample_t *a = &tr->s[0], *b = &tr->s[tr->n - 1];
   if (!(b->t > 0))
     return verr_set(err, "trajectory %s: --loop needs a path that lasts (its last sample is at t = %g s)", path, b->t);
-  double gap =
-      sqrt((b->pos[0] - a->pos[0]) * (b->pos[0] - a->pos[0]) + (b->pos[1] - a->pos[1]) * (b->pos[1] - a->pos[1]) +
-           (b->pos[2] - a->pos[2]) * (b->pos[2] - a->pos[2]));
+  double gap = v3_dist(b->pos, a->pos);
   if (gap > DEVICE_LOOP_GAP_M)
     return verr_set(err,
                     "trajectory %s: --loop needs the last sample back at the first: they are %.1f mm apart "
