@@ -43,6 +43,12 @@
 # the writer's CPU, where it preempts the physics thread
 # (docs/numerics.md §11.5).
 #
+# --command-playout N: every server (alone and in the lab) puts its tools'
+# commands into effect one per step, holding up to N steps of them
+# (viscera-server --command-playout; server/session/command_playout.h): a
+# trainee whose commands arrive unevenly then still drives an even tool
+# path; the summary sums what the servers say they held back and dropped.
+#
 # Scheduling: the servers' physics loops run SCHED_FIFO at --rt-priority S
 # (default 70) and the trainees' 1 kHz loops at --haptic-rt-priority H
 # (default 80: the haptic tick is the most latency-critical thread and is
@@ -83,7 +89,7 @@
 #                             [--baseline S] [--rt-priority S] [--haptic-rt-priority H]
 #                             [--scene FILE] [--busy] [--one-server [--seat-threads K]]
 #                             [--cpu-wake-latency US] [--server-cpus LIST] [--client-cpus LIST]
-#                             [--physics-cpus LIST] [--rounds R]
+#                             [--physics-cpus LIST] [--command-playout N] [--rounds R]
 # (the press is at x 12 mm, y 4 mm from above, 8 mm deep into an organ whose
 # top is at z = 35 mm: the shipped kidney and gallbladder; classroom
 # scenes: classroom_kidney.yaml, classroom_gallbladder.yaml)
@@ -93,6 +99,7 @@ set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD="$ROOT/build" OUT="$ROOT/out/load" SEATS=5 SUBS=30 DURATION=600 BASELINE=30 RTPRIO=70 HRTPRIO=80
 SCENE="$ROOT/assets/scenes/classroom_kidney.yaml" BUSY=0 ONE=0 SEATTH=0 WAKE="" SRVCPUS="" CLICPUS="" PHYCPUS=""
+PLAYOUT=""
 ROUNDS=1 ROUND_ARGS=() # every option but --out and --rounds, for each round's own run
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -118,6 +125,7 @@ while [ $# -gt 0 ]; do
     --physics-cpus) PHYCPUS="$2"; shift 2 ;;
     --client-cpus) CLICPUS="$2"; shift 2 ;;
     --rounds) ROUNDS="$2"; shift 2 ;;
+    --command-playout) PLAYOUT="$2"; shift 2 ;;
     -h|--help) awk 'NR > 2 && /^#/ { sub(/^# ?/, ""); print; next } NR > 2 { exit }' "$0"; exit 0 ;;
     *) echo "load_bench.sh: unknown option '$1'" >&2; exit 2 ;;
   esac
@@ -158,6 +166,10 @@ done
 [ -n "$SRVCPUS" ] && SRV_PIN=(taskset -c "$SRVCPUS")
 [ -n "$CLICPUS" ] && CLI_PIN=(taskset -c "$CLICPUS")
 [ -n "$PHYCPUS" ] && SRV_RT+=(--physics-cpus "$PHYCPUS")
+if [ -n "$PLAYOUT" ]; then
+  [[ "$PLAYOUT" =~ ^[0-8]$ ]] || { echo "load_bench.sh: --command-playout '$PLAYOUT' is not a number of steps 0..8" >&2; exit 2; }
+  SRV_RT+=(--command-playout "$PLAYOUT")
+fi
 [ -x "$BUILD/tests/bench/delta_sub" ] || { echo "load_bench.sh: $BUILD/tests/bench/delta_sub missing (build with -DVISCERA_BUILD_BENCH=ON)" >&2; exit 1; }
 export CYCLONEDDS_URI="${CYCLONEDDS_URI:-file://$ROOT/deploy/cyclonedds-loopback.xml}"
 # Another configuration than loopback: with a security fragment, or VISCERA_INSECURE=1 (warns).
@@ -462,6 +474,11 @@ run_alone alone2
     echo "  CPU wake-up latency: the machine's own (no PM QoS request; --cpu-wake-latency)"
   fi
   echo "  CPUs: servers on ${SRVCPUS:-any}$([ -n "$PHYCPUS" ] && echo " (their physics loops on $PHYCPUS)"), trainees and subscribers on ${CLICPUS:-any}"
+  playout_sum() { # LOG...: the servers' command playout lines summed
+    sed -n 's/^server: command playout (up to \([0-9]*\) step(s)): \([0-9]*\) commands waited.* \([0-9]*\) superseded.* \([0-9]*\) dropped.*/\1 \2 \3 \4/p' "$@" 2>/dev/null |
+      awk '{ d = $1; w += $2; s += $3; c += $4; n++ } END { if (n) printf "up to %d step(s): %d commands waited, %d superseded, %d dropped to catch up (%d server(s))", d, w, s, c, n; else printf "no command playout line" }'
+  }
+  echo "  command playout, the lab: $(playout_sum "$OUT"/seat[0-9]*-server.log); the seat alone: $(playout_sum "$OUT/alone-server.log" "$OUT/alone2-server.log")"
   echo "  alone (baseline, $BASELINE s): $(step_line "$OUT/alone-server.log")"
   echo "  alone again after the lab: $(step_line "$OUT/alone2-server.log")"
   for i in $(seq 1 "$SEATS"); do

@@ -8,6 +8,7 @@
 #include "cpu_pin.h"
 #include "cpu_wake.h"
 #include "dds/vdds.h"
+#include "session/command_playout.h"
 #include "session/server_app.h"
 #include "vrt.h"
 
@@ -19,6 +20,10 @@ static void usage(FILE *f) {
           "  --partition P       session partition (default: " VDDS_DEFAULT_PARTITION ")\n"
           "  --duration S        stop after S seconds (default: run until SIGINT/SIGTERM)\n"
           "  --tool-timeout S    release a tool after S s without commands (default 0.5)\n"
+          "  --command-playout N a tool's commands may wait up to N steps (0..%d, default %d) so that\n"
+          "                      one comes into effect per step however they bunched on the way:\n"
+          "                      the tool moves evenly and every command is answered; 0: the newest\n"
+          "                      at once, skipping the others (docs/numerics.md §11.8)\n"
           "  --final-mesh PATH   on exit write the last published frame's exact positions (OBJ)\n"
           "  --checkpoint FILE   resume from FILE when it holds this scene's state (kill -9, crash), and\n"
           "                      write the state there every --checkpoint-every s and at exit\n"
@@ -57,7 +62,7 @@ static void usage(FILE *f) {
           "  --version           print the version and exit\n"
           "DDS configuration comes from CYCLONEDDS_URI (unset: deploy/cyclonedds-loopback.xml, one machine).\n"
           "Exit status: 0 done (or --check passed), 1 bad scene or runtime error, 2 usage error.\n",
-          CPU_WAKE_MAX_US, SERVER_APP_MAX_SEATS);
+          PLAYOUT_MAX_DEPTH, PLAYOUT_DEFAULT_DEPTH, CPU_WAKE_MAX_US, SERVER_APP_MAX_SEATS);
 }
 
 enum {
@@ -73,7 +78,8 @@ enum {
   OPT_FIRST_SEAT = 'F',
   OPT_SEAT_THREADS = 'G',
   OPT_CPU_WAKE = 'W',
-  OPT_PHYSICS_CPUS = 'P'
+  OPT_PHYSICS_CPUS = 'P',
+  OPT_COMMAND_PLAYOUT = 'Y'
 };
 
 /* A number of seconds: >= 0 when `zero_ok`, else > 0. */
@@ -97,6 +103,17 @@ static int on_option(void *ctx, int code, const char *arg) {
     return seconds("duration", arg, 1, &o->opts.duration);
   case OPT_TOOL_TIMEOUT:
     return seconds("tool-timeout", arg, 0, &o->opts.tool_timeout);
+  case OPT_COMMAND_PLAYOUT: {
+    char *end = NULL;
+    long n = strtol(arg, &end, 10);
+    if (end == arg || *end || n < 0 || n > PLAYOUT_MAX_DEPTH) {
+      fprintf(stderr, "viscera-server: --command-playout '%s' is not a number of steps 0..%d\n", arg,
+              PLAYOUT_MAX_DEPTH);
+      return 2;
+    }
+    o->opts.command_playout = (size_t)n;
+    return 0;
+  }
   case OPT_FINAL_MESH:
     o->opts.final_mesh = arg;
     return 0;
@@ -165,6 +182,7 @@ int main(int argc, char **argv) {
                                      {"duration", required_argument, 0, OPT_DURATION},
                                      {"final-mesh", required_argument, 0, OPT_FINAL_MESH},
                                      {"tool-timeout", required_argument, 0, OPT_TOOL_TIMEOUT},
+                                     {"command-playout", required_argument, 0, OPT_COMMAND_PLAYOUT},
                                      {"check", no_argument, 0, OPT_CHECK},
                                      {"checkpoint", required_argument, 0, OPT_CHECKPOINT},
                                      {"checkpoint-every", required_argument, 0, OPT_CHECKPOINT_EVERY},
@@ -181,10 +199,11 @@ int main(int argc, char **argv) {
                            .options = lo,
                            .option = on_option,
                            .usage = usage};
-  server_app_options_t o = {.seats = 0,
-                            .first_seat = 0,
-                            .cpu_wake_us = -1,
-                            .opts = {.duration = 0, .tool_timeout = 0.5, .checkpoint_every = 1.0}};
+  server_app_options_t o = {
+      .seats = 0,
+      .first_seat = 0,
+      .cpu_wake_us = -1,
+      .opts = {.duration = 0, .tool_timeout = 0.5, .command_playout = PLAYOUT_DEFAULT_DEPTH, .checkpoint_every = 1.0}};
   cli_common_t common = {0};
   int rc = cli_parse(&spec, argc, argv, &common, &o);
   if (rc != CLI_RUN) return rc;

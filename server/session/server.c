@@ -283,6 +283,7 @@ static int setup(server_t *s, const scene_t *scene, verr_t *err) {
   if (s->opts->dds_setup_lock) pthread_mutex_unlock(s->opts->dds_setup_lock);
   if (rc) return -1;
   tool_roles_init(&s->roles, &s->rt.scene);
+  s->roles.playout_depth = s->opts->command_playout;
   writer_stations_init(&s->stations);
   s->control.roles = &s->roles;
   applied_input_init(&s->ai, s->w_applied, &s->rt, &s->control.paused);
@@ -466,13 +467,11 @@ static void count_gate_drops(server_t *s) {
  * (seq: best effort may deliver out of order; issue 14.2); counts and
  * reports the rest. A writer whose station may not drive the tool is
  * blocked at the gate for that tool, so its flood cannot evict the
- * owner's commands from the reader. Returns the tools with a new command
- * (bit t). */
-static uint32_t take_commands(server_t *s, uint64_t now) {
+ * owner's commands from the reader. */
+static void take_commands(server_t *s, uint64_t now) {
   enum { MAXS = 16 };
   void *samples[MAXS] = {0};
   dds_sample_info_t infos[MAXS];
-  uint32_t fresh = 0; /* tools with a new command this step */
   count_gate_drops(s);
   for (;;) {
     int n = dds_take(s->r_cmd, samples, infos, MAXS, MAXS);
@@ -497,20 +496,17 @@ static uint32_t take_commands(server_t *s, uint64_t now) {
         report_rejected(s, v, c->tool_id, station, "");
         continue;
       }
-      const tool_pose_t *last = &s->roles.tool[c->tool_id].side[side];
-      if (last->has && last->writer == infos[i].publication_handle && cmd.seq <= last->cmd.seq) {
+      if (tool_roles_stale(&s->roles, c->tool_id, side, infos[i].publication_handle, cmd.seq)) {
         s->stats->commands_stale++; /* older than what this writer already gave: never applied after it */
         continue;
       }
       tool_roles_note(&s->roles, c->tool_id, side, station, infos[i].publication_handle, &cmd, now);
-      fresh |= 1u << c->tool_id;
       s->tool[c->tool_id].last_cmd_mono = now;
       s->stats->commands++;
     }
     dds_return_loan(s->r_cmd, samples, n);
     if (n < MAXS) break;
   }
-  return fresh;
 }
 
 /* Releases every driven tool whose client is gone: its writer lost its
@@ -1007,10 +1003,13 @@ int server_step_begin(server_t *s, uint64_t t0) {
   s->rolled = 0;
   /* In: take and convert the commands, check them, note each side's latest. */
   applied_input_tick(&s->ai);
-  uint32_t fresh = take_commands(s, t0);
-  /* Once per step, after every side's latest command is in: each tool with
-   * a new one takes its effective command (owner, guide or their mix) into
-   * its core record. */
+  take_commands(s, t0);
+  /* Once per step, after every side's commands are in: each side puts its
+   * next waiting command into effect (command_playout.h: one per step, so
+   * a tool moves evenly however its commands bunched on the way), and each
+   * tool whose command changed takes its effective command (owner, guide or
+   * their mix) into its core record. */
+  uint32_t fresh = tool_roles_advance(&s->roles);
   for (size_t t = 0; t < s->rt.ntools; t++)
     if (fresh & (1u << t)) drive_tool(s, t, t0);
   release_lost_tools(s, t0);
@@ -1242,6 +1241,9 @@ void server_close(server_t *s) {
     stats->deltas_skipped += s->pubs[i].skipped;
   }
   region_work_t work = runtime_region_work(&s->rt);
+  stats->playout_depth = s->roles.playout_depth;
+  tool_roles_playout_totals(&s->roles, &stats->commands_delayed, &stats->commands_superseded,
+                            &stats->commands_caught_up);
   stats->region_organs = work.organs;
   stats->region_node_updates = work.node_updates;
   stats->region_block_evals = work.block_evals;

@@ -24,6 +24,7 @@ typedef struct server_opts {
   const char *final_mesh; /* write exact positions of the last published frame here (OBJ) */
   int quiet;
   double tool_timeout;           /* s without a command before a tool is released */
+  size_t command_playout;        /* steps a command may wait for its step (command_playout.h); 0: the newest at once */
   const char *checkpoint;        /* state file: resumed from at start when it fits the scene, written periodically */
   double checkpoint_every;       /* s of simulated time between checkpoints */
   int rt_priority;               /* 1..99: the step loop's thread runs SCHED_FIFO at it (vrt.h); 0 = normal */
@@ -47,6 +48,11 @@ typedef struct server_stats {
    * DDS stored them (also counted in rejected[]), by cause; commands not
    * applied because their writer had already sent a newer one. */
   uint64_t gate_out_of_range, gate_refused, gate_blocked, commands_stale;
+  /* The playout (command_playout.h) at close, summed over the tools:
+   * commands put into effect a step or more after their take, never put
+   * into effect (a bunch beyond the depth), dropped to give latency back. */
+  size_t playout_depth;
+  uint64_t commands_delayed, commands_superseded, commands_caught_up;
   long rss_start_kb, rss_max_kb; /* resident set at the first step, and the largest seen at a metrics period */
   double peak_force;
   double step_us_median, step_us_p99, step_us_max;

@@ -89,6 +89,11 @@ static void print_stats(const scene_t *scene, const server_opts_t *opts, const s
     fprintf(stderr, "%s%s: %" PRIu64, v > 1 ? ", " : "", tool_command_verdict_str((tool_cmd_verdict_t)v),
             s->rejected[v]);
   fprintf(stderr, ")\n");
+  if (s->commands)
+    fprintf(stderr,
+            "server: command playout (up to %zu step(s)): %" PRIu64 " commands waited a step or more to keep the "
+            "tool's path even, %" PRIu64 " superseded in bunches beyond it, %" PRIu64 " dropped to catch up\n",
+            s->playout_depth, s->commands_delayed, s->commands_superseded, s->commands_caught_up);
   if (s->gate_out_of_range || s->gate_refused || s->gate_blocked || s->commands_stale)
     fprintf(stderr,
             "server: intake gate dropped %" PRIu64 " for tools not in the scene, %" PRIu64 " malformed, %" PRIu64

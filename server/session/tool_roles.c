@@ -25,6 +25,7 @@ void tool_roles_init(tool_roles_t *r, const scene_t *scene) {
     tr->max_coupling = scene->tools[t].stiffness;
     tr->version = 1;
   }
+  r->playout_depth = PLAYOUT_DEFAULT_DEPTH;
   r->changed = r->ntools ? (uint32_t)((1ull << r->ntools) - 1) : 0;
 }
 
@@ -42,11 +43,55 @@ void tool_roles_note(tool_roles_t *r, size_t t, tool_side_t side, const char *st
                      const tool_cmd_t *c, uint64_t now_ns) {
   if (t >= r->ntools || side == TOOL_SIDE_REJECTED) return;
   tool_pose_t *p = &r->tool[t].side[side];
-  p->has = 1;
+  if (p->writer != writer) command_playout_clear(&p->playout);
   copy_station(p->station, station);
   p->writer = writer;
-  tool_input_from_cmd(c, &p->cmd);
+  tool_input_t in;
+  tool_input_from_cmd(c, &in);
+  command_playout_push(&p->playout, r->playout_depth, &in);
   p->mono_ns = now_ns;
+}
+
+int tool_roles_stale(const tool_roles_t *r, size_t t, tool_side_t side, uint64_t writer, uint64_t seq) {
+  if (t >= r->ntools || side == TOOL_SIDE_REJECTED) return 0;
+  const tool_pose_t *p = &r->tool[t].side[side];
+  if (p->writer != writer) return 0;
+  if (p->playout.n) return seq <= p->playout.wait[p->playout.n - 1].seq;
+  return p->has && seq <= p->cmd.seq;
+}
+
+uint32_t tool_roles_advance(tool_roles_t *r) {
+  uint32_t moved = 0;
+  for (size_t t = 0; t < r->ntools; t++)
+    for (int s = 0; s < 2; s++) {
+      tool_pose_t *p = &r->tool[t].side[s];
+      if (command_playout_next(&p->playout, &p->cmd)) {
+        p->has = 1;
+        moved |= 1u << t;
+      }
+    }
+  return moved;
+}
+
+void tool_roles_playout_totals(const tool_roles_t *r, uint64_t *delayed, uint64_t *superseded, uint64_t *caught_up) {
+  *delayed = r->delayed;
+  *superseded = r->superseded;
+  *caught_up = r->caught_up;
+  for (size_t t = 0; t < r->ntools; t++)
+    for (int s = 0; s < 2; s++) {
+      const command_playout_t *q = &r->tool[t].side[s].playout;
+      *delayed += q->delayed;
+      *superseded += q->superseded;
+      *caught_up += q->caught_up;
+    }
+}
+
+/* Drops a side's commands, in effect and waiting; its counters go to the totals. */
+static void forget_side(tool_roles_t *r, tool_pose_t *p) {
+  r->delayed += p->playout.delayed;
+  r->superseded += p->playout.superseded;
+  r->caught_up += p->playout.caught_up;
+  memset(p, 0, sizeof *p);
 }
 
 static int present(const tool_pose_t *p, uint64_t now_ns) {
@@ -84,17 +129,20 @@ int tool_roles_effective(const tool_roles_t *r, size_t t, uint64_t now_ns, tool_
 
 int tool_roles_side_of_writer(const tool_roles_t *r, size_t t, uint64_t writer) {
   if (t >= r->ntools) return -1;
-  for (int s = 0; s < 2; s++)
-    if (r->tool[t].side[s].has && r->tool[t].side[s].writer == writer) return s;
+  for (int s = 0; s < 2; s++) {
+    const tool_pose_t *p = &r->tool[t].side[s];
+    if ((p->has || p->playout.n) && p->writer == writer) return s;
+  }
   return -1;
 }
 
 void tool_roles_forget(tool_roles_t *r, size_t t, tool_side_t side) {
-  if (t < r->ntools && side != TOOL_SIDE_REJECTED) memset(&r->tool[t].side[side], 0, sizeof r->tool[t].side[side]);
+  if (t < r->ntools && side != TOOL_SIDE_REJECTED) forget_side(r, &r->tool[t].side[side]);
 }
 
 void tool_roles_forget_all(tool_roles_t *r) {
-  for (size_t t = 0; t < r->ntools; t++) memset(r->tool[t].side, 0, sizeof r->tool[t].side);
+  for (size_t t = 0; t < r->ntools; t++)
+    for (int s = 0; s < 2; s++) forget_side(r, &r->tool[t].side[s]);
   r->changed = r->ntools ? (uint32_t)((1ull << r->ntools) - 1) : 0;
 }
 
@@ -112,7 +160,7 @@ const char *tool_roles_who(const char *station, char *buf, size_t n) {
 static void revalidate(tool_roles_t *r, size_t t) {
   for (int s = 0; s < 2; s++) {
     tool_pose_t *p = &r->tool[t].side[s];
-    if (p->has && tool_roles_classify(r, t, p->station) != (tool_side_t)s) memset(p, 0, sizeof *p);
+    if ((p->has || p->playout.n) && tool_roles_classify(r, t, p->station) != (tool_side_t)s) forget_side(r, p);
   }
 }
 

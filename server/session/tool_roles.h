@@ -34,6 +34,7 @@
 
 #include "station.h"
 #include "runtime/tool_command.h"
+#include "session/command_playout.h"
 #include "scene.h"
 #include "viscera.h"
 
@@ -43,13 +44,15 @@
 
 typedef enum tool_side { TOOL_SIDE_OWNER = 0, TOOL_SIDE_GUIDE = 1, TOOL_SIDE_REJECTED = 2 } tool_side_t;
 
-/* The latest command taken from one side of a tool. */
+/* One side of a tool: the command in effect and those waiting for their
+ * step (command_playout.h), with the sender of the latest taken. */
 typedef struct tool_pose {
-  int has;                             /* a command was taken since the side was (re)set */
-  char station[TOOL_ROLE_STATION_MAX]; /* who sent it ("" anonymous) */
+  int has;                             /* a command came into effect since the side was (re)set */
+  char station[TOOL_ROLE_STATION_MAX]; /* who sent the latest taken ("" anonymous) */
   uint64_t writer;                     /* its writer's publication handle (liveliness) */
-  uint64_t mono_ns;                    /* when it was taken (server monotonic clock) */
-  tool_input_t cmd;                    /* the command (its seq and echo go back in ContactFeedback) */
+  uint64_t mono_ns;                    /* when the latest was taken (server monotonic clock) */
+  tool_input_t cmd;                    /* the command in effect (its seq and echo go back in ContactFeedback) */
+  command_playout_t playout;           /* taken, waiting for their step */
 } tool_pose_t;
 
 typedef struct tool_role {
@@ -64,7 +67,10 @@ typedef struct tool_role {
 typedef struct tool_roles {
   size_t ntools;
   tool_role_t tool[SCENE_MAX_TOOLS];
-  uint32_t changed; /* bit t: tool t's role changed and is not yet published */
+  uint32_t changed;     /* bit t: tool t's role changed and is not yet published */
+  size_t playout_depth; /* steps a command may wait (command_playout.h); PLAYOUT_DEFAULT_DEPTH after init */
+  /* The playout's counters of sides since forgotten (command_playout_t). */
+  uint64_t delayed, superseded, caught_up;
 } tool_roles_t;
 
 /* The command the tool takes now (tool_roles_effective), for
@@ -84,9 +90,24 @@ void tool_roles_init(tool_roles_t *r, const scene_t *scene);
  * t must be < ntools. */
 tool_side_t tool_roles_classify(const tool_roles_t *r, size_t t, const char *station);
 
-/* Keeps command c (already validated by tool_command_check, runtime/tool_command.h) as side's latest. */
+/* Keeps command c (already validated by tool_command_check, runtime/tool_command.h) as side's latest
+ * taken: it waits for its step (tool_roles_advance). A writer other than
+ * the side's last one drops what that one left waiting. */
 void tool_roles_note(tool_roles_t *r, size_t t, tool_side_t side, const char *station, uint64_t writer,
                      const tool_cmd_t *c, uint64_t now_ns);
+
+/* 1 when `writer` already gave tool t's side a command with seq >= `seq`
+ * (taken, in effect or waiting): this one is older and never applied
+ * after it (best effort may deliver out of order). */
+int tool_roles_stale(const tool_roles_t *r, size_t t, tool_side_t side, uint64_t writer, uint64_t seq);
+
+/* Once per step, after the step's commands were noted: every side with a
+ * command waiting puts the next into effect (command_playout_next).
+ * Returns the tools whose command in effect changed (bit t). */
+uint32_t tool_roles_advance(tool_roles_t *r);
+
+/* The playout's counters summed over every side, past and present. */
+void tool_roles_playout_totals(const tool_roles_t *r, uint64_t *delayed, uint64_t *superseded, uint64_t *caught_up);
 
 /* The mixed pose of tool t at now_ns; returns 0 when neither side is
  * present (nothing to apply), 1 otherwise. */

@@ -21,13 +21,18 @@
 # RT_PRIORITY=N (environment) runs both 1 kHz loops SCHED_FIFO at N (their
 # --rt-priority: the loop threads only, DDS threads stay normal), as
 # deploy/bench.sh does; unset, both run at normal priority.
+# OLD_ARGS="..." (environment) adds those options to the old build's
+# server (e.g. OLD_BUILD = NEW_BUILD and OLD_ARGS="--command-playout 0":
+# the same server with and without the command playout); the table then
+# names the two by their options instead of by feedback before the step.
 # usage: feedback_first_bench.sh NEW_BUILD OLD_BUILD SRC OUT [RUNS] [SECONDS]
 set -euo pipefail
 NEW="$1"; OLD="$2"; SRC="$3"; OUT="$4"; RUNS="${5:-10}"; SECS="${6:-3}"
 D="${VISCERA_DOMAIN:-228}"
 export CYCLONEDDS_URI="${CYCLONEDDS_URI:-file://$SRC/deploy/cyclonedds-loopback.xml}"
 mkdir -p "$OUT"
-rt=() hrate=()
+rt=() hrate=() oldargs=()
+[ -n "${OLD_ARGS:-}" ] && read -r -a oldargs <<<"$OLD_ARGS"
 [ -n "${RT_PRIORITY:-}" ] && rt=(--rt-priority "$RT_PRIORITY")
 [ -n "${HAPTIC_RATE:-}" ] && hrate=(--rate "$HAPTIC_RATE")
 pids=()
@@ -35,10 +40,12 @@ cleanup() { for p in "${pids[@]}"; do kill -9 "$p" 2>/dev/null || true; done; }
 trap cleanup EXIT
 
 one() { # BUILD TAG RUN: prints latency_us_mean latency_us_median
-  local b="$1" tag="$2" i="$3" part="fbbench/$2$3"
+  local b="$1" tag="$2" i="$3" part="fbbench/$2$3" extra=()
+  [ "$tag" = old ] && extra=("${oldargs[@]}")
   "$b/server/viscera-server" --scene "$SRC/assets/scenes/default.yaml" --domain "$D" --partition "$part" --quiet "${rt[@]}" \
+    "${extra[@]}" \
     >"$OUT/$tag$i.server.out" 2>"$OUT/$tag$i.server.log" &
-  local s=$!; pids+=($s)
+  local s=$!; pids+=("$s")
   sleep 1.2
   sleep "$(printf '0.%06d' $((RANDOM % 1000)))"
   "$NEW/client/haptic/viscera-haptic" --trajectory "$SRC/assets/trajectories/palpate_kidney.traj" --domain "$D" \
@@ -69,7 +76,7 @@ echo "load after: $(uptime)"
 # ContactFeedback is ~80 bytes), 1 kHz, same loopback configuration.
 rtt="nan"
 if command -v ddsperf >/dev/null; then
-  ddsperf -i "$D" -D 8 pong >"$OUT/pong.log" 2>&1 & p=$!; pids+=($p)
+  ddsperf -i "$D" -D 8 pong >"$OUT/pong.log" 2>&1 & p=$!; pids+=("$p")
   sleep 0.5
   ddsperf -i "$D" -D 6 ping 1000Hz size 64 >"$OUT/ping.log" 2>&1 || true
   kill $p 2>/dev/null || true; wait $p 2>/dev/null || true
@@ -84,13 +91,15 @@ fi
 # check against the load's stalls, the median of the runs' means.
 med() { grep " $1 " "$OUT/runs.txt" | sed -n 's/.*mean_us=\([0-9.]*\).*/\1/p' | sort -g |
   awk '{v[NR] = $1} END {if (NR) printf "%.1f", NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2; else print "nan"}'; }
-awk -v rtt="$rtt" -v med_old="$(med old)" -v med_new="$(med new)" '
+old_name="old (feedback after step)" new_name="new (feedback before step)"
+[ ${#oldargs[@]} -gt 0 ] && { old_name="old, ${oldargs[*]}"; new_name="new, default options"; }
+awk -v rtt="$rtt" -v med_old="$(med old)" -v med_new="$(med new)" -v old_name="$old_name" -v new_name="$new_name" '
   /^run / { split($4, a, "="); v = a[2]; if (v != "nan") { s[$3] += v; n[$3]++ } }
   END {
     for (t in n) m[t] = s[t] / n[t]
     printf "\n%-28s %17s %17s %5s\n", "server build", "mean of means us", "median of means", "runs"
-    printf "%-28s %17.1f %17.1f %5d\n", "old (feedback after step)", m["old"], med_old, n["old"]
-    printf "%-28s %17.1f %17.1f %5d\n", "new (feedback before step)", m["new"], med_new, n["new"]
+    printf "%-28s %17.1f %17.1f %5d\n", old_name, m["old"], med_old, n["old"]
+    printf "%-28s %17.1f %17.1f %5d\n", new_name, m["new"], med_new, n["new"]
     if (rtt != "nan") {
       floor = 500 + rtt
       printf "floor: half a step 500 us + DDS round trip %.1f us (ddsperf ping/pong) = %.1f us\n", rtt, floor

@@ -35,7 +35,8 @@ net_sites() {
 # net_press NAME SECONDS SEED TRAJ [EMULATOR-OPTIONS...]: one palpation
 # session through the link: the emulator started (--duration SECONDS --seed
 # SEED and the options), the server in site a (assets/scenes/default.yaml,
-# partition $SEAT), the scripted trainee in site b along TRAJ at its default
+# partition $SEAT, and the options in the array NET_SERVER_ARGS when the
+# caller set it), the scripted trainee in site b along TRAJ at its default
 # 1 kHz (killed after SECONDS), then the server stopped with SIGINT and the
 # link stopped. Leaves OUT/NAME-server.out/.log, NAME-haptic.out/.log (its
 # SUMMARY line), NAME-force.csv and NAME-link.txt; fail()s on any error.
@@ -44,7 +45,7 @@ net_press() {
   shift 4
   link_start --duration "$secs" --seed "$seed" "$@" || fail "$name: emulator did not start"
   run_in_site a "$BUILD/server/viscera-server" --scene "$SRC/assets/scenes/default.yaml" --partition "$SEAT" \
-    > "$OUT/$name-server.out" 2> "$OUT/$name-server.log" &
+    ${NET_SERVER_ARGS[@]+"${NET_SERVER_ARGS[@]}"} > "$OUT/$name-server.out" 2> "$OUT/$name-server.log" &
   srv=$!; PIDS+=("$srv")
   run_in_site b timeout "$secs" "$BUILD/client/haptic/viscera-haptic" --trajectory "$traj" --partition "$SEAT" \
     --wait-server 15 --force-csv "$OUT/$name-force.csv" > "$OUT/$name-haptic.out" 2> "$OUT/$name-haptic.log" \

@@ -108,6 +108,7 @@ static void test_mix(void) {
   cb.orientation[1] = 1; /* the guide holds its shaft another way */
   tool_roles_note(&r, 0, TOOL_SIDE_OWNER, "alice", 11, &ca, t0);
   tool_roles_note(&r, 0, TOOL_SIDE_GUIDE, "bob", 22, &cb, t0 + 1 * MS);
+  CHECK(tool_roles_advance(&r) == 1u); /* the step puts them into effect (command_playout.h) */
   CHECK(tool_roles_effective(&r, 0, t0 + 2 * MS, &e) == 1);
   CHECK(e.owner_present && e.guide_present);
   CHECK_NEAR(e.cmd.pos[0], 0.25 * 0.02, 1e-7);
@@ -151,6 +152,7 @@ static void test_absent_side(void) {
   tool_cmd_t ca = command(0.0, 0.0, 0.04, 0, 4.0f, 1), cb = command(0.02, 0.0, 0.04, 1, 4.0f, 2);
   tool_roles_note(&r, 1, TOOL_SIDE_OWNER, "alice", 11, &ca, t0);
   tool_roles_note(&r, 1, TOOL_SIDE_GUIDE, "bob", 22, &cb, t0 + 60 * MS);
+  CHECK(tool_roles_advance(&r) == 2u);
   tool_effective_t e;
   /* At +100 ms both are there (the owner exactly at its limit). */
   CHECK(tool_roles_effective(&r, 1, t0 + 100 * MS, &e) == 1);
@@ -166,6 +168,7 @@ static void test_absent_side(void) {
   /* The guide's writer lost: the owner alone at once. */
   tool_roles_note(&r, 1, TOOL_SIDE_OWNER, "alice", 11, &ca, t0 + 200 * MS);
   tool_roles_note(&r, 1, TOOL_SIDE_GUIDE, "bob", 22, &cb, t0 + 200 * MS);
+  CHECK(tool_roles_advance(&r) == 2u);
   CHECK(tool_roles_side_of_writer(&r, 1, 22) == TOOL_SIDE_GUIDE);
   CHECK(tool_roles_side_of_writer(&r, 1, 11) == TOOL_SIDE_OWNER);
   CHECK(tool_roles_side_of_writer(&r, 1, 33) == -1);
@@ -189,6 +192,7 @@ static void test_role_changes_drop_stale_sides(void) {
   tool_cmd_t cb = command(0.02, 0.0, 0.04, 0, 4.0f, 2);
   /* Tool 0 is anyone's: bob's command is an owner-side one... */
   tool_roles_note(&r, 0, TOOL_SIDE_OWNER, "bob", 22, &cb, t0);
+  CHECK(tool_roles_advance(&r) == 1u && r.tool[0].side[TOOL_SIDE_OWNER].has);
   /* ...until bob becomes the guide: then it must not keep counting as the owner. */
   CHECK(apply(&r, viscera_CONTROL_GUIDE, 0, "bob", 0.5, 0, text, sizeof text) == 0);
   CHECK(!r.tool[0].side[TOOL_SIDE_OWNER].has);
@@ -197,6 +201,7 @@ static void test_role_changes_drop_stale_sides(void) {
   /* Guide bob's command; then the tool is assigned to alice: guiding ends and
    * bob's pose goes. */
   tool_roles_note(&r, 0, TOOL_SIDE_GUIDE, "bob", 22, &cb, t0);
+  CHECK(tool_roles_advance(&r) == 1u && r.tool[0].side[TOOL_SIDE_GUIDE].has);
   uint32_t v = r.tool[0].version;
   CHECK(apply(&r, viscera_CONTROL_ASSIGN_TOOL, 0, "alice", 0, 0, text, sizeof text) == 0);
   CHECK(strstr(text, "guiding by station 'bob' ended") != NULL);
