@@ -17,7 +17,8 @@
 #   --first K           number of the first seat (default 1)
 #   --prefix P          partition prefix (default lab)
 #   --scene FILE        scene every seat runs (default assets/scenes/default.yaml)
-#   --trainees          a scripted haptic client per seat (palpate_kidney.traj: 4.5 s);
+#   --trainees          a scripted haptic client per seat (palpate_kidney.traj: 4.5 s, from
+#                       its server's first answer: viscera-haptic --start-on-answer);
 #                       with --duration S > 0 each palpates over and over (viscera-haptic
 #                       --loop) until 1 s before the servers stop (at least one palpation),
 #                       so a dashboard or an instructor's command finds them at work; with
@@ -252,7 +253,8 @@ if [ $TRAINEES = 1 ]; then
   for i in $(seq "$FIRST" "$LAST"); do
     s=$(printf 'seat%02d' "$i")
     start "$s-haptic" "trainee-$s" "$BUILD/client/haptic/viscera-haptic" --partition "$PREFIX/$s" \
-      --trajectory "$ROOT/assets/trajectories/palpate_kidney.traj" "${TRAINEE_RUN[@]}" --quiet "${HAP_RT[@]}"
+      --trajectory "$ROOT/assets/trajectories/palpate_kidney.traj" --start-on-answer "${TRAINEE_RUN[@]}" --quiet \
+      "${HAP_RT[@]}"
   done
 fi
 

@@ -357,7 +357,8 @@ run_alone() { # TAG: files OUT/TAG-*
       > "$OUT/$tag-sub$k.out" 2>&1 &
     subs+=($!)
   done
-  "${CLI_PIN[@]}" "$BUILD/client/haptic/viscera-haptic" --partition "load/$tag" --trajectory "$TRAJ" --duration "$BASELINE" --quiet \
+  "${CLI_PIN[@]}" "$BUILD/client/haptic/viscera-haptic" --partition "load/$tag" --trajectory "$TRAJ" --start-on-answer \
+    --duration "$BASELINE" --quiet \
     "${HAP_RT[@]}" > "$OUT/$tag-haptic.log" 2>&1 || true
   wait "$srv" || true
   for p in "${subs[@]}"; do kill -TERM "$p" 2>/dev/null || true; done
@@ -388,7 +389,8 @@ fi
 sleep 1
 for i in $(seq 1 "$SEATS"); do
   s=$(printf 'seat%02d' "$i")
-  "${CLI_PIN[@]}" "$BUILD/client/haptic/viscera-haptic" --partition "load/$s" --trajectory "$TRAJ" --duration "$DURATION" --quiet \
+  "${CLI_PIN[@]}" "$BUILD/client/haptic/viscera-haptic" --partition "load/$s" --trajectory "$TRAJ" --start-on-answer \
+    --duration "$DURATION" --quiet \
     "${HAP_RT[@]}" > "$OUT/$s-haptic.log" 2>&1 &
   pids+=($!); register $! trainee "$s" viscera-haptic
 done

@@ -214,11 +214,25 @@ void haptic_loop_run(const haptic_loop_t *l) {
   uint64_t period_ns = (uint64_t)(1e9 / o->rate);
   double run_for = o->duration >= 0 ? o->duration : 1e300;
   uint64_t start = vtime_mono_ns(), next = start, prev_tick = 0;
+  /* The device's clock (a scripted path's time): from the loop's start, or
+   * with --start-on-answer from the server's first answer (0 until then:
+   * the path's first pose), so that the start of a path is not lost while
+   * the server's reader has yet to match this writer. */
+  uint64_t dev_start = o->start_on_answer ? 0 : start, last_fb_mono = 0;
+  st->script_start_s = o->start_on_answer ? -1.0 : 0.0;
   double finished_at = -1;
   while (!*l->stop) {
     vtime_sleep_until(next);
     uint64_t now = vtime_mono_ns();
     double t = (double)(now - start) * 1e-9;
+    if (!dev_start && (last_fb_mono || t >= o->wait_server)) {
+      dev_start = now;
+      st->script_start_s = t;
+      if (!last_fb_mono)
+        fprintf(stderr, "haptic: warning: no answer from the server within %.1f s: the path starts without one\n",
+                o->wait_server);
+    }
+    double td = dev_start ? (double)(now - dev_start) * 1e-9 : 0.0;
     if (prev_tick) {
       if (st->nperiod < st->cap) st->period_us[st->nperiod++] = (double)(now - prev_tick) * 1e-3;
       if (now > next + 1000000ull) st->late_ticks++; /* more than 1 ms late */
@@ -226,16 +240,16 @@ void haptic_loop_run(const haptic_loop_t *l) {
     prev_tick = now;
     double pos[3], quat[4];
     uint32_t buttons = 0;
-    l->dev->ops->read(l->dev, t, pos, quat, &buttons);
+    l->dev->ops->read(l->dev, td, pos, quat, &buttons);
     send_command(l, &s, now, pos, quat, buttons);
-    uint64_t last_fb_mono = read_feedback(l, &s, t, now);
+    last_fb_mono = read_feedback(l, &s, t, now);
     guide_output_t gout;
     render_force(l, &s, t, now, last_fb_mono, pos, &gout);
     l->dev->ops->write_force(l->dev, gout.f);
     record_force(l, &s, t, pos, &gout);
 
     if (t >= run_for) break;
-    if (o->duration < 0 && l->dev->ops->finished(l->dev, t)) {
+    if (o->duration < 0 && dev_start && l->dev->ops->finished(l->dev, td)) {
       if (finished_at < 0) finished_at = t;
       if (t - finished_at > 0.5) break;
     }

@@ -20,7 +20,8 @@ typedef struct haptic_stats {
   size_t nperiod, cap;
   double peak_force, force_sum; /* N; the sum over ticks in contact */
   uint64_t ticks, contact_ticks, late_ticks;
-  double elapsed_s; /* wall time of the loop */
+  double elapsed_s;      /* wall time of the loop */
+  double script_start_s; /* --start-on-answer: loop time at which the path started (-1: not started) */
   /* Contact under delay (contact_render.h): the passivity observer's
    * largest energy (J, <= 0 passive), the largest one-tick force change
    * (N, cuts excluded), controller ticks, forces cut at a lost server,

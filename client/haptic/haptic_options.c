@@ -19,6 +19,11 @@ void haptic_usage(FILE *f) {
           "  --trajectory FILE   scripted device: play this path (t x y z [buttons] per line)\n"
           "  --loop              scripted device: play it over and over until --duration or a signal\n"
           "                      (the path must end where it begins)\n"
+          "  --start-on-answer   scripted device: hold the path's first pose until the server first\n"
+          "                      answers (a ContactFeedback for this tool), then play it from 0, so\n"
+          "                      no part of it goes out before the server hears this client (its\n"
+          "                      command reader matches a new writer some 0.1-0.5 s after the scene\n"
+          "                      is seen); no answer within --wait-server s: it starts, with a warning\n"
           "  --device-index N    real devices: which one of that kind (default 0)\n"
           "  --workspace-scale S real devices: scene metres per device metre (default 1)\n"
           "  --workspace-offset X,Y,Z  real devices: scene position (m) of the device's\n"
@@ -73,10 +78,12 @@ enum {
   OPT_GUIDE_RTT = 'G',
   OPT_CPU_WAKE = 'W',
   OPT_LOOP = 'L',
+  OPT_START_ON_ANSWER = 'A',
 };
 
 static const struct option haptic_long_options[] = {{"trajectory", required_argument, 0, OPT_TRAJECTORY},
                                                     {"loop", no_argument, 0, OPT_LOOP},
+                                                    {"start-on-answer", no_argument, 0, OPT_START_ON_ANSWER},
                                                     {"tool", required_argument, 0, OPT_TOOL},
                                                     {"station", required_argument, 0, OPT_STATION},
                                                     {"rate", required_argument, 0, OPT_RATE},
@@ -150,6 +157,9 @@ static int on_option(void *ctx, int code, const char *arg) {
     return 0;
   case OPT_LOOP:
     o->dcfg.loop = 1;
+    return 0;
+  case OPT_START_ON_ANSWER:
+    o->start_on_answer = 1;
     return 0;
   case OPT_TOOL:
     o->tool = (unsigned)v;
@@ -246,9 +256,9 @@ int haptic_options_parse(haptic_options_t *o, int argc, char **argv) {
             device_names());
     return 2;
   }
-  if (o->dcfg.loop && strcmp(o->device, "scripted") != 0) {
-    fprintf(stderr, "viscera-haptic: --loop: only the scripted device plays a trajectory (--device is '%s')\n",
-            o->device);
+  if ((o->dcfg.loop || o->start_on_answer) && strcmp(o->device, "scripted") != 0) {
+    fprintf(stderr, "viscera-haptic: --%s: only the scripted device plays a trajectory (--device is '%s')\n",
+            o->dcfg.loop ? "loop" : "start-on-answer", o->device);
     return 2;
   }
   if (!(o->rate >= 10 && o->rate <= 10000) || !(o->max_force > 0)) {

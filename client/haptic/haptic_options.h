@@ -24,6 +24,7 @@ typedef struct haptic_options {
   double max_force;                    /* --max-force N */
   double max_stiffness;                /* --max-stiffness K, N/m; 0 = no stated limit */
   double wait_server;                  /* --wait-server S */
+  int start_on_answer;                 /* --start-on-answer: the path's clock starts at the server's first answer */
   double duration;                     /* --duration S; < 0: end of the trajectory + 0.5 s */
   char trajectory_path[DATA_PATH_MAX]; /* --trajectory found (data_path_resolve: installed ones by name) */
 } haptic_options_t;

@@ -26,6 +26,12 @@ void haptic_summary_print(const haptic_options_t *o, haptic_stats_t *st, haptic_
           "%" PRIu64 " ticks over 1 ms late; jitter p99 %.1f us\n",
           st->ticks, st->elapsed_s, (double)st->ticks / st->elapsed_s, per.median, per.p99, per.max, st->late_ticks,
           jitter_p99);
+  if (o->start_on_answer) {
+    if (st->script_start_s >= 0)
+      fprintf(stderr, "haptic: path started at %.3f s of the loop (--start-on-answer)\n", st->script_start_s);
+    else
+      fprintf(stderr, "haptic: path never started (no answer, --start-on-answer)\n");
+  }
   fprintf(
       stderr,
       "haptic: force peak %.3f N, mean in contact %.3f N, %" PRIu64 " ticks in contact, %" PRIu64 " feedback samples\n",

@@ -51,6 +51,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "busy_path.h"
 #include "runtime/scene_runtime.h"
 #include "test_assets.h"
 #include "scene.h"
@@ -58,23 +59,6 @@
 #include "vtime.h"
 
 enum { MAX_SEATS = 8 };
-
-/* load_bench.sh --busy's probe target at simulated time t (m). */
-static void busy_target(double t, double p[3]) {
-  p[1] = 0.004;
-  if (t < 0.5) {
-    p[0] = 0.012;
-    p[2] = 0.07 + (0.027 - 0.07) * t / 0.5;
-    return;
-  }
-  p[2] = 0.027;
-  if (t < 1.0) {
-    p[0] = 0.012 + 0.005 * (t - 0.5) / 0.5;
-    return;
-  }
-  double ph = fmod(t - 1.0, 2.0); /* 1 s to x = 7 mm, 1 s back to 17 mm */
-  p[0] = ph < 1.0 ? 0.017 - 0.010 * ph : 0.007 + 0.010 * (ph - 1.0);
-}
 
 /* Overwrites n bytes, one store per cache line: what other processes do to
  * the core's caches between two ticks of a server. */

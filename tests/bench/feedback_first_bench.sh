@@ -21,18 +21,20 @@
 # RT_PRIORITY=N (environment) runs both 1 kHz loops SCHED_FIFO at N (their
 # --rt-priority: the loop threads only, DDS threads stay normal), as
 # deploy/bench.sh does; unset, both run at normal priority.
-# OLD_ARGS="..." (environment) adds those options to the old build's
-# server (e.g. OLD_BUILD = NEW_BUILD and OLD_ARGS="--command-playout 0":
-# the same server with and without the command playout); the table then
-# names the two by their options instead of by feedback before the step.
+# OLD_ARGS="..." and NEW_ARGS="..." (environment) add those options to the
+# old and the new build's server (e.g. OLD_BUILD = NEW_BUILD and NEW_ARGS=
+# "--command-playout 1": the same server without and with the command
+# playout); the table then names the two by their options instead of by
+# feedback before the step.
 # usage: feedback_first_bench.sh NEW_BUILD OLD_BUILD SRC OUT [RUNS] [SECONDS]
 set -euo pipefail
 NEW="$1"; OLD="$2"; SRC="$3"; OUT="$4"; RUNS="${5:-10}"; SECS="${6:-3}"
 D="${VISCERA_DOMAIN:-228}"
 export CYCLONEDDS_URI="${CYCLONEDDS_URI:-file://$SRC/deploy/cyclonedds-loopback.xml}"
 mkdir -p "$OUT"
-rt=() hrate=() oldargs=()
+rt=() hrate=() oldargs=() newargs=()
 [ -n "${OLD_ARGS:-}" ] && read -r -a oldargs <<<"$OLD_ARGS"
+[ -n "${NEW_ARGS:-}" ] && read -r -a newargs <<<"$NEW_ARGS"
 [ -n "${RT_PRIORITY:-}" ] && rt=(--rt-priority "$RT_PRIORITY")
 [ -n "${HAPTIC_RATE:-}" ] && hrate=(--rate "$HAPTIC_RATE")
 pids=()
@@ -41,7 +43,7 @@ trap cleanup EXIT
 
 one() { # BUILD TAG RUN: prints latency_us_mean latency_us_median
   local b="$1" tag="$2" i="$3" part="fbbench/$2$3" extra=()
-  [ "$tag" = old ] && extra=("${oldargs[@]}")
+  if [ "$tag" = old ]; then extra=("${oldargs[@]}"); else extra=("${newargs[@]}"); fi
   "$b/server/viscera-server" --scene "$SRC/assets/scenes/default.yaml" --domain "$D" --partition "$part" --quiet "${rt[@]}" \
     "${extra[@]}" \
     >"$OUT/$tag$i.server.out" 2>"$OUT/$tag$i.server.log" &
@@ -92,7 +94,9 @@ fi
 med() { grep " $1 " "$OUT/runs.txt" | sed -n 's/.*mean_us=\([0-9.]*\).*/\1/p' | sort -g |
   awk '{v[NR] = $1} END {if (NR) printf "%.1f", NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2; else print "nan"}'; }
 old_name="old (feedback after step)" new_name="new (feedback before step)"
-[ ${#oldargs[@]} -gt 0 ] && { old_name="old, ${oldargs[*]}"; new_name="new, default options"; }
+if [ $((${#oldargs[@]} + ${#newargs[@]})) -gt 0 ]; then
+  old_name="old, ${oldargs[*]:-default options}" new_name="new, ${newargs[*]:-default options}"
+fi
 awk -v rtt="$rtt" -v med_old="$(med old)" -v med_new="$(med new)" -v old_name="$old_name" -v new_name="$new_name" '
   /^run / { split($4, a, "="); v = a[2]; if (v != "nan") { s[$3] += v; n[$3]++ } }
   END {

@@ -25,3 +25,10 @@ add_test(NAME haptic_loop_open_path COMMAND viscera-haptic --loop --wait-server 
          --trajectory ${PROJECT_SOURCE_DIR}/assets/trajectories/push_hold_kidney.traj)
 set_tests_properties(haptic_loop_open_path PROPERTIES LABELS integration TIMEOUT 20
   PASS_REGULAR_EXPRESSION "push_hold_kidney.traj: --loop needs the last sample back at the first: they are 43.0 mm apart")
+# --start-on-answer: the scripted path from the server's first answer
+# (nothing of it lost before the server matched the client), refused for a
+# real device. Domain 196.
+viscera_integration_test(start_on_answer 196 start_on_answer_test.sh)
+add_test(NAME haptic_start_on_answer_refused COMMAND viscera-haptic --start-on-answer --device hd)
+set_tests_properties(haptic_start_on_answer_refused PROPERTIES LABELS integration TIMEOUT 20
+  PASS_REGULAR_EXPRESSION "--start-on-answer: only the scripted device plays a trajectory \\(--device is 'hd'\\)")
