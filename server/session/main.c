@@ -93,6 +93,17 @@ static int seconds(const char *opt, const char *arg, int zero_ok, double *out) {
   return 0;
 }
 
+/* An integer lo..hi: 0, or 2 after a message naming the option and `what` it must be. */
+static int integer(const char *opt, const char *arg, long lo, long hi, const char *what, long *out) {
+  char *end = NULL;
+  *out = strtol(arg, &end, 10);
+  if (end == arg || *end || *out < lo || *out > hi) {
+    fprintf(stderr, "viscera-server: --%s '%s' is not a %s %ld..%ld\n", opt, arg, what, lo, hi);
+    return 2;
+  }
+  return 0;
+}
+
 static int on_option(void *ctx, int code, const char *arg) {
   server_app_options_t *o = ctx;
   switch (code) {
@@ -104,13 +115,8 @@ static int on_option(void *ctx, int code, const char *arg) {
   case OPT_TOOL_TIMEOUT:
     return seconds("tool-timeout", arg, 0, &o->opts.tool_timeout);
   case OPT_COMMAND_PLAYOUT: {
-    char *end = NULL;
-    long n = strtol(arg, &end, 10);
-    if (end == arg || *end || n < 0 || n > PLAYOUT_MAX_DEPTH) {
-      fprintf(stderr, "viscera-server: --command-playout '%s' is not a number of steps 0..%d\n", arg,
-              PLAYOUT_MAX_DEPTH);
-      return 2;
-    }
+    long n;
+    if (integer("command-playout", arg, 0, PLAYOUT_MAX_DEPTH, "number of steps", &n)) return 2;
     o->opts.command_playout = (size_t)n;
     return 0;
   }
@@ -142,33 +148,20 @@ static int on_option(void *ctx, int code, const char *arg) {
     o->check_only = 1;
     return 0;
   case OPT_SEATS: {
-    char *end = NULL;
-    long n = strtol(arg, &end, 10);
-    if (end == arg || *end || n < 1 || n > SERVER_APP_MAX_SEATS) {
-      fprintf(stderr, "viscera-server: --seats '%s' is not a number of seats 1..%d\n", arg, SERVER_APP_MAX_SEATS);
-      return 2;
-    }
+    long n;
+    if (integer("seats", arg, 1, SERVER_APP_MAX_SEATS, "number of seats", &n)) return 2;
     o->seats = (int)n;
     return 0;
   }
   case OPT_SEAT_THREADS: {
-    char *end = NULL;
-    long n = strtol(arg, &end, 10);
-    if (end == arg || *end || n < 1 || n > SERVER_APP_MAX_SEATS) {
-      fprintf(stderr, "viscera-server: --seat-threads '%s' is not a number of threads 1..%d\n", arg,
-              SERVER_APP_MAX_SEATS);
-      return 2;
-    }
+    long n;
+    if (integer("seat-threads", arg, 1, SERVER_APP_MAX_SEATS, "number of threads", &n)) return 2;
     o->seat_threads = (int)n;
     return 0;
   }
   case OPT_FIRST_SEAT: {
-    char *end = NULL;
-    long n = strtol(arg, &end, 10);
-    if (end == arg || *end || n < 1 || n > 99) {
-      fprintf(stderr, "viscera-server: --first-seat '%s' is not a seat number 1..99\n", arg);
-      return 2;
-    }
+    long n;
+    if (integer("first-seat", arg, 1, 99, "seat number", &n)) return 2;
     o->first_seat = (int)n;
     return 0;
   }
