@@ -17,7 +17,7 @@ _viscera() {
       ;;
     --domain | --partition | --duration | --seats | --first | --prefix | --tool | --station | --speed | --seek | \
       --wait | --rt-priority | --cpu-wake-latency | --seat-threads | --first-seat | --tile | --size | --cols | \
-      --width | --height | --interval-ms | --max-frames)
+      --width | --height | --interval-ms | --max-frames | --command-playout | --wait-server)
       return 0 # a value the user types
       ;;
   esac

@@ -1,4 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
+# shellcheck shell=bash
 # prelude.sh: what every network test script starts with, sourced right after
 # `set -euo pipefail` (arguments BUILD SRC OUT as ctest passes them):
 #   BUILD, SRC, OUT   build tree, source tree, the test's output directory (emptied)
