@@ -20,7 +20,7 @@ for bad in 0 x; do
   [ "$rc" = 2 ] && grep -q "bad rounds" "$OUT.err" || fail "--rounds $bad: exit $rc, expected 2: $(cat "$OUT.err")"
 done
 bash "$SRC/deploy/load_bench.sh" --build "$BUILD" --out "$OUT" --rounds 2 --seats 2 --subscribers 2 --duration 6 \
-  --baseline 2 --one-server --seat-threads 1 --rt-priority 0 --haptic-rt-priority 0 > "$OUT.log" 2>&1 ||
+  --baseline 2 --one-server --seat-threads 1 --rt-priority 0 --haptic-rt-priority 0 --command-playout 1 > "$OUT.log" 2>&1 ||
   { tail -20 "$OUT.log" >&2; fail "load_bench.sh --rounds 2 failed"; }
 S="$OUT/summary.txt"
 med() { sed -n 's/^server: step CPU time median \([0-9.]*\) us.*/\1/p' "$1"; }
@@ -34,6 +34,12 @@ for k in 1 2; do
   lo=$(for s in seat01 seat02; do med "$OUT/round$k/$s-server.log"; done | sort -g | head -1)
   want=$(awk -v lo="$lo" -v a1="$a1" -v a2="$a2" 'BEGIN { printf "seats %+.0f %% to", 100 * (lo / ((a1 + a2) / 2) - 1) }')
   case "$line" in *"$want"*) ;; *) fail "round $k: '$line' does not set the seats against the mean ($want)" ;; esac
+  # --command-playout reached every server, and every trainee played its path from its server's answer.
+  grep -Eq "^  command playout, the lab: up to 1 step\(s\): [0-9]+ commands waited, .*\(2 server\(s\)\); the seat alone: up to 1 step\(s\): .*\(2 server\(s\)\)$" \
+    "$OUT/round$k/summary.txt" || fail "round $k: no command playout line of 1 step for the lab's and the seat alone's servers"
+  for h in "$OUT/round$k"/*-haptic.log; do
+    grep -q "^haptic: path started at [0-9.]* s of the loop (--start-on-answer)" "$h" || fail "$h: the path did not start on the answer"
+  done
   grep -Eq "^  round $k: lowest real-time ratio [0-9.]+; delta latency median [0-9.]+ us" "$S" || fail "no lab figures for round $k"
 done
 V='(unchanged within noise|slower than the seat alone beyond noise|no slower than the seat alone [(]faster beyond noise[)])$'

@@ -89,6 +89,8 @@ expect_recorded_pids_gone "$DB"
 for s in seat01 seat02; do
   expect_frames "$OUT/a/$s-frames1"
   expect_trainee_force "$OUT/a/$s-haptic.log"
+  grep -q "^haptic: path started at [0-9.]* s of the loop (--start-on-answer)" "$OUT/a/$s-haptic.log" ||
+    fail "$s: the trainee did not play its path from its server's answer"
 done
 expect_logs "$OUT/a" recorder seat01-server seat01-viewer1 seat01-haptic seat02-server seat02-viewer1 seat02-haptic
 expect_logs "$OUT/b" seat03-server seat04-server
