@@ -27,6 +27,16 @@
 # (viscera-server --seat-threads; server/session/seat_group.h); default the
 # server's own, one per online CPU; K = SEATS: a thread per seat.
 #
+# --beside (with --one-server, 2 seats or more): the lab's last seat runs in
+# a server process of its own, exactly as the seat alone runs, while the
+# other seats run in the one process: five seats are still on the machine
+# with all their clients, and the seat beside is a seat alone under the
+# lab's load. The summary sets the one process's seats against the seat
+# alone (as always), the seat beside against the seat alone (what the
+# machine shared with the lab costs any seat), and the one process's seats
+# against the seat beside (what stepping seats together costs or saves
+# under the same load; docs/numerics.md §11.9).
+#
 # --cpu-wake-latency US: the servers and trainees (alone and in the lab)
 # hold a PM QoS request that no CPU take longer than US us to wake from
 # idle (viscera-server --cpu-wake-latency; 0: idle CPUs poll): on a virtual
@@ -89,7 +99,7 @@
 #                             [--baseline S] [--rt-priority S] [--haptic-rt-priority H]
 #                             [--scene FILE] [--busy] [--one-server [--seat-threads K]]
 #                             [--cpu-wake-latency US] [--server-cpus LIST] [--client-cpus LIST]
-#                             [--physics-cpus LIST] [--command-playout N] [--rounds R]
+#                             [--physics-cpus LIST] [--command-playout N] [--rounds R] [--beside]
 # (the press is at x 12 mm, y 4 mm from above, 8 mm deep into an organ whose
 # top is at z = 35 mm: the shipped kidney and gallbladder; classroom
 # scenes: classroom_kidney.yaml, classroom_gallbladder.yaml)
@@ -99,12 +109,12 @@ set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD="$ROOT/build" OUT="$ROOT/out/load" SEATS=5 SUBS=30 DURATION=600 BASELINE=30 RTPRIO=70 HRTPRIO=80
 SCENE="$ROOT/assets/scenes/classroom_kidney.yaml" BUSY=0 ONE=0 SEATTH=0 WAKE="" SRVCPUS="" CLICPUS="" PHYCPUS=""
-PLAYOUT=""
+PLAYOUT="" BESIDE=0
 ROUNDS=1 ROUND_ARGS=() # every option but --out and --rounds, for each round's own run
 while [ $# -gt 0 ]; do
   case "$1" in
     --out | --rounds) ;;
-    --busy | --one-server) ROUND_ARGS+=("$1") ;;
+    --busy | --one-server | --beside) ROUND_ARGS+=("$1") ;;
     *) ROUND_ARGS+=("$1" "${2-}") ;;
   esac
   case "$1" in
@@ -119,6 +129,7 @@ while [ $# -gt 0 ]; do
     --scene) SCENE="$2"; shift 2 ;;
     --busy) BUSY=1; shift ;;
     --one-server) ONE=1; shift ;;
+    --beside) BESIDE=1; shift ;;
     --seat-threads) SEATTH="$2"; shift 2 ;;
     --cpu-wake-latency) WAKE="$2"; shift 2 ;;
     --server-cpus) SRVCPUS="$2"; shift 2 ;;
@@ -131,13 +142,19 @@ while [ $# -gt 0 ]; do
   esac
 done
 for v in SEATS SUBS DURATION BASELINE ROUNDS; do [[ "${!v}" =~ ^[0-9]+$ ]] && [ "${!v}" -ge 1 ] || { echo "load_bench.sh: bad ${v,,}" >&2; exit 2; }; done
-[[ "$SEATTH" =~ ^[0-9]+$ ]] && [ "$SEATTH" -le "$SEATS" ] ||
-  { echo "load_bench.sh: --seat-threads '$SEATTH' is not a number of threads 1..$SEATS" >&2; exit 2; }
+[ "$BESIDE" = 0 ] || { [ "$ONE" = 1 ] && [ "$SEATS" -ge 2 ]; } ||
+  { echo "load_bench.sh: --beside needs --one-server and 2 seats or more (the last seat runs in a process of its own)" >&2; exit 2; }
+GROUPED=$((SEATS - BESIDE)) # the seats the lab's one server process steps (--one-server)
+[[ "$SEATTH" =~ ^[0-9]+$ ]] && [ "$SEATTH" -le "$GROUPED" ] ||
+  { echo "load_bench.sh: --seat-threads '$SEATTH' is not a number of threads 1..$GROUPED" >&2; exit 2; }
 SEATTH=$((10#$SEATTH))
 [ "$SEATTH" = 0 ] || [ "$ONE" = 1 ] || { echo "load_bench.sh: --seat-threads needs --one-server" >&2; exit 2; }
 GROUPS_OPT=() NTHREADS=$SEATTH
 [ "$SEATTH" -gt 0 ] && GROUPS_OPT=(--seat-threads "$SEATTH")
-[ "$NTHREADS" -gt 0 ] || NTHREADS=$(( $(nproc) < SEATS ? $(nproc) : SEATS )) # the server's default
+[ "$NTHREADS" -gt 0 ] || NTHREADS=$(( $(nproc) < GROUPED ? $(nproc) : GROUPED )) # the server's default
+# The seats set against the seat alone: with --beside all but the last.
+LAB_SEATS=$(seq 1 "$GROUPED")
+BESIDE_SEAT=$(printf 'seat%02d' "$SEATS")
 check_prio() {
   [[ "$2" =~ ^[0-9]{1,2}$ ]] ||
     { echo "load_bench.sh: $1 '$2' is not 0 (normal scheduling) or a SCHED_FIFO priority 1..99" >&2; exit 2; }
@@ -200,38 +217,49 @@ if [ "$ROUNDS" -gt 1 ]; then
     bash "$0" "${ROUND_ARGS[@]}" --out "$OUT/round$k" > "$OUT/round$k.txt" 2>&1 ||
       { tail -5 "$OUT/round$k.txt" >&2; echo "load_bench.sh: round $k failed (its output: $OUT/round$k.txt)" >&2; exit 1; }
   done
-  # label, sed expression: each round's seats against the mean of that
-  # round's two runs of the seat alone, then the median over the rounds
-  # against the median of the rounds' alone-to-alone spreads.
-  # A third argument "work": the verdict speaks of work, not of time.
+  # label, sed expression [mode [vs]]: each round's seats against the mean
+  # of that round's two runs of the seat alone, then the median over the
+  # rounds against the median of the rounds' alone-to-alone spreads.
+  # mode "work": the verdict speaks of work, not of time. vs (--beside):
+  # "alone" (default) the one process's seats against the seat alone,
+  # "beside" the seat beside the lab against the seat alone, "seats-beside"
+  # the one process's seats against the seat beside (the band still the
+  # seat alone's own spread: the noise of one seat's run).
   rounds_against_alone() {
     local k i d
     for k in $(seq 1 "$ROUNDS"); do
       d="$OUT/round$k"
       echo "$k a1 $(sed -n "$2" "$d/alone-server.log")"
       echo "$k a2 $(sed -n "$2" "$d/alone2-server.log")"
-      for i in $(seq 1 "$SEATS"); do echo "$k seat $(sed -n "$2" "$d/$(printf 'seat%02d' "$i")-server.log")"; done
-    done | awk -v what="$1" -v R="$ROUNDS" -v mode="${3:-time}" '
+      for i in $LAB_SEATS; do echo "$k seat $(sed -n "$2" "$d/$(printf 'seat%02d' "$i")-server.log")"; done
+      [ "$BESIDE" = 0 ] || echo "$k beside $(sed -n "$2" "$d/$BESIDE_SEAT-server.log")"
+    done | awk -v what="$1" -v R="$ROUNDS" -v mode="${3:-time}" -v vs="${4:-alone}" '
       function med(a, n,   i, j, t) { # sorts a[1..n], returns its median
         for (i = 2; i <= n; i++) { t = a[i]; for (j = i - 1; j >= 1 && a[j] > t; j--) a[j + 1] = a[j]; a[j + 1] = t }
         return n % 2 ? a[(n + 1) / 2] : (a[n / 2] + a[n / 2 + 1]) / 2 }
-      NF == 3 && $3 > 0 { if ($2 == "a1") a1[$1] = $3; else if ($2 == "a2") a2[$1] = $3; else v[$1, ++nv[$1]] = $3 }
+      NF == 3 && $3 > 0 {
+        if ($2 == "a1") a1[$1] = $3; else if ($2 == "a2") a2[$1] = $3; else if ($2 == "beside") b[$1] = $3
+        if ($2 == (vs == "beside" ? "beside" : "seat")) v[$1, ++nv[$1]] = $3 }
       END {
+        who = vs == "beside" ? "the seat beside the lab" : "the seats"
+        against = vs == "seats-beside" ? "the seat beside the lab" : "the seat alone"
         for (k = 1; k <= R; k++) {
-          if (!(k in a1) || !(k in a2) || !nv[k]) { printf "  %s, round %d: figures missing\n", what, k; continue }
+          if (!(k in a1) || !(k in a2) || !nv[k] || (vs == "seats-beside" && !(k in b))) { printf "  %s, round %d: figures missing\n", what, k; continue }
           ref = (a1[k] + a2[k]) / 2; d = (a1[k] > a2[k] ? a1[k] - a2[k] : a2[k] - a1[k]) / ref
+          if (vs == "seats-beside") ref = b[k]
           n = 0; for (i = 1; i <= nv[k]; i++) r[++n] = v[k, i] / ref
           m = med(r, n); L[++nr] = m; D[nr] = d
-          printf "  %s, round %d: alone %.1f / %.1f %s (spread %.1f %%), seats %+.0f %% to %+.0f %% of their mean (median %+.0f %%)\n",
-            what, k, a1[k], a2[k], mode == "work" ? "node updates" : "us", 100 * d, 100 * (r[1] - 1), 100 * (r[n] - 1), 100 * (m - 1)
+          if (vs == "alone")
+            printf "  %s, round %d: alone %.1f / %.1f %s (spread %.1f %%), seats %+.0f %% to %+.0f %% of their mean (median %+.0f %%)\n",
+              what, k, a1[k], a2[k], mode == "work" ? "node updates" : "us", 100 * d, 100 * (r[1] - 1), 100 * (r[n] - 1), 100 * (m - 1)
         }
         if (!nr) exit
         mL = med(L, nr); mD = med(D, nr); band = 1.5 * mD
         verdict = "unchanged within noise"
-        if (mL - 1 > band) verdict = mode == "work" ? "more than the seat alone beyond noise" : "slower than the seat alone beyond noise"
-        if (1 - mL > band) verdict = mode == "work" ? "less than the seat alone beyond noise" : "no slower than the seat alone (faster beyond noise)"
-        printf "  %s over %d rounds: the seats %+.1f %% against the seat alone (rounds %+.0f %% to %+.0f %%); the seat alone'\''s own spread %.1f %% (rounds %.1f-%.1f %%), band +-%.1f %%: %s\n",
-          what, nr, 100 * (mL - 1), 100 * (L[1] - 1), 100 * (L[nr] - 1), 100 * mD, 100 * D[1], 100 * D[nr], 100 * band, verdict }'
+        if (mL - 1 > band) verdict = (mode == "work" ? "more than " : "slower than ") against " beyond noise"
+        if (1 - mL > band) verdict = mode == "work" ? "less than " against " beyond noise" : "no slower than " against " (faster beyond noise)"
+        printf "  %s over %d rounds: %s %+.1f %% against %s (rounds %+.0f %% to %+.0f %%); the seat alone'\''s own spread %.1f %% (rounds %.1f-%.1f %%), band +-%.1f %%: %s\n",
+          what, nr, who, 100 * (mL - 1), against, 100 * (L[1] - 1), 100 * (L[nr] - 1), 100 * mD, 100 * D[1], 100 * D[nr], 100 * band, verdict }'
   }
   # The tissue step at equal work: each round's seats' (work, tissue CPU
   # mean) pairs on a line through their mean, with one slope for all rounds
@@ -246,7 +274,7 @@ if [ "$ROUNDS" -gt 1 ]; then
       d="$OUT/round$k"
       echo "$k a1 $(sed -n "$WORK_SED" "$d/alone-server.log") $(sed -n "$TMEAN_SED" "$d/alone-server.log")"
       echo "$k a2 $(sed -n "$WORK_SED" "$d/alone2-server.log") $(sed -n "$TMEAN_SED" "$d/alone2-server.log")"
-      for i in $(seq 1 "$SEATS"); do
+      for i in $LAB_SEATS; do
         f="$d/$(printf 'seat%02d' "$i")-server.log"
         echo "$k seat $(sed -n "$WORK_SED" "$f") $(sed -n "$TMEAN_SED" "$f")"
       done
@@ -302,9 +330,17 @@ if [ "$ROUNDS" -gt 1 ]; then
     rounds_against_alone "step CPU median" "$STEP_SED"
     rounds_against_alone "  of it the tissue step" "$TISSUE_SED"
     rounds_against_alone "  the rest (commands, feedback, inputs, frames)" "$REST_SED"
+    if [ "$BESIDE" = 1 ]; then # the same three, for the seat beside the lab and against it
+      for vs in beside seats-beside; do
+        rounds_against_alone "step CPU median" "$STEP_SED" time "$vs"
+        rounds_against_alone "  of it the tissue step" "$TISSUE_SED" time "$vs"
+        rounds_against_alone "  the rest (commands, feedback, inputs, frames)" "$REST_SED" time "$vs"
+      done
+    fi
     if grep -q '^server: physics work per step' "$OUT/round1/alone-server.log"; then
       rounds_against_alone "physics work (node updates per step with an organ awake)" "$WORK_SED" work
       rounds_at_equal_work
+      [ "$BESIDE" = 0 ] || rounds_against_alone "physics work (node updates per step with an organ awake)" "$WORK_SED" work beside
     fi
     for k in $(seq 1 "$ROUNDS"); do
       rt=$(sed -n 's/^server: step CPU time median .*; \([0-9.]*\) simulated s per wall s.*/\1/p' "$OUT/round$k"/seat*-server.log | sort -g | head -1)
@@ -374,17 +410,18 @@ register() { echo "$1 $2 $3 $4" >> "$OUT/procs.txt"; }
 now_us() { echo "${EPOCHREALTIME/[.,]/}"; } # bash 5; the decimal sign follows the locale
 T0=$(now_us)
 servers=() srvnames=()
+start_seat_server() { # seatNN: a server process of its own for that seat of the lab
+  "${SRV_PIN[@]}" "$BUILD/server/viscera-server" --scene "$SCENE" --partition "load/$1" --duration $((DURATION + 3)) --quiet \
+    "${SRV_RT[@]}" > "$OUT/$1-server.out" 2> "$OUT/$1-server.log" &
+  servers+=($!); srvnames+=("$1"); pids+=($!); register $! server "$1" viscera-server
+}
 if [ "$ONE" = 1 ]; then
-  "${SRV_PIN[@]}" "$BUILD/server/viscera-server" --scene "$SCENE" --partition load --seats "$SEATS" --duration $((DURATION + 3)) \
+  "${SRV_PIN[@]}" "$BUILD/server/viscera-server" --scene "$SCENE" --partition load --seats "$GROUPED" --duration $((DURATION + 3)) \
     --quiet "${SRV_RT[@]}" "${GROUPS_OPT[@]}" > "$OUT/seats-server.out" 2> "$OUT/seats-server.log" &
   servers+=($!); srvnames+=(seats); pids+=($!); register $! server seats viscera-server
+  [ "$BESIDE" = 0 ] || start_seat_server "$BESIDE_SEAT"
 else
-  for i in $(seq 1 "$SEATS"); do
-    s=$(printf 'seat%02d' "$i")
-    "${SRV_PIN[@]}" "$BUILD/server/viscera-server" --scene "$SCENE" --partition "load/$s" --duration $((DURATION + 3)) --quiet \
-      "${SRV_RT[@]}" > "$OUT/$s-server.out" 2> "$OUT/$s-server.log" &
-    servers+=($!); srvnames+=("$s"); pids+=($!); register $! server "$s" viscera-server
-  done
+  for i in $(seq 1 "$SEATS"); do start_seat_server "$(printf 'seat%02d' "$i")"; done
 fi
 sleep 1
 for i in $(seq 1 "$SEATS"); do
@@ -463,7 +500,7 @@ done
 pids=()
 run_alone alone2
 {
-  echo "load_bench: $SEATS seats x $SCENE_NAME $([ "$ONE" = 1 ] && { [ "$NTHREADS" -lt "$SEATS" ] && echo "in one server process ($NTHREADS physics thread$([ "$NTHREADS" = 1 ] || echo s), each stepping its seats in turn) " || echo "in one server process (a physics thread per seat) "; } || echo "in a server process each ")($(sed -n 's/.*organ .\(.*\).: model \([a-z_]*\),.* \([0-9]*\) nodes.*/\1, \2, \3 nodes/p' "$OUT/check.txt" | head -1 | grep . || echo "see the scene"), 1 kHz physics), $([ "$BUSY" = 1 ] && echo "every seat pressed all the time" || echo "press and release every 4 s"), $SUBS subscribers ($late late), $DURATION s"
+  echo "load_bench: $SEATS seats x $SCENE_NAME $([ "$ONE" = 1 ] && { [ "$NTHREADS" -lt "$SEATS" ] && echo "in one server process ($NTHREADS physics thread$([ "$NTHREADS" = 1 ] || echo s), each stepping its seats in turn) " || echo "in one server process (a physics thread per seat) "; } || echo "in a server process each ")$([ "$BESIDE" = 1 ] && echo "but $BESIDE_SEAT, beside them in a process of its own as the seat alone runs ")($(sed -n 's/.*organ .\(.*\).: model \([a-z_]*\),.* \([0-9]*\) nodes.*/\1, \2, \3 nodes/p' "$OUT/check.txt" | head -1 | grep . || echo "see the scene"), 1 kHz physics), $([ "$BUSY" = 1 ] && echo "every seat pressed all the time" || echo "press and release every 4 s"), $SUBS subscribers ($late late), $DURATION s"
   sched() { # what PRIO LOG...: the policy asked and how many processes refused it
     local what=$1 prio=$2; shift 2
     if [ "$prio" = 0 ]; then echo "$what normal scheduling"; return; fi
@@ -485,7 +522,7 @@ run_alone alone2
   echo "  alone again after the lab: $(step_line "$OUT/alone2-server.log")"
   for i in $(seq 1 "$SEATS"); do
     s=$(printf 'seat%02d' "$i")
-    echo "  $s: $(step_line "$OUT/$s-server.log")"
+    echo "  $s$([ "$BESIDE" = 1 ] && [ "$s" = "$BESIDE_SEAT" ] && echo " (beside the lab, its own process)"): $(step_line "$OUT/$s-server.log")"
   done
   # The lab's seats against the seat alone (issue 17 item 6: "step time
   # unchanged from one seat alone"), step CPU medians: the whole step, then
@@ -494,14 +531,16 @@ run_alone alone2
   # "Unchanged within noise": every seat's median inside the span of the two
   # runs of the seat alone, widened on each side by their difference (the
   # reference's spread as measured in this run; see the header).
-  against_alone() { # label, sed expression printing one number from a server log
+  # With --beside, the same for the seat beside the lab (who "the seat
+  # beside the lab", seats: the last).
+  against_alone() { # label, sed expression printing one number from a server log [, who, seat numbers]
     local a1 a2
     a1=$(sed -n "$2" "$OUT/alone-server.log")
     a2=$(sed -n "$2" "$OUT/alone2-server.log")
-    for i in $(seq 1 "$SEATS"); do sed -n "$2" "$OUT/$(printf 'seat%02d' "$i")-server.log"; done | sort -g |
-      awk -v a1="${a1:-0}" -v a2="${a2:-0}" -v what="$1" 'NF { v[++n] = $1 } END {
+    for i in ${4:-$LAB_SEATS}; do sed -n "$2" "$OUT/$(printf 'seat%02d' "$i")-server.log"; done | sort -g |
+      awk -v a1="${a1:-0}" -v a2="${a2:-0}" -v what="$1" -v who="${3:-seats}" 'NF { v[++n] = $1 } END {
         if (!n || a1 <= 0) exit
-        printf "  %s, seats against the seat alone: %+.0f %% to %+.0f %% (%.1f-%.1f us against %.1f us)", what,
+        printf "  %s, %s against the seat alone: %+.0f %% to %+.0f %% (%.1f-%.1f us against %.1f us)", what, who,
           100 * (v[1] / a1 - 1), 100 * (v[n] / a1 - 1), v[1], v[n], a1
         if (a2 > 0) {
           lo = (a1 < a2 ? a1 : a2); hi = (a1 < a2 ? a2 : a1); d = hi - lo
@@ -515,11 +554,15 @@ run_alone alone2
   against_alone "step CPU median" "$STEP_SED"
   against_alone "  of it the tissue step" "$TISSUE_SED"
   against_alone "  the rest (commands, feedback, inputs, frames)" "$REST_SED"
+  if [ "$BESIDE" = 1 ]; then
+    against_alone "step CPU median" "$STEP_SED" "the seat beside the lab" "$SEATS"
+    against_alone "  of it the tissue step" "$TISSUE_SED" "the seat beside the lab" "$SEATS"
+  fi
   if grep -q '^server: physics work per step' "$OUT/alone-server.log"; then # the tissue step's work (WORK_SED)
     echo "  physics work (node updates per step with an organ awake): alone $(sed -n "$WORK_SED" "$OUT/alone-server.log"), seats $(
-      for i in $(seq 1 "$SEATS"); do sed -n "$WORK_SED" "$OUT/$(printf 'seat%02d' "$i")-server.log"; done | sort -g |
+      for i in $LAB_SEATS; do sed -n "$WORK_SED" "$OUT/$(printf 'seat%02d' "$i")-server.log"; done | sort -g |
         awk 'NF { v[++n] = $1 } END { if (n) printf "%s-%s", v[1], v[n]; else printf "n/a" }'
-    ), alone again $(sed -n "$WORK_SED" "$OUT/alone2-server.log")"
+    )$([ "$BESIDE" = 1 ] && echo ", the seat beside the lab $(sed -n "$WORK_SED" "$OUT/$BESIDE_SEAT-server.log")"), alone again $(sed -n "$WORK_SED" "$OUT/alone2-server.log")"
   fi
   if [ -n "$(awake_line "$OUT/alone-server.log")" ]; then
     echo "  organ sleeping: alone: $(awake_line "$OUT/alone-server.log")"

@@ -29,6 +29,12 @@ add_test(NAME load_bench_rounds_smoke COMMAND bash ${CMAKE_CURRENT_LIST_DIR}/loa
          ${PROJECT_BINARY_DIR} ${CMAKE_CURRENT_BINARY_DIR}/load_rounds)
 set_tests_properties(load_bench_rounds_smoke PROPERTIES LABELS bench TIMEOUT 180
   ENVIRONMENT "CYCLONEDDS_URI=file://${VISCERA_DDS_CONFIG};VISCERA_DOMAIN=177")
+# --beside: the lab's last seat in a process of its own, set against the
+# seat alone and against the one process's seats (issue 17 item 6).
+add_test(NAME load_bench_beside_smoke COMMAND bash ${CMAKE_CURRENT_LIST_DIR}/load_beside_smoke.sh ${PROJECT_SOURCE_DIR}
+         ${PROJECT_BINARY_DIR} ${CMAKE_CURRENT_BINARY_DIR}/load_beside)
+set_tests_properties(load_bench_beside_smoke PROPERTIES LABELS bench TIMEOUT 180
+  ENVIRONMENT "CYCLONEDDS_URI=file://${VISCERA_DDS_CONFIG};VISCERA_DOMAIN=210")
 # --neighbour: a second thread writes its own memory while the seats step;
 # it must have run (passes counted) and the seats still be timed.
 add_test(NAME bench_seats_neighbour_smoke COMMAND bench_seats --seats 1 --seconds 1.6 --neighbour 64)
