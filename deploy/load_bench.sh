@@ -500,7 +500,7 @@ done
 pids=()
 run_alone alone2
 {
-  echo "load_bench: $SEATS seats x $SCENE_NAME $([ "$ONE" = 1 ] && { [ "$NTHREADS" -lt "$SEATS" ] && echo "in one server process ($NTHREADS physics thread$([ "$NTHREADS" = 1 ] || echo s), each stepping its seats in turn) " || echo "in one server process (a physics thread per seat) "; } || echo "in a server process each ")$([ "$BESIDE" = 1 ] && echo "but $BESIDE_SEAT, beside them in a process of its own as the seat alone runs ")($(sed -n 's/.*organ .\(.*\).: model \([a-z_]*\),.* \([0-9]*\) nodes.*/\1, \2, \3 nodes/p' "$OUT/check.txt" | head -1 | grep . || echo "see the scene"), 1 kHz physics), $([ "$BUSY" = 1 ] && echo "every seat pressed all the time" || echo "press and release every 4 s"), $SUBS subscribers ($late late), $DURATION s"
+  echo "load_bench: $SEATS seats x $SCENE_NAME $([ "$ONE" = 1 ] && { [ "$NTHREADS" -lt "$GROUPED" ] && echo "in one server process ($NTHREADS physics thread$([ "$NTHREADS" = 1 ] || echo s), each stepping its seats in turn) " || echo "in one server process (a physics thread per seat) "; } || echo "in a server process each ")$([ "$BESIDE" = 1 ] && echo "but $BESIDE_SEAT, beside them in a process of its own as the seat alone runs ")($(sed -n 's/.*organ .\(.*\).: model \([a-z_]*\),.* \([0-9]*\) nodes.*/\1, \2, \3 nodes/p' "$OUT/check.txt" | head -1 | grep . || echo "see the scene"), 1 kHz physics), $([ "$BUSY" = 1 ] && echo "every seat pressed all the time" || echo "press and release every 4 s"), $SUBS subscribers ($late late), $DURATION s"
   sched() { # what PRIO LOG...: the policy asked and how many processes refused it
     local what=$1 prio=$2; shift 2
     if [ "$prio" = 0 ]; then echo "$what normal scheduling"; return; fi
