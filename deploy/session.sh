@@ -35,20 +35,36 @@ trap cleanup EXIT
 
 echo "session: domain $DOMAIN, partition '$PART', output in $OUT"
 "$BUILD/server/viscera-server" --scene "$SCENE" "${common[@]}" ${SERVER_ARGS:-} >"$OUT/server.out" 2>"$OUT/server.log" &
-SERVER=$!; pids+=($SERVER)
+SERVER=$!; pids+=("$SERVER")
 "$BUILD/client/recorder/viscera-recorder" "${common[@]}" --out "$OUT/session.db" --quiet \
   >"$OUT/recorder.out" 2>"$OUT/recorder.log" &
-RECORDER=$!; pids+=($RECORDER)
+RECORDER=$!; pids+=("$RECORDER")
 "$BUILD/client/viewer/viscera-viewer" "${common[@]}" --out "$OUT/frames" ${VIEWER_ARGS:---interval-ms 100} \
   >"$OUT/viewer.out" 2>"$OUT/viewer.log" &
-VIEWER=$!; pids+=($VIEWER)
+VIEWER=$!; pids+=("$VIEWER")
+# A server that refused its scene (a wrong field, a missing mesh) or died has
+# said why in its log; the user sees that, not a hand waiting for a server
+# that is gone. Prints the log's last lines and succeeds when the server exited.
+server_gone() {
+  kill -0 "$SERVER" 2>/dev/null && return 1
+  echo "session: the server exited (see $OUT/server.log):" >&2
+  tail -n 5 "$OUT/server.log" | sed 's/^/  /' >&2
+  return 0
+}
 # Let the viewer and recorder discover the server before the hand moves.
 sleep 1.5
+if server_gone; then exit 1; fi
+# set -e would end the script here, silently, on a failing client.
+HAPTIC_RC=0
 "$BUILD/client/haptic/viscera-haptic" --trajectory "$TRAJ" "${common[@]}" \
-  --force-csv "$OUT/haptic_force.csv" --rt-priority 50 >"$OUT/haptic.out" 2>"$OUT/haptic.log"
-HAPTIC_RC=$?
+  --force-csv "$OUT/haptic_force.csv" --rt-priority 50 >"$OUT/haptic.out" 2>"$OUT/haptic.log" || HAPTIC_RC=$?
+if [ $HAPTIC_RC -ne 0 ] && server_gone; then exit 1; fi
 sleep 0.5
 for p in $VIEWER $RECORDER $SERVER; do kill -INT "$p" 2>/dev/null || true; wait "$p" 2>/dev/null || true; done
 pids=()
 trap - EXIT
-[ $HAPTIC_RC -eq 0 ] || { echo "session: haptic client failed (see $OUT/haptic.log)" >&2; exit 1; }
+if [ $HAPTIC_RC -ne 0 ]; then
+  echo "session: haptic client failed, status $HAPTIC_RC (see $OUT/haptic.log):" >&2
+  tail -n 5 "$OUT/haptic.log" | sed 's/^/  /' >&2
+  exit 1
+fi
