@@ -207,7 +207,7 @@ int resim_app_run(const resim_options_t *o) {
     scene_path = scene_buf;
   }
   static resim_recording_t rec;
-  if (resim_recording_load(&rec, o->rec_path, o->partition, &err)) {
+  if (resim_recording_load(&rec, o->rec_path, o->partition, o->run, &err)) {
     fprintf(stderr, "viscera-resim: %s\n", err.msg);
     return 2;
   }
@@ -218,6 +218,13 @@ int resim_app_run(const resim_options_t *o) {
   }
   print_build(&rec);
   if (rec.partition[0]) printf("SESSION partition=%s\n", rec.partition);
+  if (rec.run) {
+    printf("RUN run=%zu runs=%zu\n", rec.run, rec.nruns);
+    fprintf(stderr,
+            "viscera-resim: note: the server ran %zu times in this session (restarted while the recorder ran): "
+            "re-simulating run %zu%s, the other runs' samples left out (--run N picks another)\n",
+            rec.nruns, rec.run, rec.run == rec.nruns ? ", the last" : "");
+  }
   if (rec.warnings[0]) fprintf(stderr, "viscera-resim: warning: %s\n", rec.warnings);
   if (rec.skipped)
     fprintf(stderr, "viscera-resim: warning: %" PRIu64 " sample(s) skipped; first: %s\n", rec.skipped, rec.first_skip);
