@@ -8,6 +8,10 @@
 #     RUN run=2 runs=2, RESUMED at the restarted server's step, bit exact;
 #   - --run 1: the first run, from rest up to the kill, bit exact;
 #   - --run 3: exit 2 naming the two runs.
+# viscera-report on that recording agrees with the resumed server's own
+# measures (its PALPATION line), which leave out what run 1 did after the
+# checkpoint: before, that stretch of simulated time was counted twice and
+# the force chart ran back in time; and it warns of the restart.
 # Before, both runs' inputs were applied in one re-simulation: "diverged",
 # 18446744073709549925 AppliedInputs "missing" (a negative count) and exit 1.
 # Steps wait for the processes' own output (the recorder's topic line, the
@@ -68,4 +72,22 @@ grep -q '^RESUMED' "$OUT/resim1.out" && fail "--run 1: run 1 started from a resu
 "$RESIM" "$DB" --run 3 --quiet >"$OUT/resim3.out" 2>"$OUT/resim3.log"; rc=$?
 [ $rc -eq 2 ] && grep -q -- '--run 3: the session holds 2 run(s)' "$OUT/resim3.log" ||
   fail "--run 3: exit $rc, $(cat "$OUT/resim3.log")"
-echo "PASS: run 1 (from rest) and run 2 (resumed at step $step) each re-simulated bit for bit"
+# viscera-report on the same recording: the resumed server's measures (restored
+# from its checkpoint) leave out what run 1 did after the checkpoint; so does
+# the report, instead of counting that stretch of simulated time twice.
+"$BUILD/client/report/viscera-report" --quiet --out "$OUT/report" "$DB" 2>"$OUT/report.log" ||
+  fail "viscera-report failed: $(cat "$OUT/report.log")"
+cat "$OUT/report.log"
+grep -q "the server restarted 1 time(s)" "$OUT/report.log" || fail "report: no warning of the restart"
+line=$(grep '^PALPATION tool=probe ' "$OUT/server2.out") || fail "run 2 printed no PALPATION line"
+val() { echo "$line" | grep -o " $1=[^ ]*" | cut -d= -f2; }
+col() { awk -F, -v k="$1" 'NR==1 { for (i = 1; i <= NF; i++) if ($i == k) c = i } NR==2 { print $c }' "$OUT/report/report.csv"; }
+# the report replays the recorded feedback: within 0.05 s or 3 % of the server's own figure
+near() { awk -v a="$1" -v b="$2" 'BEGIN { d = a - b; if (d < 0) d = -d; exit !(d <= 0.05 || d <= 0.03 * b) }'; }
+for m in "contact_time contact_time_s" "time_above_ST time_above_ST_s" "time_above_MPF time_above_MPF_s"; do
+  set -- $m
+  s=$(val "$1"); r=$(col "$2")
+  echo "$1: server $s s, report $r s"
+  near "${r:-0}" "${s:-0}" || fail "report $2 = $r s, the server's $1 = $s s"
+done
+echo "PASS: run 1 (from rest) and run 2 (resumed at step $step) each re-simulated bit for bit; the report agrees with run 2's measures"
