@@ -6,6 +6,7 @@
 
 #include <inttypes.h>
 #include <math.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -141,10 +142,15 @@ static int print_others(const resim_recording_t *rec, const resim_result_t *res,
   if (!res->applied) return bad;
   if (rec->applied_lost) {
     bad = 1;
+    /* In a damaged file they are most likely in the part that could not be
+     * read, not lost by the recorder. */
+    bool damaged = rec->warnings[0] || rec->skipped;
     fprintf(stderr,
-            "viscera-resim: %" PRIu64 " AppliedInput sample(s) are missing from the recording (the recorder lost "
-            "them): the inputs of those steps are unknown\n",
-            rec->applied_lost);
+            "viscera-resim: %" PRIu64 " AppliedInput sample(s) are missing from the recording (%s): the inputs of "
+            "those steps are unknown\n",
+            rec->applied_lost,
+            damaged ? "in the damaged part of the file named above, or lost by the recorder"
+                    : "the recorder lost them");
   }
   if (o->mismatched || o->unreached || o->max_err > tolerance) {
     bad = 1;
