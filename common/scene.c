@@ -464,13 +464,11 @@ enum {
   V_REGION_SPEED,
   V_NKEYS
 };
-static const char *const solver_keys[V_NKEYS] = {[V_SUBSTEPS] = "substeps",
-                                                 [V_ITERATIONS] = "iterations",
-                                                 [V_CG_TOLERANCE] = "cg_tolerance",
-                                                 [V_CG_MAX_ITERATIONS] = "cg_max_iterations",
-                                                 [V_TET_SIZE] = "tet_size",
-                                                 [V_REGION_FORCE] = "region_force",
-                                                 [V_REGION_SPEED] = "region_speed"};
+static const char *const solver_keys[V_NKEYS] = {
+    [V_SUBSTEPS] = "substeps",         [V_ITERATIONS] = "iterations",
+    [V_CG_TOLERANCE] = "cg_tolerance", [V_CG_MAX_ITERATIONS] = "cg_max_iterations",
+    [V_TET_SIZE] = "tet_size",         [V_REGION_FORCE] = "region_force",
+    [V_REGION_SPEED] = "region_speed"};
 
 enum {
   O_NAME,
@@ -756,6 +754,8 @@ static int parse_organ(const ctx_t *c, const node_t *n, size_t idx, const char *
                        s->organs[j].line);
   join(fp, sizeof fp, path, "mesh");
   if (v[O_MESH] && resolve_mesh(c, v[O_MESH], fp, base_dir, o->mesh, sizeof o->mesh)) return -1;
+  o->mesh_line = v[O_MESH] ? v[O_MESH]->line : 0;
+  o->volume_line = v[O_VOLUME] ? v[O_VOLUME]->line : 0;
   join(fp, sizeof fp, path, "model");
   if (v[O_MODEL] && get_choice(c, v[O_MODEL], fp, scene_models, COUNT(scene_models), o->model, sizeof o->model))
     return -1;

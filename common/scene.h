@@ -34,17 +34,17 @@ typedef struct scene_material {
   double stretch_bend_k; /* N, stretch-bend coupling k_sb [0] */
   /* PBD / XPBD (docs/methods.md C §4): stiffness in 0..1 for PBD, compliance
    * (m/N for distance, 1/(N m^2)... per constraint) for XPBD. */
-  double distance_stiffness;   /* PBD [1] */
-  double volume_stiffness;     /* PBD [1] */
-  double distance_compliance;  /* XPBD [1e-4] */
-  double volume_compliance;    /* XPBD [1e-6] */
+  double distance_stiffness;  /* PBD [1] */
+  double volume_stiffness;    /* PBD [1] */
+  double distance_compliance; /* XPBD [1e-4] */
+  double volume_compliance;   /* XPBD [1e-6] */
   /* vertex_based (docs/methods.md B ch. 4): slopes of the slope-intercept rule for
    * the touched node and its first and second rings, m1 > m2 > m3 > 0. */
   double slope_m1, slope_m2, slope_m3; /* [1, 0.6, 0.3] */
   /* adaptive_mass_spring (docs/methods.md B ch. 5): one-ring faces larger than
    * refine_area are subdivided, up to refine_levels levels. */
-  double refine_area;    /* m^2 [2e-5] */
-  int refine_levels;     /* [2] */
+  double refine_area; /* m^2 [2e-5] */
+  int refine_levels;  /* [2] */
 } scene_material_t;
 
 /* Default CG iteration cap of the integrator implicit_pcg (one step per ms). */
@@ -92,13 +92,14 @@ typedef struct scene_organ {
   /* Force-based models: explicit_euler, symplectic_euler, verlet, rk4, implicit_euler. */
   char integrator[32];
   scene_solver_t solver;
-  double position[3];        /* m, translation applied after scale (default 0) */
-  double scale;              /* applied to the mesh coordinates (default 1) */
-  float color[3];            /* RGB 0..1 (default 0.8 0.35 0.3) */
+  double position[3]; /* m, translation applied after scale (default 0) */
+  double scale;       /* applied to the mesh coordinates (default 1) */
+  float color[3];     /* RGB 0..1 (default 0.8 0.35 0.3) */
   scene_material_t material;
-  int fixed_below_set;       /* 1 if fixed_below was given */
-  double fixed_below;        /* m, vertices with z below this are fixed */
-  int line;                  /* line of the organ entry, for later messages */
+  int fixed_below_set;        /* 1 if fixed_below was given */
+  double fixed_below;         /* m, vertices with z below this are fixed */
+  int line;                   /* line of the organ entry, for later messages */
+  int mesh_line, volume_line; /* lines of its `mesh:` and `volume:` keys (0: not given), for the files' problems */
 } scene_organ_t;
 
 /* Tool kinds and what each can do (key `kind:`):
@@ -190,17 +191,17 @@ typedef struct scene_task {
 
 typedef struct scene {
   char path[SCENE_PATH_LEN];
-  char name[SCENE_NAME_LEN];  /* required */
+  char name[SCENE_NAME_LEN]; /* required */
   char description[256];
-  double dt;                  /* s, physics step (default 0.001) */
-  double publish_hz;          /* MeshDelta rate (default 30) */
-  double quant_step;          /* m, MeshDelta quantization (default 1e-5) */
-  double gravity[3];          /* m/s^2 (default 0 0 0: organs rest on home springs) */
+  double dt;         /* s, physics step (default 0.001) */
+  double publish_hz; /* MeshDelta rate (default 30) */
+  double quant_step; /* m, MeshDelta quantization (default 1e-5) */
+  double gravity[3]; /* m/s^2 (default 0 0 0: organs rest on home springs) */
   /* Organ sleeping (server/runtime/organ_sleep.h): an organ whose surface moved
    * slower than sleep_speed for sleep_after s, with no tool near, is not
    * stepped until a tool comes near. */
-  double sleep_speed;         /* m/s; 0 (the default) = organs never sleep */
-  double sleep_after;         /* s (default 0.1), >= 2 dt */
+  double sleep_speed; /* m/s; 0 (the default) = organs never sleep */
+  double sleep_after; /* s (default 0.1), >= 2 dt */
   /* s of wall time: a MeshDelta equal to the last one written is skipped
    * unless this long passed (server/session/mesh_publisher.h); 0 (the default)
    * writes every frame. */
@@ -208,7 +209,7 @@ typedef struct scene {
   /* physics.integrator: the integrator of every organ that names none
    * ("" when not given: organs default to symplectic_euler). */
   char integrator[32];
-  size_t norgans;             /* >= 1 */
+  size_t norgans; /* >= 1 */
   scene_organ_t organs[SCENE_MAX_ORGANS];
   size_t ntools;
   scene_tool_t tools[SCENE_MAX_TOOLS];

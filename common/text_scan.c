@@ -76,6 +76,10 @@ int text_scan_next(text_scan_t *s, verr_t *err) {
     char c = s->buf[s->pos];
     if (c == '\n' || is_blank(c) || (s->comment && c == s->comment)) break;
     if (c == '\0') return text_scan_fail(s, err, "a NUL byte: binary data where text was expected");
+    /* Any other control byte is binary data too; naming it (not echoing the
+     * token) keeps escape sequences from a random file off the terminal. */
+    if ((unsigned char)c < 0x20 || c == 0x7f)
+      return text_scan_fail(s, err, "a control byte 0x%02x: binary data where text was expected", (unsigned char)c);
     if (n + 1 >= TEXT_SCAN_TOKEN_MAX)
       return text_scan_fail(s, err, "a token longer than %d characters", TEXT_SCAN_TOKEN_MAX - 1);
     s->tok[n++] = c;

@@ -35,20 +35,51 @@ trap cleanup EXIT
 
 echo "session: domain $DOMAIN, partition '$PART', output in $OUT"
 "$BUILD/server/viscera-server" --scene "$SCENE" "${common[@]}" ${SERVER_ARGS:-} >"$OUT/server.out" 2>"$OUT/server.log" &
-SERVER=$!; pids+=($SERVER)
+SERVER=$!; pids+=("$SERVER")
 "$BUILD/client/recorder/viscera-recorder" "${common[@]}" --out "$OUT/session.db" --quiet \
   >"$OUT/recorder.out" 2>"$OUT/recorder.log" &
-RECORDER=$!; pids+=($RECORDER)
+RECORDER=$!; pids+=("$RECORDER")
 "$BUILD/client/viewer/viscera-viewer" "${common[@]}" --out "$OUT/frames" ${VIEWER_ARGS:---interval-ms 100} \
   >"$OUT/viewer.out" 2>"$OUT/viewer.log" &
-VIEWER=$!; pids+=($VIEWER)
+VIEWER=$!; pids+=("$VIEWER")
+# A process that stopped early has said why in its log: a server that refused
+# its scene (a wrong field, a missing mesh), a viewer or recorder that refused
+# its options. The user sees that, not a hand waiting for a server that is
+# gone or a session without frames. gone NAME PID: prints NAME's log tail and
+# succeeds when that process has exited.
+gone() {
+  kill -0 "$2" 2>/dev/null && return 1
+  echo "session: the $1 exited (see $OUT/$1.log):" >&2
+  tail -n 5 "$OUT/$1.log" | sed 's/^/  /' >&2
+  return 0
+}
 # Let the viewer and recorder discover the server before the hand moves.
 sleep 1.5
+if gone server "$SERVER" || gone viewer "$VIEWER" || gone recorder "$RECORDER"; then exit 1; fi
+# set -e would end the script here, silently, on a failing client.
+HAPTIC_RC=0
 "$BUILD/client/haptic/viscera-haptic" --trajectory "$TRAJ" "${common[@]}" \
-  --force-csv "$OUT/haptic_force.csv" --rt-priority 50 >"$OUT/haptic.out" 2>"$OUT/haptic.log"
-HAPTIC_RC=$?
+  --force-csv "$OUT/haptic_force.csv" --rt-priority 50 >"$OUT/haptic.out" 2>"$OUT/haptic.log" || HAPTIC_RC=$?
+if [ $HAPTIC_RC -ne 0 ] && gone server "$SERVER"; then exit 1; fi
 sleep 0.5
-for p in $VIEWER $RECORDER $SERVER; do kill -INT "$p" 2>/dev/null || true; wait "$p" 2>/dev/null || true; done
+# Each stops cleanly (status 0) on SIGINT; any other status is its own failure.
+FAILED=()
+for entry in "viewer:$VIEWER" "recorder:$RECORDER" "server:$SERVER"; do
+  name=${entry%%:*} pid=${entry#*:} rc=0
+  kill -INT "$pid" 2>/dev/null || true
+  wait "$pid" 2>/dev/null || rc=$?
+  [ $rc -eq 0 ] || FAILED+=("$name (status $rc)")
+done
 pids=()
 trap - EXIT
-[ $HAPTIC_RC -eq 0 ] || { echo "session: haptic client failed (see $OUT/haptic.log)" >&2; exit 1; }
+for f in "${FAILED[@]}"; do
+  name=${f%% *}
+  echo "session: the $f failed (see $OUT/$name.log):" >&2
+  tail -n 5 "$OUT/$name.log" | sed 's/^/  /' >&2
+done
+if [ $HAPTIC_RC -ne 0 ]; then
+  echo "session: haptic client failed, status $HAPTIC_RC (see $OUT/haptic.log):" >&2
+  tail -n 5 "$OUT/haptic.log" | sed 's/^/  /' >&2
+  exit 1
+fi
+[ ${#FAILED[@]} -eq 0 ] || exit 1

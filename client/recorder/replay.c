@@ -29,7 +29,7 @@ static void usage(FILE *f) {
              "                      [--loop] [--quiet]\n"
              "  --domain N      DDS domain to publish in (default: the recorded one)\n" CLI_HELP_INSECURE
              "  --partition P   partition to publish in (default: the recorded one, if not a pattern)\n"
-             "  --speed X       playback speed factor, > 0 (default 1)\n"
+             "  --speed X       playback speed factor, > 0 and at most 1e6 (default 1)\n"
              "  --seek S        skip the first S seconds (transient-local state is still sent)\n"
              "  --pause-at S    pause when the replay reaches recording time S seconds (once)\n"
              "  --loop          start over at the end until interrupted\n"
@@ -60,11 +60,11 @@ static int on_option(void *ctx, int code, const char *arg) {
   replay_options_t *r = ctx;
   switch (code) {
   case OPT_SPEED:
-    return number("speed", arg, 0.0, 0, 1e6, "a number > 0", &r->speed);
+    return number("speed", arg, 0.0, 0, 1e6, "a number > 0 and at most 1e6", &r->speed);
   case OPT_PAUSE_AT:
-    return number("pause-at", arg, 0.0, 1, 1e8, "seconds >= 0", &r->pause_at);
+    return number("pause-at", arg, 0.0, 1, 1e8, "seconds, 0 to 1e8", &r->pause_at);
   case OPT_SEEK:
-    return number("seek", arg, 0.0, 1, 1e8, "seconds >= 0", &r->seek);
+    return number("seek", arg, 0.0, 1, 1e8, "seconds, 0 to 1e8", &r->seek);
   case OPT_LOOP:
     r->loop = true;
     return 0;

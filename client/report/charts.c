@@ -70,8 +70,15 @@ int rep_chart_force(const rep_recording_t *r, const char *path, verr_t *err) {
   double ax[1] = {0}, ay[1] = {0};
   if (ret == 0) plot_add(p, "", 1, ax, ay, PLOT_GREY, -1, PLOT_LINE_NONE);
   if (ret == 0) {
-    plot_note(p, "time above ST %.2f s, above MPF %.2f s, above SFT %.2f s; in contact %.2f s", r->sum.time_above[0],
-              r->sum.time_above[1], r->sum.time_above[2], r->sum.contact_time);
+    /* Only the levels the scene set: "0.00 s above SFT" of an unset SFT
+     * would read as a trainee who stayed below it. */
+    char above[160] = "";
+    size_t len = 0;
+    for (int k = 0; k < THR_COUNT; k++)
+      if (r->sum.levels[k] > 0 && len < sizeof above)
+        len += (size_t)snprintf(above + len, sizeof above - len, "%s above %s %.2f s", len ? "," : "time",
+                                thr_name((thr_id_t)k), r->sum.time_above[k]);
+    plot_note(p, "%s; in contact %.2f s", len ? above : "no thresholds set", r->sum.contact_time);
     ret = plot_write_png(p, path, err);
   }
   plot_free(p);

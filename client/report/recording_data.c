@@ -51,11 +51,41 @@ typedef struct load_ctx {
    * one file (a partition pattern) interleave (many). */
   int64_t last_fb_writer;
   uint64_t fb_writer_switches;
+  /* A restarted server (resumed from its checkpoint, or from rest) goes on
+   * from an earlier simulated time than its predecessor reached; what the
+   * predecessor did after that time was rolled back with it. Per tool the
+   * writer of its last feedback, then what was left out. */
+  int64_t tool_fb_writer[REP_MAX_TOOLS];
+  /* Writers met so far (a restart is a writer never met before; two
+   * servers taking turns, a mixed recording, are not restarts). */
+  int64_t met[64];
+  size_t nmet;
+  uint64_t rolled_back; /* feedback samples left out */
+  uint32_t restarts;    /* restarts seen in the feedback */
+  double first_restart; /* simulated time the first restart went on from */
+  int64_t last_ev_writer;
+  double last_ev_t;
+  bool ev_seen;
+  uint64_t events_rolled_back;
+  /* Threshold crossings from the events, (time, level), until counted. */
+  struct crossing {
+    double t;
+    int k;
+  } * cross;
+  size_t ncross, capcross;
   /* One seat of a lab: only rows of writers in partition `seat` count. */
   const char *seat;
   const rec_writer_t *writers;
   size_t nwriters;
 } load_ctx_t;
+
+/* True the first time writer `id` is met (and remembers it while there is room). */
+static bool first_met(load_ctx_t *c, int64_t id) {
+  for (size_t i = 0; i < c->nmet; i++)
+    if (c->met[i] == id) return false;
+  if (c->nmet < sizeof c->met / sizeof c->met[0]) c->met[c->nmet++] = id;
+  return true;
+}
 
 static bool in_seat(const load_ctx_t *c, const recfile_row_t *row) {
   if (!c->seat) return true;
@@ -106,6 +136,17 @@ static int on_feedback(void *arg, const void *sample, const recfile_row_t *row) 
   double f = sqrt((double)fb->force[0] * fb->force[0] + (double)fb->force[1] * fb->force[1] +
                   (double)fb->force[2] * fb->force[2]);
   double ts = (double)fb->sim_time_ns * 1e-9;
+  int64_t *last_writer = &c->tool_fb_writer[fb->tool_id];
+  bool new_writer = row->writer_id > 0 && first_met(c, row->writer_id);
+  if (new_writer && t->nforce && *last_writer > 0 && ts < t->force[t->nforce - 1].t) {
+    /* Force and proxy samples are appended together: one count for both. */
+    size_t keep = t->nforce;
+    while (keep && t->force[keep - 1].t >= ts) keep--;
+    c->rolled_back += t->nforce - keep;
+    t->nforce = t->nproxy = keep;
+    if (!c->restarts++) c->first_restart = ts;
+  }
+  if (row->writer_id > 0) *last_writer = row->writer_id;
   if (!grow((void **)&t->force, &t->capforce, t->nforce, sizeof *t->force) ||
       !grow((void **)&t->proxy, &t->capproxy, t->nproxy, sizeof *t->proxy)) {
     c->oom = true;
@@ -180,10 +221,34 @@ static int on_event(void *arg, const void *sample, const recfile_row_t *row) {
   c->last_event_writer[src] = row->writer_id;
   c->last_event_seq[src] = e->seq;
   r->nevents++;
+  double et = (double)e->sim_time_ns * 1e-9;
+  bool new_writer = row->writer_id > 0 && first_met(c, row->writer_id);
+  if (new_writer && c->ev_seen && et < c->last_ev_t) {
+    /* A restarted server: its predecessor's events after `et` were rolled back. */
+    size_t n = 0;
+    for (size_t i = 0; i < c->ncross; i++)
+      if (c->cross[i].t < et) c->cross[n++] = c->cross[i];
+    c->events_rolled_back += c->ncross - n;
+    c->ncross = n;
+    n = 0;
+    for (size_t i = 0; i < r->ntask_events; i++)
+      if (r->task_events[i].t < et) r->task_events[n++] = r->task_events[i];
+    c->events_rolled_back += r->ntask_events - n;
+    r->ntask_events = n;
+  }
+  c->ev_seen = true;
+  c->last_ev_writer = row->writer_id;
+  c->last_ev_t = et;
   int32_t kind = (int32_t)e->kind;
   if (kind == (int32_t)viscera_EVENT_THRESHOLD_CROSSED_UP) {
     int k = threshold_of_text(e->text);
-    if (k >= 0) r->event_crossings[k]++;
+    if (k >= 0) {
+      if (!grow((void **)&c->cross, &c->capcross, c->ncross, sizeof *c->cross)) {
+        c->oom = true;
+        return 1;
+      }
+      c->cross[c->ncross++] = (struct crossing){et, k};
+    }
   } else if (kind >= 0 && (kind == c->task_started || kind == c->task_completed)) {
     if (!grow((void **)&r->task_events, &r->captask_events, r->ntask_events, sizeof *r->task_events)) {
       c->oom = true;
@@ -393,7 +458,15 @@ int rep_recording_load(rep_recording_t *r, const char *path, const char *label, 
   describe_identity(r, rf, &c);
   free(writers);
   recfile_close(rf);
+  for (size_t i = 0; i < c.ncross; i++) r->event_crossings[c.cross[i].k]++;
+  free(c.cross);
   if (c.oom) return verr_set(err, "%s: out of memory while reading", path);
+  if (c.restarts)
+    warn(r,
+         "the server restarted %u time(s) (resumed from its checkpoint, or from rest), first going on from "
+         "simulated time %.3f s: %llu force sample(s) and %llu event(s) of the run before, later than where the "
+         "next run went on, are left out, as the restarted server's own measures leave them",
+         c.restarts, c.first_restart, (unsigned long long)c.rolled_back, (unsigned long long)c.events_rolled_back);
   if (!r->have_scene_info) warn(r, "%s", "no SceneInfo: thresholds unknown (ST/MPF/SFT measures are 0)");
   if (c.fb_writer_switches > 10)
     warn(r,

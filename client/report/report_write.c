@@ -64,7 +64,7 @@ int rep_write_csv(const rep_recording_t *const *recs, int n, const rep_limits_t 
     }
     for (int k = 0; k < THR_COUNT; k++) {
       fputc(',', f);
-      csv_num(f, "%.4g", r->sum.levels[k]);
+      csv_num(f, "%.4g", r->sum.levels[k] > 0 ? r->sum.levels[k] : NAN); /* empty: not set */
     }
     fprintf(f, ",%s,", r->sum.crossings_from_events ? "events" : "force_trace");
     /* tasks as name=seconds;... (unfinished: name=incomplete) */
@@ -244,6 +244,23 @@ static void html_summary(FILE *f, const rep_recording_t *const *recs, int n, con
   fputs("</table>\n", f);
 }
 
+/* A tool's thresholds; a level of 0 is one the scene did not set, which
+ * must not read as a limit of 0 N. */
+static void html_levels(FILE *f, const double levels[THR_COUNT]) {
+  bool any = false;
+  for (int k = 0; k < THR_COUNT; k++) any |= levels[k] > 0;
+  if (!any) {
+    fputs("no thresholds set", f);
+    return;
+  }
+  for (int k = 0; k < THR_COUNT; k++) {
+    if (levels[k] > 0)
+      fprintf(f, "%s%s %.2f N", k ? ", " : "", thr_name((thr_id_t)k), levels[k]);
+    else
+      fprintf(f, "%s%s not set", k ? ", " : "", thr_name((thr_id_t)k));
+  }
+}
+
 static int html_section(FILE *f, const rep_recording_t *r, int i, const rep_charts_t *ch, const rep_layout_t *lay,
                         bool first, verr_t *err) {
   fprintf(f, "<h2 id=s%d%s>", i + 1, first ? " class=first" : "");
@@ -265,9 +282,9 @@ static int html_section(FILE *f, const rep_recording_t *r, int i, const rep_char
     if (r->tools[t].present) {
       fputs("<tr><td>tool ", f);
       html_text(f, r->tools[t].name);
-      fprintf(f, "</td><td>%zu force samples, %zu commands; ST %.2f N, MPF %.2f N, SFT %.2f N</td></tr>",
-              r->tools[t].nforce, r->tools[t].ncmd, r->tools[t].levels[0], r->tools[t].levels[1],
-              r->tools[t].levels[2]);
+      fprintf(f, "</td><td>%zu force samples, %zu commands; ", r->tools[t].nforce, r->tools[t].ncmd);
+      html_levels(f, r->tools[t].levels);
+      fputs("</td></tr>", f);
     }
   fputs("</table>\n", f);
   if (r->warnings[0]) {

@@ -3,6 +3,7 @@
 #include "dds/vdds_ident.h"
 
 #include <errno.h>
+#include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -36,19 +37,34 @@ static void copy_text(char *dst, size_t size, sqlite3_stmt *st, int col) {
 
 /* A file that is not a database at all gets a plain answer before SQLite is
  * involved, so the message does not depend on SQLite's wording. */
-static int check_file(const char *path, verr_t *err) {
+static int check_file(const char *path, bool *wal_mode, verr_t *err) {
   struct stat sb;
   if (stat(path, &sb) != 0) return verr_set(err, "%s: %s", path, strerror(errno));
   if (S_ISDIR(sb.st_mode)) return verr_set(err, "%s: is a directory, not a recording", path);
   if (sb.st_size == 0) return verr_set(err, "%s: empty file, not a recording", path);
   FILE *f = fopen(path, "rb");
   if (!f) return verr_set(err, "%s: %s", path, strerror(errno));
-  char hdr[16] = {0};
+  unsigned char hdr[20] = {0};
   size_t n = fread(hdr, 1, sizeof hdr, f);
   fclose(f);
-  if (n < sizeof hdr || memcmp(hdr, "SQLite format 3", 16) != 0)
+  if (n < 16 || memcmp(hdr, "SQLite format 3", 16) != 0)
     return verr_set(err, "%s: not a SQLite database, so not a viscera recording", path);
+  /* Header bytes 18-19 (write and read format versions) are 2 in WAL mode. */
+  *wal_mode = n == sizeof hdr && hdr[18] == 2 && hdr[19] == 2;
   return 0;
+}
+
+/* A WAL-mode database with no table at all is what a recorder leaves in its
+ * main file while it runs or after kill -9: schema and samples wait in
+ * PATH-wal until the WAL is checkpointed (at a clean stop, or every few MB).
+ * Copied without that file it reads as empty; say so rather than "not a
+ * recording", since the fix is to bring the -wal file along. */
+static bool wal_left_behind(const char *path, bool wal_mode, int ntables) {
+  if (!wal_mode || ntables != 0) return false;
+  char wal[PATH_MAX + 8];
+  snprintf(wal, sizeof wal, "%s-wal", path);
+  struct stat sb;
+  return stat(wal, &sb) != 0 || sb.st_size == 0;
 }
 
 static int pragma_int(sqlite3 *db, const char *sql, int64_t *v) {
@@ -74,15 +90,17 @@ static const char *db_reason(sqlite3 *db, int rc) {
 
 /* Reads the identification and which required tables exist; the SQLite
  * code of the first failure otherwise. */
-static int load_schema(sqlite3 *db, int64_t *app_id, bool have[REC_REQUIRED_TABLE_COUNT]) {
+static int load_schema(sqlite3 *db, int64_t *app_id, bool have[REC_REQUIRED_TABLE_COUNT], int *ntables) {
   static const char *required[] = REC_REQUIRED_TABLES;
   int rc = pragma_int(db, "PRAGMA application_id", app_id);
   if (rc != SQLITE_OK) return rc;
   sqlite3_stmt *st = NULL;
   rc = sqlite3_prepare_v2(db, "SELECT name FROM sqlite_master WHERE type='table'", -1, &st, NULL);
   if (rc != SQLITE_OK) return rc;
+  *ntables = 0;
   while ((rc = sqlite3_step(st)) == SQLITE_ROW) {
     const char *name = (const char *)sqlite3_column_text(st, 0);
+    (*ntables)++;
     for (int i = 0; name && i < REC_REQUIRED_TABLE_COUNT; i++)
       if (strcmp(name, required[i]) == 0) have[i] = true;
   }
@@ -154,7 +172,8 @@ static void read_topics(recfile_t *rf) {
 
 int recfile_open(recfile_t **out, const char *path, verr_t *err) {
   *out = NULL;
-  if (check_file(path, err) < 0) return -1;
+  bool wal_mode = false;
+  if (check_file(path, &wal_mode, err) < 0) return -1;
   recfile_t *rf = calloc(1, sizeof *rf);
   if (!rf || !(rf->path = strdup(path))) {
     free(rf);
@@ -171,14 +190,15 @@ int recfile_open(recfile_t **out, const char *path, verr_t *err) {
   sqlite3_busy_timeout(rf->db, 2000);
   int64_t app_id = 0;
   bool have[REC_REQUIRED_TABLE_COUNT] = {false};
-  rc = load_schema(rf->db, &app_id, have);
+  int ntables = 0;
+  rc = load_schema(rf->db, &app_id, have, &ntables);
   if ((rc & 0xff) == SQLITE_CORRUPT) {
     /* SQLite refuses a file shorter than its header says (a truncated
      * copy, a disk that filled up) unless the schema is "writable"; on a
      * read-only connection that only relaxes the check, and every page
      * that is still there can be read. */
     sqlite3_exec(rf->db, "PRAGMA writable_schema=ON", NULL, NULL, NULL);
-    int rc2 = load_schema(rf->db, &app_id, have);
+    int rc2 = load_schema(rf->db, &app_id, have, &ntables);
     if (rc2 == SQLITE_OK) {
       rf->damaged = true;
       warn(rf, "%s", "truncated or damaged (SQLite: database disk image is malformed); reading what is left");
@@ -187,6 +207,13 @@ int recfile_open(recfile_t **out, const char *path, verr_t *err) {
   }
   if (rc != SQLITE_OK) {
     verr_set(err, "%s: %s", path, db_reason(rf->db, rc));
+    goto fail;
+  }
+  if (wal_left_behind(path, wal_mode, ntables)) {
+    verr_set(err,
+             "%s: holds no tables yet: its content is in the write-ahead log %s-wal, which is missing (a recorder "
+             "killed or still running keeps its samples there; copy that file beside this one)",
+             path, path);
     goto fail;
   }
   static const char *required[] = REC_REQUIRED_TABLES;

@@ -25,6 +25,8 @@ static void usage(FILE *f) {
              "  --csv FILE        one line per compared frame: step,sim_time_s,organ,kind,max_err_m,rms_err_m,exact\n"
              "  --partition P     the session of partition P (a lab's recording holds every seat's session,\n"
              "                    e.g. lab/seat03); needed when the recording holds more than one\n"
+             "  --run N           the session's Nth run of its server (1 = the first; default the last): a\n"
+             "                    server killed and restarted while the recorder ran leaves several\n"
              "  --quiet           no progress lines\n"
              "  --help            this text\n"
              "  --version         print the version and exit\n"
@@ -33,7 +35,7 @@ static void usage(FILE *f) {
              "interaction event.\nExit status: 0 within tolerance, 1 beyond, 2 on an error or a usage error.\n");
 }
 
-enum { OPT_SCENE = 's', OPT_TOLERANCE = 't', OPT_CSV = 'c', OPT_MESH_DIR = 'm' };
+enum { OPT_SCENE = 's', OPT_TOLERANCE = 't', OPT_CSV = 'c', OPT_MESH_DIR = 'm', OPT_RUN = 'r' };
 
 static int on_option(void *ctx, int code, const char *arg) {
   resim_options_t *o = ctx;
@@ -55,21 +57,29 @@ static int on_option(void *ctx, int code, const char *arg) {
       return 2;
     }
     return 0;
+  case OPT_RUN: {
+    long v = strtol(arg, &end, 10);
+    if (!end || *end || end == arg || v < 1 || v > 1000000) {
+      fprintf(stderr, "viscera-resim: --run '%s' is not a run number 1, 2, ...\n", arg);
+      return 2;
+    }
+    o->run = (size_t)v;
+    return 0;
+  }
   }
   return 0; /* not reached: cli_parse passes only the codes above */
 }
 
 int main(int argc, char **argv) {
-  static const struct option lo[] = {{"scene", required_argument, 0, OPT_SCENE},
-                                     {"tolerance", required_argument, 0, OPT_TOLERANCE},
-                                     {"csv", required_argument, 0, OPT_CSV},
-                                     {"mesh-dir", required_argument, 0, OPT_MESH_DIR},
-                                     {0, 0, 0, 0}};
+  static const struct option lo[] = {
+      {"scene", required_argument, 0, OPT_SCENE}, {"tolerance", required_argument, 0, OPT_TOLERANCE},
+      {"csv", required_argument, 0, OPT_CSV},     {"mesh-dir", required_argument, 0, OPT_MESH_DIR},
+      {"run", required_argument, 0, OPT_RUN},     {0, 0, 0, 0}};
   const cli_spec_t spec = {.program = "viscera-resim",
                            .common = CLI_QUIET | CLI_PARTITION,
                            .partition_error = "--partition needs 1..255 characters",
                            .partition_max = 256,
-                           .shortopts = "s:t:c:m:qh",
+                           .shortopts = "s:t:c:m:r:qh",
                            .options = lo,
                            .option = on_option,
                            .usage = usage};

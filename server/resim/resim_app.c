@@ -6,6 +6,7 @@
 
 #include <inttypes.h>
 #include <math.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -141,10 +142,15 @@ static int print_others(const resim_recording_t *rec, const resim_result_t *res,
   if (!res->applied) return bad;
   if (rec->applied_lost) {
     bad = 1;
+    /* In a damaged file they are most likely in the part that could not be
+     * read, not lost by the recorder. */
+    bool damaged = rec->warnings[0] || rec->skipped;
     fprintf(stderr,
-            "viscera-resim: %" PRIu64 " AppliedInput sample(s) are missing from the recording (the recorder lost "
-            "them): the inputs of those steps are unknown\n",
-            rec->applied_lost);
+            "viscera-resim: %" PRIu64 " AppliedInput sample(s) are missing from the recording (%s): the inputs of "
+            "those steps are unknown\n",
+            rec->applied_lost,
+            damaged ? "in the damaged part of the file named above, or lost by the recorder"
+                    : "the recorder lost them");
   }
   if (o->mismatched || o->unreached || o->max_err > tolerance) {
     bad = 1;
@@ -207,7 +213,7 @@ int resim_app_run(const resim_options_t *o) {
     scene_path = scene_buf;
   }
   static resim_recording_t rec;
-  if (resim_recording_load(&rec, o->rec_path, o->partition, &err)) {
+  if (resim_recording_load(&rec, o->rec_path, o->partition, o->run, &err)) {
     fprintf(stderr, "viscera-resim: %s\n", err.msg);
     return 2;
   }
@@ -218,6 +224,13 @@ int resim_app_run(const resim_options_t *o) {
   }
   print_build(&rec);
   if (rec.partition[0]) printf("SESSION partition=%s\n", rec.partition);
+  if (rec.run) {
+    printf("RUN run=%zu runs=%zu\n", rec.run, rec.nruns);
+    fprintf(stderr,
+            "viscera-resim: note: the server ran %zu times in this session (restarted while the recorder ran): "
+            "re-simulating run %zu%s, the other runs' samples left out (--run N picks another)\n",
+            rec.nruns, rec.run, rec.run == rec.nruns ? ", the last" : "");
+  }
   if (rec.warnings[0]) fprintf(stderr, "viscera-resim: warning: %s\n", rec.warnings);
   if (rec.skipped)
     fprintf(stderr, "viscera-resim: warning: %" PRIu64 " sample(s) skipped; first: %s\n", rec.skipped, rec.first_skip);

@@ -488,18 +488,20 @@ static int in_session(void *arg, const void *sample, const recfile_row_t *row) {
   return f->cb(f->arg, sample, row);
 }
 
-int resim_recording_load(resim_recording_t *rec, const char *path, const char *partition, verr_t *err) {
+int resim_recording_load(resim_recording_t *rec, const char *path, const char *partition, size_t run, verr_t *err) {
   memset(rec, 0, sizeof *rec);
   recfile_t *rf = NULL;
   if (recfile_open(&rf, path, err)) return -1;
   resim_session_t session;
-  if (resim_session_pick(rf, partition, &session, err)) {
+  if (resim_session_pick(rf, partition, run, &session, err)) {
     verr_t e = *err;
     verr_set(err, "%s: %s", path, e.msg);
     recfile_close(rf);
     return -1;
   }
   snprintf(rec->partition, sizeof rec->partition, "%s", session.partition);
+  rec->nruns = session.nruns;
+  rec->run = session.run;
   snprintf(rec->warnings, sizeof rec->warnings, "%s", recfile_warnings(rf));
   load_ctx_t ctx = {.rec = rec};
   /* SceneInfo first: dt turns every sim time into a step, and the organ and
@@ -542,8 +544,9 @@ int resim_recording_load(resim_recording_t *rec, const char *path, const char *p
   resim_session_free(&session);
   free(ctx.rebuild_ts);
   /* The server numbers its samples from 1: a missing one is a lost input
-   * (duplicates, which a reliable reader does not deliver, would hide one). */
-  if (ctx.seq_n) rec->applied_lost = ctx.seq_max - ctx.seq_n;
+   * (duplicates, which a reliable reader does not deliver, would hide one;
+   * more samples than numbers can only be duplicates, not a negative loss). */
+  if (ctx.seq_n && ctx.seq_max > ctx.seq_n) rec->applied_lost = ctx.seq_max - ctx.seq_n;
   if (rc) {
     resim_recording_free(rec);
     return -1;

@@ -174,13 +174,17 @@ typedef struct resim_recording {
   char first_skip[256];
   char warnings[512];  /* from the recording reader (damage, missing pragmas) */
   char partition[256]; /* the session read (resim_session.h), "" when the recording holds only one */
+  size_t nruns, run;   /* the session's server runs and the one read (resim_session.h; run 0: the only one) */
 } resim_recording_t;
 
 /* Reads the session of `partition` (NULL: the recording's only one; a
- * lab's recording of several seats needs one, resim_session.h).
+ * lab's recording of several seats needs one, resim_session.h), and of it
+ * server run `run` (1 = the first, 0 = the last: a server restarted while
+ * the recorder ran left several).
  * Returns 0, or -1 with err naming the file and what is wrong (not a
- * recording, no SceneInfo, unreadable, several sessions and none chosen). */
-int resim_recording_load(resim_recording_t *rec, const char *path, const char *partition, verr_t *err);
+ * recording, no SceneInfo, unreadable, several sessions and none chosen,
+ * no such run). */
+int resim_recording_load(resim_recording_t *rec, const char *path, const char *partition, size_t run, verr_t *err);
 void resim_recording_free(resim_recording_t *rec);
 
 #endif

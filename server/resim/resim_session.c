@@ -53,7 +53,12 @@ static size_t sessions(const rec_writer_t *w, size_t n, int64_t scene_topic, cha
   return count;
 }
 
-int resim_session_pick(recfile_t *rf, const char *partition, resim_session_t *out, verr_t *err) {
+/* Writers of one participant share the first 12 bytes of their GUIDs. */
+#define PARTICIPANT_HEX 24
+
+static bool same_participant(const char *a, const char *b) { return !strncmp(a, b, PARTICIPANT_HEX); }
+
+int resim_session_pick(recfile_t *rf, const char *partition, size_t run, resim_session_t *out, verr_t *err) {
   memset(out, 0, sizeof *out);
   const recfile_topic_t *t = recfile_topic_by_name(rf, "viscera_SceneInfo");
   rec_writer_t *w = NULL;
@@ -61,32 +66,59 @@ int resim_session_pick(recfile_t *rf, const char *partition, resim_session_t *ou
   if (rec_writers_load(rf, &w, &n, err)) return -1;
   char names[200];
   size_t count = t ? sessions(w, n, t->id, names, sizeof names) : 0;
-  if (!partition || !*partition) {
+  bool whole = !partition || !*partition;
+  if (whole && count > 1) {
     free(w);
-    if (count > 1)
-      return verr_set(err, "the recording holds %zu sessions (partitions %s): choose one with --partition", count,
-                      names);
-    return 0; /* one session (or none: the SceneInfo check says so) */
+    return verr_set(err, "the recording holds %zu sessions (partitions %s): choose one with --partition", count, names);
   }
+  /* The server runs of the session: the owners of its SceneInfo writers,
+   * in the order the recorder met them (writer ids grow). */
+  const char **runs = malloc((n ? n : 1) * sizeof *runs);
   out->ids = malloc((n ? n : 1) * sizeof *out->ids);
-  if (!out->ids) {
+  if (!runs || !out->ids) {
+    free(runs);
     free(w);
+    resim_session_free(out);
     return verr_set(err, "out of memory for %zu writers", n);
   }
-  bool scene = false;
+  size_t nruns = 0;
+  for (size_t i = 0; t && i < n; i++) {
+    if (w[i].topic_id != t->id || (!whole && !lists(w[i].partitions, partition))) continue;
+    bool seen = false;
+    for (size_t j = 0; j < nruns && !seen; j++) seen = same_participant(runs[j], w[i].guid);
+    if (!seen) runs[nruns++] = w[i].guid;
+  }
+  int rc = 0;
+  if (!whole && !nruns)
+    rc = verr_set(err, "no session in partition '%.100s' (the recording's: %s)", partition, count ? names : "none");
+  else if (run > nruns)
+    rc = verr_set(err, "--run %zu: the session holds %zu run(s) of its server", run, nruns);
+  if (rc || (whole && nruns <= 1)) { /* an error, or one session of one run: every sample */
+    free(runs);
+    free(w);
+    if (rc)
+      resim_session_free(out);
+    else {
+      free(out->ids);
+      out->ids = NULL;
+      out->nruns = nruns;
+    }
+    return rc;
+  }
+  size_t keep = run ? run - 1 : nruns - 1;
   for (size_t i = 0; i < n; i++) {
-    if (!lists(w[i].partitions, partition)) continue;
-    out->ids[out->n++] = w[i].id;
-    scene |= t && w[i].topic_id == t->id;
+    if (!whole && !lists(w[i].partitions, partition)) continue;
+    bool other = false;
+    for (size_t j = 0; j < nruns && !other; j++) other = j != keep && same_participant(runs[j], w[i].guid);
+    if (!other) out->ids[out->n++] = w[i].id;
   }
+  free(runs);
   free(w);
-  if (!scene) {
-    resim_session_free(out);
-    return verr_set(err, "no session in partition '%.100s' (the recording's: %s)", partition, count ? names : "none");
-  }
   qsort(out->ids, out->n, sizeof *out->ids, cmp_id);
   out->filter = true;
-  snprintf(out->partition, sizeof out->partition, "%s", partition);
+  out->nruns = nruns;
+  out->run = nruns > 1 ? keep + 1 : 0;
+  if (!whole) snprintf(out->partition, sizeof out->partition, "%s", partition);
   return 0;
 }
 

@@ -4,6 +4,7 @@
 #include "runtime/topology_follow.h"
 
 #include <math.h>
+#include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -16,6 +17,16 @@
 
 static void apply_contacts(model_t *m, void *vctx);
 
+/* A problem of the organ's mesh or volume file, at the line of the key that
+ * names that file: `volume:` when the message is about it, else `mesh:`. */
+static int file_error(verr_t *err, const scene_t *sc, const scene_organ_t *cfg, uint32_t id, const char *what) {
+  bool volume = cfg->volume[0] && (!cfg->mesh[0] || strstr(what, cfg->volume));
+  int line = volume ? cfg->volume_line : cfg->mesh_line;
+  return verr_set(err, "%s:%d: field 'organs[%u].%s': organ '%s'%s%s%s: %s", sc->path, line ? line : cfg->line, id,
+                  volume ? "volume" : "mesh", cfg->name, cfg->model[0] ? " (model " : "", cfg->model,
+                  cfg->model[0] ? ")" : "", what);
+}
+
 static int organ_init(organ_rt_t *o, runtime_t *rt, const scene_organ_t *cfg, uint32_t id, double tool_k, verr_t *err) {
   const scene_t *sc = &rt->scene;
   memset(o, 0, sizeof *o);
@@ -24,8 +35,7 @@ static int organ_init(organ_rt_t *o, runtime_t *rt, const scene_organ_t *cfg, ui
   o->rt = rt;
   verr_t e;
   tet_mesh_t volume = {0};
-  if (organ_geometry_load(cfg, &o->rest, &volume, &e))
-    return verr_set(err, "%s:%d: organ '%s': %s", sc->path, cfg->line, cfg->name, e.msg);
+  if (organ_geometry_load(cfg, &o->rest, &volume, &e)) return file_error(err, sc, cfg, id, e.msg);
   /* The defects no model can take are refused, the ones with one right
    * answer repaired (mesh_admit.h); the volume models need a closed
    * surface, the surface ones also take a sheet. */
@@ -36,7 +46,7 @@ static int organ_init(organ_rt_t *o, runtime_t *rt, const scene_organ_t *cfg, ui
   if (mesh_admit(&o->rest, &ao, cfg->mesh[0] ? cfg->mesh : cfg->volume, o->mesh_note, sizeof o->mesh_note, &e)) {
     mesh_free(&o->rest);
     tet_mesh_free(&volume);
-    return verr_set(err, "%s:%d: organ '%s' (model %s): %s", sc->path, cfg->line, cfg->name, cfg->model, e.msg);
+    return file_error(err, sc, cfg, id, e.msg);
   }
   /* The proxy spring acts on the contact vertices like an extra home
    * spring, so explicit schemes include the stiffest tool in their bound. */

@@ -142,6 +142,11 @@ static void refusals(void) {
           "$Elements\n1\n1 5 0 1 1 1 1 1 1 1 1\n$EndElements\n",
           10, "hexahedron");
   refused("vol_r3.msh", "$MeshFormat\n4.1 1 8\n", 2, "binary");
+  /* control bytes (here an escape sequence) are named, never echoed */
+  refused("vol_r3b.msh", "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$No\033[2Jdes\n", 4, "a control byte 0x1b");
+  refused("vol_r3c.vtk",
+          "# vtk DataFile Version 3.0\nt\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS 4 double\n0 0 \0010\n", 6,
+          "a control byte 0x01");
   refused("vol_r4.msh", "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n2\n1 0 0 0\n2 0 zero 0\n", 7, "not a number");
   refused("vol_r5.msh",
           "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n4\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 1 1 0\n"

@@ -244,7 +244,7 @@ static const char *run_readers(const char *path, dds_entity_t pp, dds_entity_t p
     return "recfile refused without a message";
   }
   static resim_recording_t rec;
-  if (resim_recording_load(&rec, path, NULL, &e) == 0) {
+  if (resim_recording_load(&rec, path, NULL, 0, &e) == 0) {
     int bad = rec.dt > 0 && (double)rec.last_step * rec.dt > RESIM_MAX_SIM_S + 1;
     resim_recording_free(&rec);
     if (bad) return "resim planned beyond RESIM_MAX_SIM_S";

@@ -116,5 +116,14 @@ run recinfo_v7 1 "format version 7 \\(session row\\) is not one this tool reads"
 run replay_v7 1 "format version 7" "$REPLAY" "$WORK/v7.db" "${RP[@]}"
 run resim_v7 2 "format version 7" "$RESIM" --scene "$SRC/assets/scenes/default.yaml" "$WORK/v7.db" --quiet
 
+echo "== 6. 64 KB zeroed in the middle of the file: inputs in the damaged part"
+# Sample pages (rows of every topic, in recording order) are lost there and
+# read again after it: AppliedInputs are missing in between, and resim blames
+# the damage it has just reported, not the recorder.
+cp "$DB" "$WORK/zeroed.db"
+dd if=/dev/zero of="$WORK/zeroed.db" bs=1 seek=$(($(stat -c %s "$DB") * 2 / 5)) count=65536 conv=notrunc status=none
+run resim_zeroed 1 "missing from the recording \(in the damaged part of the file" "$RESIM" \
+  --scene "$SRC/assets/scenes/default.yaml" "$WORK/zeroed.db" --quiet
+
 [ $fail -eq 0 ] && echo "damaged_recordings: PASS"
 exit $fail

@@ -22,3 +22,5 @@ viscera_integration_test(bad_commands 13 bad_commands_test.sh)
 viscera_integration_test(bad_input 14 bad_input_test.sh)
 viscera_integration_test(failover 15 failover_test.sh)
 viscera_integration_test(example_scenes 16 scenes_test.sh)
+# deploy/session.sh says which process failed and why (a refused scene, a missing trajectory).
+viscera_integration_test(session_failures 199 session_failures_test.sh)

@@ -4,3 +4,8 @@
 if(TARGET viscera-resim)
   viscera_integration_test(resim_resume 207 resim_resume_test.sh)
 endif()
+# A server killed and resumed while the recorder ran: each run of the server re-simulates
+# on its own (resim_restart_test.sh, viscera-resim --run). Domain 169.
+if(TARGET viscera-resim)
+  viscera_integration_test(resim_restart 169 resim_restart_test.sh)
+endif()

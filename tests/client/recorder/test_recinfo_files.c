@@ -269,6 +269,43 @@ int main(void) {
   }
   expect_rejected(p, "damaged viscera recording");
 
+  /* a recorder killed or still running: its committed batches are in the
+   * -wal file; the main file copied alone holds no table, and the message
+   * names the missing -wal instead of "not a viscera recording" */
+  {
+    char live[512];
+    path_in(live, sizeof live, "live.db");
+    verr_t err = {{0}};
+    store_t *s = NULL;
+    store_session_t meta = {"unit", "viscera/unit", 42, 1700000000000000000LL, "host", "test"};
+    CHECK(store_open(&s, live, false, &meta, &err) == 0);
+    int64_t tid = 0;
+    if (s) CHECK(store_add_topic(s, "viscera_ToolCommand", &viscera_ToolCommand_desc, NULL, 1, &tid, &err) == 0);
+    static unsigned char cdr[64] = {0, 1};
+    for (int i = 0; s && i < 100; i++) {
+      store_sample_t smp = {tid, 0,         1700000000000000000LL + i, 1700000000000000000LL + i, REC_KIND_DATA, false,
+                            cdr, sizeof cdr};
+      CHECK(store_add_sample(s, &smp, &err) == 0);
+    }
+    if (s) CHECK(store_commit(s, &err) == 0);
+    path_in(p, sizeof p, "copied_without_wal.db");
+    copy_prefix(live, p, file_size(live));
+    char want[600];
+    snprintf(want, sizeof want, "%s-wal, which is missing", p);
+    expect_rejected(p, want);
+    /* beside its -wal the same file reads, all 100 samples */
+    recfile_t *rf = NULL;
+    CHECK(recfile_open(&rf, live, &err) == 0);
+    if (rf) {
+      count_ctx_t c = {0};
+      recfile_scan_report_t rep;
+      recfile_scan(rf, 0, true, count_row, &c, &rep);
+      CHECK(c.rows == 100);
+      recfile_close(rf);
+    }
+    if (s) store_close(s, -1, &err);
+  }
+
   /* truncated copies: never a crash; a salvage never claims more rows than
    * the file had, and a cut file never passes as undamaged */
   long size = file_size(good);
