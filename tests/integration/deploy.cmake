@@ -10,3 +10,6 @@ set_tests_properties(systemd_units PROPERTIES SKIP_RETURN_CODE 77)
 viscera_integration_test(lab_one_server 173 lab_one_server_test.sh)
 # lab.sh --one-server --secure: one group identity for the process's seats. Domain 174.
 viscera_integration_test(lab_one_server_secure 174 lab_one_server_secure_test.sh)
+# lab.sh's printed commands pasted in another directory, PKI given by a
+# relative path as in the README (--secure, one seat). Domain 229.
+viscera_integration_test(lab_paste 229 lab_paste_test.sh)
