@@ -13,3 +13,6 @@ viscera_integration_test(lab_one_server_secure 174 lab_one_server_secure_test.sh
 # lab.sh's printed commands pasted in another directory, PKI given by a
 # relative path as in the README (--secure, one seat). Domain 229.
 viscera_integration_test(lab_paste 229 lab_paste_test.sh)
+# lab.sh --one-server with ten seats: each seat's split log holds its own
+# figures only. Domain 230.
+viscera_integration_test(lab_one_server_logs 230 lab_one_server_logs_test.sh)
