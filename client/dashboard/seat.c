@@ -120,6 +120,7 @@ static void on_event(seat_t *s, const void *x, double now) {
     s->crossings[a - 1]++;
     if (a >= s->alert || now > s->alert_until) s->alert = a;
     s->alert_until = now + SEAT_ALERT_HOLD_S;
+    s->alert_sim_s = (double)e->sim_time_ns * 1e-9;
     break;
   }
   case viscera_EVENT_CLIENT_LOST:
@@ -168,6 +169,15 @@ int seat_poll(seat_t *s, double now, verr_t *err) {
   take_all(s, s->rd_role, &s->gate_role, on_role, now);
   take_all(s, s->rd_measures, &s->gate_measures, on_measures, now);
   if (now > s->alert_until) s->alert = SEAT_OK;
+  /* A dashboard started late takes the seat's past events (SessionEvent is
+   * transient-local): a crossing long over in the seat's simulated time
+   * raises no alert. (After a reset the simulated time restarts below the
+   * crossing's; the dashboard's own hold then ends the alert.) */
+  double sim_now = (double)scene_view_sim_time_ns(&s->sv) * 1e-9;
+  if (s->alert != SEAT_OK && sim_now - s->alert_sim_s > SEAT_ALERT_HOLD_S) {
+    s->alert = SEAT_OK;
+    s->alert_until = 0;
+  }
   /* A trainee still pressing above a threshold stays alerted after the
    * crossing's hold runs out. */
   float st, mpf, sft, mf;

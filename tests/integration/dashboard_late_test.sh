@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
+# The instructor's dashboard started late (README "Classroom and remote
+# sessions": a dashboard opened after the lab began). SessionEvent is
+# transient-local, so a dashboard that joins takes the seat's past threshold
+# crossings; they count in its crossings, but a crossing long over in the
+# seat's simulated time must not put the seat in alert: before the fix every
+# seat showed "above MPF" (red, 0.00 N) for the first 3 s of a dashboard
+# started after its trainee had pressed.
+# One seat: a scripted trainee palpates once (crossing ST and MPF) and exits;
+# 3 s later (the crossings are then over 3 s old) a dashboard writes rows every
+# 250 ms for 3 s. Asserts: it sees the scene, counts the past MPF crossing,
+# and every row with the scene says "ok" at 0 N.
+# usage: dashboard_late_test.sh BUILD SRC OUT
+set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/prelude.sh"
+TRAJ="$SRC/assets/trajectories/palpate_kidney.traj"
+"$BUILD/server/viscera-server" --scene "$SRC/assets/scenes/default.yaml" --partition lab/seat01 \
+  > "$OUT/server.log" 2>&1 & SRV=$!; PIDS+=("$SRV")
+"$BUILD/client/haptic/viscera-haptic" --partition lab/seat01 --trajectory "$TRAJ" --start-on-answer --wait-server 60 \
+  --quiet > "$OUT/haptic.log" 2>&1 || fail "the trainee did not exit cleanly"
+grep -q "MPF crossed up" "$OUT/server.log" || fail "the trainee's press did not cross MPF"
+# The press crossed up 2-3 s before the path's end; this margin puts it well
+# past the hold in simulated time too (a margin, nothing is timed).
+sleep 3
+"$BUILD/client/dashboard/viscera-dashboard" --seats 1 --out "$OUT/dash" --interval-ms 250 --duration 3 \
+  > "$OUT/dashboard.log" 2>&1 || fail "the dashboard failed"
+csv="$OUT/dash/dashboard.csv"
+# columns: 4 have_scene, 5 force_n, 7 alert, 9 crossings_mpf
+rows=$(awk -F, '$3 == "lab/seat01" && $4 == 1' "$csv")
+[ -n "$rows" ] || fail "the late dashboard never saw the seat's scene"
+echo "$rows" | tail -2
+echo "$rows" | awk -F, '$9 >= 1 { ok = 1 } END { exit !ok }' || fail "the late dashboard did not count the past MPF crossing"
+bad=$(echo "$rows" | awk -F, '$7 != "ok" || $5 + 0 > 0' | head -3)
+[ -z "$bad" ] || fail "a crossing long over put the seat in alert on a dashboard started late: $bad"
+kill -INT $SRV; wait $SRV || fail "server exited with an error"
+PIDS=()
+echo PASS
