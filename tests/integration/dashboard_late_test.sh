@@ -10,7 +10,8 @@
 # One seat: a scripted trainee palpates once (crossing ST and MPF) and exits;
 # 3 s later (the crossings are then over 3 s old) a dashboard writes rows every
 # 250 ms for 3 s. Asserts: it sees the scene, counts the past MPF crossing,
-# and every row with the scene says "ok" at 0 N.
+# and every row with the scene says "ok" at 0 N. Part 2 (below): the
+# thresholds an instructor set reach a dashboard started after the change.
 # usage: dashboard_late_test.sh BUILD SRC OUT
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/prelude.sh"
@@ -33,6 +34,38 @@ echo "$rows" | tail -2
 echo "$rows" | awk -F, '$9 >= 1 { ok = 1 } END { exit !ok }' || fail "the late dashboard did not count the past MPF crossing"
 bad=$(echo "$rows" | awk -F, '$7 != "ok" || $5 + 0 > 0' | head -3)
 [ -z "$bad" ] || fail "a crossing long over put the seat in alert on a dashboard started late: $bad"
+
+# Part 2: the thresholds in force. A trainee presses and holds (about
+# 0.97 N); the instructor lowers SFT to 0.9 N below the held force
+# (viscera-control thresholds); a dashboard started after the SFT crossing's
+# hold judges the held force by the new levels: "SFT". Before the fix the
+# server's SceneInfo kept the scene file's levels (SFT 1.5 N), so the
+# dashboard said "MPF" and drew the old lines.
+n_sft=$(grep -c "SFT crossed up" "$OUT/server.log" || true)
+"$BUILD/client/haptic/viscera-haptic" --partition lab/seat01 --trajectory "$SRC/assets/trajectories/push_hold_kidney.traj" \
+  --start-on-answer --duration 30 --quiet > "$OUT/hold.log" 2>&1 & H=$!; PIDS+=("$H")
+n_mpf=$(grep -c "MPF crossed up" "$OUT/server.log" || true)
+for ((t = 0; t < 600; t++)); do
+  [ "$(grep -c "MPF crossed up" "$OUT/server.log" || true)" -gt "$n_mpf" ] && break
+  sleep 0.1
+done
+[ "$(grep -c "MPF crossed up" "$OUT/server.log" || true)" -gt "$n_mpf" ] || fail "the held press never crossed MPF"
+"$BUILD/client/control/viscera-control" --partition lab/seat01 thresholds 0 0.4 0.7 0.9 > "$OUT/control.log" 2>&1 ||
+  fail "the thresholds were not applied"
+for ((t = 0; t < 600; t++)); do
+  [ "$(grep -c "SFT crossed up" "$OUT/server.log" || true)" -gt "$n_sft" ] && break
+  sleep 0.1
+done
+[ "$(grep -c "SFT crossed up" "$OUT/server.log" || true)" -gt "$n_sft" ] || fail "the server did not take the new SFT"
+sleep 4 # past the crossing's 3 s hold: the dashboard judges the force by the levels it was given
+"$BUILD/client/dashboard/viscera-dashboard" --seats 1 --out "$OUT/dash2" --interval-ms 250 --duration 2 \
+  > "$OUT/dashboard2.log" 2>&1 || fail "the second dashboard failed"
+held=$(awk -F, '$3 == "lab/seat01" && $4 == 1 && $5 + 0 > 0.92' "$OUT/dash2/dashboard.csv")
+[ -n "$held" ] || fail "the second dashboard saw no held press above 0.92 N"
+echo "$held" | tail -1
+bad=$(echo "$held" | awk -F, '$7 != "SFT"' | head -3)
+[ -z "$bad" ] || fail "a force above the instructor's new SFT (0.9 N) not shown as SFT: $bad"
+kill -INT $H; wait $H || fail "the holding trainee failed"
 kill -INT $SRV; wait $SRV || fail "server exited with an error"
 PIDS=()
 echo PASS
