@@ -16,3 +16,6 @@ viscera_integration_test(lab_paste 229 lab_paste_test.sh)
 # lab.sh --one-server with ten seats: each seat's split log holds its own
 # figures only. Domain 230.
 viscera_integration_test(lab_one_server_logs 230 lab_one_server_logs_test.sh)
+# pki.sh rerun on a lab's PKI (adding a server group): identities already
+# handed out stay valid. Domain 208.
+viscera_integration_test(pki_rerun 208 pki_rerun_test.sh)
