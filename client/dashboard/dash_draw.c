@@ -202,6 +202,10 @@ static void draw_tile(dash_t *d, int i, cairo_t *cr, int x, int y, verr_t *err) 
       cairo_set_source_rgb(cr, 0.6, 0.6, 0.6);
     text(cr, x + 8, y + DASH_HEADER_H + 22, 15, s->client_lost ? "trainee lost" : "trainee left");
   }
+  if (s->paused) { /* the instructor's own pause, so the seat's stillness is not mistaken for idleness */
+    cairo_set_source_rgb(cr, 0.45, 0.7, 1.0);
+    text(cr, x + 8, y + DASH_HEADER_H + (s->client_lost || s->client_left ? 42 : 22), 15, "paused");
+  }
   if (s->alert != SEAT_OK) {
     /* The frame an instructor notices from across the room. */
     double c[3];

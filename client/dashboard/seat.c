@@ -134,6 +134,15 @@ static void on_event(seat_t *s, const void *x, double now) {
   case viscera_EVENT_CONTACT_BEGIN:
     s->client_lost = s->client_left = 0;
     break;
+  case viscera_EVENT_CONTROL_APPLIED:
+    /* The server's answer carries the command's kind in `value`; a reset
+     * keeps the pause (the server does), so only these two change it. A
+     * dashboard started later takes the answer from the event history. */
+    if (e->value == (double)viscera_CONTROL_PAUSE)
+      s->paused = 1;
+    else if (e->value == (double)viscera_CONTROL_RESUME)
+      s->paused = 0;
+    break;
   default:
     break;
   }

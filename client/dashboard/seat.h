@@ -65,6 +65,7 @@ typedef struct seat {
   uint32_t crossings[3];            /* upward crossings seen: ST, MPF, SFT */
   int client_lost;                  /* the trainee's client is gone without a goodbye (see below) */
   int client_left;                  /* it exited cleanly: its ToolCommand instance was disposed */
+  int paused;                       /* the instructor paused the seat: its server applied a pause, no resume since */
   seat_event_t events[SEAT_EVENTS]; /* newest at (nevents - 1) % SEAT_EVENTS */
   uint64_t nevents;
   seat_role_t roles[SCENE_VIEW_MAX_TOOLS];

@@ -11,7 +11,8 @@
 # 3 s later (the crossings are then over 3 s old) a dashboard writes rows every
 # 250 ms for 3 s. Asserts: it sees the scene, counts the past MPF crossing,
 # and every row with the scene says "ok" at 0 N. Part 2 (below): the
-# thresholds an instructor set reach a dashboard started after the change.
+# thresholds an instructor set reach a dashboard started after the change;
+# part 3: a seat the instructor paused shows as paused until resumed.
 # usage: dashboard_late_test.sh BUILD SRC OUT
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/prelude.sh"
@@ -65,6 +66,26 @@ held=$(awk -F, '$3 == "lab/seat01" && $4 == 1 && $5 + 0 > 0.92' "$OUT/dash2/dash
 echo "$held" | tail -1
 bad=$(echo "$held" | awk -F, '$7 != "SFT"' | head -3)
 [ -z "$bad" ] || fail "a force above the instructor's new SFT (0.9 N) not shown as SFT: $bad"
+
+# Part 3: a paused seat. The instructor pauses it (as the README's
+# five-minute block does); a dashboard started after that shows it paused
+# (CSV column 14, and "paused" in light blue on the tile) until a resume.
+# Before, nothing on the dashboard told a paused seat from an idle one.
+"$BUILD/client/control/viscera-control" --partition lab/seat01 pause >> "$OUT/control.log" 2>&1 || fail "pause refused"
+"$BUILD/client/dashboard/viscera-dashboard" --seats 1 --out "$OUT/dash3" --interval-ms 250 --duration 2 \
+  > "$OUT/dashboard3.log" 2>&1 || fail "the third dashboard failed"
+last=$(awk -F, '$3 == "lab/seat01" && $4 == 1' "$OUT/dash3/dashboard.csv" | tail -1)
+[ -n "$last" ] || fail "the third dashboard never saw the scene"
+[ "$(echo "$last" | cut -d, -f14)" = 1 ] || fail "a dashboard started after the pause does not show the seat paused: $last"
+png=$(printf '%s/dash3/dashboard_%05d.png' "$OUT" "$(echo "$last" | cut -d, -f1)")
+n=$("$BUILD/tests/integration/png_region" "$png" 6 28 130 40 115 179 255 30 | sed -n 's/^match=\([0-9]*\) of .*/\1/p')
+echo "paused label pixels: ${n:-0}"
+[ "${n:-0}" -ge 30 ] || fail "the tile does not say 'paused' (${n:-0} light blue pixels in its label)"
+"$BUILD/client/control/viscera-control" --partition lab/seat01 resume >> "$OUT/control.log" 2>&1 || fail "resume refused"
+"$BUILD/client/dashboard/viscera-dashboard" --seats 1 --out "$OUT/dash4" --interval-ms 250 --duration 2 \
+  > "$OUT/dashboard4.log" 2>&1 || fail "the fourth dashboard failed"
+last=$(awk -F, '$3 == "lab/seat01" && $4 == 1' "$OUT/dash4/dashboard.csv" | tail -1)
+[ "$(echo "$last" | cut -d, -f14)" = 0 ] || fail "the seat still shown paused after the resume: $last"
 kill -INT $H; wait $H || fail "the holding trainee failed"
 kill -INT $SRV; wait $SRV || fail "server exited with an error"
 PIDS=()
