@@ -2,6 +2,7 @@
 #include "seat.h"
 
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -106,6 +107,14 @@ static void take_all(seat_t *s, dds_entity_t rd, vdds_gate_t *g, void (*fn)(seat
   }
 }
 
+/* Which server of the seat is adopted now (+1 per restart, seat_server.h). */
+static uint32_t server_generation(seat_t *s) {
+  pthread_mutex_lock(&s->sv.server.lock);
+  uint32_t g = s->sv.server.generation;
+  pthread_mutex_unlock(&s->sv.server.lock);
+  return g;
+}
+
 static void on_event(seat_t *s, const void *x, double now) {
   const viscera_SessionEvent *e = x;
   keep_event(s, e);
@@ -138,10 +147,12 @@ static void on_event(seat_t *s, const void *x, double now) {
     /* The server's answer carries the command's kind in `value`; a reset
      * keeps the pause (the server does), so only these two change it. A
      * dashboard started later takes the answer from the event history. */
-    if (e->value == (double)viscera_CONTROL_PAUSE)
+    if (e->value == (double)viscera_CONTROL_PAUSE) {
       s->paused = 1;
-    else if (e->value == (double)viscera_CONTROL_RESUME)
+      s->paused_gen = server_generation(s);
+    } else if (e->value == (double)viscera_CONTROL_RESUME) {
       s->paused = 0;
+    }
     break;
   default:
     break;
@@ -178,6 +189,8 @@ int seat_poll(seat_t *s, double now, verr_t *err) {
   take_all(s, s->rd_role, &s->gate_role, on_role, now);
   take_all(s, s->rd_measures, &s->gate_measures, on_measures, now);
   if (now > s->alert_until) s->alert = SEAT_OK;
+  /* A restarted server starts unpaused; its history holds no resume. */
+  if (s->paused && server_generation(s) != s->paused_gen) s->paused = 0;
   /* A dashboard started late takes the seat's past events (SessionEvent is
    * transient-local): a crossing long over in the seat's simulated time
    * raises no alert. (After a reset the simulated time restarts below the

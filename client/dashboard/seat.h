@@ -66,6 +66,7 @@ typedef struct seat {
   int client_lost;                  /* the trainee's client is gone without a goodbye (see below) */
   int client_left;                  /* it exited cleanly: its ToolCommand instance was disposed */
   int paused;                       /* the instructor paused the seat: its server applied a pause, no resume since */
+  uint32_t paused_gen;              /* the server (seat_server generation) that applied it: a new one is not paused */
   seat_event_t events[SEAT_EVENTS]; /* newest at (nevents - 1) % SEAT_EVENTS */
   uint64_t nevents;
   seat_role_t roles[SCENE_VIEW_MAX_TOOLS];

@@ -12,7 +12,8 @@
 # 250 ms for 3 s. Asserts: it sees the scene, counts the past MPF crossing,
 # and every row with the scene says "ok" at 0 N. Part 2 (below): the
 # thresholds an instructor set reach a dashboard started after the change;
-# part 3: a seat the instructor paused shows as paused until resumed.
+# part 3: a seat the instructor paused shows as paused until resumed, or
+# (part 4) until its server restarts.
 # usage: dashboard_late_test.sh BUILD SRC OUT
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/prelude.sh"
@@ -87,6 +88,23 @@ echo "paused label pixels: ${n:-0}"
 last=$(awk -F, '$3 == "lab/seat01" && $4 == 1' "$OUT/dash4/dashboard.csv" | tail -1)
 [ "$(echo "$last" | cut -d, -f14)" = 0 ] || fail "the seat still shown paused after the resume: $last"
 kill -INT $H; wait $H || fail "the holding trainee failed"
+
+# Part 4: a paused seat whose server restarts (a new server starts unpaused,
+# and its history has no resume): a dashboard running across the restart
+# shows the pause, then not once the new server is there.
+"$BUILD/client/control/viscera-control" --partition lab/seat01 pause >> "$OUT/control.log" 2>&1 || fail "pause refused"
+"$BUILD/client/dashboard/viscera-dashboard" --seats 1 --out "$OUT/dash5" --interval-ms 250 \
+  > "$OUT/dashboard5.log" 2>&1 & D=$!; PIDS+=("$D")
+csv5="$OUT/dash5/dashboard.csv"
+paused_rows() { awk -F, -v v="$1" '$3 == "lab/seat01" && $4 == 1 && $14 == v' "$csv5" 2>/dev/null | wc -l; }
+for ((t = 0; t < 600; t++)); do [ "$(paused_rows 1)" -gt 0 ] && break; sleep 0.1; done
+[ "$(paused_rows 1)" -gt 0 ] || fail "the running dashboard never showed the pause"
 kill -INT $SRV; wait $SRV || fail "server exited with an error"
+"$BUILD/server/viscera-server" --scene "$SRC/assets/scenes/default.yaml" --partition lab/seat01 \
+  > "$OUT/server2.log" 2>&1 & SRV=$!; PIDS+=("$SRV")
+for ((t = 0; t < 600; t++)); do [ "$(paused_rows 0)" -gt 0 ] && break; sleep 0.1; done
+[ "$(paused_rows 0)" -gt 0 ] || fail "the seat still shown paused after its server restarted: $(tail -1 "$csv5")"
+kill -INT $D; wait $D || fail "the fifth dashboard failed"
+kill -INT $SRV; wait $SRV || fail "the second server exited with an error"
 PIDS=()
 echo PASS
