@@ -130,6 +130,9 @@ mkdir -p "$OUT"
 OUT="$(cd "$OUT" && pwd)" # children get absolute paths
 LAST=$((FIRST + SEATS - 1))
 PKI="${PKI:-$OUT/pki}"
+# The identities' file:// URIs go into the commands printed below, which are
+# pasted in other terminals and directories: the path must not be relative.
+case "$PKI" in /*) ;; *) PKI="$PWD/$PKI" ;; esac
 # One server process for several seats holds one identity, granted the
 # server's role in those seats only (pki.sh --server-group).
 PKI_ARGS=(--seats "$LAST" --prefix "$PREFIX")

@@ -24,6 +24,10 @@
 #   CYCLONEDDS_URI="file://<network config>,file://OUT_DIR/identities/NAME/security.xml"
 # The private keys are not encrypted: keep OUT_DIR readable only by the lab
 # account (the script makes it 0700). Needs openssl only.
+# Run again on the same OUT_DIR (more seats, another --server-group), it keeps
+# the two CAs it finds there and signs everything anew with them: identities
+# already handed out, running processes and copies of the PKI on other
+# machines stay valid. Remove OUT_DIR to start from new CAs.
 set -euo pipefail
 
 usage() { awk 'NR > 2 && /^#/ { sub(/^# ?/, ""); print; next } NR > 2 { exit }' "$0"; } # the header
@@ -61,10 +65,19 @@ mkdir -p "$CA" "$OUT/identities"
 newkey() { openssl ecparam -name prime256v1 -genkey -noout -out "$1" 2>/dev/null; chmod 600 "$1"; }
 
 make_ca() { # name file-stem
+  # An existing CA is kept: a rerun (more seats, a --server-group that
+  # lab.sh --one-server asks for) then signs with the same CAs, so the
+  # certificates already handed out, running processes and copies of the
+  # PKI on other machines stay valid. Remove OUT_DIR for new CAs.
+  if [ -s "$CA/$2.pem" ] && [ -s "$CA/$2_key.pem" ]; then
+    KEPT+=("$2")
+    return 0
+  fi
   newkey "$CA/$2_key.pem"
   openssl req -x509 -new -key "$CA/$2_key.pem" -days "$DAYS" -sha256 \
     -subj "/C=NL/O=$ORG/CN=$1" -out "$CA/$2.pem" 2>/dev/null
 }
+KEPT=()
 make_ca "$ORG identity CA" identity_ca
 make_ca "$ORG permissions CA" permissions_ca
 
@@ -191,4 +204,5 @@ for name in "${identities[@]}"; do
 XML
 done
 rm -f "$CA"/*.srl
+[ ${#KEPT[@]} = 0 ] || echo "pki.sh: $OUT: kept the existing CAs (${KEPT[*]}): earlier certificates stay valid"
 echo "pki.sh: $OUT: ${#identities[@]} identities (${identities[*]}), partitions $PREFIX/seat01..$(printf 'seat%02d' "$SEATS")"

@@ -1,6 +1,8 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 #include "control_run.h"
 
+#include "control_deliver.h"
+
 #include <inttypes.h>
 #include <stdio.h>
 #include <string.h>
@@ -19,6 +21,7 @@ int control_run(const control_options_t *o) {
     return 2;
   }
   int rc = 2;
+  control_deliver_t deliver = {0}; /* closed at out: whatever was opened */
   /* The answer is believed from the seat's server only (seat_server.h,
    * issue 15.2); its events are source 0, the only key let in. */
   seat_server_t server;
@@ -38,6 +41,11 @@ int control_run(const control_options_t *o) {
             err.msg);
     goto out;
   }
+  const char *part = o->partition ? o->partition : VDDS_DEFAULT_PARTITION;
+  if (control_deliver_open(&deliver, dds.participant, w, part) < 0) {
+    fprintf(stderr, "viscera-control: DDS: cannot read the subscriptions\n");
+    goto out;
+  }
   /* The server is there once its SceneInfo (transient-local) arrives. A
    * matched writer alone proves nothing: a recorder's reader matches too. */
   dds_entity_t r_scene = vdds_reader(&dds, VT_SCENE_INFO, &err);
@@ -47,7 +55,6 @@ int control_run(const control_options_t *o) {
   }
   uint64_t start = vtime_mono_ns(), deadline = start + (uint64_t)(o->wait_s * 1e9);
   int have_server = 0, told = 0;
-  const char *part = o->partition ? o->partition : VDDS_DEFAULT_PARTITION;
   while (!have_server && vtime_mono_ns() < deadline) {
     if (vdds_nothing_seen_due(&told, vdds_matched_writers(r_scene), start, vtime_mono_ns()))
       vdds_explain_nothing_seen(stderr, "viscera-control", "no server found", o->domain, part, VDDS_NOTHING_SEEN_S);
@@ -83,6 +90,7 @@ int control_run(const control_options_t *o) {
         rc = 2;
         break;
       }
+      control_deliver_wrote(&deliver);
       next_send = vtime_mono_ns() + 500000000ull;
     }
     void *samples[8] = {0};
@@ -110,11 +118,20 @@ int control_run(const control_options_t *o) {
     if (rc != 1) break;
     dds_sleepfor(DDS_MSECS(10));
   }
+  if (rc == 0 || rc == 3) { /* answered: the seat's other readers (a recorder) get it too */
+    int missing = 0;
+    if (control_deliver_finish(&deliver, &o->cmd, 0.3, 2.0, &missing))
+      fprintf(stderr,
+              "viscera-control: %d other reader(s) of SessionControl in '%s' (a recorder?) not reached within 2 s; "
+              "the server has the command\n",
+              missing, part);
+  }
   if (rc == 1) fprintf(stderr, "viscera-control: no answer from the server within %.1f s\n", o->wait_s);
   if (rc == 3) rc = 1;
   if (ignored)
     fprintf(stderr, "viscera-control: %" PRIu64 " SessionEvent samples ignored: not from the seat's server\n", ignored);
 out:
+  control_deliver_close(&deliver);
   vdds_close(&dds);
   seat_server_close(&server);
   vdds_gate_destroy(&gate);

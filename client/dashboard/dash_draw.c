@@ -190,12 +190,22 @@ static void draw_tile(dash_t *d, int i, cairo_t *cr, int x, int y, verr_t *err) 
   float st, mpf, sft, maxf;
   double f = seat_force(s, &st, &mpf, &sft, &maxf);
   char head[200];
-  snprintf(head, sizeof head, "%.60s  %.64s  %.2f N%s", s->partition, s->sv.have_scene ? s->sv.scene_name : "-", f,
-           s->client_lost   ? "  trainee lost"
-           : s->client_left ? "  trainee left"
-                            : "");
+  snprintf(head, sizeof head, "%.60s  %.64s  %.2f N", s->partition, s->sv.have_scene ? s->sv.scene_name : "-", f);
   cairo_set_source_rgb(cr, 0.9, 0.9, 0.92);
   text_fit(cr, x + 6, y + 15, 12, head, tw - 12);
+  if (s->client_lost || s->client_left) {
+    /* On the scene, in the focus view's colours: at the end of the header
+     * it was cut off on a tile of the default size. */
+    if (s->client_lost)
+      cairo_set_source_rgb(cr, 0.95, 0.35, 0.3);
+    else
+      cairo_set_source_rgb(cr, 0.6, 0.6, 0.6);
+    text(cr, x + 8, y + DASH_HEADER_H + 22, 15, s->client_lost ? "trainee lost" : "trainee left");
+  }
+  if (s->paused) { /* the instructor's own pause, so the seat's stillness is not mistaken for idleness */
+    cairo_set_source_rgb(cr, 0.45, 0.7, 1.0);
+    text(cr, x + 8, y + DASH_HEADER_H + (s->client_lost || s->client_left ? 42 : 22), 15, "paused");
+  }
   if (s->alert != SEAT_OK) {
     /* The frame an instructor notices from across the room. */
     double c[3];

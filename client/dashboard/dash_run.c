@@ -98,7 +98,7 @@ int dash_run(const dash_options_t *o) {
       return 1;
     }
     fprintf(csv, "frame,wall_s,seat,have_scene,force_n,peak_n,alert,crossings_st,crossings_mpf,crossings_sft,"
-                 "client_lost,focused,client_left\n");
+                 "client_lost,focused,client_left,paused\n");
   }
 
   static seat_t seats[MAX_SEATS];
@@ -205,9 +205,9 @@ int dash_run(const dash_options_t *o) {
         seat_t *s = &seats[i];
         float st, mpf, sft, maxf;
         double f = seat_force(s, &st, &mpf, &sft, &maxf);
-        fprintf(csv, "%d,%.3f,%s,%d,%.4f,%.4f,%s,%u,%u,%u,%d,%d,%d\n", frame, now, s->partition, s->sv.have_scene, f,
+        fprintf(csv, "%d,%.3f,%s,%d,%.4f,%.4f,%s,%u,%u,%u,%d,%d,%d,%d\n", frame, now, s->partition, s->sv.have_scene, f,
                 s->peak, seat_level_name(s->alert), s->crossings[0], s->crossings[1], s->crossings[2], s->client_lost,
-                i == focused, s->client_left);
+                i == focused, s->client_left, s->paused);
       }
       fflush(csv);
       frame++;

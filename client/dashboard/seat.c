@@ -2,6 +2,7 @@
 #include "seat.h"
 
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -106,6 +107,14 @@ static void take_all(seat_t *s, dds_entity_t rd, vdds_gate_t *g, void (*fn)(seat
   }
 }
 
+/* Which server of the seat is adopted now (+1 per restart, seat_server.h). */
+static uint32_t server_generation(seat_t *s) {
+  pthread_mutex_lock(&s->sv.server.lock);
+  uint32_t g = s->sv.server.generation;
+  pthread_mutex_unlock(&s->sv.server.lock);
+  return g;
+}
+
 static void on_event(seat_t *s, const void *x, double now) {
   const viscera_SessionEvent *e = x;
   keep_event(s, e);
@@ -120,6 +129,7 @@ static void on_event(seat_t *s, const void *x, double now) {
     s->crossings[a - 1]++;
     if (a >= s->alert || now > s->alert_until) s->alert = a;
     s->alert_until = now + SEAT_ALERT_HOLD_S;
+    s->alert_sim_s = (double)e->sim_time_ns * 1e-9;
     break;
   }
   case viscera_EVENT_CLIENT_LOST:
@@ -132,6 +142,17 @@ static void on_event(seat_t *s, const void *x, double now) {
     break;
   case viscera_EVENT_CONTACT_BEGIN:
     s->client_lost = s->client_left = 0;
+    break;
+  case viscera_EVENT_CONTROL_APPLIED:
+    /* The server's answer carries the command's kind in `value`; a reset
+     * keeps the pause (the server does), so only these two change it. A
+     * dashboard started later takes the answer from the event history. */
+    if (e->value == (double)viscera_CONTROL_PAUSE) {
+      s->paused = 1;
+      s->paused_gen = server_generation(s);
+    } else if (e->value == (double)viscera_CONTROL_RESUME) {
+      s->paused = 0;
+    }
     break;
   default:
     break;
@@ -168,6 +189,17 @@ int seat_poll(seat_t *s, double now, verr_t *err) {
   take_all(s, s->rd_role, &s->gate_role, on_role, now);
   take_all(s, s->rd_measures, &s->gate_measures, on_measures, now);
   if (now > s->alert_until) s->alert = SEAT_OK;
+  /* A restarted server starts unpaused; its history holds no resume. */
+  if (s->paused && server_generation(s) != s->paused_gen) s->paused = 0;
+  /* A dashboard started late takes the seat's past events (SessionEvent is
+   * transient-local): a crossing long over in the seat's simulated time
+   * raises no alert. (After a reset the simulated time restarts below the
+   * crossing's; the dashboard's own hold then ends the alert.) */
+  double sim_now = (double)scene_view_sim_time_ns(&s->sv) * 1e-9;
+  if (s->alert != SEAT_OK && sim_now - s->alert_sim_s > SEAT_ALERT_HOLD_S) {
+    s->alert = SEAT_OK;
+    s->alert_until = 0;
+  }
   /* A trainee still pressing above a threshold stays alerted after the
    * crossing's hold runs out. */
   float st, mpf, sft, mf;

@@ -20,8 +20,10 @@
 #include "view/scene_view.h"
 #include "seat_text.h"
 
+/* SEAT_ALERT_HOLD_S: an alert stays up this long after its crossing, both in
+ * the dashboard's time and in the seat's simulated time. */
 #define SEAT_HISTORY 600      /* force samples kept (60 s at 10 Hz) */
-#define SEAT_ALERT_HOLD_S 3.0 /* an alert stays up this long after its crossing */
+#define SEAT_ALERT_HOLD_S 3.0 /* s */
 #define SEAT_EVENTS 8         /* events kept for the focus view */
 
 /* One SessionEvent as the focus view lists it. */
@@ -51,7 +53,7 @@ typedef struct seat {
   scene_view_t sv;
   dds_entity_t rd_event, rd_role, rd_measures;      /* believed from the seat's server only (sv.server) */
   vdds_gate_t gate_event, gate_role, gate_measures; /* bounded: source 0, the tools */
-  dds_entity_t rd_presence; /* ToolCommand, read for its instance states only (seat_presence) */
+  dds_entity_t rd_presence;                         /* ToolCommand, read for its instance states only (seat_presence) */
   int have_camera;
   camera_t cam;
   float history[SEAT_HISTORY]; /* N, newest at (nhist - 1) % SEAT_HISTORY */
@@ -59,9 +61,12 @@ typedef struct seat {
   float peak;                       /* N since the dashboard started */
   seat_alert_t alert;               /* highest level crossed up within SEAT_ALERT_HOLD_S, or the force's level now */
   double alert_until;               /* dashboard time (s) the alert shows until */
+  double alert_sim_s;               /* the server's simulated time of the crossing behind the alert */
   uint32_t crossings[3];            /* upward crossings seen: ST, MPF, SFT */
   int client_lost;                  /* the trainee's client is gone without a goodbye (see below) */
   int client_left;                  /* it exited cleanly: its ToolCommand instance was disposed */
+  int paused;                       /* the instructor paused the seat: its server applied a pause, no resume since */
+  uint32_t paused_gen;              /* the server (seat_server generation) that applied it: a new one is not paused */
   seat_event_t events[SEAT_EVENTS]; /* newest at (nevents - 1) % SEAT_EVENTS */
   uint64_t nevents;
   seat_role_t roles[SCENE_VIEW_MAX_TOOLS];

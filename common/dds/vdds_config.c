@@ -1,8 +1,10 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 #include "dds/vdds_config.h"
 
+#include <errno.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "data_path.h"
 
@@ -69,11 +71,54 @@ int vdds_config_loopback(void) {
   return loop;
 }
 
+/* The first file:// element of CYCLONEDDS_URI that cannot be opened, copied
+ * into `path` with the reason in *why; 0 when there is none. A security
+ * fragment that is not there reads as "security off", and the refusal would
+ * then tell the user to add the identity they did name. */
+static int unreadable_file(char *path, size_t cap, int *why) {
+  const char *uri = getenv("CYCLONEDDS_URI");
+  if (!uri || !*uri) return 0;
+  char *copy = strdup(uri);
+  if (!copy) return 0;
+  int found = 0;
+  char *save = NULL;
+  for (char *e = strtok_r(copy, ",", &save); e && !found; e = strtok_r(NULL, ",", &save)) {
+    while (*e == ' ' || *e == '\t' || *e == '\n') e++;
+    size_t n = strlen(e);
+    while (n && (e[n - 1] == ' ' || e[n - 1] == '\n')) e[--n] = 0;
+    if (strncmp(e, "file://", 7) != 0) continue;
+    FILE *t = fopen(e + 7, "r");
+    if (t) {
+      fclose(t);
+      continue;
+    }
+    *why = errno;
+    snprintf(path, cap, "%s", e + 7);
+    found = 1;
+  }
+  free(copy);
+  return found;
+}
+
 int vdds_config_check_insecure(FILE *f, const char *tag, int *warned, verr_t *err) {
   if (vdds_config_loopback() || vdds_config_secure()) return 0;
   const char *uri = getenv("CYCLONEDDS_URI");
   const char *ins = getenv("VISCERA_INSECURE");
   if (!ins || strcmp(ins, "1")) {
+    /* A file that is not there (a security fragment named by a relative
+     * path, pasted in another directory) reads as "security off": name it
+     * instead of telling the user to add the identity they did name. */
+    char missing[256], cwd[128];
+    int why = 0;
+    if (unreadable_file(missing, sizeof missing, &why)) {
+      int rel = missing[0] != '/';
+      if (!rel || !getcwd(cwd, sizeof cwd)) cwd[0] = 0;
+      verr_set(err,
+               "refusing to start: CYCLONEDDS_URI names file://%s, which cannot be read (%s%s%s); name it by its "
+               "absolute path (file:///...)",
+               missing, strerror(why), rel ? "; a relative path is read from the current directory " : "", cwd);
+      return -1;
+    }
     verr_set(err,
              "refusing to start: DDS Security is off and CYCLONEDDS_URI (%s) is not the loopback configuration: "
              "anyone on that network could read this session and drive its tools. Add an identity from "

@@ -51,7 +51,9 @@ int vdds_config_loopback(void);
  * the same). Returns 0 when the process may go on: loopback, secure, or
  * allowed, in which case a warning naming the configuration is written to
  * f (once per process: the caller keeps `warned`, NULL: always). Returns -1
- * with err naming the configuration and the ways on otherwise. */
+ * with err naming the configuration and the ways on otherwise; when a file://
+ * element cannot be read (an identity's fragment by a relative path from
+ * another directory), err names that file and the current directory instead. */
 int vdds_config_check_insecure(FILE *f, const char *tag, int *warned, verr_t *err);
 
 /* What every DDS participant of viscera is created after: the default

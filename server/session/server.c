@@ -157,9 +157,12 @@ static void publish_scene_info(server_t *s) {
     tools[t].length = (float)c->length;
     tools[t].stiffness = (float)c->stiffness;
     tools[t].max_force = (float)c->max_force;
-    tools[t].st = (float)c->st;
-    tools[t].mpf = (float)c->mpf;
-    tools[t].sft = (float)c->sft;
+    /* The levels in force: the scene's, or an instructor's SET_THRESHOLDS
+     * (dashboards and viewers draw and judge by these). */
+    const thr_tracker_t *tr = &s->tool[t].thr;
+    tools[t].st = (float)tr->level[THR_ST];
+    tools[t].mpf = (float)tr->level[THR_MPF];
+    tools[t].sft = (float)tr->level[THR_SFT];
   }
   si.organs._buffer = organs;
   si.organs._length = si.organs._maximum = (uint32_t)s->rt.norgans;
@@ -638,6 +641,9 @@ static int read_controls(server_t *s) {
       free(edit);
       free(old);
       if (!s->opts->quiet) fprintf(stderr, "%s: %s\n", s->tag, text);
+      /* New levels, or the scene's again after a rebuild: SceneInfo
+       * (transient-local) carries the levels in force, also to late joiners. */
+      if ((r == 0 && c->kind == viscera_CONTROL_SET_THRESHOLDS) || result == 1 || result == 2) publish_scene_info(s);
       publish_event(s, r == 0 ? viscera_EVENT_CONTROL_APPLIED : viscera_EVENT_INPUT_REJECTED, c->organ_id, c->tool_id,
                     (double)c->kind, text);
     }

@@ -267,6 +267,7 @@ static int run_seats(const scene_t *scene, const server_app_options_t *o) {
   for (int t = 0; t < threads; t++) pthread_join(th[t], NULL);
   /* A seat that did not start was reported at once (seat_group.h); the
    * others served: their figures. */
+  fflush(stdout); /* what the run printed goes before the first seat's block */
   for (int t = 0; t < threads; t++)
     for (int i = 0; i < g[t].n; i++) {
       const seat_group_member_t *mk = &g[t].m[i];
@@ -275,10 +276,16 @@ static int run_seats(const scene_t *scene, const server_app_options_t *o) {
         rc = 1;
         continue;
       }
+      /* Seat by seat, stdout flushed at each seat's end: a block-buffered
+       * stdout in the same file as stderr otherwise spills a flush into
+       * the middle of a line, and deploy/seat_logs.sh, which splits the
+       * log at each seat's header, hands a seat's figures to the seat
+       * before it. */
       fprintf(stderr, "server: seat '%s' (%d of %d):\n", seats[k].partition, k + 1, n);
       print_stats(scene, &seats[k].opts, &seats[k].st);
       printf("SEAT partition=%s index=%d of=%d\n", seats[k].partition, k + 1, n);
       print_summary(scene, &seats[k].st);
+      fflush(stdout);
     }
   pthread_mutex_destroy(&dds_setup_lock);
   free(seats);

@@ -77,15 +77,18 @@ int main(void) {
     setenv("CYCLONEDDS_URI", "file:///opt/viscera/deploy/cyclonedds-loopback.xml", 1);
     CHECK(vdds_config_loopback() == 1);
     CHECK(vdds_config_check_insecure(stderr, "t", NULL, &e) == 0);
-    setenv("CYCLONEDDS_URI", "file:///opt/viscera/deploy/cyclonedds-lan.xml", 1);
+    /* A file that exists: one that does not is refused for that (below). */
+    const char *src = getenv("VISCERA_SOURCE_DIR");
+    char lan[1024], two[2048];
+    snprintf(lan, sizeof lan, "file://%s/deploy/cyclonedds-lan.xml", src ? src : ".");
+    setenv("CYCLONEDDS_URI", lan, 1);
     CHECK(vdds_config_loopback() == 0);
     f = fmemopen(out, sizeof out, "w");
     CHECK(f && vdds_config_check_insecure(f, "t", &warned, &e) == -1 && warned == 0);
     if (f) fclose(f);
     CHECK(out[0] == 0); /* refused: the message is the caller's to print */
-    CHECK(strstr(e.msg, "refusing to start") && strstr(e.msg, "DDS Security is off") &&
-          strstr(e.msg, "/opt/viscera/deploy/cyclonedds-lan.xml") && strstr(e.msg, "--insecure") &&
-          strstr(e.msg, "VISCERA_INSECURE=1") && strstr(e.msg, "deploy/pki.sh"));
+    CHECK(strstr(e.msg, "refusing to start") && strstr(e.msg, "DDS Security is off") && strstr(e.msg, lan) &&
+          strstr(e.msg, "--insecure") && strstr(e.msg, "VISCERA_INSECURE=1") && strstr(e.msg, "deploy/pki.sh"));
     CHECK(vdds_config_prepare(stderr, "t", &e) == -1); /* the path every participant takes */
     setenv("VISCERA_INSECURE", "0", 1);
     CHECK(vdds_config_check_insecure(stderr, "t", NULL, &e) == -1);
@@ -100,6 +103,18 @@ int main(void) {
     if (f) fclose(f);
     CHECK(out[0] == 0);
     unsetenv("VISCERA_INSECURE");
+    /* The identity's fragment named but not there (lab.sh's printed commands
+     * with a relative --pki, pasted in another directory): the refusal names
+     * that file, not "add an identity". */
+    snprintf(two, sizeof two, "%s,file://no/such/pki/identities/instructor/security.xml", lan);
+    setenv("CYCLONEDDS_URI", two, 1);
+    CHECK(vdds_config_check_insecure(stderr, "t", NULL, &e) == -1);
+    CHECK(strstr(e.msg, "file://no/such/pki/identities/instructor/security.xml, which cannot be read") &&
+          strstr(e.msg, "relative path is read from the current directory /") && !strstr(e.msg, "Add an identity"));
+    snprintf(two, sizeof two, "%s,file:///no/such/security.xml", lan);
+    setenv("CYCLONEDDS_URI", two, 1);
+    CHECK(vdds_config_check_insecure(stderr, "t", NULL, &e) == -1);
+    CHECK(strstr(e.msg, "file:///no/such/security.xml, which cannot be read") && !strstr(e.msg, "relative path"));
     setenv("CYCLONEDDS_URI", "file:///x/cyclonedds-loopback.xml,<CycloneDDS><Domain><Security/></Domain></CycloneDDS>",
            1);
     CHECK(vdds_config_loopback() == 0 && vdds_config_check_insecure(stderr, "t", NULL, &e) == 0);
