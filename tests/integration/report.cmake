@@ -6,7 +6,7 @@
 if(TARGET viscera-report AND TARGET viscera-viewer)
   viscera_integration_test(report_e2e 100 report_test.sh)
 endif()
-# A scene without palpation thresholds: the report shows them as unset, not 0 N. Domain 208.
+# A scene without palpation thresholds: the report shows them as unset, not 0 N. Domain 192.
 if(TARGET viscera-report AND TARGET viscera-viewer)
-  viscera_integration_test(report_no_thresholds 208 report_no_thresholds_test.sh)
+  viscera_integration_test(report_no_thresholds 192 report_no_thresholds_test.sh)
 endif()
