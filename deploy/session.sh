@@ -36,7 +36,11 @@ trap cleanup EXIT
 echo "session: domain $DOMAIN, partition '$PART', output in $OUT"
 "$BUILD/server/viscera-server" --scene "$SCENE" "${common[@]}" ${SERVER_ARGS:-} >"$OUT/server.out" 2>"$OUT/server.log" &
 SERVER=$!; pids+=("$SERVER")
-"$BUILD/client/recorder/viscera-recorder" "${common[@]}" --out "$OUT/session.db" --quiet \
+# The recording names its scene (viscera-recinfo's "scene:"): the file's own
+# `scene:` name, or the file's stem if that line is not found.
+SCENE_NAME=$(sed -n 's/^scene:[[:space:]]*\([A-Za-z0-9_-]*\).*/\1/p' "$SCENE" 2>/dev/null | head -n 1)
+[ -n "$SCENE_NAME" ] || SCENE_NAME=$(basename "$SCENE" .yaml)
+"$BUILD/client/recorder/viscera-recorder" "${common[@]}" --out "$OUT/session.db" --scene "$SCENE_NAME" --quiet \
   >"$OUT/recorder.out" 2>"$OUT/recorder.log" &
 RECORDER=$!; pids+=("$RECORDER")
 "$BUILD/client/viewer/viscera-viewer" "${common[@]}" --out "$OUT/frames" ${VIEWER_ARGS:---interval-ms 100} \

@@ -37,6 +37,8 @@ awk -v w="$win" -v o="$outside" 'BEGIN { exit !(w > 1.0 && w > 4 * o) }' \
 # 3. Recording: ToolCommand and MeshDelta present, timestamps increasing.
 "$BUILD/client/recorder/viscera-recinfo" "$OUT/session.db" --check-monotonic > "$OUT/recinfo.txt" || fail "recinfo --check-monotonic failed"
 cat "$OUT/recinfo.txt"
+# The recording names the scene by the scene file's `scene:` name.
+grep -q "^scene: *kidney-palpation$" "$OUT/recinfo.txt" || fail "recording does not name its scene (kidney-palpation)"
 for topic in viscera_ToolCommand viscera_MeshDelta viscera_MeshState; do
   grep -q "$topic" "$OUT/recinfo.txt" || fail "recording lacks $topic"
 done
