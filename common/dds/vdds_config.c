@@ -37,38 +37,66 @@ static int file_secure(const char *path) {
   return secure;
 }
 
-int vdds_config_secure(void) {
+/* Calls fn on each element of CYCLONEDDS_URI (Cyclone takes a
+ * comma-separated list of file:// URIs and inline XML), trimmed of blanks at
+ * both ends, until fn returns nonzero: that value, 0 when none did, -1 when
+ * CYCLONEDDS_URI is unset or the copy cannot be made. */
+static int uri_find(int (*fn)(const char *e, void *ctx), void *ctx) {
   const char *uri = getenv("CYCLONEDDS_URI");
-  if (!uri || !*uri) return 0;
-  char *copy = strdup(uri);
-  if (!copy) return 0;
-  int secure = 0;
-  /* Cyclone takes a comma-separated list of file:// URIs and inline XML. */
+  char *copy = uri ? strdup(uri) : NULL;
+  if (!copy) return -1;
+  int hit = 0;
   char *save = NULL;
-  for (char *e = strtok_r(copy, ",", &save); e && !secure; e = strtok_r(NULL, ",", &save)) {
+  for (char *e = strtok_r(copy, ",", &save); e && !hit; e = strtok_r(NULL, ",", &save)) {
     while (*e == ' ' || *e == '\t' || *e == '\n') e++;
-    secure = strncmp(e, "file://", 7) == 0 ? file_secure(e + 7) : text_secure(e);
+    size_t n = strlen(e);
+    while (n && (e[n - 1] == ' ' || e[n - 1] == '\t' || e[n - 1] == '\n')) e[--n] = 0;
+    hit = fn(e, ctx);
   }
   free(copy);
-  return secure;
+  return hit;
+}
+
+static int elem_secure(const char *e, void *ctx) {
+  (void)ctx;
+  return strncmp(e, "file://", 7) == 0 ? file_secure(e + 7) : text_secure(e);
+}
+
+int vdds_config_secure(void) {
+  const char *uri = getenv("CYCLONEDDS_URI");
+  return uri && *uri && uri_find(elem_secure, NULL) > 0;
+}
+
+static int elem_not_loopback(const char *e, void *ctx) {
+  (void)ctx;
+  static const char want[] = "/cyclonedds-loopback.xml";
+  size_t n = strlen(e);
+  return !(strncmp(e, "file://", 7) == 0 && n >= sizeof want - 1 && !strcmp(e + n - (sizeof want - 1), want));
 }
 
 int vdds_config_loopback(void) {
   const char *uri = getenv("CYCLONEDDS_URI");
   if (!uri || !*uri) return 1;
-  char *copy = strdup(uri);
-  if (!copy) return 0;
-  int loop = 1;
-  char *save = NULL;
-  static const char want[] = "/cyclonedds-loopback.xml";
-  for (char *e = strtok_r(copy, ",", &save); e && loop; e = strtok_r(NULL, ",", &save)) {
-    while (*e == ' ' || *e == '\t' || *e == '\n') e++;
-    size_t n = strlen(e);
-    while (n && (e[n - 1] == ' ' || e[n - 1] == '\n')) e[--n] = 0;
-    loop = strncmp(e, "file://", 7) == 0 && n >= sizeof want - 1 && !strcmp(e + n - (sizeof want - 1), want);
+  return uri_find(elem_not_loopback, NULL) == 0; /* every element the loopback file */
+}
+
+typedef struct unreadable {
+  char *path;
+  size_t cap;
+  int why;
+} unreadable_t;
+
+static int elem_unreadable(const char *e, void *ctx) {
+  unreadable_t *u = ctx;
+  if (strncmp(e, "file://", 7) != 0) return 0;
+  FILE *t = fopen(e + 7, "r");
+  if (t) {
+    fclose(t);
+    return 0;
   }
-  free(copy);
-  return loop;
+  u->why = errno;
+  snprintf(u->path, u->cap, "%s", e + 7);
+  return 1;
 }
 
 /* The first file:// element of CYCLONEDDS_URI that cannot be opened, copied
@@ -76,28 +104,10 @@ int vdds_config_loopback(void) {
  * fragment that is not there reads as "security off", and the refusal would
  * then tell the user to add the identity they did name. */
 static int unreadable_file(char *path, size_t cap, int *why) {
-  const char *uri = getenv("CYCLONEDDS_URI");
-  if (!uri || !*uri) return 0;
-  char *copy = strdup(uri);
-  if (!copy) return 0;
-  int found = 0;
-  char *save = NULL;
-  for (char *e = strtok_r(copy, ",", &save); e && !found; e = strtok_r(NULL, ",", &save)) {
-    while (*e == ' ' || *e == '\t' || *e == '\n') e++;
-    size_t n = strlen(e);
-    while (n && (e[n - 1] == ' ' || e[n - 1] == '\n')) e[--n] = 0;
-    if (strncmp(e, "file://", 7) != 0) continue;
-    FILE *t = fopen(e + 7, "r");
-    if (t) {
-      fclose(t);
-      continue;
-    }
-    *why = errno;
-    snprintf(path, cap, "%s", e + 7);
-    found = 1;
-  }
-  free(copy);
-  return found;
+  unreadable_t u = {.path = path, .cap = cap, .why = 0};
+  if (uri_find(elem_unreadable, &u) <= 0) return 0;
+  *why = u.why;
+  return 1;
 }
 
 int vdds_config_check_insecure(FILE *f, const char *tag, int *warned, verr_t *err) {
