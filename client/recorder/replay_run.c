@@ -311,6 +311,17 @@ static int publish_all(replay_t *r) {
     goto out;
   }
   find_time_range(r);
+  /* A time past the last sample is allowed (nothing else to play), but the
+   * user asked for something this recording does not have: say so. */
+  double span_s = r->t_end > r->t0 ? (double)(r->t_end - r->t0) / 1e9 : 0.0;
+  if (r->o.seek > span_s)
+    fprintf(stderr,
+            "replay: %s: --seek %g s is past the recording's last sample (%.3f s): only its state "
+            "(transient-local) topics are written\n",
+            r->o.path, r->o.seek, span_s);
+  if (r->o.pause_at > span_s)
+    fprintf(stderr, "replay: %s: --pause-at %g s is past the recording's last sample (%.3f s): it will not pause\n",
+            r->o.path, r->o.pause_at, span_s);
   vsignal_on_stop(on_signal, 0);
   vsignal_on(SIGUSR1, on_usr1, SA_RESTART);
   if (!r->o.quiet)

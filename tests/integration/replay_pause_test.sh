@@ -73,4 +73,11 @@ awk -v b="$before" -v mn="$amin" 'BEGIN { exit !(mn - b >= 1.8) }' ||
   fail "samples after the pause arrived less than 1.8 s later than before (burst at resume?)"
 awk -v mn="$amin" -v mx="$amax" 'BEGIN { exit !(mx - mn < 1.0) }' ||
   fail "delay after resume drifts by $(awk -v a="$amin" -v b="$amax" 'BEGIN{print b-a}') s: original timing not kept"
+# A --seek or --pause-at past the recording's last sample is not refused
+# (nothing is left to play) but said: before, the replay ended silently.
+"$REPLAY" "$DB" --domain "$D2" --partition "$PART/past" --seek 100000 --pause-at 200000 --quiet \
+  >"$OUT/past.out" 2>"$OUT/past.log" || fail "replay past the end exited with an error"
+grep -q -- "--seek 100000 s is past the recording's last sample" "$OUT/past.log" || fail "no word of --seek past the end"
+grep -q -- "--pause-at 200000 s is past the recording's last sample .*: it will not pause" "$OUT/past.log" ||
+  fail "no word of --pause-at past the end"
 echo "replay_pause: PASS"
