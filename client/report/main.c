@@ -141,5 +141,14 @@ int main(int argc, char **argv) {
     usage(stderr);
     return 2;
   }
+  /* Sections, chart legends and CSV rows are told apart by the name alone:
+   * two recordings of one name would read as one trainee. */
+  for (int i = 1; i < o.nin; i++)
+    for (int j = 0; j < i; j++)
+      if (!strcmp(o.in[i].label, o.in[j].label)) {
+        fprintf(stderr, "report: two recordings are named '%s' (%s and %s): give each its own --label NAME=FILE.db\n",
+                o.in[i].label, o.in[j].path, o.in[i].path);
+        return 2;
+      }
   return report_run(&o);
 }

@@ -5,6 +5,7 @@
 # as a limit of 0 N. The HTML names each tool's thresholds as "no thresholds
 # set" (never "ST 0.00 N"), and report.csv leaves ST_N, MPF_N and SFT_N empty
 # like every other measure it cannot give; the measures above a level are n/a.
+# Also: two recordings given one name are refused.
 # usage: report_no_thresholds_test.sh BUILD SRC OUT
 set -euo pipefail
 BUILD="$1"; SRC="$2"; OUT="$3"
@@ -25,4 +26,10 @@ grep -q 'tool probe-right</td><td>[^<]*no thresholds set' "$HTML" || fail "HTML:
 ! grep -q -E '(ST|MPF|SFT) 0\.00 N' "$HTML" || fail "HTML: an unset threshold shown as 0.00 N"
 levels=$(awk -F, 'NR==1 { for (i = 1; i <= NF; i++) if ($i == "ST_N") c = i } NR==2 { print $c "," $(c + 1) "," $(c + 2) }' "$CSV")
 [ "$levels" = ",," ] || fail "report.csv: ST_N,MPF_N,SFT_N = '$levels', want empty (not set)"
+# Two recordings under one name would read as one trainee: refused (exit 2),
+# naming both files. Before, the report drew two sections of that name.
+rc=0; "$BUILD/client/report/viscera-report" --quiet --out "$OUT/twice" --label "a=$OUT/s/session.db" \
+  --label "a=$OUT/s/session.db" 2>"$OUT/twice.err" || rc=$?
+[ "$rc" = 2 ] || fail "two recordings named 'a': exit $rc, want 2"
+grep -q "two recordings are named 'a'" "$OUT/twice.err" || fail "no word of the name given twice: $(cat "$OUT/twice.err")"
 echo "report_no_thresholds: PASS (peak $peak N)"
