@@ -206,6 +206,30 @@ static void task_of_event(const viscera_SessionEvent *e, rep_task_event_t *te) {
   if (!te->name[0]) snprintf(te->name, sizeof te->name, "task");
 }
 
+/* A cut begins (a new entry) or ends (the tool's open cut, or an entry of
+ * its own when its beginning is not in the recording). false: out of
+ * memory. */
+static bool on_cut(rep_recording_t *r, const viscera_SessionEvent *e, double et, bool begin) {
+  rep_cut_t *cut = NULL;
+  for (size_t i = r->ncuts; !begin && i-- > 0;)
+    if (r->cuts[i].tool == e->tool_id && isnan(r->cuts[i].t_end)) {
+      cut = &r->cuts[i];
+      break;
+    }
+  if (!cut) {
+    if (!grow((void **)&r->cuts, &r->capcuts, r->ncuts, sizeof *r->cuts)) return false;
+    cut = &r->cuts[r->ncuts++];
+    *cut = (rep_cut_t){
+        .t_begin = begin ? et : NAN, .t_end = NAN, .tool = e->tool_id, .organ = e->organ_id, .changes = NAN};
+  }
+  if (!begin) {
+    cut->t_end = et;
+    cut->changes = isfinite(e->value) && e->value >= 0 ? e->value : NAN;
+    snprintf(cut->result, sizeof cut->result, "%s", e->text);
+  }
+  return true;
+}
+
 static int on_event(void *arg, const void *sample, const recfile_row_t *row) {
   load_ctx_t *c = arg;
   if (!in_seat(c, row)) return 0;
@@ -235,6 +259,13 @@ static int on_event(void *arg, const void *sample, const recfile_row_t *row) {
       if (r->task_events[i].t < et) r->task_events[n++] = r->task_events[i];
     c->events_rolled_back += r->ntask_events - n;
     r->ntask_events = n;
+    n = 0;
+    for (size_t i = 0; i < r->ncuts; i++)
+      if (!(r->cuts[i].t_begin >= et)) r->cuts[n++] = r->cuts[i];
+    c->events_rolled_back += r->ncuts - n;
+    r->ncuts = n;
+    for (size_t i = 0; i < r->ncuts; i++)
+      if (r->cuts[i].t_end >= et) r->cuts[i].t_end = r->cuts[i].changes = NAN, r->cuts[i].result[0] = 0;
   }
   c->ev_seen = true;
   c->last_ev_writer = row->writer_id;
@@ -259,9 +290,14 @@ static int on_event(void *arg, const void *sample, const recfile_row_t *row) {
     te->mark = kind == c->task_started ? REP_TASK_STARTED : REP_TASK_COMPLETED;
     te->value = te->mark == REP_TASK_COMPLETED && isfinite(e->value) ? e->value : NAN;
     task_of_event(e, te);
+  } else if (kind == (int32_t)viscera_EVENT_CUT_BEGIN || kind == (int32_t)viscera_EVENT_CUT_END) {
+    if (!on_cut(r, e, et, kind == (int32_t)viscera_EVENT_CUT_BEGIN)) {
+      c->oom = true;
+      return 1;
+    }
   }
-  /* Other kinds (grasps, cuts, instructor commands, topology changes) are
-   * the session's record, not measures: nothing is lost by leaving them. */
+  /* Other kinds (grasps, instructor commands, topology changes) are the
+   * session's record, not measures: nothing is lost by leaving them. */
   return 0;
 }
 
@@ -490,5 +526,6 @@ void rep_recording_free(rep_recording_t *r) {
     free(r->tools[i].proxy);
   }
   free(r->task_events);
+  free(r->cuts);
   memset(r, 0, sizeof *r);
 }

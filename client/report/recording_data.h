@@ -26,6 +26,17 @@
  * tool after 0.5 s by default, so a longer pause restarts the path. */
 #define REP_GAP_S 0.5
 
+/* One cut of a scalpel, from the server's CUT_BEGIN / CUT_END events:
+ * simulated times (NAN: that event is not in the recording, e.g. a cut still
+ * going when the recording ended), the topology changes it made and the
+ * server's own words at its end (vertex count, incision width). */
+typedef struct rep_cut {
+  double t_begin, t_end; /* s */
+  int tool, organ;
+  double changes;   /* NAN until its end */
+  char result[257]; /* SessionEvent.text is string<256> */
+} rep_cut_t;
+
 typedef struct rep_tool {
   bool present; /* has samples or a ToolInfo */
   char name[72];
@@ -67,6 +78,8 @@ typedef struct rep_recording {
   int ntools; /* highest present tool id + 1 */
   uint32_t event_crossings[THR_COUNT];
   size_t nevents;
+  rep_cut_t *cuts; /* in the order they began */
+  size_t ncuts, capcuts;
   rep_task_event_t *task_events;
   size_t ntask_events, captask_events;
   rep_task_t tasks[REP_MAX_TASKS];

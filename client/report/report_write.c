@@ -37,13 +37,27 @@ static size_t count_lines(const char *s) {
   return n;
 }
 
+/* The time the recording's cuts took (those with both ends) and the
+ * topology changes they made (those that ended); NAN when no cut gives it. */
+static void cut_totals(const rep_recording_t *r, double *time, double *changes) {
+  size_t nt = 0, nc = 0;
+  *time = *changes = 0;
+  for (size_t i = 0; i < r->ncuts; i++) {
+    const rep_cut_t *c = &r->cuts[i];
+    if (isfinite(c->t_begin) && isfinite(c->t_end)) *time += c->t_end - c->t_begin, nt++;
+    if (isfinite(c->changes)) *changes += c->changes, nc++;
+  }
+  if (!nt) *time = NAN;
+  if (!nc) *changes = NAN;
+}
+
 int rep_write_csv(const rep_recording_t *const *recs, int n, const rep_limits_t *limits, const char *path,
                   verr_t *err) {
   FILE *f = fopen(path, "w");
   if (!f) return verr_set(err, "%s: cannot create: %s", path, strerror(errno));
   fprintf(f, "label,file,scene,partition,identity,start_utc,complete");
   for (int m = 0; m < REP_NMEASURES; m++) fprintf(f, ",%s", rep_measure(m)->key);
-  fprintf(f, ",ST_N,MPF_N,SFT_N,crossings_source,tasks,verdict,failed,warnings\n");
+  fprintf(f, ",ST_N,MPF_N,SFT_N,crossings_source,tasks,cuts,cut_time_s,cut_topology_changes,verdict,failed,warnings\n");
   for (int i = 0; i < n; i++) {
     const rep_recording_t *r = recs[i];
     char start[40];
@@ -79,6 +93,17 @@ int rep_write_csv(const rep_recording_t *const *recs, int n, const rep_limits_t 
         len += (size_t)snprintf(tasks + len, sizeof tasks - len, "%s%s=incomplete", t ? ";" : "", tk->name);
     }
     csv_text(f, tasks);
+    /* cuts: how many began or ended, their time (those with both ends) and
+     * topology changes (those that ended); empty when there was none */
+    double cut_time = 0, cut_changes = 0;
+    cut_totals(r, &cut_time, &cut_changes);
+    if (r->ncuts) {
+      fprintf(f, ",%zu,", r->ncuts);
+      csv_num(f, "%.3f", cut_time);
+      fputc(',', f);
+      csv_num(f, "%.0f", cut_changes);
+    } else
+      fputs(",,,", f);
     /* verdict, and the limits that failed as "KEY<=BOUND;..." */
     char failed[512] = "";
     size_t fl = 0;
@@ -261,6 +286,45 @@ static void html_levels(FILE *f, const double levels[THR_COUNT]) {
   }
 }
 
+/* The scalpel's cuts, from the server's events: when each began, how long
+ * it lasted, the topology changes it made and the server's words at its end
+ * (vertices, incision width). Nothing when the session cut nothing. */
+static void html_cuts(FILE *f, const rep_recording_t *r) {
+  if (!r->ncuts) return;
+  double time, changes;
+  cut_totals(r, &time, &changes);
+  fprintf(f, "<h3>Cuts</h3>\n<p>%zu cut(s)", r->ncuts);
+  if (isfinite(time)) fprintf(f, ", %.3f s of cutting", time);
+  if (isfinite(changes)) fprintf(f, ", %.0f topology change(s)", changes);
+  fputs(".</p>\n<table><tr><th>cut</th><th>tool</th><th>began</th><th>lasted</th><th>topology changes</th>"
+        "<th>at its end (the server's words)</th></tr>\n",
+        f);
+  for (size_t i = 0; i < r->ncuts; i++) {
+    const rep_cut_t *c = &r->cuts[i];
+    fprintf(f, "<tr><td>%zu</td><td>", i + 1);
+    if (c->tool >= 0 && c->tool < r->ntools && r->tools[c->tool].name[0])
+      html_text(f, r->tools[c->tool].name);
+    else
+      fprintf(f, "#%d", c->tool);
+    fputs("</td>", f);
+    if (isfinite(c->t_begin))
+      fprintf(f, "<td>%.3f s</td>", c->t_begin);
+    else
+      fputs("<td class=na>not recorded</td>", f);
+    if (isfinite(c->t_begin) && isfinite(c->t_end))
+      fprintf(f, "<td>%.3f s</td>", c->t_end - c->t_begin);
+    else
+      fputs("<td class=na>n/a</td>", f);
+    if (isfinite(c->changes))
+      fprintf(f, "<td>%.0f</td><td>", c->changes);
+    else
+      fputs("<td class=na>n/a</td><td>", f);
+    html_text(f, isfinite(c->t_end) ? c->result : "not ended in the recording");
+    fputs("</td></tr>\n", f);
+  }
+  fputs("</table>\n", f);
+}
+
 static int html_section(FILE *f, const rep_recording_t *r, int i, const rep_charts_t *ch, const rep_layout_t *lay,
                         bool first, verr_t *err) {
   fprintf(f, "<h2 id=s%d%s>", i + 1, first ? " class=first" : "");
@@ -320,6 +384,7 @@ static int html_section(FILE *f, const rep_recording_t *r, int i, const rep_char
   fprintf(f, "</table>\n<p class=note>crossings from %s.</p>\n",
           r->sum.crossings_from_events ? "the server's SessionEvents"
                                        : "the replayed force trace (no events recorded)");
+  html_cuts(f, r);
   if (ch->force_png && ch->force_png[i]) return html_png(f, ch->force_png[i], "contact force over time", err);
   return 0;
 }

@@ -10,3 +10,7 @@ endif()
 if(TARGET viscera-report AND TARGET viscera-viewer)
   viscera_integration_test(report_no_thresholds 192 report_no_thresholds_test.sh)
 endif()
+# A cutting session: the report gives the scalpel's cuts as the server ended them. Domain 170.
+if(TARGET viscera-report AND TARGET viscera-viewer)
+  viscera_integration_test(report_cuts 170 report_cuts_test.sh)
+endif()
