@@ -196,7 +196,11 @@ start() { # start NAME IDENTITY COMMAND... : log in OUT/NAME.log
   uri="$(as "$2")" || exit 1
   shift 2
   [ -z "$stop_sig" ] || return 0
-  env CYCLONEDDS_URI="$uri" "$@" > "$OUT/$name.log" 2>&1 &
+  # The log exists once start() returns: the child opens it only when it
+  # runs, and a lab stopped at once (the next identity missing) would kill
+  # it before, leaving no log of a process it did start.
+  : > "$OUT/$name.log"
+  env CYCLONEDDS_URI="$uri" "$@" >> "$OUT/$name.log" 2>&1 &
   pids+=($!) names+=("$name")
 }
 pause() { # a sleep that SIGINT/SIGTERM cut short
